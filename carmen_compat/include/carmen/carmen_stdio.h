@@ -1,0 +1,52 @@
+/* carmen_stdio.h — CARMEN 0.7.4's stdio wrapper with transparent gzip.
+ *
+ * A name ending in ".gz" is read and written through zlib; anything else is a
+ * plain FILE. The content is never sniffed (as in CARMEN). The functions keep
+ * CARMEN's names and signatures so existing code links unchanged. */
+#ifndef CARMEN_CARMEN_STDIO_H
+#define CARMEN_CARMEN_STDIO_H
+
+#include <stdio.h>
+#include <zlib.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+  int compressed;  /* 1 when the stream goes through zlib */
+  FILE *fp;        /* plain stream (compressed == 0) */
+  gzFile comp_fp;  /* zlib stream (compressed == 1) */
+} carmen_FILE;
+
+/* Opens `filename` with an fopen() mode ("r", "w", "rb", "wb", "a"...).
+ * Returns NULL and sets errno on failure. */
+carmen_FILE *carmen_fopen(const char *filename, const char *mode);
+/* Closes and frees the stream; returns 0 on success, EOF on error (for a
+ * written gzip stream an error means the file is incomplete). */
+int carmen_fclose(carmen_FILE *fp);
+int carmen_fgetc(carmen_FILE *fp);
+int carmen_fputc(int c, carmen_FILE *fp);
+char *carmen_fgets(char *s, int size, carmen_FILE *fp);
+size_t carmen_fread(void *ptr, size_t size, size_t nmemb, carmen_FILE *fp);
+size_t carmen_fwrite(const void *ptr, size_t size, size_t nmemb, carmen_FILE *fp);
+int carmen_fprintf(carmen_FILE *fp, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+int carmen_feof(carmen_FILE *fp);
+/* Non-zero when the stream hit a read/write error (or, compressed, a corrupt
+ * or truncated gzip stream). Not in CARMEN; offered so callers can tell a
+ * clean end of file from damage. */
+int carmen_ferror(carmen_FILE *fp);
+/* Seeks; on a compressed stream only SEEK_SET/SEEK_CUR are supported and a
+ * backward seek rewinds and decompresses again (slow, as in CARMEN). */
+int carmen_fseek(carmen_FILE *fp, long offset, int whence);
+long carmen_ftell(carmen_FILE *fp);
+int carmen_fflush(carmen_FILE *fp);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* CARMEN_CARMEN_STDIO_H */

@@ -1,0 +1,134 @@
+// carmen_stdio: CARMEN's FILE wrapper, gzip when the name ends in ".gz".
+#include "carmen/carmen_stdio.h"
+
+#include <cerrno>
+#include <cstdarg>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace {
+
+bool ends_with_gz(const char *name) {
+  const size_t n = std::strlen(name);
+  return n >= 3 && std::strcmp(name + n - 3, ".gz") == 0;
+}
+
+}  // namespace
+
+extern "C" {
+
+carmen_FILE *carmen_fopen(const char *filename, const char *mode) {
+  if (filename == nullptr || mode == nullptr) {
+    errno = EINVAL;
+    return nullptr;
+  }
+  auto *f = static_cast<carmen_FILE *>(std::calloc(1, sizeof(carmen_FILE)));
+  if (f == nullptr) return nullptr;
+  f->compressed = ends_with_gz(filename) ? 1 : 0;
+  if (f->compressed) {
+    // zlib wants "rb"/"wb"; make sure the mode says binary.
+    std::string m(mode);
+    if (m.find('b') == std::string::npos) m += 'b';
+    f->comp_fp = gzopen(filename, m.c_str());
+    if (f->comp_fp == nullptr) {
+      if (errno == 0) errno = EIO;
+      std::free(f);
+      return nullptr;
+    }
+    gzbuffer(f->comp_fp, 1 << 17);
+  } else {
+    f->fp = std::fopen(filename, mode);
+    if (f->fp == nullptr) {
+      std::free(f);
+      return nullptr;
+    }
+  }
+  return f;
+}
+
+int carmen_fclose(carmen_FILE *fp) {
+  if (fp == nullptr) return EOF;
+  int rc = 0;
+  if (fp->compressed) {
+    rc = gzclose(fp->comp_fp) == Z_OK ? 0 : EOF;
+  } else {
+    rc = std::fclose(fp->fp);
+  }
+  std::free(fp);
+  return rc;
+}
+
+int carmen_fgetc(carmen_FILE *fp) {
+  return fp->compressed ? gzgetc(fp->comp_fp) : std::fgetc(fp->fp);
+}
+
+int carmen_fputc(int c, carmen_FILE *fp) {
+  return fp->compressed ? gzputc(fp->comp_fp, c) : std::fputc(c, fp->fp);
+}
+
+char *carmen_fgets(char *s, int size, carmen_FILE *fp) {
+  return fp->compressed ? gzgets(fp->comp_fp, s, size) : std::fgets(s, size, fp->fp);
+}
+
+size_t carmen_fread(void *ptr, size_t size, size_t nmemb, carmen_FILE *fp) {
+  if (!fp->compressed) return std::fread(ptr, size, nmemb, fp->fp);
+  if (size == 0 || nmemb == 0) return 0;
+  return gzfread(ptr, size, nmemb, fp->comp_fp);
+}
+
+size_t carmen_fwrite(const void *ptr, size_t size, size_t nmemb, carmen_FILE *fp) {
+  if (!fp->compressed) return std::fwrite(ptr, size, nmemb, fp->fp);
+  if (size == 0 || nmemb == 0) return 0;
+  return gzfwrite(ptr, size, nmemb, fp->comp_fp);
+}
+
+int carmen_fprintf(carmen_FILE *fp, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  va_list ap2;
+  va_copy(ap2, ap);
+  const int n = std::vsnprintf(nullptr, 0, fmt, ap);
+  va_end(ap);
+  if (n < 0) {
+    va_end(ap2);
+    return n;
+  }
+  std::vector<char> buf(static_cast<size_t>(n) + 1);
+  std::vsnprintf(buf.data(), buf.size(), fmt, ap2);
+  va_end(ap2);
+  const size_t written = carmen_fwrite(buf.data(), 1, static_cast<size_t>(n), fp);
+  return written == static_cast<size_t>(n) ? n : -1;
+}
+
+int carmen_feof(carmen_FILE *fp) {
+  return fp->compressed ? gzeof(fp->comp_fp) : std::feof(fp->fp);
+}
+
+int carmen_ferror(carmen_FILE *fp) {
+  if (!fp->compressed) return std::ferror(fp->fp);
+  int err = Z_OK;
+  gzerror(fp->comp_fp, &err);
+  return err != Z_OK && err != Z_STREAM_END ? 1 : 0;
+}
+
+int carmen_fseek(carmen_FILE *fp, long offset, int whence) {
+  if (!fp->compressed) return std::fseek(fp->fp, offset, whence);
+  if (whence == SEEK_END) {
+    errno = EINVAL;
+    return -1;
+  }
+  return gzseek(fp->comp_fp, offset, whence) < 0 ? -1 : 0;
+}
+
+long carmen_ftell(carmen_FILE *fp) {
+  return fp->compressed ? static_cast<long>(gztell(fp->comp_fp)) : std::ftell(fp->fp);
+}
+
+int carmen_fflush(carmen_FILE *fp) {
+  return fp->compressed ? (gzflush(fp->comp_fp, Z_SYNC_FLUSH) == Z_OK ? 0 : EOF)
+                        : std::fflush(fp->fp);
+}
+
+}  // extern "C"
