@@ -1,2 +1,368 @@
-// placeholder until the engine lands
-int main() { return 2; }
+// log2map — turns a CARMEN laser log into a map, as CARMEN's evidence grid
+// (vasco/egrid.c) would (DESIGN §3).
+//
+//   log2map [options] LOG OUT [OUT...]
+//
+// Outputs by extension: .map / .map.gz (CARMEN), .pgm (+ .yaml, ROS
+// map_server), .png. Exit 0 ok, 1 bad input or runtime error, 2 usage error.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <future>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/error.h"
+#include "carmen_compat/image_io.h"
+#include "carmen_compat/ini_file.h"
+#include "carmen_compat/map_file.h"
+#include "vasco_gpu/backend.h"
+#include "vasco_gpu/grid.h"
+#include "vasco_gpu/params.h"
+#include "vasco_gpu/scan_batch.h"
+#include "vasco_gpu/version.h"
+#if defined(VASCO_HAVE_CUDA)
+#include "vasco_gpu/cuda_backend.h"
+#endif
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+enum class OutputKind { CarmenMap, Pgm, Png };
+
+bool ends_with(const std::string &s, const std::string &suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+bool output_kind(const std::string &path, OutputKind *kind) {
+  if (ends_with(path, ".map") || ends_with(path, ".map.gz")) *kind = OutputKind::CarmenMap;
+  else if (ends_with(path, ".pgm")) *kind = OutputKind::Pgm;
+  else if (ends_with(path, ".png")) *kind = OutputKind::Png;
+  else return false;
+  return true;
+}
+
+// A one-line progress bar on stderr, only when stderr is a terminal.
+class ProgressBar {
+ public:
+  ProgressBar(const char *label, bool enabled) : label_(label), enabled_(enabled) {}
+  ~ProgressBar() { done(); }
+  void update(uint64_t done_units, uint64_t total) {
+    if (!enabled_ || total == 0) return;
+    const int pct = static_cast<int>(100.0 * double(done_units) / double(total));
+    if (pct == last_) return;
+    last_ = pct;
+    const int width = 40, filled = std::min(width, pct * width / 100);
+    std::fprintf(stderr, "\r%-8s [%s%s] %3d%%", label_, std::string(filled, '#').c_str(),
+                 std::string(width - filled, ' ').c_str(), std::min(pct, 100));
+    std::fflush(stderr);
+    shown_ = true;
+  }
+  void done() {
+    if (shown_) std::fprintf(stderr, "\r%*s\r", 60, "");
+    shown_ = false;
+  }
+
+ private:
+  const char *label_;
+  bool enabled_;
+  int last_ = -1;
+  bool shown_ = false;
+};
+
+std::string json_escape(const std::string &s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+std::string basename_of(const std::string &path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string yaml_beside(const std::string &pgm) { return pgm.substr(0, pgm.size() - 4) + ".yaml"; }
+
+void write_output(const std::string &out, OutputKind kind, const carmen::GridMap &grid,
+                  const carmen::GlobalOffset &origin, const std::string &log,
+                  const std::string &backend_name) {
+  switch (kind) {
+    case OutputKind::CarmenMap: {
+      carmen::MapFile mf;
+      const std::string desc = "vasco_gpu " + std::string(vasco::version()) + " " + backend_name;
+      const auto now = static_cast<int64_t>(std::time(nullptr));
+      mf.comments = carmen::standard_map_comments(grid.size_x, grid.size_y, grid.resolution,
+                                                  basename_of(log), desc, "log2map", now);
+      carmen::CreatorInfo creator;
+      creator.user = "log2map";
+      creator.origin = basename_of(log);
+      creator.description = desc;
+      creator.time = now;
+      mf.creator = creator;
+      mf.gridmap = grid;
+      mf.offset = origin;
+      carmen::write_map_file(out, mf);
+      break;
+    }
+    case OutputKind::Pgm:
+      carmen::write_pgm_with_yaml(out, grid, origin);
+      break;
+    case OutputKind::Png:
+      carmen::write_png(out, grid);
+      break;
+  }
+}
+
+// Refuses, before any work is done, an output whose directory cannot be written.
+void check_writable(const std::string &out) {
+  const size_t slash = out.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : out.substr(0, slash));
+  if (access(dir.c_str(), W_OK) != 0)
+    throw carmen::FileError(out, "cannot write here: directory '" + dir + "' " +
+                                     (access(dir.c_str(), F_OK) != 0 ? "does not exist" : "is not writable"));
+}
+
+struct Options {
+  std::string log;
+  std::vector<std::string> outputs;
+  std::string param_file;
+  std::string robot;
+  std::string backend = "auto";
+  std::string cuda_mode = "float";
+  int threads = 0;
+  bool lenient = false, json = false, quiet = false;
+  std::map<std::string, std::string> overrides;  // --vasco_KEY VALUE
+};
+
+int run(const Options &opt) {
+  const auto t_start = Clock::now();
+  std::vector<OutputKind> kinds;
+  for (const auto &out : opt.outputs) {
+    OutputKind k;
+    output_kind(out, &k);
+    kinds.push_back(k);
+  }
+
+  for (const auto &out : opt.outputs) check_writable(out);
+
+  vasco::BackendOptions bopt;
+  bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
+  bopt.threads = opt.threads;
+
+  // CUDA initialisation costs a few tenths of a second: start it now, on
+  // another thread, while the log is parsed.
+  std::future<bool> gpu_ready;
+#if defined(VASCO_HAVE_CUDA)
+  if (opt.backend == "cuda" || opt.backend == "auto") {
+    gpu_ready = std::async(std::launch::async, [dev = bopt.cuda_device] {
+      std::string why;
+      return vasco::cuda_usable(dev, &why);
+    });
+  }
+#endif
+
+  // Parameters: the ini (or vasco's defaults), then command-line overrides.
+  carmen::ParamFile params;
+  if (!opt.param_file.empty()) params = carmen::ParamFile::load(opt.param_file, opt.robot);
+  for (const auto &kv : opt.overrides) params.set_override(kv.first, kv.second);
+  std::vector<std::string> warnings;
+  for (const auto &w : params.warnings()) warnings.push_back(w.str());
+  vasco::MapperParams mp = vasco::MapperParams::from_params(params, &warnings);
+
+  // Parse.
+  const auto t_parse = Clock::now();
+  carmen::LogReaderOptions ropt;
+  ropt.strict = !opt.lenient;
+  vasco::LogLoadStats load;
+  vasco::ScanBatch batch;
+  {
+    ProgressBar bar("parse", !opt.quiet && isatty(STDERR_FILENO));
+    batch = vasco::load_scans(opt.log, mp, ropt, &load,
+                              [&](uint64_t done, uint64_t total) { bar.update(done, total); });
+  }
+  // The log's PARAM lines are a second, lower-priority source.
+  for (size_t i = 0; i < load.params.size(); ++i)
+    params.add_fallback(load.params[i].first, load.params[i].second, opt.log, load.param_lines[i]);
+  mp = vasco::MapperParams::from_params(params, nullptr);
+  const double parse_s = seconds_since(t_parse);
+  if (batch.num_scans() == 0)
+    throw carmen::FileError(opt.log, "no FLASER or ROBOTLASER1 scans to map" +
+                                         std::string(load.laser_messages > 0 ? " in the selected range (vasco_first_scan/vasco_num_scans)" : ""));
+
+  const vasco::GridGeometry geo = vasco::size_grid(batch, mp);
+  if (gpu_ready.valid()) gpu_ready.wait();
+  auto backend = vasco::make_backend(opt.backend, bopt);
+
+  // Map.
+  const auto t_map = Clock::now();
+  vasco::MapStats ms;
+  std::vector<float> cells = backend->map(batch, mp, geo, &ms);
+  const double map_total_s = seconds_since(t_map);
+
+  // Finish.
+  const auto t_finish = Clock::now();
+  const vasco::FinishedMap fin =
+      vasco::finish_grid(cells.data(), geo.size_x, geo.size_y, geo.resolution,
+                         static_cast<int>(mp.downsample), static_cast<int>(mp.border));
+  cells.clear();
+  cells.shrink_to_fit();
+  const double finish_s = seconds_since(t_finish);
+  uint64_t known = 0;
+  for (float v : fin.cells) known += v != -1.0f;
+  if (known == 0) warnings.push_back(opt.log + ": no cell was updated: the map is all unknown");
+
+  // Write.
+  const auto t_write = Clock::now();
+  carmen::GridMap grid;
+  grid.size_x = fin.size_x;
+  grid.size_y = fin.size_y;
+  grid.resolution = fin.resolution;
+  grid.cells = fin.cells;
+  carmen::GlobalOffset origin;
+  origin.x = geo.world_x(static_cast<double>(fin.min_x) * fin.downsample);
+  origin.y = geo.world_y(static_cast<double>(fin.min_y) * fin.downsample);
+  origin.theta = 0;  // theta_offset is the first scan's heading, so the grid axes are the world axes
+  // Each writer is atomic (temporary file + rename); should a later output
+  // fail, the ones this run already wrote are removed too, so a failure
+  // leaves no map behind.
+  std::vector<std::string> written;
+  try {
+    for (size_t i = 0; i < opt.outputs.size(); ++i) {
+      const std::string &out = opt.outputs[i];
+      write_output(out, kinds[i], grid, origin, opt.log, backend->name());
+      written.push_back(out);
+      if (kinds[i] == OutputKind::Pgm) written.push_back(yaml_beside(out));
+    }
+  } catch (...) {
+    for (const auto &w : written) std::remove(w.c_str());
+    throw;
+  }
+  const double write_s = seconds_since(t_write);
+  const double total_s = seconds_since(t_start);
+
+  for (const auto &w : warnings) std::fprintf(stderr, "log2map: warning: %s\n", w.c_str());
+  const auto &ls = load.log;
+  const uint64_t odd_ranges = ls.nan_ranges + ls.inf_ranges + ls.negative_ranges;
+  if (!opt.quiet) {
+    std::fprintf(stderr,
+                 "log2map: %s: %zu scans (of %ld laser messages), %llu beams used, %llu skipped "
+                 "(>= 50 m, NaN or inf), %llu cell updates\n",
+                 opt.log.c_str(), batch.num_scans(), load.laser_messages,
+                 (unsigned long long)ms.beams_used, (unsigned long long)ms.beams_skipped,
+                 (unsigned long long)ms.cell_updates);
+    if (odd_ranges)
+      std::fprintf(stderr, "log2map: odd ranges kept as data: %llu NaN, %llu inf, %llu negative\n",
+                   (unsigned long long)ls.nan_ranges, (unsigned long long)ls.inf_ranges,
+                   (unsigned long long)ls.negative_ranges);
+    if (ls.total_bad_lines())
+      std::fprintf(stderr, "log2map: lenient: skipped %llu bad lines\n%s",
+                   (unsigned long long)ls.total_bad_lines(), ls.summary().c_str());
+    std::fprintf(stderr,
+                 "log2map: grid %d x %d at %g m -> map %d x %d at %g m (%llu known cells)\n",
+                 geo.size_x, geo.size_y, geo.resolution, fin.size_x, fin.size_y, fin.resolution,
+                 (unsigned long long)known);
+    std::fprintf(stderr,
+                 "log2map: backend %s; parse %.3f s, upload %.3f s, map %.3f s, download %.3f s, "
+                 "finish %.3f s, write %.3f s, total %.3f s\n",
+                 backend->name().c_str(), parse_s, ms.upload_s, ms.map_s, ms.download_s, finish_s,
+                 write_s, total_s);
+  }
+  if (opt.json) {
+    std::ostringstream j;
+    j.precision(9);
+    j << "{\"log\":\"" << json_escape(opt.log) << "\",\"backend\":\"" << backend->name()
+      << "\",\"scans\":" << batch.num_scans() << ",\"laser_messages\":" << load.laser_messages
+      << ",\"beams_used\":" << ms.beams_used << ",\"beams_skipped\":" << ms.beams_skipped
+      << ",\"cell_updates\":" << ms.cell_updates << ",\"nan_ranges\":" << ls.nan_ranges
+      << ",\"inf_ranges\":" << ls.inf_ranges << ",\"negative_ranges\":" << ls.negative_ranges
+      << ",\"bad_lines\":" << ls.total_bad_lines() << ",\"grid\":[" << geo.size_x << ","
+      << geo.size_y << "],\"map\":[" << fin.size_x << "," << fin.size_y
+      << "],\"map_resolution\":" << fin.resolution << ",\"known_cells\":" << known
+      << ",\"origin\":[" << origin.x << "," << origin.y << "]"
+      << ",\"seconds\":{\"parse\":" << parse_s << ",\"upload\":" << ms.upload_s
+      << ",\"map\":" << ms.map_s << ",\"map_total\":" << map_total_s
+      << ",\"download\":" << ms.download_s << ",\"finish\":" << finish_s
+      << ",\"write\":" << write_s << ",\"total\":" << total_s << "},\"outputs\":[";
+    for (size_t i = 0; i < opt.outputs.size(); ++i)
+      j << (i ? "," : "") << "\"" << json_escape(opt.outputs[i]) << "\"";
+    j << "]}\n";
+    std::fputs(j.str().c_str(), stdout);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  Options opt;
+  CLI::App app{"log2map: builds a CARMEN evidence-grid map (vasco/egrid.c) from a laser log.\n"
+               "Outputs by extension: .map, .map.gz (CARMEN), .pgm (+ .yaml, ROS map_server), .png."};
+  app.set_version_flag("--version", [] {
+    std::string s = std::string("log2map (vasco_gpu) ") + vasco::version() + "\nbackends compiled in:";
+    for (const auto &b : vasco::compiled_backends()) s += " " + b;
+    return s;
+  });
+  app.add_option("LOG", opt.log, "CARMEN log (.log, .clf, or gzipped .gz)")->required();
+  app.add_option("OUT", opt.outputs, "output files: .map, .map.gz, .pgm, .png")->required();
+  app.add_option("--param-file", opt.param_file, "carmen.ini with vasco_* keys (default: vasco's defaults)");
+  app.add_option("--robot", opt.robot, "robot section of the ini to use");
+  app.add_option("--backend", opt.backend, "cpu_double | cpu_float | cuda | auto (default: auto)")
+      ->check(CLI::IsMember({"cpu_double", "cpu_float", "cuda", "auto"}));
+  app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
+      ->check(CLI::IsMember({"float", "exact"}));
+  app.add_flag("--lenient", opt.lenient, "skip bad log lines (and report them) instead of stopping");
+  app.add_flag("--json", opt.json, "print machine-readable statistics on stdout");
+  app.add_flag("--quiet", opt.quiet, "no progress and no summary");
+  std::map<std::string, std::string> raw;
+  for (const auto &key : vasco::mapper_param_keys()) {
+    app.add_option("--" + key, raw[key], "override " + key)->type_name("VALUE");
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError &e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  for (const auto &kv : raw)
+    if (app.count("--" + kv.first) > 0) opt.overrides[kv.first] = kv.second;
+  for (const auto &out : opt.outputs) {
+    OutputKind k;
+    if (!output_kind(out, &k)) {
+      std::fprintf(stderr, "log2map: %s: unknown output type (use .map, .map.gz, .pgm or .png)\n", out.c_str());
+      return 2;
+    }
+  }
+  try {
+    return run(opt);
+  } catch (const carmen::FileError &e) {
+    std::fprintf(stderr, "log2map: %s\n", e.what());
+  } catch (const std::bad_alloc &) {
+    std::fprintf(stderr, "log2map: out of memory\n");
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "log2map: %s\n", e.what());
+  }
+  return 1;
+}

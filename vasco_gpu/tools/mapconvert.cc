@@ -1,2 +1,192 @@
-// placeholder until the map tools land
-int main() { return 2; }
+// mapconvert: convert a CARMEN map file, or describe it.
+//
+//   mapconvert [--mode trinary|scale|raw] IN OUT   convert by OUT's extension
+//   mapconvert --info IN                           print what the map holds
+//
+// Exit status: 0 ok, 1 a file could not be read or written (the message
+// names it), 2 usage error.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <exception>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/error.h"
+#include "carmen_compat/image_io.h"
+#include "carmen_compat/map_file.h"
+
+namespace {
+
+const char kUsage[] =
+    "usage: mapconvert [--mode trinary|scale|raw] IN OUT\n"
+    "       mapconvert --info IN\n"
+    "\n"
+    "Converts the CARMEN map IN (.map or .map.gz) to OUT, chosen by OUT's extension:\n"
+    "  .map     CARMEN map (all chunks kept)\n"
+    "  .map.gz  CARMEN map, gzip-compressed\n"
+    "  .pgm     ROS map_server / nav2 image, with a .yaml beside it (origin from the\n"
+    "           map's OFFSET chunk, else 0 0 0); --mode sets the YAML mode and the\n"
+    "           grey levels (default trinary)\n"
+    "  .png     8-bit grey picture (black occupied, white free, mid grey unknown)\n"
+    "--info prints the size, resolution, chunks, unknown fraction and value range.\n"
+    "\n"
+    "Exit status: 0 ok, 1 a file could not be read or written, 2 usage error.\n";
+
+int usage_error(const std::string &msg) {
+  std::fprintf(stderr, "mapconvert: %s\n%s", msg.c_str(), kUsage);
+  return 2;
+}
+
+bool ends_with(const std::string &s, const char *suffix) {
+  const size_t n = std::strlen(suffix);
+  return s.size() >= n && s.compare(s.size() - n, n, suffix) == 0;
+}
+
+enum class OutKind { None, Map, Pgm, Png };
+
+OutKind kind_of(const std::string &path) {
+  if (ends_with(path, ".map") || ends_with(path, ".map.gz")) return OutKind::Map;
+  if (ends_with(path, ".pgm")) return OutKind::Pgm;
+  if (ends_with(path, ".png")) return OutKind::Png;
+  return OutKind::None;
+}
+
+std::string quoted(const std::string &s) { return "\"" + s + "\""; }
+
+void print_info(const std::string &path, const carmen::MapFile &m) {
+  std::printf("file: %s\n", path.c_str());
+  std::printf("comment lines: %zu\n", m.comments.size());
+  std::printf("chunks: %zu\n", m.chunks.size());
+  for (const carmen::ChunkInfo &c : m.chunks) {
+    std::printf("  %-10s %10d bytes at byte %lld%s%s\n", carmen::chunk_type_name(c.type).c_str(), c.size,
+                static_cast<long long>(c.offset), c.named() ? (" named " + quoted(c.name)).c_str() : "",
+                c.used ? "" : " (skipped)");
+  }
+  if (m.creator) {
+    const carmen::CreatorInfo &c = *m.creator;
+    char date[64] = "?";
+    const std::time_t t = static_cast<std::time_t>(c.time);
+    std::tm tm_utc;
+    if (gmtime_r(&t, &tm_utc) != nullptr) std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S UTC", &tm_utc);
+    std::printf("creator: user %s, time %s (%d-byte time_t%s), origin %s, description %s\n", quoted(c.user).c_str(),
+                date, c.time_bytes, m.old_style_creator ? ", old-style chunk" : "", quoted(c.origin).c_str(),
+                quoted(c.description).c_str());
+  }
+  if (m.offset) std::printf("offset: x %g y %g theta %g\n", m.offset->x, m.offset->y, m.offset->theta);
+  if (m.places) std::printf("places: %zu\n", m.places->size());
+  if (m.offlimits) {
+    std::printf("offlimits: %zu points, %zu lines, %zu rectangles\n", m.offlimits->points.size(),
+                m.offlimits->lines.size(), m.offlimits->rects.size());
+  }
+  if (m.laserscans) std::printf("laserscans: %zu\n", m.laserscans->size());
+  if (m.unknown_chunks > 0) std::printf("skipped chunks: %d\n", m.unknown_chunks);
+  if (!m.gridmap) {
+    std::printf("gridmap: none\n");
+    return;
+  }
+  const carmen::GridMap &g = *m.gridmap;
+  size_t unknown = 0, offlimits = 0;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (float v : g.cells) {
+    if (v == carmen::kUnknownCell) {
+      ++unknown;
+      continue;
+    }
+    if (v >= 2.0f) ++offlimits;
+    lo = std::min(lo, double(v));
+    hi = std::max(hi, double(v));
+  }
+  const size_t n = g.cells.size();
+  std::printf("size: %d x %d cells\n", g.size_x, g.size_y);
+  std::printf("resolution: %.9g m\n", g.resolution);
+  std::printf("extent: %g x %g m\n", g.size_x * g.resolution, g.size_y * g.resolution);
+  std::printf("unknown: %zu of %zu cells (%.2f%%)\n", unknown, n, n ? 100.0 * double(unknown) / double(n) : 0.0);
+  if (unknown < n) {
+    std::printf("known values: min %.9g max %.9g\n", lo, hi);
+  } else {
+    std::printf("known values: none\n");
+  }
+  if (offlimits > 0) std::printf("off-limits cells: %zu\n", offlimits);
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  bool info = false;
+  bool mode_given = false;
+  carmen::PgmMode mode = carmen::PgmMode::Trinary;
+  std::vector<std::string> files;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string &a = args[i];
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "--info") {
+      info = true;
+    } else if (a == "--mode" || a.rfind("--mode=", 0) == 0) {
+      std::string value;
+      if (a == "--mode") {
+        if (i + 1 >= args.size()) return usage_error("--mode needs a value");
+        value = args[++i];
+      } else {
+        value = a.substr(7);
+      }
+      if (!carmen::parse_pgm_mode(value, &mode)) {
+        return usage_error("unknown --mode '" + value + "' (trinary, scale or raw)");
+      }
+      mode_given = true;
+    } else if (a == "--") {
+      files.insert(files.end(), args.begin() + static_cast<long>(i) + 1, args.end());
+      break;
+    } else if (a.size() > 1 && a[0] == '-') {
+      return usage_error("unknown option '" + a + "'");
+    } else {
+      files.push_back(a);
+    }
+  }
+
+  if (info) {
+    if (files.size() != 1) return usage_error("--info takes one map file");
+    if (mode_given) return usage_error("--mode applies to .pgm output, not --info");
+  } else if (files.size() != 2) {
+    return usage_error(files.empty() ? "no files given" : "expected IN and OUT");
+  }
+
+  OutKind kind = OutKind::None;
+  if (!info) {
+    kind = kind_of(files[1]);
+    if (kind == OutKind::None) {
+      return usage_error("cannot tell the output format of '" + files[1] + "' (use .map, .map.gz, .pgm or .png)");
+    }
+    if (mode_given && kind != OutKind::Pgm) return usage_error("--mode applies to .pgm output only");
+  }
+
+  try {
+    const carmen::MapFile m = carmen::read_map_file(files[0]);
+    if (info) {
+      print_info(files[0], m);
+      return 0;
+    }
+    const std::string &out = files[1];
+    if (kind == OutKind::Map) {
+      carmen::write_map_file(out, m);
+    } else {
+      if (!m.gridmap) throw carmen::FileError(files[0], "has no GRIDMAP chunk: there is no image to make");
+      if (kind == OutKind::Pgm) {
+        carmen::write_pgm_with_yaml(out, *m.gridmap, m.offset.value_or(carmen::GlobalOffset{}), mode);
+      } else {
+        carmen::write_png(out, *m.gridmap);
+      }
+    }
+    return 0;
+  } catch (const carmen::FileError &e) {
+    std::fprintf(stderr, "mapconvert: %s\n", e.what());
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "mapconvert: %s: %s\n", files[0].c_str(), e.what());
+  }
+  return 1;
+}

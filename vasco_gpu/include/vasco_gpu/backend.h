@@ -1,0 +1,60 @@
+// backend.h — the interface every mapping backend implements, and the
+// factory that picks one by name.
+#ifndef VASCO_GPU_BACKEND_H
+#define VASCO_GPU_BACKEND_H
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "vasco_gpu/grid.h"
+#include "vasco_gpu/params.h"
+#include "vasco_gpu/scan_batch.h"
+
+namespace vasco {
+
+// Counts and phase times of one mapping run.
+struct MapStats {
+  uint64_t scans = 0;
+  uint64_t beams_used = 0;     // range < 50 m: traced
+  uint64_t beams_skipped = 0;  // range >= 50 m, NaN or +inf: skipped entirely
+  uint64_t cell_updates = 0;   // odds updates applied
+  double upload_s = 0;         // host -> device (GPU backends)
+  double map_s = 0;            // the update itself (kernels only, for GPU backends)
+  double download_s = 0;       // device -> host
+};
+
+enum class CudaMode { Float, Exact };
+
+struct BackendOptions {
+  CudaMode cuda_mode = CudaMode::Float;
+  int threads = 0;   // cpu_threads: 0 = all cores
+  int cuda_device = 0;
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual std::string name() const = 0;
+  // Applies every scan of `batch`, in order, to a fresh evidence grid of
+  // geometry `geo` (all cells unknown) and returns it: x-major floats,
+  // cells[x * size_y + y], -1 for unknown.
+  virtual std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
+                                 const GridGeometry &geo, MapStats *stats) = 0;
+};
+
+// Backend names accepted by make_backend: cpu_double, cpu_float, cpu_threads,
+// cuda (if compiled in) and auto (cuda when a GPU is usable, else cpu_double).
+std::vector<std::string> compiled_backends();
+
+// Creates a backend; throws std::invalid_argument for an unknown name and
+// std::runtime_error for `cuda` without a usable GPU (the message says why).
+std::unique_ptr<Backend> make_backend(const std::string &name, const BackendOptions &options = {});
+
+std::unique_ptr<Backend> make_cpu_double_backend();
+std::unique_ptr<Backend> make_cpu_float_backend();
+
+}  // namespace vasco
+
+#endif  // VASCO_GPU_BACKEND_H

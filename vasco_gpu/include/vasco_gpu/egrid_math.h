@@ -1,0 +1,288 @@
+// egrid_math.h — the per-cell mathematics of CARMEN 0.7.4's evidence grid
+// (vasco/egrid.c), written once and compiled into every backend: the CPU
+// oracle, the float CPU port and the CUDA kernels. A CPU test of these
+// functions therefore exercises exactly what the GPU runs.
+//
+// Everything here is a pure function of its arguments. Double versions follow
+// CARMEN's C operation by operation (left-to-right evaluation, no fused
+// multiply-add: host code is built with -ffp-contract=off and device code with
+// --fmad=false), so results are bit-identical wherever they run.
+#ifndef VASCO_GPU_EGRID_MATH_H
+#define VASCO_GPU_EGRID_MATH_H
+
+#include <climits>
+#include <cmath>
+#include <cstdint>
+
+#if defined(__CUDACC__)
+#define VG_HD __host__ __device__ __forceinline__
+#else
+#define VG_HD inline
+#endif
+
+namespace vasco {
+namespace egrid {
+
+// Beams whose float range is not below this are skipped entirely
+// (egrid.c's LASER_RANGE_LIMIT): they clear nothing.
+constexpr double kLaserRangeLimit = 50.0;
+// Distance used for cells beyond the distance table (egrid.c uses 1e6).
+constexpr double kFarDistance = 1e6;
+// Cell value meaning "unknown".
+constexpr float kUnknown = -1.0f;
+
+// ---------------------------------------------------------------------------
+// Integer helpers with x86-64 semantics. CARMEN's C relies on them for
+// degenerate input (e.g. a range of -inf gives an end cell of INT_MIN, and
+// the Bresenham set-up then wraps around); we reproduce them without
+// undefined behaviour.
+// ---------------------------------------------------------------------------
+
+// (int)v as cvttsd2si computes it: truncation toward zero, and INT_MIN for
+// NaN or a value outside the int range.
+VG_HD int trunc_to_int(double v) {
+  if (!(v > -2147483649.0 && v < 2147483648.0)) return INT_MIN;
+  return static_cast<int>(v);
+}
+
+VG_HD int wrap_add(int a, int b) {
+  return static_cast<int>(static_cast<uint32_t>(a) + static_cast<uint32_t>(b));
+}
+VG_HD int wrap_sub(int a, int b) {
+  return static_cast<int>(static_cast<uint32_t>(a) - static_cast<uint32_t>(b));
+}
+VG_HD int wrap_mul(int a, int b) {
+  return static_cast<int>(static_cast<uint32_t>(a) * static_cast<uint32_t>(b));
+}
+VG_HD int wrap_neg(int a) { return static_cast<int>(0u - static_cast<uint32_t>(a)); }
+// abs() as the machine computes it: abs(INT_MIN) == INT_MIN.
+VG_HD int wrap_abs(int a) { return a < 0 ? wrap_neg(a) : a; }
+
+// ---------------------------------------------------------------------------
+// CARMEN's Bresenham line (global.c), DESIGN §2.1. Both ends are visited.
+// ---------------------------------------------------------------------------
+struct BresenhamLine {
+  int x, y;        // current point in the swapped/flipped frame
+  int x_end;       // major coordinate of the end point (swapped/flipped frame)
+  int inc;         // +1 or -1 along the major axis
+  int d, incr_e, incr_ne;
+  bool steep, flipped;
+};
+
+VG_HD void bresenham_init(BresenhamLine &l, int x1, int y1, int x2, int y2) {
+  // slope as CARMEN computes it: a zero dx gives +-inf (steep), 0/0 gives NaN
+  // (not steep: a single cell).
+  const double dx = static_cast<double>(wrap_sub(x2, x1));
+  const double dy = static_cast<double>(wrap_sub(y2, y1));
+  const double slope = dy / dx;
+  l.steep = (slope < 0 ? -slope : slope) > 1.0;
+  if (l.steep) {
+    int t = x1; x1 = y1; y1 = t;
+    t = x2; x2 = y2; y2 = t;
+  }
+  l.flipped = static_cast<int64_t>(wrap_sub(x2, x1)) * static_cast<int64_t>(wrap_sub(y2, y1)) < 0;
+  if (l.flipped) {
+    y1 = wrap_neg(y1);
+    y2 = wrap_neg(y2);
+  }
+  l.inc = x2 > x1 ? 1 : -1;
+  const int delta_x = wrap_sub(x2, x1);
+  const int delta_y = wrap_sub(y2, y1);
+  l.incr_e = wrap_mul(wrap_mul(2, delta_y), l.inc);
+  l.incr_ne = wrap_mul(wrap_mul(2, wrap_sub(delta_y, delta_x)), l.inc);
+  l.d = wrap_mul(wrap_sub(wrap_mul(2, delta_y), delta_x), l.inc);
+  l.x = x1;
+  l.y = y1;
+  l.x_end = x2;
+}
+
+// The current cell in grid coordinates (undoing the flip, then the swap).
+VG_HD void bresenham_current(const BresenhamLine &l, int *cx, int *cy) {
+  const int y = l.flipped ? wrap_neg(l.y) : l.y;
+  if (l.steep) {
+    *cx = y;
+    *cy = l.x;
+  } else {
+    *cx = l.x;
+    *cy = y;
+  }
+}
+
+// Advances one cell; returns false (and does not move) when the end was the
+// current cell.
+VG_HD bool bresenham_next(BresenhamLine &l) {
+  if (l.x == l.x_end) return false;
+  l.x = wrap_add(l.x, l.inc);
+  if (l.d < 0 || (l.inc < 0 && l.d <= 0)) {
+    l.d = wrap_add(l.d, l.incr_e);
+  } else {
+    l.d = wrap_add(l.d, l.incr_ne);
+    l.y = wrap_add(l.y, l.inc);
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// The same walk in closed form, for one thread per cell. Valid for lines whose
+// |dx| and |dy| are below 2^29 (then no intermediate value of the sequential
+// walk overflows); is_closed_form_line() says whether a line qualifies. The
+// cell at step k (0 <= k <= |major delta|) is the cell the sequential walk
+// emits after k calls to bresenham_next.
+// ---------------------------------------------------------------------------
+struct LineParams {
+  int x1, y1;       // start, grid coordinates
+  int major_len;    // number of steps: the walk visits major_len + 1 cells
+  int a, b;         // |major delta| and |minor delta| in the swapped/flipped frame
+  int inc;          // +1 or -1
+  bool steep, flipped;
+};
+
+VG_HD bool is_closed_form_line(int x1, int y1, int x2, int y2) {
+  const int64_t dx = static_cast<int64_t>(x2) - x1;
+  const int64_t dy = static_cast<int64_t>(y2) - y1;
+  const int64_t lim = int64_t(1) << 29;
+  return dx > -lim && dx < lim && dy > -lim && dy < lim;
+}
+
+VG_HD LineParams line_params(int x1, int y1, int x2, int y2) {
+  BresenhamLine l;
+  bresenham_init(l, x1, y1, x2, y2);
+  LineParams p;
+  p.x1 = x1;
+  p.y1 = y1;
+  p.steep = l.steep;
+  p.flipped = l.flipped;
+  p.inc = l.inc;
+  int minor_end = l.steep ? x2 : y2;  // minor coordinate of the end, swapped/flipped frame
+  if (l.flipped) minor_end = -minor_end;
+  const int dmaj = l.x_end - l.x;
+  const int dmin = minor_end - l.y;
+  p.a = dmaj < 0 ? -dmaj : dmaj;
+  p.b = dmin < 0 ? -dmin : dmin;
+  p.major_len = p.a;
+  return p;
+}
+
+// Minor offset (in units of inc) after k major steps. The sequential walk
+// takes the minor step when D >= 0 going forward and when D > 0 going
+// backward; solving its recurrence gives round-half-up resp. round-half-down
+// of k*b/a.
+VG_HD int line_minor_offset(const LineParams &p, int k) {
+  if (p.a == 0) return 0;
+  const int64_t num = 2 * static_cast<int64_t>(p.b) * k + p.a - (p.inc < 0 ? 1 : 0);
+  return static_cast<int>(num / (2 * static_cast<int64_t>(p.a)));
+}
+
+VG_HD void line_cell(const LineParams &p, int k, int *cx, int *cy) {
+  const int m = line_minor_offset(p, k);
+  const int sx1 = p.steep ? p.y1 : p.x1;      // major start
+  int sy1 = p.steep ? p.x1 : p.y1;            // minor start
+  if (p.flipped) sy1 = -sy1;
+  const int maj = sx1 + p.inc * k;
+  int min = sy1 + p.inc * m;
+  if (p.flipped) min = -min;
+  if (p.steep) {
+    *cx = min;
+    *cy = maj;
+  } else {
+    *cx = maj;
+    *cy = min;
+  }
+}
+
+// Inverse: the step at which the line visits cell (cx, cy), or -1 if it does
+// not. Cheap (multiplications, no division): used by one-thread-per-cell
+// kernels to test whether a beam crosses their cell.
+VG_HD int line_step_of_cell(const LineParams &p, int cx, int cy) {
+  const int maj = p.steep ? cy : cx;
+  int min = p.steep ? cx : cy;
+  const int sx1 = p.steep ? p.y1 : p.x1;
+  int sy1 = p.steep ? p.x1 : p.y1;
+  if (p.flipped) {
+    sy1 = -sy1;
+    min = -min;
+  }
+  const int k = (maj - sx1) * p.inc;
+  if (k < 0 || k > p.major_len) return -1;
+  const int m = (min - sy1) * p.inc;
+  if (m < 0) return -1;
+  // m == line_minor_offset(p, k)  <=>  2a*m <= num < 2a*(m+1)
+  if (p.a == 0) return m == 0 ? k : -1;
+  const int64_t num = 2 * static_cast<int64_t>(p.b) * k + p.a - (p.inc < 0 ? 1 : 0);
+  const int64_t lo = 2 * static_cast<int64_t>(p.a) * m;
+  return (num >= lo && num < lo + 2 * static_cast<int64_t>(p.a)) ? k : -1;
+}
+
+// ---------------------------------------------------------------------------
+// The sensor model and the odds update (DESIGN §2 step 6).
+// ---------------------------------------------------------------------------
+struct ModelParams {
+  double prior, occ, emp;   // prior_occ, occ_evidence, emp_evidence
+  double sure, max;         // max_sure_range, max_range
+};
+
+// The evidence p for a cell at distance d of a beam of range r; returns false
+// when the beam stops here (d >= max_range).
+VG_HD bool sensor_model(const ModelParams &m, double d, double r, double *p) {
+  const double ev = d < r ? m.emp : m.occ;
+  if (d < m.sure) {
+    *p = ev;
+  } else if (d < m.max) {
+    *p = ev + (d - m.sure) / m.max * (m.prior - ev);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// Distance between two cells i and j cells apart, as the distance table holds it.
+VG_HD double cell_distance(int i, int j, double resolution) {
+  return sqrt(static_cast<double>(i * i + j * j)) * resolution;
+}
+
+// One odds update of a stored cell, exactly as egrid.c evaluates it:
+// new = 1 - 1 / (1 + ((1-prior)/prior) * p / (1-p) * old / (1-old)), every step
+// in double except `1 - old`, which in CARMEN's C is int minus float: a float
+// subtraction. An unknown cell (-1) is first set to (float)prior.
+VG_HD float odds_update(float cell, double prior, double p) {
+  if (cell == kUnknown) cell = static_cast<float>(prior);
+  double t = (1.0 - prior) / prior;
+  t = t * p;
+  t = t / (1.0 - p);
+  t = t * static_cast<double>(cell);
+  t = t / static_cast<double>(1.0f - cell);
+  const double v = 1.0 - 1.0 / (1.0 + t);
+  return static_cast<float>(v);
+}
+
+// The float port (the paper's CPU version): the same update in single precision.
+struct ModelParamsF {
+  float prior, occ, emp, sure, max;
+};
+
+VG_HD bool sensor_model_f(const ModelParamsF &m, float d, float r, float *p) {
+  const float ev = d < r ? m.emp : m.occ;
+  if (d < m.sure) {
+    *p = ev;
+  } else if (d < m.max) {
+    *p = ev + (d - m.sure) / m.max * (m.prior - ev);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+VG_HD float odds_update_f(float cell, float prior, float p) {
+  if (cell == kUnknown) cell = prior;
+  float t = (1.0f - prior) / prior;
+  t = t * p;
+  t = t / (1.0f - p);
+  t = t * cell;
+  t = t / (1.0f - cell);
+  return 1.0f - 1.0f / (1.0f + t);
+}
+
+}  // namespace egrid
+}  // namespace vasco
+
+#endif  // VASCO_GPU_EGRID_MATH_H

@@ -1,0 +1,55 @@
+// grid.h — grid sizing (DESIGN §3 step 2) and the finishing step that
+// downsamples and crops an evidence grid (DESIGN §2 step 7).
+#ifndef VASCO_GPU_GRID_H
+#define VASCO_GPU_GRID_H
+
+#include <cstdint>
+#include <vector>
+
+namespace vasco {
+
+struct MapperParams;
+struct ScanBatch;
+
+// Where the evidence grid lies: its size and the first scan's pose, which
+// fixes the frame (theta_offset = the first scan's heading, so the grid axes
+// are the world axes).
+struct GridGeometry {
+  int size_x = 0, size_y = 0;
+  double resolution = 0;
+  double theta_offset = 0;
+  double x0 = 0, y0 = 0;  // world position of the first used scan's laser
+
+  uint64_t num_cells() const { return static_cast<uint64_t>(size_x) * static_cast<uint64_t>(size_y); }
+  // World coordinates of the lower-left corner of cell (gx, gy).
+  double world_x(double gx) const { return (gx - size_x / 2.0) * resolution + x0; }
+  double world_y(double gy) const { return (gy - size_y / 2.0) * resolution + y0; }
+};
+
+// Grids larger than this many cells are refused with a clear error rather
+// than allocated (4 GiB of floats).
+constexpr uint64_t kMaxGridCells = uint64_t(1) << 30;
+
+// Sizes the grid for a batch (DESIGN §3 step 2). Throws std::runtime_error
+// when the batch is empty or the grid would be absurdly large.
+GridGeometry size_grid(const ScanBatch &batch, const MapperParams &params);
+
+// The result of finish: a downsampled, cropped grid.
+struct FinishedMap {
+  int size_x = 0, size_y = 0;
+  double resolution = 0;
+  int min_x = 0, min_y = 0;   // crop offset, in downsampled cells
+  int downsample = 1;
+  std::vector<float> cells;   // x-major: cells[x * size_y + y]; -1 unknown
+};
+
+// CARMEN's finish (DESIGN §2 step 7): block means of known cells (summed in
+// double), crop to the known bounding box plus `border`, new size max - min
+// (no +1), resolution times `downsample`. Throws std::invalid_argument for a
+// downsample < 1 or border < 0.
+FinishedMap finish_grid(const float *cells, int size_x, int size_y, double resolution,
+                        int downsample, int border);
+
+}  // namespace vasco
+
+#endif  // VASCO_GPU_GRID_H

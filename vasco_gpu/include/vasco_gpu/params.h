@@ -1,0 +1,49 @@
+// params.h — the mapper's parameters (DESIGN §2), from a carmen.ini, a log's
+// PARAM lines and command-line overrides, validated once.
+#ifndef VASCO_GPU_PARAMS_H
+#define VASCO_GPU_PARAMS_H
+
+#include <string>
+#include <vector>
+
+namespace carmen {
+class ParamFile;
+}
+
+namespace vasco {
+
+struct MapperParams {
+  // vasco's defaults (vegrid.c).
+  double resolution = 0.025;  // vasco_resolution, m per cell
+  double p_prior = 0.5;       // vasco_p_prior
+  double p_occ = 0.55;        // vasco_p_occ
+  double p_emp = 0.45;        // vasco_p_emp
+  double range_sure = 5.0;    // vasco_range_sure, m
+  double range_max = 10.0;    // vasco_range_max, m
+  double wall_size = 0.2;     // vasco_wall_size, m
+  long downsample = 4;        // vasco_downsample
+  long border = 20;           // vasco_border, cells (of the downsampled map)
+  long first_scan = 0;        // vasco_first_scan: index of the first laser message used
+  long num_scans = -1;        // vasco_num_scans: how many (-1: all)
+  double max_prob = 0.95;     // stored as CARMEN does; never used
+
+  // Reads every vasco_* key present in `params` (the rest keep their
+  // defaults) and validates; errors name the key and FILE:LINE. Unknown
+  // vasco_* keys are appended to `warnings` (typos).
+  static MapperParams from_params(const carmen::ParamFile &params, std::vector<std::string> *warnings);
+
+  // Checks the ranges (probabilities strictly between 0 and 1, resolution > 0,
+  // 0 <= range_sure <= range_max, downsample >= 1, border >= 0, ...); throws
+  // std::invalid_argument naming the key.
+  void validate() const;
+
+  // Number of distance-table entries per axis: (int)(range_max / resolution).
+  int table_size() const;
+};
+
+// The names of all keys MapperParams understands (vasco_resolution, ...).
+const std::vector<std::string> &mapper_param_keys();
+
+}  // namespace vasco
+
+#endif  // VASCO_GPU_PARAMS_H

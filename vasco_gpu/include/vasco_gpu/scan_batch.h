@@ -1,0 +1,57 @@
+// scan_batch.h — the laser scans of a log, as a structure of arrays: what
+// every backend consumes (and what the CUDA backend uploads once).
+#ifndef VASCO_GPU_SCAN_BATCH_H
+#define VASCO_GPU_SCAN_BATCH_H
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/log_reader.h"
+
+namespace vasco {
+
+struct MapperParams;
+
+struct ScanBatch {
+  // Per scan: the laser pose (double, as parsed) and its beam geometry.
+  std::vector<double> x, y, theta;
+  std::vector<double> first_angle;   // angle of beam 0 relative to theta
+  std::vector<double> angle_step;    // added after every beam
+  std::vector<uint64_t> beam_offset; // scan s owns beams [beam_offset[s], beam_offset[s+1])
+  std::vector<long> line;            // line of the scan in the log (for messages)
+  // Per beam: the range as CARMEN stores it (parsed as double, kept as float).
+  std::vector<float> range;
+
+  ScanBatch() : beam_offset{0} {}
+  size_t num_scans() const { return x.size(); }
+  size_t num_beams() const { return range.size(); }
+  int beams_in(size_t s) const { return static_cast<int>(beam_offset[s + 1] - beam_offset[s]); }
+  const float *ranges_of(size_t s) const { return range.data() + beam_offset[s]; }
+
+  void add_scan(double px, double py, double ptheta, double first, double step, const float *r,
+                int n, long source_line);
+};
+
+// What reading a log produced, besides the scans.
+struct LogLoadStats {
+  carmen::LogStats log;          // counts, skipped and bad lines, odd ranges
+  long laser_messages = 0;       // FLASER + ROBOTLASER1 lines seen
+  long scans_used = 0;           // after vasco_first_scan / vasco_num_scans
+  std::vector<std::pair<std::string, std::string>> params;  // PARAM lines (name, value)
+  std::vector<long> param_lines;                            // their line numbers
+};
+
+// Reads the laser scans of a log by DESIGN §3 step 1: every FLASER and
+// ROBOTLASER1 line in file order (laser pose; FLASER's configuration guessed
+// from its beam count), then the contiguous subset [first_scan, first_scan +
+// num_scans). `progress(done, total)` (bytes of the file) is called now and
+// then when set. Throws carmen::FileError on bad input.
+ScanBatch load_scans(const std::string &log_path, const MapperParams &params,
+                     const carmen::LogReaderOptions &options, LogLoadStats *stats,
+                     const std::function<void(uint64_t, uint64_t)> &progress = {});
+
+}  // namespace vasco
+
+#endif  // VASCO_GPU_SCAN_BATCH_H
