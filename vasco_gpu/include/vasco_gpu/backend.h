@@ -20,6 +20,7 @@ struct MapStats {
   uint64_t beams_used = 0;     // range < 50 m: traced
   uint64_t beams_skipped = 0;  // range >= 50 m, NaN or +inf: skipped entirely
   uint64_t cell_updates = 0;   // odds updates applied
+  double prep_s = 0;           // host work before the upload (GPU backends: placing beams)
   double upload_s = 0;         // host -> device (GPU backends)
   double map_s = 0;            // the update itself (kernels only, for GPU backends)
   double download_s = 0;       // device -> host

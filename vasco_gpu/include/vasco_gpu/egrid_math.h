@@ -244,15 +244,29 @@ VG_HD double cell_distance(int i, int j, double resolution) {
 // new = 1 - 1 / (1 + ((1-prior)/prior) * p / (1-p) * old / (1-old)), every step
 // in double except `1 - old`, which in CARMEN's C is int minus float: a float
 // subtraction. An unknown cell (-1) is first set to (float)prior.
-VG_HD float odds_update(float cell, double prior, double p) {
-  if (cell == kUnknown) cell = static_cast<float>(prior);
+//
+// Split in two so that a kernel can compute the part that does not depend on
+// the cell ahead of time: odds_factor(prior, p) is the left-to-right product
+// ((1-prior)/prior) * p / (1-p) — the same operations in the same order, so
+// odds_apply(cell, prior, odds_factor(prior, p)) == odds_update(cell, prior, p)
+// bit for bit.
+VG_HD double odds_factor(double prior, double p) {
   double t = (1.0 - prior) / prior;
   t = t * p;
   t = t / (1.0 - p);
-  t = t * static_cast<double>(cell);
+  return t;
+}
+
+VG_HD float odds_apply(float cell, double prior, double factor) {
+  if (cell == kUnknown) cell = static_cast<float>(prior);
+  double t = factor * static_cast<double>(cell);
   t = t / static_cast<double>(1.0f - cell);
   const double v = 1.0 - 1.0 / (1.0 + t);
   return static_cast<float>(v);
+}
+
+VG_HD float odds_update(float cell, double prior, double p) {
+  return odds_apply(cell, prior, odds_factor(prior, p));
 }
 
 // The float port (the paper's CPU version): the same update in single precision.

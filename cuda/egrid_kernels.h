@@ -1,0 +1,126 @@
+// egrid_kernels.h — what the CUDA backend's host side (vasco_gpu/src/cuda/)
+// calls. Plain C++: no CUDA syntax, so host code compiled by the C++
+// compiler can include it. All pointers are device pointers; every launcher
+// enqueues on `stream` and checks the launch.
+#ifndef VASCO_CUDA_EGRID_KERNELS_H
+#define VASCO_CUDA_EGRID_KERNELS_H
+
+#include <cuda_runtime.h>
+
+#include <cstddef>
+#include <cstdint>
+
+namespace vasco {
+namespace cuda {
+
+// Model parameters as the oracle uses them (double).
+struct DeviceModel {
+  double prior, occ, emp, sure, max;  // prior_occ, occ/emp evidence, sure/max range
+  double resolution, wall;
+  int table_size;                     // (int)(max_range / resolution)
+  int size_x, size_y;                 // grid size in cells
+};
+
+// ---------------------------------------------------------------------------
+// Exact mode: bit-identical to cpu_double.
+// ---------------------------------------------------------------------------
+
+// One used beam, as the host's oracle code placed it (skipped beams are not
+// uploaded; the order is the oracle's (scan, beam) order).
+struct ExactBeam {
+  int x2, y2;     // end cell (oracle::beam_end, host libm)
+  int scan;       // index of the scan (its start cell is in the scan table)
+  float range;    // the float range
+};
+
+struct StartCell {
+  int x1, y1;
+};
+
+// A beam's walk, in the form one thread per cell needs to test membership
+// without division (see egrid_math.h line_step_of_cell). 48 bytes.
+struct LineRec {
+  int x1, y1;       // start cell, grid coordinates
+  int sx1, sy1;     // start in the swapped/flipped frame (major, minor)
+  int two_a, two_b; // 2|major delta| (1 when it is 0) and 2|minor delta|
+  int bias;         // |major delta| - (inc < 0), or 0 when the delta is 0
+  int k_max;        // last step that can update a cell: min(|major delta|, table_size - 1)
+  int flags;        // kSteep | kFlipped | kBackward | kDegenerate
+  float range;
+  int x2, y2;       // end cell (for the sequential fall-back of degenerate lines)
+};
+constexpr int kSteep = 1, kFlipped = 2, kBackward = 4, kDegenerate = 8;
+constexpr int kTile = 16;  // exact mode works on kTile x kTile cell tiles
+
+// Scratch sizes for the CUB calls of exact mode.
+size_t exact_scan_temp_bytes(size_t num_beams);
+size_t exact_sort_temp_bytes(size_t num_pairs);
+
+// Distance and odds-factor tables (table_size^2 doubles each), computed on
+// the device with the oracle's operations.
+void launch_exact_tables(const DeviceModel &m, double *dist, double *factor_free,
+                         double *factor_occ, cudaStream_t stream);
+
+// Per beam: builds its LineRec and counts the tiles its walk passes through.
+void launch_exact_lines(const DeviceModel &m, const ExactBeam *beams, const StartCell *starts,
+                        size_t num_beams, LineRec *lines, uint32_t *tile_counts,
+                        cudaStream_t stream);
+
+// Exclusive prefix sum of the per-beam tile counts (num_beams + 1 entries out).
+void exact_scan(const uint32_t *counts, uint32_t *offsets, size_t num_beams, void *temp,
+                size_t temp_bytes, cudaStream_t stream);
+
+// Per beam: writes (tile, beam) pairs at its offset, in walk order.
+void launch_exact_pairs(const DeviceModel &m, const LineRec *lines, const uint32_t *offsets,
+                        size_t num_beams, uint32_t *pair_tile, uint32_t *pair_beam,
+                        cudaStream_t stream);
+
+// Stable sort of the pairs by tile: each tile's beams stay in (scan, beam) order.
+void exact_sort(const uint32_t *tile_in, uint32_t *tile_out, const uint32_t *beam_in,
+                uint32_t *beam_out, size_t num_pairs, int tile_bits, void *temp,
+                size_t temp_bytes, cudaStream_t stream);
+
+// Each tile's slice [begin, end) of the sorted pairs.
+void launch_exact_tile_ranges(const uint32_t *sorted_tile, size_t num_pairs, uint32_t *tile_begin,
+                              uint32_t *tile_end, size_t num_tiles, cudaStream_t stream);
+
+// One block per tile, one thread per cell: applies every beam of the tile's
+// list, in order, to the thread's own cell, and writes the final grid
+// (x-major floats, -1 unknown). Tables may be null (distances on the fly).
+void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
+                        const uint32_t *tile_begin, const uint32_t *tile_end, const double *dist,
+                        const double *factor_free, const double *factor_occ, float *grid,
+                        unsigned long long *cell_updates, cudaStream_t stream);
+
+// ---------------------------------------------------------------------------
+// Float mode: single precision, all scans fused into one launch.
+// ---------------------------------------------------------------------------
+struct FloatScan {
+  float lx, ly;        // laser position in cells (from the host's double placement)
+  float theta;         // heading in the grid frame
+  int x1, y1;          // start cell
+  float first, step;   // beam angles: theta + first + i * step
+  uint32_t beam_begin; // first beam in the range array
+  int beam_count;
+};
+
+struct FloatModel {
+  float prior, occ, emp, sure, max, resolution, wall;
+  float logodds_prior;  // log(prior / (1 - prior))
+  int table_size, size_x, size_y;
+};
+
+// Adds every beam's log-odds evidence to `logodds` (atomics: no update is
+// lost) and marks the cells it touches.
+void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans,
+                      const float *ranges, float *logodds, uint8_t *touched,
+                      unsigned long long *counters, cudaStream_t stream);
+
+// logodds -> probability; untouched cells -1. In place (float).
+void launch_float_finalize(const FloatModel &m, float *grid_logodds, const uint8_t *touched,
+                           size_t num_cells, cudaStream_t stream);
+
+}  // namespace cuda
+}  // namespace vasco
+
+#endif  // VASCO_CUDA_EGRID_KERNELS_H

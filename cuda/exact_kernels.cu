@@ -1,0 +1,247 @@
+// Exact mode of the CUDA backend: a GRIDMAP bit-identical to cpu_double.
+//
+// The oracle's result for a cell is its updates applied in (scan, beam)
+// order (DESIGN §2.2). We keep that order per cell without a per-cell sort:
+//   1. the host places every beam with the oracle's own code (end cells);
+//   2. per beam, the tiles (kTile x kTile cells) its walk passes through are
+//      listed as (tile, beam) pairs, written in beam order;
+//   3. a stable radix sort by tile keeps each tile's beams in beam order;
+//   4. one block per tile, one thread per cell: each thread runs down its
+//      tile's beam list and applies, in order, the updates of the beams that
+//      cross its cell — its own cell only, so no two threads ever touch the
+//      same cell and no update can be lost.
+// Every double operation is the oracle's (egrid_math.h, built with
+// --fmad=false), so the values match bit for bit.
+#include <math_constants.h>
+
+#include <cub/cub.cuh>
+
+#include "cuda_check.h"
+#include "egrid_kernels.h"
+#include "line_rec.cuh"
+#include "vasco_gpu/egrid_math.h"
+
+namespace vasco {
+namespace cuda {
+namespace {
+
+using egrid::BresenhamLine;
+
+__device__ __forceinline__ bool inside(int cx, int cy, const DeviceModel &m) {
+  return cx >= 0 && cx < m.size_x && cy >= 0 && cy < m.size_y;
+}
+
+__device__ __forceinline__ int tile_of(int cx, int cy, int tiles_y) {
+  return (cx / kTile) * tiles_y + cy / kTile;
+}
+
+// Walks the steps that can update a cell (k <= k_max) with the oracle's
+// walker, calling visit(tile) once per tile entered. A straight line's cells
+// are monotone in x and in y, so a tile, once left, is never re-entered.
+template <class Visit>
+__device__ void for_each_tile(const LineRec &L, const DeviceModel &m, Visit visit) {
+  if (L.k_max < 0) return;
+  const int tiles_y = (m.size_y + kTile - 1) / kTile;
+  BresenhamLine line;
+  egrid::bresenham_init(line, L.x1, L.y1, L.x2, L.y2);
+  int prev = -1;
+  for (int k = 0; k <= L.k_max; ++k) {
+    int cx, cy;
+    egrid::bresenham_current(line, &cx, &cy);
+    if (inside(cx, cy, m)) {
+      const int t = tile_of(cx, cy, tiles_y);
+      if (t != prev) {
+        visit(t);
+        prev = t;
+      }
+    }
+    if (!egrid::bresenham_next(line)) break;
+  }
+}
+
+__global__ void tables_kernel(DeviceModel m, double *dist, double *ff, double *fo) {
+  const int n = m.table_size * m.table_size;
+  const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
+  for (int idx = blockIdx.x * blockDim.x + threadIdx.x; idx < n; idx += gridDim.x * blockDim.x) {
+    const int i = idx / m.table_size, j = idx % m.table_size;
+    const double d = egrid::cell_distance(i, j, m.resolution);
+    dist[idx] = d;
+    double p;
+    // A range of +inf makes every cell free, -inf every cell occupied.
+    ff[idx] = egrid::sensor_model(model, d, CUDART_INF, &p) ? egrid::odds_factor(m.prior, p) : 0.0;
+    fo[idx] = egrid::sensor_model(model, d, -CUDART_INF, &p) ? egrid::odds_factor(m.prior, p) : 0.0;
+  }
+}
+
+__global__ void lines_kernel(DeviceModel m, const ExactBeam *beams, const StartCell *starts,
+                             size_t n, LineRec *lines, uint32_t *counts) {
+  const size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  const ExactBeam b = beams[i];
+  const StartCell s = starts[b.scan];
+  const LineRec L = make_line(s.x1, s.y1, b.x2, b.y2, b.range, m.table_size);
+  lines[i] = L;
+  uint32_t c = 0;
+  for_each_tile(L, m, [&](int) { ++c; });
+  counts[i] = c;
+}
+
+__global__ void pairs_kernel(DeviceModel m, const LineRec *lines, const uint32_t *offsets, size_t n,
+                             uint32_t *pair_tile, uint32_t *pair_beam) {
+  const size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  uint32_t o = offsets[i];
+  for_each_tile(lines[i], m, [&](int t) {
+    pair_tile[o] = static_cast<uint32_t>(t);
+    pair_beam[o] = static_cast<uint32_t>(i);
+    ++o;
+  });
+}
+
+__global__ void tile_ranges_kernel(const uint32_t *key, size_t n, uint32_t *begin, uint32_t *end) {
+  const size_t p = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
+  if (p >= n) return;
+  const uint32_t t = key[p];
+  if (p == 0 || key[p - 1] != t) begin[t] = static_cast<uint32_t>(p);
+  if (p == n - 1 || key[p + 1] != t) end[t] = static_cast<uint32_t>(p + 1);
+}
+
+constexpr int kTileThreads = kTile * kTile;
+
+__global__ void __launch_bounds__(kTileThreads)
+    tiles_kernel(DeviceModel m, const LineRec *lines, const uint32_t *sorted_beam,
+                 const uint32_t *tile_begin, const uint32_t *tile_end, const double *dist,
+                 const double *ff, const double *fo, float *grid, unsigned long long *updates) {
+  __shared__ LineRec sh[kTileThreads];
+  const int tiles_y = (m.size_y + kTile - 1) / kTile;
+  const int tile = blockIdx.x;
+  const int cx = (tile / tiles_y) * kTile + threadIdx.x / kTile;
+  const int cy = (tile % tiles_y) * kTile + threadIdx.x % kTile;
+  const bool active = inside(cx, cy, m);
+  const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
+  const int T = m.table_size;
+  float cell = egrid::kUnknown;
+  unsigned count = 0;
+  const uint32_t begin = tile_begin[tile], end = tile_end[tile];
+  for (uint32_t base = begin; base < end; base += kTileThreads) {
+    const int n = static_cast<int>(min(static_cast<uint32_t>(kTileThreads), end - base));
+    if (static_cast<int>(threadIdx.x) < n) sh[threadIdx.x] = lines[sorted_beam[base + threadIdx.x]];
+    __syncthreads();
+    if (active) {
+      for (int e = 0; e < n; ++e) {
+        const LineRec &L = sh[e];
+        const int k = step_of_cell(L, cx, cy);
+        if (k < 0) continue;
+        const int i = egrid::wrap_abs(egrid::wrap_sub(cx, L.x1));
+        const int j = egrid::wrap_abs(egrid::wrap_sub(cy, L.y1));
+        // i, j <= k <= table_size - 1: inside the table.
+        const double d = dist ? dist[i * T + j] : egrid::cell_distance(i, j, m.resolution);
+        // The oracle stops the beam at the first cell with d >= max; d never
+        // decreases along a walk, so that is: no update where d >= max.
+        if (!(d < m.max)) continue;
+        double f;
+        if (ff) {
+          f = d < static_cast<double>(L.range) ? ff[i * T + j] : fo[i * T + j];
+        } else {
+          double p;
+          egrid::sensor_model(model, d, L.range, &p);
+          f = egrid::odds_factor(m.prior, p);
+        }
+        cell = egrid::odds_apply(cell, m.prior, f);
+        ++count;
+      }
+    }
+    __syncthreads();
+  }
+  if (active) grid[static_cast<size_t>(cx) * m.size_y + cy] = cell;
+  const unsigned warp_sum = __reduce_add_sync(0xffffffffu, count);
+  if ((threadIdx.x & 31) == 0 && warp_sum) atomicAdd(updates, static_cast<unsigned long long>(warp_sum));
+}
+
+unsigned blocks_for(size_t n, unsigned threads) {
+  return static_cast<unsigned>((n + threads - 1) / threads);
+}
+
+}  // namespace
+
+size_t exact_scan_temp_bytes(size_t num_beams) {
+  size_t bytes = 0;
+  VG_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, bytes, static_cast<const uint32_t *>(nullptr),
+                                              static_cast<uint32_t *>(nullptr),
+                                              static_cast<int64_t>(num_beams + 1)));
+  return bytes;
+}
+
+size_t exact_sort_temp_bytes(size_t num_pairs) {
+  size_t bytes = 0;
+  VG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(
+      nullptr, bytes, static_cast<const uint32_t *>(nullptr), static_cast<uint32_t *>(nullptr),
+      static_cast<const uint32_t *>(nullptr), static_cast<uint32_t *>(nullptr),
+      static_cast<int64_t>(num_pairs)));
+  return bytes;
+}
+
+void launch_exact_tables(const DeviceModel &m, double *dist, double *ff, double *fo,
+                         cudaStream_t stream) {
+  const size_t n = static_cast<size_t>(m.table_size) * m.table_size;
+  if (n == 0) return;
+  tables_kernel<<<min(blocks_for(n, 256), 4096u), 256, 0, stream>>>(m, dist, ff, fo);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+void launch_exact_lines(const DeviceModel &m, const ExactBeam *beams, const StartCell *starts,
+                        size_t num_beams, LineRec *lines, uint32_t *counts, cudaStream_t stream) {
+  if (num_beams == 0) return;
+  lines_kernel<<<blocks_for(num_beams, 128), 128, 0, stream>>>(m, beams, starts, num_beams, lines,
+                                                                counts);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+void exact_scan(const uint32_t *counts, uint32_t *offsets, size_t num_beams, void *temp,
+                size_t temp_bytes, cudaStream_t stream) {
+  // counts has num_beams + 1 entries, the last one 0, so offsets[num_beams] is the total.
+  VG_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp, temp_bytes, counts, offsets,
+                                              static_cast<int64_t>(num_beams + 1), stream));
+}
+
+void launch_exact_pairs(const DeviceModel &m, const LineRec *lines, const uint32_t *offsets,
+                        size_t num_beams, uint32_t *pair_tile, uint32_t *pair_beam,
+                        cudaStream_t stream) {
+  if (num_beams == 0) return;
+  pairs_kernel<<<blocks_for(num_beams, 128), 128, 0, stream>>>(m, lines, offsets, num_beams,
+                                                                pair_tile, pair_beam);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+void exact_sort(const uint32_t *tile_in, uint32_t *tile_out, const uint32_t *beam_in,
+                uint32_t *beam_out, size_t num_pairs, int tile_bits, void *temp, size_t temp_bytes,
+                cudaStream_t stream) {
+  VG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp, temp_bytes, tile_in, tile_out, beam_in,
+                                                beam_out, static_cast<int64_t>(num_pairs), 0,
+                                                tile_bits, stream));
+}
+
+void launch_exact_tile_ranges(const uint32_t *sorted_tile, size_t num_pairs, uint32_t *tile_begin,
+                              uint32_t *tile_end, size_t num_tiles, cudaStream_t stream) {
+  VG_CUDA_CHECK(cudaMemsetAsync(tile_begin, 0, num_tiles * sizeof(uint32_t), stream));
+  VG_CUDA_CHECK(cudaMemsetAsync(tile_end, 0, num_tiles * sizeof(uint32_t), stream));
+  if (num_pairs == 0) return;
+  tile_ranges_kernel<<<blocks_for(num_pairs, 256), 256, 0, stream>>>(sorted_tile, num_pairs,
+                                                                     tile_begin, tile_end);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
+                        const uint32_t *tile_begin, const uint32_t *tile_end, const double *dist,
+                        const double *ff, const double *fo, float *grid,
+                        unsigned long long *updates, cudaStream_t stream) {
+  const size_t tiles = static_cast<size_t>((m.size_x + kTile - 1) / kTile) *
+                       ((m.size_y + kTile - 1) / kTile);
+  if (tiles == 0) return;
+  tiles_kernel<<<static_cast<unsigned>(tiles), kTileThreads, 0, stream>>>(
+      m, lines, sorted_beam, tile_begin, tile_end, dist, ff, fo, grid, updates);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+}  // namespace cuda
+}  // namespace vasco

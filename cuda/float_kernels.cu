@@ -1,0 +1,147 @@
+// Float mode of the CUDA backend: the paper's parallelization (a group of
+// threads per beam, one thread per cell of the beam) done without lost
+// updates, with every scan fused into one launch.
+//
+// Why fusing is allowed: the odds update multiplies the cell's odds by
+// ((1-prior)/prior) * p/(1-p); in log-odds that is a sum,
+//     L = logit(prior) + sum over updates of (logit(p) - logit(prior)),
+// and a sum does not depend on the order of its terms. So all beams of all
+// scans can be applied at once, with atomic adds (no update is lost).
+//
+// What this changes against the oracle: (1) single precision and a
+// different association of the same product, so values differ in the last
+// bits; (2) saturation — the oracle stores a float after every update, and
+// once a cell rounds to exactly 1.0 (or 0.0) its odds are infinite (zero) and
+// it stays there for good, while the log-odds sum keeps counting: a cell that
+// the oracle pinned at 1.0 can come back below 1 here if enough free updates
+// follow. Measured in the agreement tables (DESIGN §4).
+#include "cuda_check.h"
+#include "egrid_kernels.h"
+#include "vasco_gpu/egrid_math.h"
+
+namespace vasco {
+namespace cuda {
+namespace {
+
+constexpr int kWarpsPerBlock = 8;
+
+__device__ __forceinline__ void add_evidence(const FloatModel &m, int cx, int cy, int x1, int y1,
+                                             float r, float *logodds, uint8_t *touched,
+                                             unsigned *count, bool *stop) {
+  if (cx < 0 || cx >= m.size_x || cy < 0 || cy >= m.size_y) return;
+  const int i = abs(cx - x1), j = abs(cy - y1);
+  const float d = (i >= m.table_size || j >= m.table_size)
+                      ? 1e6f
+                      : sqrtf(static_cast<float>(i * i + j * j)) * m.resolution;
+  const egrid::ModelParamsF mf{m.prior, m.occ, m.emp, m.sure, m.max};
+  float p;
+  if (!egrid::sensor_model_f(mf, d, r, &p)) {
+    *stop = true;
+    return;
+  }
+  const size_t c = static_cast<size_t>(cx) * m.size_y + cy;
+  atomicAdd(logodds + c, __logf(p / (1.0f - p)) - m.logodds_prior);
+  touched[c] = 1;
+  ++*count;
+}
+
+__global__ void __launch_bounds__(kWarpsPerBlock * 32)
+    float_map_kernel(FloatModel m, const FloatScan *scans, int num_scans, const float *ranges,
+                     float *logodds, uint8_t *touched, unsigned long long *counters) {
+  const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
+  unsigned used = 0, skipped = 0, updates = 0;
+  for (int s = blockIdx.x; s < num_scans; s += gridDim.x) {
+    const FloatScan sc = scans[s];
+    for (int b = warp; b < sc.beam_count; b += kWarpsPerBlock) {
+      const float r = ranges[sc.beam_begin + b];
+      if (!(r < 50.0f)) {
+        skipped += lane == 0;
+        continue;
+      }
+      used += lane == 0;
+      float sn, cs;
+      sincosf(sc.theta + sc.first + static_cast<float>(b) * sc.step, &sn, &cs);
+      const int x2 = egrid::trunc_to_int(sc.lx + (r + m.wall) * cs / m.resolution);
+      const int y2 = egrid::trunc_to_int(sc.ly + (r + m.wall) * sn / m.resolution);
+      if (!egrid::is_closed_form_line(sc.x1, sc.y1, x2, y2)) {
+        // Degenerate line (a range of -inf): one lane walks it sequentially.
+        if (lane == 0) {
+          egrid::BresenhamLine line;
+          egrid::bresenham_init(line, sc.x1, sc.y1, x2, y2);
+          bool stop = false;
+          for (int k = 0; k < m.table_size && !stop; ++k) {
+            int cx, cy;
+            egrid::bresenham_current(line, &cx, &cy);
+            add_evidence(m, cx, cy, sc.x1, sc.y1, r, logodds, touched, &updates, &stop);
+            if (!egrid::bresenham_next(line)) break;
+          }
+        }
+        continue;
+      }
+      const egrid::LineParams p = egrid::line_params(sc.x1, sc.y1, x2, y2);
+      // Cells beyond table_size steps are never updated (see oracle.h); cells
+      // with d >= max are skipped, which equals the oracle's stop because d
+      // never decreases along the walk.
+      const int k_end = min(p.major_len, m.table_size - 1);
+      const int two_a = 2 * p.a;
+      const int64_t two_b = 2 * static_cast<int64_t>(p.b);
+      const int bias = p.a - (p.inc < 0 ? 1 : 0);
+      for (int k = lane; k <= k_end; k += 32) {
+        const int mm = p.a ? static_cast<int>((two_b * k + bias) / two_a) : 0;
+        const int sx1 = p.steep ? p.y1 : p.x1;
+        int sy1 = p.steep ? p.x1 : p.y1;
+        if (p.flipped) sy1 = -sy1;
+        const int maj = sx1 + p.inc * k;
+        int mn = sy1 + p.inc * mm;
+        if (p.flipped) mn = -mn;
+        const int cx = p.steep ? mn : maj, cy = p.steep ? maj : mn;
+        bool stop = false;
+        add_evidence(m, cx, cy, sc.x1, sc.y1, r, logodds, touched, &updates, &stop);
+      }
+    }
+  }
+  // counters: beams used, beams skipped, cell updates
+  used = __reduce_add_sync(0xffffffffu, used);
+  skipped = __reduce_add_sync(0xffffffffu, skipped);
+  updates = __reduce_add_sync(0xffffffffu, updates);
+  if (lane == 0) {
+    if (used) atomicAdd(counters + 0, static_cast<unsigned long long>(used));
+    if (skipped) atomicAdd(counters + 1, static_cast<unsigned long long>(skipped));
+    if (updates) atomicAdd(counters + 2, static_cast<unsigned long long>(updates));
+  }
+}
+
+__global__ void finalize_kernel(FloatModel m, float *grid, const uint8_t *touched, size_t n) {
+  for (size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x; c < n;
+       c += static_cast<size_t>(gridDim.x) * blockDim.x) {
+    if (!touched[c]) {
+      grid[c] = egrid::kUnknown;
+    } else {
+      // p = 1 - 1/(1 + odds), odds = exp(L): saturates to exactly 1 or 0.
+      const float odds = expf(m.logodds_prior + grid[c]);
+      grid[c] = 1.0f - 1.0f / (1.0f + odds);
+    }
+  }
+}
+
+}  // namespace
+
+void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans,
+                      const float *ranges, float *logodds, uint8_t *touched,
+                      unsigned long long *counters, cudaStream_t stream) {
+  if (num_scans <= 0) return;
+  float_map_kernel<<<num_scans, kWarpsPerBlock * 32, 0, stream>>>(m, scans, num_scans, ranges,
+                                                                   logodds, touched, counters);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+void launch_float_finalize(const FloatModel &m, float *grid, const uint8_t *touched,
+                           size_t num_cells, cudaStream_t stream) {
+  if (num_cells == 0) return;
+  const unsigned blocks = static_cast<unsigned>(std::min<size_t>((num_cells + 255) / 256, 65536));
+  finalize_kernel<<<blocks, 256, 0, stream>>>(m, grid, touched, num_cells);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+}  // namespace cuda
+}  // namespace vasco

@@ -1,0 +1,374 @@
+// Host side of the CUDA backend: prepares a scan batch, uploads it once, runs
+// every scan on the GPU, downloads the grid once (the paper's working cycle).
+#include "vasco_gpu/cuda_backend.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "cuda_check.h"
+#include "egrid_kernels.h"
+#include "vasco_gpu/oracle.h"
+
+namespace vasco {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using cuda::DeviceBuffer;
+using cuda::Event;
+using cuda::PinnedBuffer;
+using cuda::Stream;
+
+struct UsableState {
+  std::once_flag once;
+  bool usable = false;
+  std::string why;
+};
+
+UsableState &usable_state() {
+  static UsableState s;
+  return s;
+}
+
+double seconds(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+std::string mib(size_t bytes) {
+  std::ostringstream s;
+  s << (bytes + (1 << 20) - 1) / (1 << 20) << " MiB";
+  return s.str();
+}
+
+// Refuses, with a clear message, a job whose device memory would not fit.
+void check_fits(size_t bytes, const char *what) {
+  size_t free_b = 0, total_b = 0;
+  VG_CUDA_CHECK(cudaMemGetInfo(&free_b, &total_b));
+  // Keep a margin for CUB scratch rounding and the context.
+  if (bytes + (size_t(64) << 20) > free_b)
+    throw std::runtime_error(std::string("the map does not fit in GPU memory: ") + what + " needs " +
+                             mib(bytes) + ", " + mib(free_b) + " free of " + mib(total_b) +
+                             " (use a coarser vasco_resolution or a CPU backend)");
+}
+
+// Places every scan with the oracle's own code, in order (the first call
+// fixes the start pose).
+std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeometry &geo) {
+  oracle::GridFrame frame;
+  frame.size_x = geo.size_x;
+  frame.size_y = geo.size_y;
+  frame.resolution = geo.resolution;
+  frame.theta_offset = geo.theta_offset;
+  std::vector<oracle::ScanStart> starts(batch.num_scans());
+  for (size_t s = 0; s < batch.num_scans(); ++s)
+    starts[s] = oracle::scan_start(frame, batch.x[s], batch.y[s], batch.theta[s]);
+  return starts;
+}
+
+// Runs fn(begin, end) over [0, n) on all cores.
+template <class Fn>
+void parallel_for(size_t n, Fn fn) {
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const size_t workers = std::min<size_t>(hw, std::max<size_t>(1, n / 64));
+  if (workers <= 1) {
+    fn(size_t(0), n);
+    return;
+  }
+  std::vector<std::thread> pool;
+  const size_t chunk = (n + workers - 1) / workers;
+  for (size_t w = 0; w < workers; ++w) {
+    const size_t b = w * chunk, e = std::min(n, b + chunk);
+    if (b >= e) break;
+    pool.emplace_back([=] { fn(b, e); });
+  }
+  for (auto &t : pool) t.join();
+}
+
+class CudaBackend : public Backend {
+ public:
+  explicit CudaBackend(const BackendOptions &o) : options_(o) {
+    VG_CUDA_CHECK(cudaSetDevice(o.cuda_device));
+  }
+  std::string name() const override {
+    return options_.cuda_mode == CudaMode::Exact ? "cuda_exact" : "cuda_float";
+  }
+
+  std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
+                         const GridGeometry &geo, MapStats *stats) override {
+    VG_CUDA_CHECK(cudaSetDevice(options_.cuda_device));
+    MapStats st;
+    std::vector<float> grid = options_.cuda_mode == CudaMode::Exact
+                                  ? map_exact(batch, params, geo, &st)
+                                  : map_float(batch, params, geo, &st);
+    st.scans = batch.num_scans();
+    if (stats != nullptr) *stats = st;
+    return grid;
+  }
+
+ private:
+  cuda::DeviceModel device_model(const MapperParams &p, const GridGeometry &geo) const {
+    cuda::DeviceModel m;
+    m.prior = p.p_prior;
+    m.occ = p.p_occ;
+    m.emp = p.p_emp;
+    m.sure = p.range_sure;
+    m.max = p.range_max;
+    m.resolution = p.resolution;
+    m.wall = p.wall_size;
+    m.table_size = p.table_size();
+    m.size_x = geo.size_x;
+    m.size_y = geo.size_y;
+    return m;
+  }
+
+  std::vector<float> map_exact(const ScanBatch &batch, const MapperParams &params,
+                               const GridGeometry &geo, MapStats *st) {
+    const auto t_prep = Clock::now();
+    const cuda::DeviceModel m = device_model(params, geo);
+    const std::vector<oracle::ScanStart> starts = place_scans(batch, geo);
+    // Used beams only, in (scan, beam) order, their end cells computed by the
+    // oracle's own code with the host's libm (DESIGN §2.2).
+    std::vector<uint32_t> used_before(batch.num_scans() + 1, 0);
+    for (size_t s = 0; s < batch.num_scans(); ++s) {
+      uint32_t used = 0;
+      const float *r = batch.ranges_of(s);
+      for (int b = 0; b < batch.beams_in(s); ++b) used += oracle::beam_used(r[b]);
+      used_before[s + 1] = used_before[s] + used;
+    }
+    const size_t nb = used_before.back();
+    st->beams_used = nb;
+    st->beams_skipped = batch.num_beams() - nb;
+    PinnedBuffer<cuda::ExactBeam> h_beams(std::max<size_t>(nb, 1));
+    PinnedBuffer<cuda::StartCell> h_starts(std::max<size_t>(batch.num_scans(), 1));
+    for (size_t s = 0; s < batch.num_scans(); ++s) h_starts[s] = {starts[s].x1, starts[s].y1};
+    parallel_for(batch.num_scans(), [&](size_t s0, size_t s1) {
+      for (size_t s = s0; s < s1; ++s) {
+        oracle::SteppedAngles angles{batch.first_angle[s], batch.angle_step[s]};
+        const float *r = batch.ranges_of(s);
+        uint32_t o = used_before[s];
+        double angle = 0;
+        for (int b = 0; b < batch.beams_in(s); ++b) {
+          angles(b, starts[s].theta, &angle);
+          if (!oracle::beam_used(r[b])) continue;
+          cuda::ExactBeam e;
+          oracle::beam_end(starts[s], angle, r[b], params.wall_size, params.resolution, &e.x2, &e.y2);
+          e.scan = static_cast<int>(s);
+          e.range = r[b];
+          h_beams[o++] = e;
+        }
+      }
+    });
+    st->prep_s = seconds(t_prep);
+
+    const int tiles_x = (geo.size_x + cuda::kTile - 1) / cuda::kTile;
+    const int tiles_y = (geo.size_y + cuda::kTile - 1) / cuda::kTile;
+    const size_t num_tiles = static_cast<size_t>(tiles_x) * tiles_y;
+    const size_t T2 = static_cast<size_t>(m.table_size) * m.table_size;
+    // Tables only when small (they replace a sqrt and two divisions per update).
+    const bool use_tables = T2 <= (size_t(1) << 22);
+    const size_t cells = geo.num_cells();
+    const size_t scan_tmp = cuda::exact_scan_temp_bytes(nb);
+    size_t fixed = nb * (sizeof(cuda::ExactBeam) + sizeof(cuda::LineRec) + 2 * sizeof(uint32_t)) +
+                   batch.num_scans() * sizeof(cuda::StartCell) + cells * sizeof(float) +
+                   2 * num_tiles * sizeof(uint32_t) + scan_tmp + (use_tables ? 3 * T2 * sizeof(double) : 0);
+    check_fits(fixed, "exact mode (beams, grid, tables)");
+
+    Stream stream;
+    Event e0, e_up, e_map, e_down;
+    DeviceBuffer<cuda::ExactBeam> d_beams(nb);
+    DeviceBuffer<cuda::StartCell> d_starts(batch.num_scans());
+    DeviceBuffer<cuda::LineRec> d_lines(nb);
+    DeviceBuffer<uint32_t> d_counts(nb + 1), d_offsets(nb + 1);
+    DeviceBuffer<uint32_t> d_tile_begin(num_tiles), d_tile_end(num_tiles);
+    DeviceBuffer<float> d_grid(cells);
+    DeviceBuffer<double> d_dist(use_tables ? T2 : 0), d_ff(use_tables ? T2 : 0), d_fo(use_tables ? T2 : 0);
+    DeviceBuffer<unsigned long long> d_updates(1);
+    DeviceBuffer<unsigned char> d_scan_tmp(std::max<size_t>(scan_tmp, 1));
+
+    e0.record(stream.get());
+    if (nb) VG_CUDA_CHECK(cudaMemcpyAsync(d_beams.get(), h_beams.get(), nb * sizeof(cuda::ExactBeam),
+                                          cudaMemcpyHostToDevice, stream.get()));
+    if (batch.num_scans())
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_starts.get(), h_starts.get(),
+                                    batch.num_scans() * sizeof(cuda::StartCell),
+                                    cudaMemcpyHostToDevice, stream.get()));
+    e_up.record(stream.get());
+
+    VG_CUDA_CHECK(cudaMemsetAsync(d_updates.get(), 0, sizeof(unsigned long long), stream.get()));
+    VG_CUDA_CHECK(cudaMemsetAsync(d_counts.get(), 0, (nb + 1) * sizeof(uint32_t), stream.get()));
+    if (use_tables) cuda::launch_exact_tables(m, d_dist.get(), d_ff.get(), d_fo.get(), stream.get());
+    cuda::launch_exact_lines(m, d_beams.get(), d_starts.get(), nb, d_lines.get(), d_counts.get(),
+                             stream.get());
+    cuda::exact_scan(d_counts.get(), d_offsets.get(), nb, d_scan_tmp.get(), scan_tmp, stream.get());
+    uint32_t num_pairs = 0;
+    VG_CUDA_CHECK(cudaMemcpyAsync(&num_pairs, d_offsets.get() + nb, sizeof(uint32_t),
+                                  cudaMemcpyDeviceToHost, stream.get()));
+    stream.synchronize();
+    const size_t sort_tmp = cuda::exact_sort_temp_bytes(num_pairs);
+    check_fits(4 * size_t(num_pairs) * sizeof(uint32_t) + sort_tmp, "exact mode (tile lists)");
+    DeviceBuffer<uint32_t> d_pair_tile(num_pairs), d_pair_beam(num_pairs);
+    DeviceBuffer<uint32_t> d_sorted_tile(num_pairs), d_sorted_beam(num_pairs);
+    DeviceBuffer<unsigned char> d_sort_tmp(std::max<size_t>(sort_tmp, 1));
+    cuda::launch_exact_pairs(m, d_lines.get(), d_offsets.get(), nb, d_pair_tile.get(),
+                             d_pair_beam.get(), stream.get());
+    int tile_bits = 1;
+    while ((size_t(1) << tile_bits) < num_tiles) ++tile_bits;
+    if (num_pairs)
+      cuda::exact_sort(d_pair_tile.get(), d_sorted_tile.get(), d_pair_beam.get(), d_sorted_beam.get(),
+                       num_pairs, tile_bits, d_sort_tmp.get(), sort_tmp, stream.get());
+    cuda::launch_exact_tile_ranges(d_sorted_tile.get(), num_pairs, d_tile_begin.get(),
+                                   d_tile_end.get(), num_tiles, stream.get());
+    cuda::launch_exact_tiles(m, d_lines.get(), d_sorted_beam.get(), d_tile_begin.get(),
+                             d_tile_end.get(), use_tables ? d_dist.get() : nullptr,
+                             use_tables ? d_ff.get() : nullptr, use_tables ? d_fo.get() : nullptr,
+                             d_grid.get(), d_updates.get(), stream.get());
+    e_map.record(stream.get());
+
+    std::vector<float> grid(cells);
+    unsigned long long updates = 0;
+    VG_CUDA_CHECK(cudaMemcpyAsync(grid.data(), d_grid.get(), cells * sizeof(float),
+                                  cudaMemcpyDeviceToHost, stream.get()));
+    VG_CUDA_CHECK(cudaMemcpyAsync(&updates, d_updates.get(), sizeof(updates), cudaMemcpyDeviceToHost,
+                                  stream.get()));
+    e_down.record(stream.get());
+    stream.synchronize();
+    st->cell_updates = updates;
+    st->upload_s = e_up.since(e0) / 1e3;
+    st->map_s = e_map.since(e_up) / 1e3;
+    st->download_s = e_down.since(e_map) / 1e3;
+    return grid;
+  }
+
+  std::vector<float> map_float(const ScanBatch &batch, const MapperParams &params,
+                               const GridGeometry &geo, MapStats *st) {
+    const auto t_prep = Clock::now();
+    const std::vector<oracle::ScanStart> starts = place_scans(batch, geo);
+    PinnedBuffer<cuda::FloatScan> h_scans(std::max<size_t>(batch.num_scans(), 1));
+    for (size_t s = 0; s < batch.num_scans(); ++s) {
+      cuda::FloatScan f;
+      f.lx = static_cast<float>(starts[s].lx);
+      f.ly = static_cast<float>(starts[s].ly);
+      f.theta = static_cast<float>(starts[s].theta);
+      f.x1 = starts[s].x1;
+      f.y1 = starts[s].y1;
+      f.first = static_cast<float>(batch.first_angle[s]);
+      f.step = static_cast<float>(batch.angle_step[s]);
+      f.beam_begin = static_cast<uint32_t>(batch.beam_offset[s]);
+      f.beam_count = batch.beams_in(s);
+      h_scans[s] = f;
+    }
+    cuda::FloatModel m;
+    m.prior = static_cast<float>(params.p_prior);
+    m.occ = static_cast<float>(params.p_occ);
+    m.emp = static_cast<float>(params.p_emp);
+    m.sure = static_cast<float>(params.range_sure);
+    m.max = static_cast<float>(params.range_max);
+    m.resolution = static_cast<float>(params.resolution);
+    m.wall = static_cast<float>(params.wall_size);
+    m.logodds_prior = static_cast<float>(std::log(params.p_prior / (1 - params.p_prior)));
+    m.table_size = params.table_size();
+    m.size_x = geo.size_x;
+    m.size_y = geo.size_y;
+    st->prep_s = seconds(t_prep);
+
+    const size_t cells = geo.num_cells(), nbeams = batch.num_beams(), nscans = batch.num_scans();
+    check_fits(cells * (sizeof(float) + 1) + nbeams * sizeof(float) + nscans * sizeof(cuda::FloatScan),
+               "float mode (grid and beams)");
+    Stream stream;
+    Event e0, e_up, e_map, e_down;
+    DeviceBuffer<cuda::FloatScan> d_scans(nscans);
+    DeviceBuffer<float> d_ranges(nbeams), d_grid(cells);
+    DeviceBuffer<uint8_t> d_touched(cells);
+    DeviceBuffer<unsigned long long> d_counters(3);
+
+    e0.record(stream.get());
+    if (nscans)
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_scans.get(), h_scans.get(), nscans * sizeof(cuda::FloatScan),
+                                    cudaMemcpyHostToDevice, stream.get()));
+    if (nbeams)
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_ranges.get(), batch.range.data(), nbeams * sizeof(float),
+                                    cudaMemcpyHostToDevice, stream.get()));
+    e_up.record(stream.get());
+    VG_CUDA_CHECK(cudaMemsetAsync(d_grid.get(), 0, cells * sizeof(float), stream.get()));
+    VG_CUDA_CHECK(cudaMemsetAsync(d_touched.get(), 0, cells, stream.get()));
+    VG_CUDA_CHECK(cudaMemsetAsync(d_counters.get(), 0, 3 * sizeof(unsigned long long), stream.get()));
+    cuda::launch_float_map(m, d_scans.get(), static_cast<int>(nscans), d_ranges.get(), d_grid.get(),
+                           d_touched.get(), d_counters.get(), stream.get());
+    cuda::launch_float_finalize(m, d_grid.get(), d_touched.get(), cells, stream.get());
+    e_map.record(stream.get());
+    std::vector<float> grid(cells);
+    unsigned long long counters[3] = {0, 0, 0};
+    VG_CUDA_CHECK(cudaMemcpyAsync(grid.data(), d_grid.get(), cells * sizeof(float),
+                                  cudaMemcpyDeviceToHost, stream.get()));
+    VG_CUDA_CHECK(cudaMemcpyAsync(counters, d_counters.get(), sizeof counters, cudaMemcpyDeviceToHost,
+                                  stream.get()));
+    e_down.record(stream.get());
+    stream.synchronize();
+    st->beams_used = counters[0];
+    st->beams_skipped = counters[1];
+    st->cell_updates = counters[2];
+    st->upload_s = e_up.since(e0) / 1e3;
+    st->map_s = e_map.since(e_up) / 1e3;
+    st->download_s = e_down.since(e_map) / 1e3;
+    return grid;
+  }
+
+  BackendOptions options_;
+};
+
+}  // namespace
+
+bool cuda_usable(int device, std::string *why) {
+  UsableState &s = usable_state();
+  std::call_once(s.once, [&] {
+    int count = 0;
+    cudaError_t err = cudaGetDeviceCount(&count);
+    if (err != cudaSuccess) {
+      s.why = std::string("no CUDA device (") + cudaGetErrorString(err) + ")";
+      return;
+    }
+    if (device < 0 || device >= count) {
+      s.why = "CUDA device " + std::to_string(device) + " does not exist (" + std::to_string(count) +
+              " present)";
+      return;
+    }
+    cudaDeviceProp prop;
+    err = cudaGetDeviceProperties(&prop, device);
+    if (err == cudaSuccess) err = cudaSetDevice(device);
+    if (err == cudaSuccess) err = cudaFree(nullptr);  // creates the context
+    if (err != cudaSuccess) {
+      s.why = std::string("CUDA device ") + std::to_string(device) + " is not usable (" +
+              cudaGetErrorString(err) + ")";
+      return;
+    }
+    if (prop.major < 9) {
+      s.why = std::string(prop.name) + " is compute capability " + std::to_string(prop.major) + "." +
+              std::to_string(prop.minor) + "; this build targets sm_90";
+      return;
+    }
+    s.usable = true;
+  });
+  if (!s.usable && why != nullptr) *why = s.why;
+  return s.usable;
+}
+
+std::string cuda_device_description(int device) {
+  cudaDeviceProp prop;
+  if (cudaGetDeviceProperties(&prop, device) != cudaSuccess) return "unknown device";
+  std::ostringstream o;
+  o << prop.name << ", " << prop.multiProcessorCount << " SMs, "
+    << prop.totalGlobalMem / (1024.0 * 1024 * 1024) << " GiB";
+  return o.str();
+}
+
+std::unique_ptr<Backend> make_cuda_backend(const BackendOptions &options) {
+  std::string why;
+  if (!cuda_usable(options.cuda_device, &why)) throw std::runtime_error("no usable GPU: " + why);
+  return std::make_unique<CudaBackend>(options);
+}
+
+}  // namespace vasco
