@@ -25,7 +25,8 @@ const char kUsage[] =
     "       mapconvert --info IN\n"
     "\n"
     "Converts the CARMEN map IN (.map or .map.gz) to OUT, chosen by OUT's extension:\n"
-    "  .map     CARMEN map (all chunks kept)\n"
+    "  .map     CARMEN map (every chunk it reads; HMAP, unknown and repeated chunks\n"
+    "           are dropped, with a note)\n"
     "  .map.gz  CARMEN map, gzip-compressed\n"
     "  .pgm     ROS map_server / nav2 image, with a .yaml beside it (origin from the\n"
     "           map's OFFSET chunk, else 0 0 0); --mode sets the YAML mode and the\n"
@@ -71,9 +72,9 @@ void print_info(const std::string &path, const carmen::MapFile &m) {
     const std::time_t t = static_cast<std::time_t>(c.time);
     std::tm tm_utc;
     if (gmtime_r(&t, &tm_utc) != nullptr) std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S UTC", &tm_utc);
-    std::printf("creator: user %s, time %s (%d-byte time_t%s), origin %s, description %s\n", quoted(c.user).c_str(),
-                date, c.time_bytes, m.old_style_creator ? ", old-style chunk" : "", quoted(c.origin).c_str(),
-                quoted(c.description).c_str());
+    std::printf("creator: user %s, time %s (%d-byte time_t%s), origin %s, description %s\n",
+                quoted(c.user).c_str(), date, c.time_bytes, m.old_style_creator ? ", old-style chunk" : "",
+                quoted(c.origin).c_str(), quoted(c.description).c_str());
   }
   if (m.offset) std::printf("offset: x %g y %g theta %g\n", m.offset->x, m.offset->y, m.offset->theta);
   if (m.places) std::printf("places: %zu\n", m.places->size());
@@ -103,7 +104,8 @@ void print_info(const std::string &path, const carmen::MapFile &m) {
   std::printf("size: %d x %d cells\n", g.size_x, g.size_y);
   std::printf("resolution: %.9g m\n", g.resolution);
   std::printf("extent: %g x %g m\n", g.size_x * g.resolution, g.size_y * g.resolution);
-  std::printf("unknown: %zu of %zu cells (%.2f%%)\n", unknown, n, n ? 100.0 * double(unknown) / double(n) : 0.0);
+  std::printf("unknown: %zu of %zu cells (%.2f%%)\n", unknown, n,
+              n ? 100.0 * double(unknown) / double(n) : 0.0);
   if (unknown < n) {
     std::printf("known values: min %.9g max %.9g\n", lo, hi);
   } else {
@@ -160,7 +162,8 @@ int main(int argc, char **argv) {
   if (!info) {
     kind = kind_of(files[1]);
     if (kind == OutKind::None) {
-      return usage_error("cannot tell the output format of '" + files[1] + "' (use .map, .map.gz, .pgm or .png)");
+      return usage_error("cannot tell the output format of '" + files[1] +
+                         "' (use .map, .map.gz, .pgm or .png)");
     }
     if (mode_given && kind != OutKind::Pgm) return usage_error("--mode applies to .pgm output only");
   }
@@ -174,6 +177,10 @@ int main(int argc, char **argv) {
     const std::string &out = files[1];
     if (kind == OutKind::Map) {
       carmen::write_map_file(out, m);
+      if (m.unknown_chunks > 0) {
+        std::fprintf(stderr, "mapconvert: note: %d chunk(s) of %s not copied (HMAP, unknown or repeated)\n",
+                     m.unknown_chunks, files[0].c_str());
+      }
     } else {
       if (!m.gridmap) throw carmen::FileError(files[0], "has no GRIDMAP chunk: there is no image to make");
       if (kind == OutKind::Pgm) {

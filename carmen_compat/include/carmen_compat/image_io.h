@@ -1,0 +1,77 @@
+// Map images: a ROS map_server / nav2 PGM + YAML pair, and PNG for people.
+//
+// Orientation (both formats, map_server's convention): image column c is
+// cell x = c, image row r (row 0 at the top) is cell y = size_y - 1 - r, so
+// +y points up in the picture.
+//
+// Cell values: p in [0, 1] is an occupancy probability; any negative value
+// (CARMEN's -1) and NaN are unknown; values >= 2 (CARMEN's in-memory
+// off-limits overlay, p + 2) are drawn as occupied.
+#ifndef CARMEN_COMPAT_IMAGE_IO_H
+#define CARMEN_COMPAT_IMAGE_IO_H
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/map_file.h"
+
+namespace carmen {
+
+// map_server's thresholds, written to the YAML and used by Trinary.
+constexpr double kOccupiedThresh = 0.65;
+constexpr double kFreeThresh = 0.196;
+
+// Grey levels (0 = black).
+//  Trinary: occupied (p > 0.65) 0, free (p < 0.196) 254, otherwise — unknown
+//           or in between — 205 (map_server reads 205 as unknown: (255-205)/255
+//           = 0.196 is neither below free_thresh nor above occupied_thresh).
+//  Scale:   round(255 * (1 - p)); unknown 205 (a PGM has no alpha channel,
+//           so map_server's scale mode cannot express unknown exactly; 205 is
+//           what map_server reads as occupancy 0.196, the free threshold).
+//  Raw:     round(100 * p) (0..100, the occupancy value itself); unknown 255,
+//           which map_server's raw mode passes on as -1 in the int8
+//           OccupancyGrid; off-limits 100.
+enum class PgmMode { Trinary, Scale, Raw };
+constexpr uint8_t kPgmOccupied = 0;
+constexpr uint8_t kPgmFree = 254;
+constexpr uint8_t kPgmUnknown = 205;
+constexpr uint8_t kPgmRawUnknown = 255;
+constexpr uint8_t kPngUnknown = 128;  // PNG: round(255 * (1 - p)); unknown mid grey
+
+// "trinary", "scale", "raw" (as in the YAML's mode key).
+const char *pgm_mode_name(PgmMode mode);
+// Parses a mode name; false if it is none of the three.
+bool parse_pgm_mode(const std::string &name, PgmMode *mode);
+
+// The grey level of one cell value.
+uint8_t pgm_pixel(float value, PgmMode mode);
+uint8_t png_pixel(float value);
+
+// The image as rows (row 0 at the top), size_x × size_y bytes.
+std::vector<uint8_t> map_to_pgm_pixels(const GridMap &map, PgmMode mode);
+std::vector<uint8_t> map_to_png_pixels(const GridMap &map);
+
+// Writes a binary PGM (P5, maxval 255, size_x wide, size_y high) and a YAML
+// beside it: the same path with the extension (whatever follows the last
+// '.' of the file name; none: appended) replaced by ".yaml". The YAML holds
+//   image: <pgm file name, relative>   resolution: <m/cell>
+//   origin: [x, y, theta]              negate: 0
+//   occupied_thresh: 0.65  free_thresh: 0.196  mode: trinary|scale|raw
+// `origin_of_cell00` is the world pose of the lower-left corner of cell
+// (0, 0) — map_server's "origin" — and is written to the YAML as it is.
+// Each file is written atomically (temp + rename); the PGM is moved into
+// place first. Throws carmen::FileError naming the file on failure and
+// std::invalid_argument for an empty or inconsistent map.
+void write_pgm_with_yaml(const std::string &pgm_path, const GridMap &map,
+                         const GlobalOffset &origin_of_cell00, PgmMode mode = PgmMode::Trinary);
+// The YAML's path for a PGM path (see above).
+std::string yaml_path_for(const std::string &pgm_path);
+
+// Writes an 8-bit greyscale PNG (no alpha), oriented as above, pixels from
+// png_pixel(). Atomic. Throws like write_pgm_with_yaml.
+void write_png(const std::string &path, const GridMap &map);
+
+}  // namespace carmen
+
+#endif  // CARMEN_COMPAT_IMAGE_IO_H

@@ -1,0 +1,228 @@
+// CARMEN 0.7.4 map files (.map, .map.gz): reading and writing, in C++.
+//
+// Layout (see the project's format notes): optional '#' comment lines, the
+// 17-byte id "CARMENMAPFILEv020", then chunks until the end of the file:
+//   uint8 type | int32 size | char description[10] | [name '\0' if type&0x80] | payload
+// where `size` counts everything after itself. All numbers are little-endian
+// (CARMEN writes host order; every known map comes from x86). This module
+// reads and writes little-endian whatever the host.
+//
+// Reading is defensive: every size a file claims is checked against what the
+// file holds before memory is allocated for it (plain files: against the file
+// size; gzip files: the payload is read in bounded pieces, so a short stream
+// fails with a clean error before the claimed size is ever allocated), and
+// every error is a carmen::FileError naming the file, the chunk and the offset.
+#ifndef CARMEN_COMPAT_MAP_FILE_H
+#define CARMEN_COMPAT_MAP_FILE_H
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace carmen {
+
+// ---------------------------------------------------------------------------
+// Chunk codes (the values of CARMEN's CARMEN_MAP_*_CHUNK macros).
+// ---------------------------------------------------------------------------
+enum MapChunkType : int {
+  kOldCreatorChunk = 0,  // pre-0.7 creator code; read as CREATOR when no CREATOR exists
+  kGridmapChunk = 1,
+  kOfflimitsChunk = 2,
+  kHmapChunk = 3,  // not supported: skipped like an unknown chunk
+  kPlacesChunk = 4,
+  kExpectedChunk = 8,  // never written by CARMEN: skipped like an unknown chunk
+  kLaserscansChunk = 16,
+  kCreatorChunk = 32,
+  kGlobalOffsetChunk = 64,
+};
+constexpr int kNamedChunkFlag = 0x80;
+constexpr char kMapLabel[] = "CARMENMAPFILE";
+constexpr char kMapVersion[] = "v020";
+constexpr int kMapIdLength = 17;  // label + version, no terminator
+
+// The 10-character description CARMEN writes for a chunk type ("GRIDMAP   "),
+// or "UNKNOWN   " for codes it does not know. The named flag is ignored.
+std::string chunk_description(int type);
+// A short name for messages: "GRIDMAP", "PLACES", ..., or "type 102".
+std::string chunk_type_name(int type);
+
+// ---------------------------------------------------------------------------
+// Cell values
+// ---------------------------------------------------------------------------
+constexpr float kUnknownCell = -1.0f;  // exactly -1 means "never observed"
+
+// True for the values a CARMEN map may hold: exactly -1 (unknown), a
+// probability in [0, 1], or [2, 3] (CARMEN's off-limits overlay adds 2 to a
+// probability in memory). Everything else — NaN, infinities, other negative
+// numbers, (1, 2), > 3 — is damage.
+bool valid_cell_value(float v);
+
+// ---------------------------------------------------------------------------
+// Payloads
+// ---------------------------------------------------------------------------
+struct GridMap {
+  int size_x = 0, size_y = 0;
+  double resolution = 0;     // metres per cell (stored in the file as float32)
+  std::vector<float> cells;  // x-major: cells[x*size_y + y]; y points up
+
+  // Bounds-checked access (throws std::out_of_range).
+  float at(int x, int y) const;
+  float &at(int x, int y);
+  bool contains(int x, int y) const { return x >= 0 && y >= 0 && x < size_x && y < size_y; }
+  // A size_x × size_y map with every cell set to `value`.
+  static GridMap filled(int size_x, int size_y, double resolution, float value = kUnknownCell);
+};
+
+struct GlobalOffset {
+  double x = 0, y = 0, theta = 0;
+};
+
+struct CreatorInfo {
+  std::string user;         // at most 10 characters are stored
+  std::string origin;       // at most 80
+  std::string description;  // at most 80
+  int64_t time = 0;         // seconds since 1970 (time_t)
+  int time_bytes = 8;       // width of time_t in the file: 4 (all shipped maps) or 8
+};
+
+// Place types (CARMEN's CARMEN_NAMED_POSITION_TYPE etc.). A position stores
+// x y, a pose x y theta, a localization init x y theta x_std y_std theta_std
+// (all as float32 in the file).
+enum PlaceType : int {
+  kNamedPosition = 1,
+  kNamedPose = 2,
+  kLocalizationInit = 3,
+};
+struct Place {
+  int type = kNamedPosition;
+  std::string name;  // at most 20 characters are stored
+  double x = 0, y = 0, theta = 0;
+  double x_std = 0, y_std = 0, theta_std = 0;
+};
+
+// Off-limits areas in cell coordinates.
+struct OffLimits {
+  struct Point {
+    int32_t x = 0, y = 0;
+  };
+  struct Segment {  // a line, or a rectangle given by two corners
+    int32_t x1 = 0, y1 = 0, x2 = 0, y2 = 0;
+  };
+  std::vector<Point> points;
+  std::vector<Segment> lines;
+  std::vector<Segment> rects;
+  bool empty() const { return points.empty() && lines.empty() && rects.empty(); }
+};
+
+struct LaserScan {
+  double x = 0, y = 0, theta = 0;  // stored as float32
+  std::vector<float> ranges;
+};
+
+using PlaceList = std::vector<Place>;
+using LaserScanList = std::vector<LaserScan>;
+using ChunkPayload = std::variant<GridMap, OffLimits, PlaceList, LaserScanList, CreatorInfo, GlobalOffset>;
+
+// A chunk written with the 0x80 flag and a name. type() is the base code.
+struct NamedChunk {
+  std::string name;  // non-empty, no NUL
+  ChunkPayload payload;
+  int type() const;
+};
+
+// What the reader saw, chunk by chunk, in file order (for --info and tests).
+struct ChunkInfo {
+  int type = 0;             // the raw type byte (named flag included)
+  int64_t offset = 0;       // byte offset of the type byte in the (uncompressed) data
+  int32_t size = 0;         // the size field: bytes after it, description included
+  std::string description;  // the 10-byte description as stored
+  std::string name;         // for named chunks
+  bool named() const { return (type & kNamedChunkFlag) != 0; }
+  int base_type() const { return type & ~kNamedChunkFlag; }
+  bool used = false;  // parsed into MapFile (false: unknown, unsupported or a duplicate)
+};
+
+struct MapFile {
+  // Comment lines without the leading '#' and the newline: the line
+  // "# Map size : 300 x 300" is stored as " Map size : 300 x 300".
+  std::vector<std::string> comments;
+  std::optional<CreatorInfo> creator;
+  std::optional<GridMap> gridmap;
+  std::optional<GlobalOffset> offset;
+  std::optional<PlaceList> places;
+  std::optional<OffLimits> offlimits;
+  std::optional<LaserScanList> laserscans;
+  std::vector<NamedChunk> named;
+  // Chunks skipped on reading (and so not written back): unknown codes,
+  // HMAP, EXPECTED (named or not) and repeated unnamed chunks of a type
+  // already read (CARMEN uses the first one).
+  int unknown_chunks = 0;
+  bool old_style_creator = false;  // the creator came from a code-0 chunk
+  std::vector<ChunkInfo> chunks;   // filled by the reader; ignored by the writer
+};
+
+// ---------------------------------------------------------------------------
+// Reading
+// ---------------------------------------------------------------------------
+struct MapReadOptions {
+  // Reject gridmaps holding values outside valid_cell_value(). On: a damaged
+  // map (NaN, huge or negative garbage) is reported, not passed on.
+  bool check_cells = true;
+};
+
+// Reads a whole map file; ".gz" names are gunzipped (as carmen_fopen does:
+// by name, not content). Throws carmen::FileError naming the file (and
+// what is wrong and where) for anything unreadable, truncated or damaged.
+MapFile read_map_file(const std::string &path);
+MapFile read_map_file(const std::string &path, const MapReadOptions &options);
+
+// Scans the chunk headers only (payloads are skipped, not parsed or kept).
+// Throws carmen::FileError like read_map_file for a damaged layout.
+std::vector<ChunkInfo> list_map_chunks(const std::string &path);
+
+// True when the file opens and its comments are followed by the CARMEN id
+// (what CARMEN's carmen_map_file() tests). Never throws.
+bool is_map_file(const std::string &path);
+
+// ---------------------------------------------------------------------------
+// Writing
+// ---------------------------------------------------------------------------
+// Writes comments, id, creator, gridmap, places, offlimits, laserscans,
+// offset (each only if present), then the named chunks, in that order. A
+// ".gz" name is gzipped. Atomic: written to a temporary file beside `path`
+// and renamed over it, so a failure never leaves half a file.
+// Comment lines are written as '#' + text + '\n'; newlines inside a comment
+// become spaces and lines are cut to 97 characters, so that CARMEN's reader
+// (fgets with a 100-byte buffer) reads each line whole.
+// Throws std::invalid_argument for an inconsistent MapFile (cells.size() !=
+// size_x*size_y, a chunk over 2 GiB, an empty chunk name, bad place type or
+// time width) and carmen::FileError for I/O failures.
+void write_map_file(const std::string &path, const MapFile &map);
+
+// The comment block CARMEN's writer puts at the top of a map (author, date,
+// size, resolution, origin, description), as MapFile::comments lines.
+std::vector<std::string> standard_map_comments(int size_x, int size_y, double resolution,
+                                               const std::string &origin, const std::string &description,
+                                               const std::string &author, int64_t time);
+
+// ---------------------------------------------------------------------------
+// Byte encoders (what write_map_file writes; used by the CARMEN C writers).
+// Each returns a whole chunk: type, size, description, [name], payload.
+// An empty name writes an unnamed chunk. Throw std::invalid_argument like
+// write_map_file.
+// ---------------------------------------------------------------------------
+std::string encode_map_id();
+std::string encode_comment_lines(const std::vector<std::string> &comments);
+std::string encode_gridmap_chunk(const GridMap &map, const std::string &name = {});
+std::string encode_creator_chunk(const CreatorInfo &creator, const std::string &name = {});
+std::string encode_global_offset_chunk(const GlobalOffset &offset, const std::string &name = {});
+std::string encode_places_chunk(const PlaceList &places, const std::string &name = {});
+std::string encode_offlimits_chunk(const OffLimits &offlimits, const std::string &name = {});
+std::string encode_laserscans_chunk(const LaserScanList &scans, const std::string &name = {});
+std::string encode_chunk(const ChunkPayload &payload, const std::string &name = {});
+
+}  // namespace carmen
+
+#endif  // CARMEN_COMPAT_MAP_FILE_H

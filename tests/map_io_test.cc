@@ -1,0 +1,304 @@
+// carmen/map_io.h: CARMEN's C API for map files.
+#include "carmen/map_io.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+
+#include "map_test_support.h"
+
+namespace {
+
+using maptest::map_fixture;
+using maptest::read_bytes;
+using maptest::TempDir;
+
+// A size_x × size_y grid in CARMEN's layout (row pointers into one block).
+struct CGrid {
+  std::vector<float> block;
+  std::vector<float *> rows;
+  CGrid(int sx, int sy) : block(size_t(sx) * size_t(sy)), rows(size_t(sx)) {
+    for (int x = 0; x < sx; ++x) rows[size_t(x)] = block.data() + size_t(x) * size_t(sy);
+  }
+};
+
+class MapIo : public ::testing::TestWithParam<const char *> {
+ protected:
+  std::string path(const std::string &stem) const { return dir_.file(stem + GetParam()); }
+  TempDir dir_;
+};
+
+TEST_P(MapIo, WriteAllThenReadEveryChunk) {
+  const std::string file = path("all");
+  CGrid grid(3, 2);
+  for (int x = 0; x < 3; ++x) {
+    for (int y = 0; y < 2; ++y)
+      grid.rows[size_t(x)][y] = (x == 0 && y == 0) ? -1.0f : 0.125f * float(x + 3 * y);
+  }
+  carmen_place_t places[2];
+  std::memset(places, 0, sizeof places);
+  places[0].type = CARMEN_NAMED_POSE_TYPE;
+  std::strcpy(places[0].name, "kitchen");
+  places[0].x = 1.5;
+  places[0].y = 2.5;
+  places[0].theta = 0.25;
+  places[1].type = CARMEN_LOCALIZATION_INIT_TYPE;
+  std::strcpy(places[1].name, "start");
+  places[1].x_std = 0.5;
+  places[1].theta_std = 0.125;
+  carmen_offlimits_t offl[3] = {{CARMEN_OFFLIMITS_RECT_ID, 1, 2, 3, 4},
+                                {CARMEN_OFFLIMITS_POINT_ID, 5, 6, 0, 0},
+                                {CARMEN_OFFLIMITS_LINE_ID, 7, 8, 9, 10}};
+  float ranges[3] = {1.0f, 2.0f, 4.0f};
+  carmen_laser_scan_t scan = {0.5, -0.5, 1.0, 3, ranges};
+
+  const time_t before = std::time(nullptr);
+  carmen_FILE *fp = carmen_fopen(file.c_str(), "w");
+  ASSERT_NE(fp, nullptr);
+  ASSERT_EQ(carmen_map_write_all(fp, grid.rows.data(), 3, 2, 0.5, "log.clf", "a test", "creator origin",
+                                 "creator desc", places, 2, offl, 3, &scan, 1),
+            0);
+  carmen_global_offset_t off = {10.0, -20.0, 0.5};
+  ASSERT_EQ(carmen_map_write_global_offset_chunk(fp, &off), 0);
+  ASSERT_EQ(carmen_fclose(fp), 0);
+
+  EXPECT_EQ(carmen_map_file(file.c_str()), 1);
+
+  carmen_map_t map;
+  std::memset(&map, 0, sizeof map);
+  ASSERT_EQ(carmen_map_read_gridmap_chunk(file.c_str(), &map), 0);
+  EXPECT_EQ(map.config.x_size, 3);
+  EXPECT_EQ(map.config.y_size, 2);
+  EXPECT_EQ(map.config.resolution, 0.5);
+  EXPECT_EQ(map.map[0][0], -1.0f);
+  EXPECT_EQ(map.map[2][1], 0.125f * 5);
+  EXPECT_EQ(map.complete_map[2 * 2 + 1], 0.125f * 5);  // x-major
+  EXPECT_EQ(map.map[1], map.complete_map + 2);
+  std::free(map.map);
+  std::free(map.complete_map);
+
+  carmen_map_config_t config;
+  ASSERT_EQ(carmen_map_read_gridmap_config(file.c_str(), &config), 0);
+  EXPECT_EQ(config.x_size, 3);
+  EXPECT_EQ(config.y_size, 2);
+
+  time_t when = 0;
+  char user[11], origin[81], desc[81];
+  ASSERT_EQ(carmen_map_read_creator_chunk(file.c_str(), &when, user, origin, desc), 0);
+  EXPECT_GE(when, before);
+  EXPECT_LE(when, std::time(nullptr));
+  EXPECT_STREQ(origin, "creator origin");
+  EXPECT_STREQ(desc, "creator desc");
+
+  carmen_map_placelist_t plist = {nullptr, 0};
+  ASSERT_EQ(carmen_map_read_places_chunk(file.c_str(), &plist), 0);
+  ASSERT_EQ(plist.num_places, 2);
+  EXPECT_STREQ(plist.places[0].name, "kitchen");
+  EXPECT_EQ(plist.places[0].type, CARMEN_NAMED_POSE_TYPE);
+  EXPECT_EQ(plist.places[0].theta, 0.25);
+  EXPECT_EQ(plist.places[1].x_std, 0.5);
+  EXPECT_EQ(plist.places[1].theta_std, 0.125);
+  std::free(plist.places);
+
+  carmen_offlimits_p ol = nullptr;
+  int nol = 0;
+  ASSERT_EQ(carmen_map_read_offlimits_chunk(file.c_str(), &ol, &nol), 0);
+  ASSERT_EQ(nol, 3);
+  // Points, then lines, then rectangles.
+  EXPECT_EQ(ol[0].type, CARMEN_OFFLIMITS_POINT_ID);
+  EXPECT_EQ(ol[0].y1, 6);
+  EXPECT_EQ(ol[1].type, CARMEN_OFFLIMITS_LINE_ID);
+  EXPECT_EQ(ol[1].x2, 9);
+  EXPECT_EQ(ol[2].type, CARMEN_OFFLIMITS_RECT_ID);
+  EXPECT_EQ(ol[2].y2, 4);
+  std::free(ol);
+
+  carmen_laser_scan_p scans = nullptr;
+  int nscans = 0;
+  ASSERT_EQ(carmen_map_read_laserscans_chunk(file.c_str(), &scans, &nscans), 0);
+  ASSERT_EQ(nscans, 1);
+  EXPECT_EQ(scans[0].num_readings, 3);
+  EXPECT_EQ(scans[0].range[2], 4.0f);
+  EXPECT_EQ(scans[0].theta, 1.0);
+  std::free(scans[0].range);
+  std::free(scans);
+
+  carmen_global_offset_t back;
+  ASSERT_EQ(carmen_map_read_global_offset_chunk(file.c_str(), &back), 0);
+  EXPECT_EQ(back.x, 10.0);
+  EXPECT_EQ(back.y, -20.0);
+  EXPECT_EQ(back.theta, 0.5);
+
+  // Creator chunk size: 180 + sizeof(time_t); gridmap 10 + 12 + 4*6.
+  EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_CREATOR_CHUNK), 180 + int(sizeof(time_t)));
+  EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_GRIDMAP_CHUNK), 46);
+  EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_HMAP_CHUNK), 0);
+}
+
+TEST_P(MapIo, CommentBlockIsCarmenReadable) {
+  const std::string file = path("comments");
+  carmen_FILE *fp = carmen_fopen(file.c_str(), "w");
+  ASSERT_NE(fp, nullptr);
+  ASSERT_EQ(carmen_map_write_comment_chunk(fp, 300, 200, 0.1, "fr079.log", std::string(200, 'd').c_str()), 0);
+  ASSERT_EQ(carmen_map_write_id(fp), 0);
+  ASSERT_EQ(carmen_fclose(fp), 0);
+  const std::string text = std::string(GetParam()).size() > 4 ? maptest::gunzip_file(file) : read_bytes(file);
+  // Every line starts with '#' and fits fgets(buf, 100) with its newline.
+  size_t start = 0, lines = 0;
+  bool size_line = false;
+  while (start < text.size() && text[start] == '#') {
+    const size_t nl = text.find('\n', start);
+    ASSERT_NE(nl, std::string::npos);
+    EXPECT_LE(nl - start + 1, 99u);
+    size_line |= text.compare(start, nl - start, "# Map size      : 300 x 200") == 0;
+    start = nl + 1;
+    ++lines;
+  }
+  EXPECT_TRUE(size_line);
+  EXPECT_GE(lines, 5u);
+  EXPECT_EQ(text.substr(start), "CARMENMAPFILEv020");
+  EXPECT_EQ(carmen_map_file(file.c_str()), 1);
+}
+
+TEST_P(MapIo, NamedChunks) {
+  const std::string file = path("named");
+  CGrid a(1, 2), b(2, 1);
+  a.block = {0.25f, 0.5f};
+  b.block = {0.75f, 1.0f};
+  carmen_global_offset_t off = {1, 2, 3};
+  carmen_FILE *fp = carmen_fopen(file.c_str(), "w");
+  ASSERT_NE(fp, nullptr);
+  ASSERT_EQ(carmen_map_write_id(fp), 0);
+  ASSERT_EQ(carmen_map_write_named_gridmap_chunk(fp, "first", a.rows.data(), 1, 2, 0.1), 0);
+  ASSERT_EQ(carmen_map_write_named_gridmap_chunk(fp, "second", b.rows.data(), 2, 1, 0.2), 0);
+  ASSERT_EQ(carmen_map_write_named_global_offset_chunk(fp, "origin", &off), 0);
+  ASSERT_EQ(carmen_fclose(fp), 0);
+
+  carmen_map_t map;
+  std::memset(&map, 0, sizeof map);
+  ASSERT_EQ(carmen_map_read_named_gridmap_chunk(file.c_str(), "second", &map), 0);
+  EXPECT_EQ(map.config.x_size, 2);
+  EXPECT_EQ(map.map[1][0], 1.0f);
+  std::free(map.map);
+  std::free(map.complete_map);
+  // No unnamed gridmap: the unnamed reader fails, with a message naming the file.
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(carmen_map_read_gridmap_chunk(file.c_str(), &map), -1);
+  EXPECT_NE(testing::internal::GetCapturedStderr().find(file), std::string::npos);
+  carmen_global_offset_t back;
+  ASSERT_EQ(carmen_map_read_named_global_offset_chunk(file.c_str(), "origin", &back), 0);
+  EXPECT_EQ(back.theta, 3.0);
+  // chunk_exists masks the named flag, like CARMEN's advance.
+  EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_GRIDMAP_CHUNK), 10 + 6 + 12 + 8);
+  EXPECT_EQ(carmen_map_named_chunk_exists(file.c_str(), CARMEN_MAP_GRIDMAP_CHUNK, "second"), 10 + 7 + 12 + 8);
+  EXPECT_EQ(carmen_map_named_chunk_exists(file.c_str(), CARMEN_MAP_GRIDMAP_CHUNK, "third"), 0);
+
+  carmen_FILE *in = carmen_fopen(file.c_str(), "r");
+  ASSERT_NE(in, nullptr);
+  ASSERT_EQ(carmen_map_advance_to_named_chunk(in, CARMEN_MAP_GRIDMAP_CHUNK, "second"), 0);
+  // Positioned after the type byte: the id (17) + first chunk (5 + 36) + 1.
+  EXPECT_EQ(carmen_ftell(in), 17 + 41 + 1);
+  carmen_fclose(in);
+}
+
+TEST_P(MapIo, AdvanceToChunkStopsAfterTheTypeByte) {
+  // A gzip or plain copy of freiburg.map.
+  const std::string file = path("fr");
+  if (std::string(GetParam()).size() > 4) {
+    maptest::gzip_to_file(file, read_bytes(map_fixture("freiburg.map")));
+  } else {
+    maptest::write_bytes(file, read_bytes(map_fixture("freiburg.map")));
+  }
+  carmen_FILE *fp = carmen_fopen(file.c_str(), "r");
+  ASSERT_NE(fp, nullptr);
+  ASSERT_EQ(carmen_map_advance_to_chunk(fp, CARMEN_MAP_GRIDMAP_CHUNK), 0);
+  unsigned char buf[4 + 10 + 8];
+  ASSERT_EQ(carmen_fread(buf, 1, sizeof buf, fp), sizeof buf);
+  const std::string s(reinterpret_cast<char *>(buf), sizeof buf);
+  EXPECT_EQ(maptest::read_i32(s, 0), 360022);
+  EXPECT_EQ(s.substr(4, 10), "GRIDMAP   ");
+  EXPECT_EQ(maptest::read_i32(s, 14), 300);
+  EXPECT_EQ(maptest::read_i32(s, 18), 300);
+  ASSERT_EQ(carmen_map_advance_to_chunk(fp, CARMEN_MAP_CREATOR_CHUNK), 0);  // rescans from the start
+  EXPECT_EQ(carmen_ftell(fp), 18);
+  EXPECT_EQ(carmen_map_advance_to_chunk(fp, CARMEN_MAP_PLACES_CHUNK), -1);
+  carmen_fclose(fp);
+}
+
+INSTANTIATE_TEST_SUITE_P(PlainAndGzip, MapIo, ::testing::Values(".map", ".map.gz"), [](const auto &info) {
+  return std::string(info.param).size() > 4 ? "gzip" : "plain";
+});
+
+TEST(MapIoFreiburg, ReadersAndUtilities) {
+  const std::string file = map_fixture("freiburg.map");
+  EXPECT_EQ(carmen_map_file(file.c_str()), 1);
+  EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_GRIDMAP_CHUNK), 360022);
+  EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_CREATOR_CHUNK), 184);
+  EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_PLACES_CHUNK), 0);
+  carmen_map_config_t config;
+  ASSERT_EQ(carmen_map_read_gridmap_config(file.c_str(), &config), 0);
+  EXPECT_EQ(config.x_size, 300);
+  EXPECT_EQ(config.y_size, 300);
+  EXPECT_EQ(config.resolution, double(0.1f));
+  EXPECT_EQ(config.map_name, nullptr);
+  time_t when = 0;
+  char user[11];
+  ASSERT_EQ(carmen_map_read_creator_chunk(file.c_str(), &when, user, nullptr, nullptr), 0);
+  EXPECT_STREQ(user, "nickr");
+  EXPECT_GT(when, 1000000000);  // 2001-09-09: the map is from 2002
+  EXPECT_LT(when, 1100000000);  // 2004-11-09
+  // Missing chunks: -1 and a message naming the file.
+  carmen_map_placelist_t plist;
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(carmen_map_read_places_chunk(file.c_str(), &plist), -1);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find(file), std::string::npos) << err;
+  EXPECT_NE(err.find("PLACES"), std::string::npos) << err;
+}
+
+TEST(MapIoDamaged, EveryReaderFailsCleanly) {
+  for (const char *name : {"longwood", "nsh_level_3", "thickwean", "wean5300"}) {
+    const std::string file = map_fixture(std::string("damaged/") + name + ".map.gz");
+    carmen_map_t map;
+    std::memset(&map, 0, sizeof map);
+    carmen_map_config_t config;
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(carmen_map_read_gridmap_chunk(file.c_str(), &map), -1) << name;
+    EXPECT_EQ(carmen_map_read_gridmap_config(file.c_str(), &config), -1) << name;
+    EXPECT_EQ(carmen_map_read_creator_chunk(file.c_str(), nullptr, nullptr, nullptr, nullptr), -1) << name;
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_NE(err.find(file), std::string::npos) << err;
+    EXPECT_EQ(map.complete_map, nullptr);
+  }
+  // wean5300 is not a map (its data is gzip inside gzip); the others are,
+  // by their id.
+  EXPECT_EQ(carmen_map_file(map_fixture("damaged/wean5300.map.gz").c_str()), 0);
+  EXPECT_EQ(carmen_map_file(map_fixture("damaged/longwood.map.gz").c_str()), 1);
+  EXPECT_EQ(carmen_map_file("/nonexistent/file.map"), 0);
+}
+
+TEST(MapIoWriters, RejectBadArguments) {
+  TempDir dir;
+  const std::string file = dir.file("bad.map");
+  carmen_FILE *fp = carmen_fopen(file.c_str(), "w");
+  ASSERT_NE(fp, nullptr);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(carmen_map_write_gridmap_chunk(fp, nullptr, 3, 3, 0.1), -1);
+  CGrid g(2, 2);
+  EXPECT_EQ(carmen_map_write_gridmap_chunk(fp, g.rows.data(), 0, 2, 0.1), -1);
+  carmen_offlimits_t bad = {17, 0, 0, 0, 0};
+  EXPECT_EQ(carmen_map_write_offlimits_chunk(fp, &bad, 1), -1);
+  carmen_place_t place;
+  std::memset(&place, 0, sizeof place);
+  place.type = 0;
+  EXPECT_EQ(carmen_map_write_places_chunk(fp, &place, 1), -1);
+  EXPECT_EQ(carmen_map_write_id(nullptr), -1);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("carmen_map_write_offlimits_chunk"), std::string::npos) << err;
+  carmen_fclose(fp);
+  EXPECT_EQ(read_bytes(file), "");  // nothing half-written
+}
+
+}  // namespace

@@ -1,0 +1,145 @@
+// The mapconvert tool, run as a program.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <string>
+
+#include "carmen_compat/map_file.h"
+#include "map_test_support.h"
+
+namespace {
+
+using maptest::map_fixture;
+using maptest::read_bytes;
+using maptest::TempDir;
+
+struct ToolRun {
+  int status = -1;     // exit code
+  std::string output;  // stdout and stderr
+};
+
+std::string quote(const std::string &s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+ToolRun mapconvert(const std::vector<std::string> &args) {
+  std::string cmd = quote(std::string(VASCO_BIN_DIR) + "/mapconvert");
+  for (const std::string &a : args) cmd += " " + quote(a);
+  cmd += " 2>&1";
+  ToolRun r;
+  FILE *p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+bool contains(const std::string &s, const std::string &part) { return s.find(part) != std::string::npos; }
+
+class MapConvert : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!maptest::file_exists(std::string(VASCO_BIN_DIR) + "/mapconvert")) {
+      GTEST_SKIP() << "mapconvert is not built in " << VASCO_BIN_DIR;
+    }
+  }
+};
+
+TEST_F(MapConvert, Usage) {
+  const ToolRun help = mapconvert({"--help"});
+  EXPECT_EQ(help.status, 0);
+  EXPECT_TRUE(contains(help.output, "usage: mapconvert")) << help.output;
+  EXPECT_EQ(mapconvert({}).status, 2);
+  EXPECT_EQ(mapconvert({"only-one.map"}).status, 2);
+  EXPECT_EQ(mapconvert({"a.map", "b.map", "c.map"}).status, 2);
+  EXPECT_EQ(mapconvert({"--info"}).status, 2);
+  EXPECT_EQ(mapconvert({"--bogus", "a.map", "b.map"}).status, 2);
+  EXPECT_EQ(mapconvert({"--mode", "fancy", "a.map", "b.pgm"}).status, 2);
+  EXPECT_EQ(mapconvert({"--mode", "raw", "a.map", "b.png"}).status, 2);  // mode is for .pgm only
+  const ToolRun ext = mapconvert({map_fixture("freiburg.map"), "out.jpg"});
+  EXPECT_EQ(ext.status, 2);
+  EXPECT_TRUE(contains(ext.output, "out.jpg")) << ext.output;
+}
+
+TEST_F(MapConvert, InfoOnFreiburg) {
+  const ToolRun r = mapconvert({"--info", map_fixture("freiburg.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "size: 300 x 300 cells")) << r.output;
+  EXPECT_TRUE(contains(r.output, "resolution: 0.1")) << r.output;
+  EXPECT_TRUE(contains(r.output, "GRIDMAP")) << r.output;
+  EXPECT_TRUE(contains(r.output, "CREATOR")) << r.output;
+  // 44740 unknown cells of 90000 (counted from the raw bytes: see map_file_test).
+  EXPECT_TRUE(contains(r.output, "unknown: 44740 of 90000 cells (49.71%)")) << r.output;
+  EXPECT_TRUE(contains(r.output, "known values: min 0.004")) << r.output;
+  EXPECT_TRUE(contains(r.output, "max 1\n")) << r.output;
+}
+
+TEST_F(MapConvert, ConvertsToEveryFormat) {
+  TempDir dir;
+  const std::string src = map_fixture("freiburg.map");
+  for (const char *name : {"fr.map", "fr.map.gz", "fr.pgm", "fr.png"}) {
+    const ToolRun r = mapconvert({src, dir.file(name)});
+    EXPECT_EQ(r.status, 0) << name << ": " << r.output;
+    EXPECT_TRUE(maptest::file_exists(dir.file(name))) << name;
+  }
+  EXPECT_EQ(read_bytes(dir.file("fr.map")), read_bytes(src));  // nothing lost or changed
+  EXPECT_EQ(maptest::gunzip_file(dir.file("fr.map.gz")), read_bytes(src));
+  EXPECT_EQ(read_bytes(dir.file("fr.pgm")).substr(0, 15), "P5\n300 300\n255\n");
+  EXPECT_EQ(read_bytes(dir.file("fr.pgm")).size(), 15u + 90000u);
+  const std::string yaml = read_bytes(dir.file("fr.yaml"));
+  EXPECT_TRUE(contains(yaml, "image: fr.pgm\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "mode: trinary\n")) << yaml;
+  EXPECT_EQ(read_bytes(dir.file("fr.png")).substr(1, 3), "PNG");
+  // And back: the gzip copy converts to the same map.
+  const ToolRun back = mapconvert({dir.file("fr.map.gz"), dir.file("back.map")});
+  EXPECT_EQ(back.status, 0) << back.output;
+  EXPECT_EQ(read_bytes(dir.file("back.map")), read_bytes(src));
+}
+
+TEST_F(MapConvert, PgmModeAndOffsetOrigin) {
+  TempDir dir;
+  carmen::MapFile m;
+  m.gridmap = carmen::GridMap::filled(2, 1, 0.25, 0.5f);
+  m.offset = carmen::GlobalOffset{-3.5, 1.25, 0};
+  carmen::write_map_file(dir.file("in.map"), m);
+  const ToolRun r = mapconvert({"--mode", "raw", dir.file("in.map"), dir.file("out.pgm")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string yaml = read_bytes(dir.file("out.yaml"));
+  EXPECT_TRUE(contains(yaml, "mode: raw\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "origin: [-3.5, 1.25, 0]\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "resolution: 0.25\n")) << yaml;
+  EXPECT_EQ(read_bytes(dir.file("out.pgm")), std::string("P5\n2 1\n255\n") + char(50) + char(50));
+}
+
+TEST_F(MapConvert, BadInputExitsOneNamingTheFile) {
+  TempDir dir;
+  for (const char *name : {"longwood", "nsh_level_3", "thickwean", "wean5300"}) {
+    const std::string file = map_fixture(std::string("damaged/") + name + ".map.gz");
+    const ToolRun info = mapconvert({"--info", file});
+    EXPECT_EQ(info.status, 1) << name;
+    EXPECT_TRUE(contains(info.output, file)) << info.output;
+    const ToolRun conv = mapconvert({file, dir.file("x.png")});
+    EXPECT_EQ(conv.status, 1) << name;
+  }
+  EXPECT_TRUE(dir.entries().empty());  // nothing written for a bad input
+  const ToolRun missing = mapconvert({dir.file("nope.map"), dir.file("x.map")});
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_TRUE(contains(missing.output, dir.file("nope.map"))) << missing.output;
+  // An output that cannot be written.
+  const ToolRun unwritable = mapconvert({map_fixture("freiburg.map"), dir.file("no/dir/x.png")});
+  EXPECT_EQ(unwritable.status, 1);
+  EXPECT_TRUE(contains(unwritable.output, dir.file("no/dir/x.png"))) << unwritable.output;
+  // A map without a grid cannot become an image.
+  carmen::write_map_file(dir.file("nogrid.map"), carmen::MapFile{});
+  const ToolRun nogrid = mapconvert({dir.file("nogrid.map"), dir.file("x.pgm")});
+  EXPECT_EQ(nogrid.status, 1);
+  EXPECT_TRUE(contains(nogrid.output, "GRIDMAP")) << nogrid.output;
+}
+
+}  // namespace
