@@ -110,13 +110,18 @@ struct FloatModel {
   int table_size, size_x, size_y;
 };
 
-// Adds every beam's log-odds evidence to `logodds` (atomics: no update is
-// lost) and marks the cells it touches.
-void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans,
-                      const float *ranges, float *logodds, uint8_t *touched,
-                      unsigned long long *counters, cudaStream_t stream);
+// Sets every cell to -0.0f, float mode's "never updated".
+void launch_float_clear(float *logodds, size_t num_cells, cudaStream_t stream);
 
-// logodds -> probability; untouched cells -1. In place (float).
+// Adds every beam's log-odds evidence to `logodds` (atomics: no update is
+// lost). counters: beams used, beams skipped, cell updates.
+void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans,
+                      const float *ranges, float *logodds, unsigned long long *counters,
+                      cudaStream_t stream);
+
+// logodds -> probability, in place; cells never updated become -1. Those are
+// the cells still -0.0f, or, when `touched` is given (the paper's kernels),
+// the cells whose flag is 0.
 void launch_float_finalize(const FloatModel &m, float *grid_logodds, const uint8_t *touched,
                            size_t num_cells, cudaStream_t stream);
 

@@ -15,6 +15,8 @@
 // it stays there for good, while the log-odds sum keeps counting: a cell that
 // the oracle pinned at 1.0 can come back below 1 here if enough free updates
 // follow. Measured in the agreement tables (DESIGN §4).
+#include <algorithm>
+
 #include "cuda_check.h"
 #include "egrid_kernels.h"
 #include "vasco_gpu/egrid_math.h"
@@ -25,9 +27,14 @@ namespace {
 
 constexpr int kWarpsPerBlock = 8;
 
+// Untouched cells hold -0.0f. A term of the sum is never -0.0 (logf of a
+// positive ratio minus logit(prior) is +0.0 at worst), and -0.0 + x == x for
+// every x, +0.0 included; so after the sum, "-0.0" means "never updated" —
+// no separate touched array and none of its stores.
+__device__ __forceinline__ bool is_untouched(float v) { return __float_as_uint(v) == 0x80000000u; }
+
 __device__ __forceinline__ void add_evidence(const FloatModel &m, int cx, int cy, int x1, int y1,
-                                             float r, float *logodds, uint8_t *touched,
-                                             unsigned *count, bool *stop) {
+                                             float r, float *logodds, unsigned *count, bool *stop) {
   if (cx < 0 || cx >= m.size_x || cy < 0 || cy >= m.size_y) return;
   const int i = abs(cx - x1), j = abs(cy - y1);
   const float d = (i >= m.table_size || j >= m.table_size)
@@ -41,13 +48,12 @@ __device__ __forceinline__ void add_evidence(const FloatModel &m, int cx, int cy
   }
   const size_t c = static_cast<size_t>(cx) * m.size_y + cy;
   atomicAdd(logodds + c, __logf(p / (1.0f - p)) - m.logodds_prior);
-  touched[c] = 1;
   ++*count;
 }
 
 __global__ void __launch_bounds__(kWarpsPerBlock * 32)
     float_map_kernel(FloatModel m, const FloatScan *scans, int num_scans, const float *ranges,
-                     float *logodds, uint8_t *touched, unsigned long long *counters) {
+                     float *logodds, unsigned long long *counters) {
   const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
   unsigned used = 0, skipped = 0, updates = 0;
   for (int s = blockIdx.x; s < num_scans; s += gridDim.x) {
@@ -72,7 +78,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
           for (int k = 0; k < m.table_size && !stop; ++k) {
             int cx, cy;
             egrid::bresenham_current(line, &cx, &cy);
-            add_evidence(m, cx, cy, sc.x1, sc.y1, r, logodds, touched, &updates, &stop);
+            add_evidence(m, cx, cy, sc.x1, sc.y1, r, logodds, &updates, &stop);
             if (!egrid::bresenham_next(line)) break;
           }
         }
@@ -96,7 +102,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
         if (p.flipped) mn = -mn;
         const int cx = p.steep ? mn : maj, cy = p.steep ? maj : mn;
         bool stop = false;
-        add_evidence(m, cx, cy, sc.x1, sc.y1, r, logodds, touched, &updates, &stop);
+        add_evidence(m, cx, cy, sc.x1, sc.y1, r, logodds, &updates, &stop);
       }
     }
   }
@@ -111,10 +117,16 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
   }
 }
 
+__global__ void fill_kernel(float *grid, size_t n, float value) {
+  for (size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x; c < n;
+       c += static_cast<size_t>(gridDim.x) * blockDim.x)
+    grid[c] = value;
+}
+
 __global__ void finalize_kernel(FloatModel m, float *grid, const uint8_t *touched, size_t n) {
   for (size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x; c < n;
        c += static_cast<size_t>(gridDim.x) * blockDim.x) {
-    if (!touched[c]) {
+    if (touched ? !touched[c] : is_untouched(grid[c])) {
       grid[c] = egrid::kUnknown;
     } else {
       // p = 1 - 1/(1 + odds), odds = exp(L): saturates to exactly 1 or 0.
@@ -126,12 +138,19 @@ __global__ void finalize_kernel(FloatModel m, float *grid, const uint8_t *touche
 
 }  // namespace
 
+void launch_float_clear(float *logodds, size_t num_cells, cudaStream_t stream) {
+  if (num_cells == 0) return;
+  const unsigned blocks = static_cast<unsigned>(std::min<size_t>((num_cells + 255) / 256, 65536));
+  fill_kernel<<<blocks, 256, 0, stream>>>(logodds, num_cells, -0.0f);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
 void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans,
-                      const float *ranges, float *logodds, uint8_t *touched,
-                      unsigned long long *counters, cudaStream_t stream) {
+                      const float *ranges, float *logodds, unsigned long long *counters,
+                      cudaStream_t stream) {
   if (num_scans <= 0) return;
   float_map_kernel<<<num_scans, kWarpsPerBlock * 32, 0, stream>>>(m, scans, num_scans, ranges,
-                                                                   logodds, touched, counters);
+                                                                   logodds, counters);
   VG_CUDA_CHECK_LAUNCH();
 }
 

@@ -88,11 +88,15 @@ TEST_P(CudaGolden, ExactModeIsBitIdenticalToTheOracle) {
 }
 
 // Float mode against the oracle: the agreement table of DESIGN §4.
-// Thresholds come from a measured run on an H100 (2026-11-23):
-//   fr079: max |dp| 3.1e-2, class agreement 99.97 %, known/unknown differs 0.002 %
-//   intel: ...
-// and leave about a factor 2-3 of room for other GPUs' float rounding; a lost
-// update or a wrong cell would break them by orders of magnitude.
+// Thresholds from a measured run on an H100 (2026-11-23, vasco defaults):
+//   fr079: class agreement 99.9727 %, known/unknown differs in 0 cells,
+//          |dp| > 0.1 in 1004 of 763716 cells known in both (1.3e-3)
+//   intel: class agreement 99.9820 %, known/unknown differs in 1 cell of 5.3 M,
+//          |dp| > 0.1 below 1e-3 of the known cells
+// max |dp| itself is not bounded: it reaches 1.0 on fr079 where the oracle
+// pinned a cell at exactly 0 or 1 (saturation, see cuda/float_kernels.cu) and
+// the log-odds sum did not. The bounds leave about a factor 3 for other GPUs'
+// rounding; a lost update or a misplaced beam breaks them by far.
 TEST_P(CudaGolden, FloatModeAgreesWithTheOracle) {
   REQUIRE_GPU();
   const MapperParams params;
@@ -104,8 +108,8 @@ TEST_P(CudaGolden, FloatModeAgreesWithTheOracle) {
   std::printf("%s", a.table(std::string("cuda float vs cpu_double, ") + GetParam()).c_str());
   EXPECT_EQ(gpu_stats.beams_used, ref_stats.beams_used);
   EXPECT_GT(a.class_agreement(), 0.999);
-  EXPECT_LT(double(a.status_differs) / double(a.cells), 1e-4);
-  EXPECT_LT(a.max_abs_diff, 0.2);
+  EXPECT_LT(double(a.status_differs) / double(a.cells), 1e-5);
+  EXPECT_LT(double(a.large_diffs) / double(a.both_known), 4e-3);
 }
 
 INSTANTIATE_TEST_SUITE_P(BundledLogs, CudaGolden,

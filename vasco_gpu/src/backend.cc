@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "vasco_gpu/cpu_threads_backend.h"
+
 #if defined(VASCO_HAVE_CUDA)
 #include "vasco_gpu/cuda_backend.h"
 #endif
@@ -9,7 +11,7 @@
 namespace vasco {
 
 std::vector<std::string> compiled_backends() {
-  std::vector<std::string> names = {"cpu_double", "cpu_float"};
+  std::vector<std::string> names = {"cpu_double", "cpu_threads", "cpu_float"};
 #if defined(VASCO_HAVE_CUDA)
   names.push_back("cuda");
 #endif
@@ -17,8 +19,8 @@ std::vector<std::string> compiled_backends() {
 }
 
 std::unique_ptr<Backend> make_backend(const std::string &name, const BackendOptions &options) {
-  (void)options;  // used by the CUDA backend only
   if (name == "cpu_double") return make_cpu_double_backend();
+  if (name == "cpu_threads") return make_cpu_threads_backend(options.threads);
   if (name == "cpu_float") return make_cpu_float_backend();
   if (name == "cuda" || name == "auto") {
 #if defined(VASCO_HAVE_CUDA)

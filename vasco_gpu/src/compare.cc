@@ -40,6 +40,7 @@ Agreement compare_maps(const std::vector<float> &ref, const std::vector<float> &
       ++a.both_known;
       const double d = std::fabs(double(r) - double(t));
       if (d > a.max_abs_diff || std::isnan(d)) a.max_abs_diff = std::isnan(d) ? INFINITY : d;
+      if (!(d <= 0.1)) ++a.large_diffs;
     } else if (rk != tk) {
       ++a.status_differs;
     }
@@ -70,10 +71,11 @@ std::string Agreement::table(const std::string &title) const {
   std::snprintf(buf, sizeof buf,
                 "%s\n"
                 "  cells %llu, known in both %llu, bit-identical %s\n"
-                "  max |dp| (known in both) %.3g, known/unknown differs %llu (%s)\n"
+                "  max |dp| (known in both) %.3g, |dp| > 0.1 in %llu cells (%s of known), known/unknown differs %llu (%s)\n"
                 "  class agreement %s: occupied %s of %llu, free %s of %llu, unknown %s of %llu\n",
                 title.c_str(), (unsigned long long)cells, (unsigned long long)both_known,
-                pct(identical, cells).c_str(), max_abs_diff, (unsigned long long)status_differs,
+                pct(identical, cells).c_str(), max_abs_diff, (unsigned long long)large_diffs,
+                pct(large_diffs, both_known).c_str(), (unsigned long long)status_differs,
                 pct(status_differs, cells).c_str(), pct(class_agree, cells).c_str(),
                 pct(occupied_agree, occupied_ref).c_str(), (unsigned long long)occupied_ref,
                 pct(free_agree, free_ref).c_str(), (unsigned long long)free_ref,

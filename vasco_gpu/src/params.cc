@@ -1,5 +1,6 @@
 #include "vasco_gpu/params.h"
 
+#include <cctype>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -99,15 +100,24 @@ MapperParams MapperParams::from_params(const carmen::ParamFile &params,
   // Validate key by key so that the error names where the bad value came from.
   const std::string e = check(p);
   if (!e.empty()) {
-    const std::string key = e.substr(0, e.find(' '));
+    // The key is the message's first word; for the range_max / resolution
+    // ratio, whichever of the two the file defines.
+    std::string key = e.substr(0, e.find(' '));
+    if (!params.has(key) && key == "vasco_range_max") key = "vasco_resolution";
     const auto where = params.find(key);
     if (where && where->line > 0) throw carmen::FileError(where->file, where->line, e);
     if (where) throw std::invalid_argument(where->file + ": " + e);
     throw std::invalid_argument(e);
   }
   if (warnings != nullptr) {
-    for (const auto &u : params.unknown_in_module("vasco", mapper_param_keys()))
+    for (const auto &u : params.unknown_in_module("vasco", mapper_param_keys())) {
+      // vasco's own keys in CARMEN's carmen.ini (scan matching, not the
+      // evidence grid) are not typos: no warning for them.
+      std::string lower = u.name;
+      for (char &c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (lower.rfind("vasco_local_map_", 0) == 0 || lower == "vasco_max_usable_laser_range") continue;
       warnings->push_back(u.where() + ": unknown parameter " + u.name + " (ignored; a typo?)");
+    }
   }
   return p;
 }

@@ -285,10 +285,10 @@ int run(const Options &opt) {
                  geo.size_x, geo.size_y, geo.resolution, fin.size_x, fin.size_y, fin.resolution,
                  (unsigned long long)known);
     std::fprintf(stderr,
-                 "log2map: backend %s; parse %.3f s, upload %.3f s, map %.3f s, download %.3f s, "
-                 "finish %.3f s, write %.3f s, total %.3f s\n",
-                 backend->name().c_str(), parse_s, ms.upload_s, ms.map_s, ms.download_s, finish_s,
-                 write_s, total_s);
+                 "log2map: backend %s; parse %.3f s, prep %.3f s, upload %.3f s, map %.3f s, "
+                 "download %.3f s, finish %.3f s, write %.3f s, total %.3f s\n",
+                 backend->name().c_str(), parse_s, ms.prep_s, ms.upload_s, ms.map_s, ms.download_s,
+                 finish_s, write_s, total_s);
   }
   if (opt.json) {
     std::ostringstream j;
@@ -302,7 +302,8 @@ int run(const Options &opt) {
       << geo.size_y << "],\"map\":[" << fin.size_x << "," << fin.size_y
       << "],\"map_resolution\":" << fin.resolution << ",\"known_cells\":" << known
       << ",\"origin\":[" << origin.x << "," << origin.y << "]"
-      << ",\"seconds\":{\"parse\":" << parse_s << ",\"upload\":" << ms.upload_s
+      << ",\"seconds\":{\"parse\":" << parse_s << ",\"prep\":" << ms.prep_s
+      << ",\"upload\":" << ms.upload_s
       << ",\"map\":" << ms.map_s << ",\"map_total\":" << map_total_s
       << ",\"download\":" << ms.download_s << ",\"finish\":" << finish_s
       << ",\"write\":" << write_s << ",\"total\":" << total_s << "},\"outputs\":[";
@@ -329,8 +330,12 @@ int main(int argc, char **argv) {
   app.add_option("OUT", opt.outputs, "output files: .map, .map.gz, .pgm, .png")->required();
   app.add_option("--param-file", opt.param_file, "carmen.ini with vasco_* keys (default: vasco's defaults)");
   app.add_option("--robot", opt.robot, "robot section of the ini to use");
-  app.add_option("--backend", opt.backend, "cpu_double | cpu_float | cuda | auto (default: auto)")
-      ->check(CLI::IsMember({"cpu_double", "cpu_float", "cuda", "auto"}));
+  app.add_option("--backend", opt.backend,
+                 "cpu_double | cpu_threads | cpu_float | cuda | auto (default: auto = cuda if a GPU "
+                 "is usable, else cpu_double)")
+      ->check(CLI::IsMember({"cpu_double", "cpu_threads", "cpu_float", "cuda", "auto"}));
+  app.add_option("--threads", opt.threads, "threads of cpu_threads (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
       ->check(CLI::IsMember({"float", "exact"}));
   app.add_flag("--lenient", opt.lenient, "skip bad log lines (and report them) instead of stopping");

@@ -28,8 +28,13 @@ struct MapStats {
 
 enum class CudaMode { Float, Exact };
 
+// Float-mode kernels: ours, or the paper's kernel and its ablation variants
+// (benchmark baselines; see cuda/paper_kernels.cu).
+enum class CudaKernel { Ours, PaperPerScan, PaperPerScanNoShared, PaperPerScanNoConst, PaperFused };
+
 struct BackendOptions {
   CudaMode cuda_mode = CudaMode::Float;
+  CudaKernel cuda_kernel = CudaKernel::Ours;
   int threads = 0;   // cpu_threads: 0 = all cores
   int cuda_device = 0;
 };
@@ -45,7 +50,7 @@ class Backend {
                                  const GridGeometry &geo, MapStats *stats) = 0;
 };
 
-// Backend names accepted by make_backend: cpu_double, cpu_float, cpu_threads,
+// Backend names accepted by make_backend: cpu_double, cpu_threads, cpu_float,
 // cuda (if compiled in) and auto (cuda when a GPU is usable, else cpu_double).
 std::vector<std::string> compiled_backends();
 

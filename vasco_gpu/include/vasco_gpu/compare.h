@@ -15,6 +15,7 @@ struct Agreement {
   uint64_t status_differs = 0;   // known in one map, unknown in the other
   uint64_t identical = 0;        // bit-identical values
   double max_abs_diff = 0;       // max |a - b| over cells known in both
+  uint64_t large_diffs = 0;      // cells known in both with |a - b| > 0.1
   // Class of a cell: occupied (p > 0.5), free (p < 0.5), unknown (-1); a cell
   // of exactly 0.5 is neither occupied nor free and counts as "even".
   uint64_t class_agree = 0;      // same class in both maps

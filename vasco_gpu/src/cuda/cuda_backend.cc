@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
 #include <cmath>
 #include <mutex>
 #include <sstream>
@@ -12,6 +15,7 @@
 
 #include "cuda_check.h"
 #include "egrid_kernels.h"
+#include "paper_kernels.h"
 #include "vasco_gpu/oracle.h"
 
 namespace vasco {
@@ -69,6 +73,30 @@ std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeo
   return starts;
 }
 
+// With VASCO_CUDA_PROFILE set, prints the time of each GPU stage to stderr
+// (events between stages; for tuning, not for the benchmark table).
+class StageTimer {
+ public:
+  explicit StageTimer(cudaStream_t s) : stream_(s), on_(std::getenv("VASCO_CUDA_PROFILE") != nullptr) {}
+  void mark(const char *name) {
+    if (!on_) return;
+    events_.emplace_back(std::make_unique<Event>(), name);
+    events_.back().first->record(stream_);
+  }
+  void report() {
+    if (!on_ || events_.size() < 2) return;
+    VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
+    for (size_t i = 1; i < events_.size(); ++i)
+      std::fprintf(stderr, "  [cuda] %-14s %8.3f ms\n", events_[i].second,
+                   events_[i].first->since(*events_[i - 1].first));
+  }
+
+ private:
+  cudaStream_t stream_;
+  bool on_;
+  std::vector<std::pair<std::unique_ptr<Event>, const char *>> events_;
+};
+
 // Runs fn(begin, end) over [0, n) on all cores.
 template <class Fn>
 void parallel_for(size_t n, Fn fn) {
@@ -94,7 +122,15 @@ class CudaBackend : public Backend {
     VG_CUDA_CHECK(cudaSetDevice(o.cuda_device));
   }
   std::string name() const override {
-    return options_.cuda_mode == CudaMode::Exact ? "cuda_exact" : "cuda_float";
+    if (options_.cuda_mode == CudaMode::Exact) return "cuda_exact";
+    switch (options_.cuda_kernel) {
+      case CudaKernel::Ours: return "cuda_float";
+      case CudaKernel::PaperPerScan: return "cuda_paper";
+      case CudaKernel::PaperPerScanNoShared: return "cuda_paper_noshared";
+      case CudaKernel::PaperPerScanNoConst: return "cuda_paper_noconst";
+      case CudaKernel::PaperFused: return "cuda_paper_fused";
+    }
+    return "cuda_float";
   }
 
   std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
@@ -198,12 +234,17 @@ class CudaBackend : public Backend {
                                     cudaMemcpyHostToDevice, stream.get()));
     e_up.record(stream.get());
 
+    StageTimer timer(stream.get());
+    timer.mark("start");
     VG_CUDA_CHECK(cudaMemsetAsync(d_updates.get(), 0, sizeof(unsigned long long), stream.get()));
     VG_CUDA_CHECK(cudaMemsetAsync(d_counts.get(), 0, (nb + 1) * sizeof(uint32_t), stream.get()));
     if (use_tables) cuda::launch_exact_tables(m, d_dist.get(), d_ff.get(), d_fo.get(), stream.get());
+    timer.mark("tables");
     cuda::launch_exact_lines(m, d_beams.get(), d_starts.get(), nb, d_lines.get(), d_counts.get(),
                              stream.get());
+    timer.mark("lines");
     cuda::exact_scan(d_counts.get(), d_offsets.get(), nb, d_scan_tmp.get(), scan_tmp, stream.get());
+    timer.mark("scan");
     uint32_t num_pairs = 0;
     VG_CUDA_CHECK(cudaMemcpyAsync(&num_pairs, d_offsets.get() + nb, sizeof(uint32_t),
                                   cudaMemcpyDeviceToHost, stream.get()));
@@ -213,19 +254,24 @@ class CudaBackend : public Backend {
     DeviceBuffer<uint32_t> d_pair_tile(num_pairs), d_pair_beam(num_pairs);
     DeviceBuffer<uint32_t> d_sorted_tile(num_pairs), d_sorted_beam(num_pairs);
     DeviceBuffer<unsigned char> d_sort_tmp(std::max<size_t>(sort_tmp, 1));
+    timer.mark("sync+alloc");
     cuda::launch_exact_pairs(m, d_lines.get(), d_offsets.get(), nb, d_pair_tile.get(),
                              d_pair_beam.get(), stream.get());
+    timer.mark("pairs");
     int tile_bits = 1;
     while ((size_t(1) << tile_bits) < num_tiles) ++tile_bits;
     if (num_pairs)
       cuda::exact_sort(d_pair_tile.get(), d_sorted_tile.get(), d_pair_beam.get(), d_sorted_beam.get(),
                        num_pairs, tile_bits, d_sort_tmp.get(), sort_tmp, stream.get());
+    timer.mark("sort");
     cuda::launch_exact_tile_ranges(d_sorted_tile.get(), num_pairs, d_tile_begin.get(),
                                    d_tile_end.get(), num_tiles, stream.get());
+    timer.mark("ranges");
     cuda::launch_exact_tiles(m, d_lines.get(), d_sorted_beam.get(), d_tile_begin.get(),
                              d_tile_end.get(), use_tables ? d_dist.get() : nullptr,
                              use_tables ? d_ff.get() : nullptr, use_tables ? d_fo.get() : nullptr,
                              d_grid.get(), d_updates.get(), stream.get());
+    timer.mark("tiles");
     e_map.record(stream.get());
 
     std::vector<float> grid(cells);
@@ -236,6 +282,9 @@ class CudaBackend : public Backend {
                                   stream.get()));
     e_down.record(stream.get());
     stream.synchronize();
+    timer.report();
+    if (std::getenv("VASCO_CUDA_PROFILE"))
+      std::fprintf(stderr, "  [cuda] %zu beams, %u tile pairs, %zu tiles\n", nb, num_pairs, num_tiles);
     st->cell_updates = updates;
     st->upload_s = e_up.since(e0) / 1e3;
     st->map_s = e_map.since(e_up) / 1e3;
@@ -282,8 +331,9 @@ class CudaBackend : public Backend {
     Event e0, e_up, e_map, e_down;
     DeviceBuffer<cuda::FloatScan> d_scans(nscans);
     DeviceBuffer<float> d_ranges(nbeams), d_grid(cells);
-    DeviceBuffer<uint8_t> d_touched(cells);
+    DeviceBuffer<uint8_t> d_touched(options_.cuda_kernel == CudaKernel::Ours ? 0 : cells);
     DeviceBuffer<unsigned long long> d_counters(3);
+    DeviceBuffer<cuda::FloatModel> d_model(1);
 
     e0.record(stream.get());
     if (nscans)
@@ -293,12 +343,34 @@ class CudaBackend : public Backend {
       VG_CUDA_CHECK(cudaMemcpyAsync(d_ranges.get(), batch.range.data(), nbeams * sizeof(float),
                                     cudaMemcpyHostToDevice, stream.get()));
     e_up.record(stream.get());
-    VG_CUDA_CHECK(cudaMemsetAsync(d_grid.get(), 0, cells * sizeof(float), stream.get()));
-    VG_CUDA_CHECK(cudaMemsetAsync(d_touched.get(), 0, cells, stream.get()));
+    StageTimer timer(stream.get());
+    timer.mark("start");
+    const bool ours = options_.cuda_kernel == CudaKernel::Ours;
+    if (ours) {
+      cuda::launch_float_clear(d_grid.get(), cells, stream.get());
+    } else {
+      VG_CUDA_CHECK(cudaMemsetAsync(d_grid.get(), 0, cells * sizeof(float), stream.get()));
+      VG_CUDA_CHECK(cudaMemsetAsync(d_touched.get(), 0, cells, stream.get()));
+    }
+    timer.mark("clear");
     VG_CUDA_CHECK(cudaMemsetAsync(d_counters.get(), 0, 3 * sizeof(unsigned long long), stream.get()));
-    cuda::launch_float_map(m, d_scans.get(), static_cast<int>(nscans), d_ranges.get(), d_grid.get(),
-                           d_touched.get(), d_counters.get(), stream.get());
-    cuda::launch_float_finalize(m, d_grid.get(), d_touched.get(), cells, stream.get());
+    if (ours) {
+      cuda::launch_float_map(m, d_scans.get(), static_cast<int>(nscans), d_ranges.get(),
+                             d_grid.get(), d_counters.get(), stream.get());
+    } else {
+      cuda::PaperVariant v = cuda::PaperVariant::PerScan;
+      if (options_.cuda_kernel == CudaKernel::PaperPerScanNoShared) v = cuda::PaperVariant::PerScanNoShared;
+      if (options_.cuda_kernel == CudaKernel::PaperPerScanNoConst) v = cuda::PaperVariant::PerScanNoConst;
+      if (options_.cuda_kernel == CudaKernel::PaperFused) v = cuda::PaperVariant::Fused;
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_model.get(), &m, sizeof m, cudaMemcpyHostToDevice, stream.get()));
+      cuda::run_paper_variant(v, m, d_model.get(), h_scans.get(), d_scans.get(),
+                              static_cast<int>(nscans), d_ranges.get(), d_grid.get(),
+                              d_touched.get(), stream.get());
+    }
+    timer.mark("map");
+    cuda::launch_float_finalize(m, d_grid.get(), ours ? nullptr : d_touched.get(), cells,
+                                stream.get());
+    timer.mark("finalize");
     e_map.record(stream.get());
     std::vector<float> grid(cells);
     unsigned long long counters[3] = {0, 0, 0};
@@ -308,9 +380,12 @@ class CudaBackend : public Backend {
                                   stream.get()));
     e_down.record(stream.get());
     stream.synchronize();
-    st->beams_used = counters[0];
-    st->beams_skipped = counters[1];
-    st->cell_updates = counters[2];
+    timer.report();
+    if (options_.cuda_kernel == CudaKernel::Ours) {
+      st->beams_used = counters[0];
+      st->beams_skipped = counters[1];
+      st->cell_updates = counters[2];
+    }
     st->upload_s = e_up.since(e0) / 1e3;
     st->map_s = e_map.since(e_up) / 1e3;
     st->download_s = e_down.since(e_map) / 1e3;

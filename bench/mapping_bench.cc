@@ -1,0 +1,332 @@
+// mapping_bench — the benchmark harness behind `make bench` (speed claims
+// are made only through it; see README "Performance").
+//
+// For each dataset (fr079-complete.gfs: 4791 x 360; fr101.carmen full rate:
+// 4758 x 360) and parameter set (paper: range_max 6.4 m at 2.5 cm, as in the
+// paper; vasco_default_raw: vasco's defaults, see below) it runs every backend
+// — cpu_double (one core), cpu_threads (all cores, exact), cpu_float, cuda
+// float, cuda exact — a warm-up and then N timed runs, and prints the median
+// of each phase: parse, prep (host-side beam placement of the GPU backends),
+// upload, map (GPU: kernels only, CUDA events), download, finish, write
+// (.map.gz), total; cell updates per second of the map phase, and the
+// speed-up of the map phase over cpu_double and over cpu_threads measured in
+// the same run. A second table is the ablation of the paper's kernel design.
+// Without a usable GPU it runs the CPU rows and says so.
+//
+//   mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset NAME]
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "carmen_compat/map_file.h"
+#include "vasco_gpu/backend.h"
+#include "vasco_gpu/cpu_threads_backend.h"
+#include "vasco_gpu/grid.h"
+#include "vasco_gpu/params.h"
+#include "vasco_gpu/scan_batch.h"
+#if defined(VASCO_HAVE_CUDA)
+#include "vasco_gpu/cuda_backend.h"
+#endif
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double now_s() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct Dataset {
+  std::string name, path;
+};
+
+struct ParamSet {
+  std::string name;
+  vasco::MapperParams params;
+};
+
+struct BackendSpec {
+  std::string label;
+  std::string factory;  // make_backend name, or "cpu_threads"
+  vasco::BackendOptions options;
+  bool gpu = false;
+};
+
+struct Phases {
+  std::vector<double> prep, upload, map, download, finish, write, total;
+  vasco::MapStats stats;
+};
+
+struct Row {
+  std::string dataset, params, backend;
+  uint64_t scans = 0, beams = 0, updates = 0;
+  double parse = 0, prep = 0, upload = 0, map = 0, download = 0, finish = 0, write = 0, total = 0;
+};
+
+std::unique_ptr<vasco::Backend> make(const BackendSpec &spec, int threads) {
+  if (spec.factory == "cpu_threads") return vasco::make_cpu_threads_backend(threads);
+  return vasco::make_backend(spec.factory, spec.options);
+}
+
+std::string temp_map_path() {
+  const char *tmp = std::getenv("TMPDIR");
+  return std::string(tmp ? tmp : "/tmp") + "/vasco_bench_" + std::to_string(getpid()) + ".map.gz";
+}
+
+// One timed run of a backend: map, finish, write.
+void run_once(vasco::Backend &backend, const vasco::ScanBatch &batch, const vasco::MapperParams &p,
+              const vasco::GridGeometry &geo, Phases *ph) {
+  const double t0 = now_s();
+  vasco::MapStats st;
+  std::vector<float> cells = backend.map(batch, p, geo, &st);
+  const double t1 = now_s();
+  const vasco::FinishedMap fin = vasco::finish_grid(cells.data(), geo.size_x, geo.size_y,
+                                                    geo.resolution, static_cast<int>(p.downsample),
+                                                    static_cast<int>(p.border));
+  const double t2 = now_s();
+  carmen::MapFile mf;
+  carmen::GridMap g;
+  g.size_x = fin.size_x;
+  g.size_y = fin.size_y;
+  g.resolution = fin.resolution;
+  g.cells = fin.cells;
+  mf.gridmap = std::move(g);
+  const std::string out = temp_map_path();
+  carmen::write_map_file(out, mf);
+  std::remove(out.c_str());
+  const double t3 = now_s();
+  ph->prep.push_back(st.prep_s);
+  ph->upload.push_back(st.upload_s);
+  // CPU backends: the wall time of map(); GPU backends: the kernels (events).
+  ph->map.push_back(backend.name().rfind("cuda", 0) == 0 ? st.map_s : (t1 - t0));
+  ph->download.push_back(st.download_s);
+  ph->finish.push_back(t2 - t1);
+  ph->write.push_back(t3 - t2);
+  ph->total.push_back(t3 - t0);
+  ph->stats = st;
+}
+
+void print_rule(int width) { std::printf("%s\n", std::string(width, '-').c_str()); }
+
+std::string ms(double s) {
+  char b[32];
+  if (s <= 0) return "-";
+  if (s < 0.01) std::snprintf(b, sizeof b, "%.2f", s * 1e3);
+  else if (s < 1) std::snprintf(b, sizeof b, "%.1f", s * 1e3);
+  else std::snprintf(b, sizeof b, "%.0f", s * 1e3);
+  return b;
+}
+
+// Wall time of a whole log2map process (start to file written), median of runs.
+double log2map_wall(const std::string &bin, const std::string &log, const std::string &backend,
+                    int runs) {
+  std::vector<double> t;
+  const std::string out = temp_map_path();
+  const std::string cmd =
+      bin + " --quiet --backend " + backend + " " + log + " " + out + " > /dev/null 2>&1";
+  for (int i = 0; i < runs + 1; ++i) {
+    const double t0 = now_s();
+    const int rc = std::system(cmd.c_str());
+    const double t1 = now_s();
+    std::remove(out.c_str());
+    if (rc != 0) return -1;
+    if (i > 0) t.push_back(t1 - t0);
+  }
+  return median(t);
+}
+
+std::string self_dir(const char *argv0) {
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  std::string p = n > 0 ? std::string(buf, static_cast<size_t>(n)) : std::string(argv0);
+  const size_t s = p.find_last_of('/');
+  return s == std::string::npos ? "." : p.substr(0, s);
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  int runs = 5, threads = 0;
+  bool ablation = true;
+  std::string only;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--runs" && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--quick") runs = 1;
+    else if (a == "--threads" && i + 1 < argc) threads = std::atoi(argv[++i]);
+    else if (a == "--no-ablation") ablation = false;
+    else if (a == "--dataset" && i + 1 < argc) only = argv[++i];
+    else {
+      std::fprintf(stderr, "usage: mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset fr079|fr101]\n");
+      return 2;
+    }
+  }
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+
+  const std::string src = VASCO_SOURCE_DIR;
+  const std::vector<Dataset> datasets = {{"fr079", src + "/logs/fr079-complete.gfs.log.gz"},
+                                         {"fr101", src + "/logs/fr101.carmen.log.gz"}};
+  vasco::MapperParams paper;
+  paper.range_max = 6.4;  // the paper's setting, at vasco's 2.5 cm cells
+  const std::vector<ParamSet> param_sets = {{"paper", paper},
+                                            {"vasco_default_raw", vasco::MapperParams{}}};
+
+  bool gpu = false;
+  std::string gpu_desc = "none";
+  double cuda_init_s = 0;
+#if defined(VASCO_HAVE_CUDA)
+  {
+    const double t0 = now_s();
+    std::string why;
+    gpu = vasco::cuda_usable(0, &why);
+    cuda_init_s = now_s() - t0;
+    gpu_desc = gpu ? vasco::cuda_device_description(0) : "none (" + why + ")";
+  }
+#else
+  gpu_desc = "none (built without CUDA)";
+#endif
+
+  std::vector<BackendSpec> specs = {{"cpu_double", "cpu_double", {}, false},
+                                    {"cpu_threads", "cpu_threads", {}, false},
+                                    {"cpu_float", "cpu_float", {}, false}};
+  if (gpu) {
+    vasco::BackendOptions f, e;
+    e.cuda_mode = vasco::CudaMode::Exact;
+    specs.push_back({"cuda float", "cuda", f, true});
+    specs.push_back({"cuda exact", "cuda", e, true});
+  }
+
+  std::printf("vasco_gpu mapping_bench: median of %d runs after a warm-up; times in ms\n", runs);
+  std::printf("CPU threads: %d; GPU: %s", threads, gpu_desc.c_str());
+  if (gpu) std::printf(" (CUDA context start-up %.0f ms, not in the rows)", cuda_init_s * 1e3);
+  std::printf("\n");
+  if (!gpu) std::printf("No usable GPU: CPU rows only.\n");
+
+  std::vector<Row> rows;
+  std::map<std::string, std::vector<std::pair<std::string, double>>> ablation_rows;
+  for (const Dataset &ds : datasets) {
+    if (!only.empty() && ds.name != only) continue;
+    if (access(ds.path.c_str(), R_OK) != 0) {
+      std::printf("%s: %s not found, skipped\n", ds.name.c_str(), ds.path.c_str());
+      continue;
+    }
+    for (const ParamSet &ps : param_sets) {
+      // Parse: the same for every backend.
+      std::vector<double> parse_t;
+      vasco::ScanBatch batch;
+      for (int r = 0; r < runs + 1; ++r) {
+        vasco::LogLoadStats ls;
+        const double t0 = now_s();
+        batch = vasco::load_scans(ds.path, ps.params, carmen::LogReaderOptions{}, &ls);
+        if (r > 0) parse_t.push_back(now_s() - t0);
+      }
+      const vasco::GridGeometry geo = vasco::size_grid(batch, ps.params);
+      std::fprintf(stderr, "%s / %s: %zu scans, grid %d x %d\n", ds.name.c_str(), ps.name.c_str(),
+                   batch.num_scans(), geo.size_x, geo.size_y);
+      for (const BackendSpec &spec : specs) {
+        std::fprintf(stderr, "  %s ...\n", spec.label.c_str());
+        auto backend = make(spec, threads);
+        Phases ph, warm;
+        run_once(*backend, batch, ps.params, geo, &warm);
+        for (int r = 0; r < runs; ++r) run_once(*backend, batch, ps.params, geo, &ph);
+        Row row;
+        row.dataset = ds.name;
+        row.params = ps.name;
+        row.backend = spec.label;
+        row.scans = batch.num_scans();
+        row.beams = ph.stats.beams_used;
+        row.updates = ph.stats.cell_updates;
+        row.parse = median(parse_t);
+        row.prep = median(ph.prep);
+        row.upload = median(ph.upload);
+        row.map = median(ph.map);
+        row.download = median(ph.download);
+        row.finish = median(ph.finish);
+        row.write = median(ph.write);
+        row.total = row.parse + median(ph.total);
+        rows.push_back(row);
+      }
+#if defined(VASCO_HAVE_CUDA)
+      if (gpu && ablation) {
+        const std::pair<const char *, vasco::CudaKernel> variants[] = {
+            {"paper: launch per scan, beam data in shared, params in constant", vasco::CudaKernel::PaperPerScan},
+            {"  - without shared memory (each thread places the beam)", vasco::CudaKernel::PaperPerScanNoShared},
+            {"  - without constant memory (params from global)", vasco::CudaKernel::PaperPerScanNoConst},
+            {"  + all scans fused into one launch", vasco::CudaKernel::PaperFused},
+            {"ours: warp per beam, block per scan, one launch", vasco::CudaKernel::Ours}};
+        for (const auto &v : variants) {
+          vasco::BackendOptions o;
+          o.cuda_kernel = v.second;
+          auto backend = vasco::make_backend("cuda", o);
+          Phases ph, warm;
+          run_once(*backend, batch, ps.params, geo, &warm);
+          for (int r = 0; r < runs; ++r) run_once(*backend, batch, ps.params, geo, &ph);
+          ablation_rows[ds.name + " / " + ps.name].push_back({v.first, median(ph.map)});
+        }
+      }
+#endif
+    }
+  }
+
+  // The table.
+  const int width = 176;
+  print_rule(width);
+  std::printf("%-6s %-17s %-11s %5s %8s %10s %7s %7s %7s %8s %8s %7s %6s %8s %9s %8s %8s\n", "data",
+              "params", "backend", "scans", "beams", "updates", "parse", "prep", "upload", "map",
+              "download", "finish", "write", "total", "Mupd/s", "x1core", "xthreads");
+  print_rule(width);
+  for (const Row &r : rows) {
+    double base = 0, threads_map = 0;
+    for (const Row &o : rows)
+      if (o.dataset == r.dataset && o.params == r.params) {
+        if (o.backend == "cpu_double") base = o.map;
+        if (o.backend == "cpu_threads") threads_map = o.map;
+      }
+    std::printf("%-6s %-17s %-11s %5llu %8llu %10llu %7s %7s %7s %8s %8s %7s %6s %8s %9.0f %8.1f %8.1f\n",
+                r.dataset.c_str(), r.params.c_str(), r.backend.c_str(), (unsigned long long)r.scans,
+                (unsigned long long)r.beams, (unsigned long long)r.updates, ms(r.parse).c_str(),
+                ms(r.prep).c_str(), ms(r.upload).c_str(), ms(r.map).c_str(), ms(r.download).c_str(),
+                ms(r.finish).c_str(), ms(r.write).c_str(), ms(r.total).c_str(),
+                r.map > 0 ? r.updates / r.map / 1e6 : 0.0, r.map > 0 ? base / r.map : 0.0,
+                r.map > 0 ? threads_map / r.map : 0.0);
+  }
+  print_rule(width);
+  std::printf("map = the update itself: CPU rows wall time; GPU rows kernels only (CUDA events),\n"
+              "with host-side beam placement under prep. total = parse + prep + upload + map +\n"
+              "download + finish + write. x1core / xthreads: map-phase speed-up over cpu_double\n"
+              "and over cpu_threads on the same data in this run.\n");
+
+  if (!ablation_rows.empty()) {
+    std::printf("\nAblation of the paper's kernel (float, no lost updates), map phase in ms:\n");
+    for (const auto &kv : ablation_rows) {
+      std::printf("  %s\n", kv.first.c_str());
+      for (const auto &v : kv.second) std::printf("    %-66s %9s\n", v.first.c_str(), ms(v.second).c_str());
+    }
+  }
+
+  // End to end: a whole log2map process on fr079 to .map.gz.
+  const std::string log2map = self_dir(argv[0]) + "/log2map";
+  if (access(log2map.c_str(), X_OK) == 0 && (only.empty() || only == "fr079")) {
+    std::printf("\nlog2map end to end (process start to .map.gz written), fr079, median of %d:\n", runs);
+    for (const char *b : {"cpu_double", "auto"}) {
+      const double t = log2map_wall(log2map, datasets[0].path, b, runs);
+      std::printf("  --backend %-10s %8s ms\n", b, t < 0 ? "failed" : ms(t).c_str());
+    }
+  }
+  return 0;
+}

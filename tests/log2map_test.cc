@@ -1,0 +1,169 @@
+// The log2map tool, run as a program: outputs, exit codes, messages.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/map_file.h"
+#include "map_test_support.h"
+#include "test_support.h"
+
+namespace {
+
+using maptest::TempDir;
+
+struct ToolRun {
+  int status = -1;
+  std::string output;  // stdout and stderr
+};
+
+std::string quote(const std::string &s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+ToolRun log2map(const std::vector<std::string> &args, bool with_stderr = true) {
+  std::string cmd = quote(std::string(VASCO_BIN_DIR) + "/log2map");
+  for (const std::string &a : args) cmd += " " + quote(a);
+  cmd += with_stderr ? " 2>&1" : " 2>/dev/null";
+  ToolRun r;
+  FILE *p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+bool contains(const std::string &s, const std::string &part) { return s.find(part) != std::string::npos; }
+
+const std::string kIntel = std::string(VASCO_LOGS_DIR) + "/intel.gfs.log.gz";
+
+std::string write_text(const TempDir &dir, const std::string &name, const std::string &text) {
+  const std::string path = dir.file(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(Log2Map, VersionNamesTheBackends) {
+  const ToolRun r = log2map({"--version"});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_TRUE(contains(r.output, "cpu_double")) << r.output;
+  EXPECT_TRUE(contains(r.output, "cpu_float")) << r.output;
+}
+
+TEST(Log2Map, UsageErrorsExitTwo) {
+  TempDir dir;
+  EXPECT_EQ(log2map({}).status, 2);
+  EXPECT_EQ(log2map({kIntel}).status, 2);
+  EXPECT_EQ(log2map({"--no-such-flag", kIntel, dir.file("a.map")}).status, 2);
+  EXPECT_EQ(log2map({"--backend", "gpu9000", kIntel, dir.file("a.map")}).status, 2);
+  const ToolRun ext = log2map({kIntel, dir.file("a.jpeg")});
+  EXPECT_EQ(ext.status, 2);
+  EXPECT_TRUE(contains(ext.output, "a.jpeg")) << ext.output;
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(Log2Map, WritesEveryFormatAndTheMapIsTheOraclesFinishedGrid) {
+  TempDir dir;
+  const ToolRun r = log2map({"--backend", "cpu_double", "--json", kIntel, dir.file("m.map.gz"),
+                             dir.file("m.pgm"), dir.file("m.png"), dir.file("plain.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"m.map.gz", "m.pgm", "m.png", "m.yaml", "plain.map"}));
+  EXPECT_TRUE(contains(r.output, "\"cell_updates\":")) << r.output;
+  EXPECT_TRUE(contains(r.output, "910 scans")) << r.output;
+
+  // The GRIDMAP equals finish(cpu_double) computed here, in process.
+  const vasco::MapperParams params;
+  const auto log = vasco::testing_support::load_log(kIntel, params);
+  const auto cells = vasco::make_cpu_double_backend()->map(log.batch, params, log.geo, nullptr);
+  const auto fin = vasco::finish_grid(cells.data(), log.geo.size_x, log.geo.size_y, log.geo.resolution,
+                                      4, 20);
+  for (const char *name : {"m.map.gz", "plain.map"}) {
+    const carmen::MapFile mf = carmen::read_map_file(dir.file(name));
+    ASSERT_TRUE(mf.gridmap.has_value());
+    EXPECT_EQ(mf.gridmap->size_x, fin.size_x);
+    EXPECT_EQ(mf.gridmap->size_y, fin.size_y);
+    EXPECT_FLOAT_EQ(static_cast<float>(mf.gridmap->resolution), 0.1f);
+    EXPECT_TRUE(mf.gridmap->cells == fin.cells) << name;
+    ASSERT_TRUE(mf.offset.has_value());
+    // OFFSET: the world position of cell (0,0)'s corner (first pose + crop).
+    EXPECT_NEAR(mf.offset->x, log.geo.world_x(fin.min_x * 4.0), 1e-9);
+    EXPECT_NEAR(mf.offset->y, log.geo.world_y(fin.min_y * 4.0), 1e-9);
+    ASSERT_TRUE(mf.creator.has_value());
+    EXPECT_EQ(mf.creator->origin, "intel.gfs.log.gz");
+  }
+  const std::string yaml = maptest::read_bytes(dir.file("m.yaml"));
+  EXPECT_TRUE(contains(yaml, "image: m.pgm")) << yaml;
+  EXPECT_TRUE(contains(yaml, "resolution: 0.1")) << yaml;
+}
+
+TEST(Log2Map, BadLogNamesFileAndLineAndLeavesNoOutput) {
+  TempDir dir;
+  const std::string log = write_text(dir, "bad.log",
+                                     "FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1.0 host 1.0\n"
+                                     "FLASER 3 1.0 abc 3.0 0 0 0 0 0 0 1.0 host 1.0\n");
+  const ToolRun r = log2map({log, dir.file("out.map"), dir.file("out.png")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(contains(r.output, "bad.log:2:")) << r.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"bad.log"}));
+  // Lenient: the bad line is skipped and reported, the map is written.
+  const ToolRun l = log2map({"--lenient", log, dir.file("out.map")});
+  EXPECT_EQ(l.status, 0) << l.output;
+  EXPECT_TRUE(contains(l.output, "skipped 1 bad line")) << l.output;
+}
+
+TEST(Log2Map, MissingLogIsAnError) {
+  TempDir dir;
+  const ToolRun r = log2map({dir.file("nope.log.gz"), dir.file("out.map")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(contains(r.output, "nope.log.gz")) << r.output;
+}
+
+TEST(Log2Map, ParameterErrorsNameTheKeyAndWhere) {
+  TempDir dir;
+  const ToolRun cli = log2map({"--vasco_p_occ", "1.5", kIntel, dir.file("o.map")});
+  EXPECT_EQ(cli.status, 1);
+  EXPECT_TRUE(contains(cli.output, "vasco_p_occ")) << cli.output;
+  const std::string ini = write_text(dir, "bad.ini", "[*]\nvasco_resolution 0.05\nvasco_range_sure 20\n");
+  const ToolRun f = log2map({"--param-file", ini, kIntel, dir.file("o.map")});
+  EXPECT_EQ(f.status, 1);
+  EXPECT_TRUE(contains(f.output, "bad.ini:3")) << f.output;
+  EXPECT_TRUE(contains(f.output, "vasco_range_sure")) << f.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"bad.ini"}));
+}
+
+TEST(Log2Map, TyposInTheIniAreWarnedAbout) {
+  TempDir dir;
+  const std::string ini = write_text(dir, "typo.ini", "[*]\nvasco_p_ocupied 0.7\n");
+  const ToolRun r = log2map({"--param-file", ini, "--vasco_num_scans", "20", kIntel, dir.file("o.map")});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "typo.ini:2")) << r.output;
+  EXPECT_TRUE(contains(r.output, "vasco_p_ocupied")) << r.output;
+  EXPECT_TRUE(contains(r.output, "20 scans")) << r.output;
+}
+
+TEST(Log2Map, UnwritableOutputFailsBeforeAnyWork) {
+  TempDir dir;
+  const ToolRun r = log2map({kIntel, dir.file("ok.map"), dir.file("no/such/dir/x.png")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(contains(r.output, "x.png")) << r.output;
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(Log2Map, CudaWithoutAGpuIsAClearError) {
+  TempDir dir;
+  const ToolRun v = log2map({"--backend", "cuda", "--vasco_num_scans", "5", kIntel, dir.file("o.map")});
+  if (v.status == 0) GTEST_SKIP() << "a GPU is usable here: this checks the no-GPU error";
+  EXPECT_EQ(v.status, 1);
+  EXPECT_TRUE(contains(v.output, "--backend cuda")) << v.output;
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+}  // namespace

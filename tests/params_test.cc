@@ -1,0 +1,105 @@
+// MapperParams: defaults, reading vasco_* keys, validation with locations.
+#include "vasco_gpu/params.h"
+
+#include <gtest/gtest.h>
+
+#include "carmen_compat/error.h"
+#include "carmen_compat/ini_file.h"
+
+namespace vasco {
+namespace {
+
+MapperParams from_text(const std::string &text, std::vector<std::string> *warnings = nullptr) {
+  return MapperParams::from_params(carmen::ParamFile::parse(text, "test.ini"), warnings);
+}
+
+TEST(MapperParams, DefaultsAreVascos) {
+  const MapperParams p = from_text("[*]\n");
+  EXPECT_EQ(p.resolution, 0.025);
+  EXPECT_EQ(p.p_prior, 0.5);
+  EXPECT_EQ(p.p_occ, 0.55);
+  EXPECT_EQ(p.p_emp, 0.45);
+  EXPECT_EQ(p.range_sure, 5.0);
+  EXPECT_EQ(p.range_max, 10.0);
+  EXPECT_EQ(p.wall_size, 0.2);
+  EXPECT_EQ(p.downsample, 4);
+  EXPECT_EQ(p.border, 20);
+  EXPECT_EQ(p.table_size(), 400);
+}
+
+TEST(MapperParams, ReadsEveryKey) {
+  const MapperParams p = from_text(
+      "[*]\nvasco_resolution 0.05\nvasco_p_prior 0.4\nvasco_p_occ 0.9\nvasco_p_emp 0.2\n"
+      "vasco_range_sure 3\nvasco_range_max 6.4\nvasco_wall_size 0.1\nvasco_downsample 2\n"
+      "vasco_border 5\nvasco_first_scan 10\nvasco_num_scans 7\n");
+  EXPECT_EQ(p.resolution, 0.05);
+  EXPECT_EQ(p.p_prior, 0.4);
+  EXPECT_EQ(p.p_occ, 0.9);
+  EXPECT_EQ(p.p_emp, 0.2);
+  EXPECT_EQ(p.range_sure, 3.0);
+  EXPECT_EQ(p.range_max, 6.4);
+  EXPECT_EQ(p.wall_size, 0.1);
+  EXPECT_EQ(p.downsample, 2);
+  EXPECT_EQ(p.border, 5);
+  EXPECT_EQ(p.first_scan, 10);
+  EXPECT_EQ(p.num_scans, 7);
+  EXPECT_EQ(p.table_size(), 128);
+}
+
+void expect_error_at(const std::string &text, const std::string &where, const std::string &key) {
+  try {
+    from_text(text);
+    FAIL() << "expected an error for " << text;
+  } catch (const carmen::FileError &e) {
+    EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+  }
+}
+
+TEST(MapperParams, ValidationNamesKeyAndLine) {
+  expect_error_at("[*]\nvasco_p_occ 1.0\n", "test.ini:2", "vasco_p_occ");
+  expect_error_at("[*]\n\nvasco_p_emp 0\n", "test.ini:3", "vasco_p_emp");
+  expect_error_at("[*]\nvasco_p_prior -0.2\n", "test.ini:2", "vasco_p_prior");
+  expect_error_at("[*]\nvasco_resolution 0\n", "test.ini:2", "vasco_resolution");
+  expect_error_at("[*]\nvasco_range_sure 11\n", "test.ini:2", "vasco_range_sure");
+  expect_error_at("[*]\nvasco_range_max -1\n", "test.ini:2", "vasco_range_max");
+  expect_error_at("[*]\nvasco_downsample 0\n", "test.ini:2", "vasco_downsample");
+  expect_error_at("[*]\nvasco_border -1\n", "test.ini:2", "vasco_border");
+  expect_error_at("[*]\nvasco_resolution abc\n", "test.ini:2", "vasco_resolution");
+}
+
+TEST(MapperParams, RangeSureMayEqualRangeMaxAndZeroIsAllowed) {
+  EXPECT_NO_THROW(from_text("[*]\nvasco_range_sure 10\n"));
+  EXPECT_NO_THROW(from_text("[*]\nvasco_range_sure 0\nvasco_range_max 0\n"));
+  EXPECT_NO_THROW(from_text("[*]\nvasco_border 0\nvasco_downsample 1\n"));
+}
+
+TEST(MapperParams, AbsurdTableIsRefused) {
+  // range_max / resolution over 32767 cells: the distance table alone would be
+  // gigabytes (and CARMEN's int i*i + j*j overflows).
+  expect_error_at("[*]\nvasco_resolution 0.0001\n", "test.ini:2", "vasco_resolution");
+}
+
+TEST(MapperParams, OverridesWinAndErrorsSayCommandLine) {
+  carmen::ParamFile f = carmen::ParamFile::parse("[*]\nvasco_p_occ 0.7\n", "test.ini");
+  f.set_override("vasco_p_occ", "0.8");
+  EXPECT_EQ(MapperParams::from_params(f, nullptr).p_occ, 0.8);
+  f.set_override("vasco_p_occ", "2");
+  try {
+    MapperParams::from_params(f, nullptr);
+    FAIL();
+  } catch (const std::exception &e) {
+    EXPECT_NE(std::string(e.what()).find("command line"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MapperParams, UnknownVascoKeysAreWarnedButCarmensOwnAreNot) {
+  std::vector<std::string> w;
+  from_text("[*]\nvasco_p_ocupied 0.6\nvasco_max_usable_laser_range 81.9\nvasco_local_map_resolution 0.08\n", &w);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("test.ini:2"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("vasco_p_ocupied"), std::string::npos) << w[0];
+}
+
+}  // namespace
+}  // namespace vasco

@@ -1,0 +1,546 @@
+// cpu_threads: the oracle's result (cpu_double, DESIGN §2) on all cores, bit
+// for bit.
+//
+// The scheme. The grid is cut into stripes of whole x columns (contiguous
+// memory, as the grid is x-major); a thread owns one stripe at a time. Stripes
+// are handed out dynamically, several per thread, cut so that they carry about
+// equal estimated work.
+//   1. Scans are placed in order with oracle::scan_start (the first call fixes
+//      the start pose).
+//   2. In parallel over scans, every used beam's end cell comes from
+//      oracle::beam_end, its angle from oracle::SteppedAngles (repeated
+//      addition, skipped beams included): the oracle's own code.
+//   3. Per beam, the x range of the cells it can update — the steps
+//      k <= k_max = min(major_len, table_size - 1) that the oracle walks — and
+//      for every stripe the list of beams whose range meets it, in (scan, beam)
+//      order. Lines that fail egrid::is_closed_form_line (degenerate, e.g.
+//      from a range of -inf) are listed in every stripe.
+//   4. Each stripe walks its beams in list order and applies the updates whose
+//      cell lies in the stripe, with the oracle's walker, sensor model and
+//      odds update (egrid_math.h).
+//
+// Why this equals the oracle.
+//  * Per cell, the oracle's result is the cell's updates applied in (scan,
+//    beam) order: a beam visits a cell at most once (the major coordinate
+//    strictly moves), and no update reads another cell. Here a cell is written
+//    by the one thread that holds its stripe, and a stripe applies its beams
+//    in (scan, beam) order; so it suffices that each stripe applies, for each
+//    beam, exactly the oracle's updates that fall in it.
+//  * The oracle (oracle::trace_beam) updates, among the steps k <= k_max, the
+//    in-grid cells before the first in-grid cell whose distance d makes
+//    sensor_model refuse (the "stop"). Stopping depends on d only and is
+//    monotone: it happens iff !(d < sure) && !(d < max), so if d stops, every
+//    d' >= d stops too.
+//  * Closed-form lines (|dx|, |dy| < 2^29): every cell lies between two ints,
+//    so nothing wraps; x and y each move monotonically (the major coordinate
+//    by inc every step, the minor by 0 or inc), starting at (x1, y1). Hence
+//    i = |cx - x1| and j = |cy - y1| never decrease, and i, j <= k < table_size,
+//    so d = sqrt((double)(i*i + j*j)) * res (the table's value; correctly
+//    rounded sqrt and product are monotone) never decreases along the walk.
+//    So the oracle's update set is simply {k <= k_max : cell in grid, d does
+//    not stop}, and within a stripe the first in-grid cell that stops is
+//    followed only by cells that stop: the stripe may break there.
+//    A stripe starts the walk at the first step k0 whose x is in the stripe:
+//    x changes by at most one per step, so |cx - x1| = M is reached first
+//    where M is the distance from x1 to the stripe's near edge; for a
+//    non-steep line k0 = M, for a steep one the closed form of the minor
+//    offset (line_minor_offset: floor((2bk + a - [inc < 0]) / 2a) >= M) gives
+//    k0 = ceil((2aM - a + [inc < 0]) / 2b). The walker's state after k0 steps
+//    with m = line_minor_offset(k0) diagonal steps is x + k0*inc,
+//    y + m*inc, D + (k0 - m)*E + m*NE (mod 2^32, as the sequential walk adds
+//    them), so the walk from k0 on is the oracle's walk, step for step; it
+//    leaves the stripe for good at the first cell beyond it (x is monotone).
+//  * Degenerate lines are walked exactly as oracle::trace_beam walks them, from
+//    step 0, stopping at the oracle's stop, in every stripe; each applies only
+//    the updates in its own columns. No monotonicity is needed there.
+//  * The per-(i, j) odds factors, when tabulated, are odds_factor(prior, p)
+//    with p = sensor_model(d, +inf) for d < range and sensor_model(d, -inf)
+//    otherwise — the same p (sensor_model uses r only through d < r), and
+//    odds_apply(cell, prior, odds_factor(prior, p)) is odds_update bit for bit.
+//  * Counts: each oracle update is applied in exactly one stripe.
+#include "vasco_gpu/cpu_threads_backend.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "vasco_gpu/oracle.h"
+
+namespace vasco {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Stripes per thread: enough slack for the dynamic hand-out to even out the
+// estimate's errors, few enough that a beam rarely spans many stripes.
+constexpr int kStripesPerThread = 4;
+// The per-column work histogram has at most this many buckets.
+constexpr int kMaxBuckets = 1 << 16;
+// Odds-factor tables only when small (as in the CUDA exact mode).
+constexpr int64_t kMaxTableEntries = int64_t(1) << 22;
+
+// Runs fn(t) for t in [0, n), fn(0) on the calling thread; rethrows the first
+// exception.
+template <class Fn>
+void run_on_threads(int n, Fn &&fn) {
+  if (n <= 1) {
+    fn(0);
+    return;
+  }
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto body = [&](int t) {
+    try {
+      fn(t);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  pool.reserve(static_cast<size_t>(n - 1));
+  try {
+    for (int t = 1; t < n; ++t) pool.emplace_back(body, t);
+  } catch (...) {
+    for (auto &th : pool) th.join();
+    throw;
+  }
+  body(0);
+  for (auto &th : pool) th.join();
+  if (error) std::rethrow_exception(error);
+}
+
+// A used beam, in (scan, beam) order.
+struct Beam {
+  int x2, y2;        // end cell (oracle::beam_end)
+  int x_lo, x_hi;    // columns its walk can update (clipped to the grid); x_lo > x_hi: none
+  float range;
+  uint32_t scan;
+  uint32_t degenerate;  // fails egrid::is_closed_form_line: every stripe, walked from step 0
+};
+
+// What a cell i, j cells from the start gets (when tabulated).
+struct Entry {
+  double d;                // the distance table's value
+  double f_free, f_occ;    // odds_factor(prior, p) for d < range, resp. not
+  int32_t stop;            // sensor_model refuses d: the oracle stops the beam
+};
+
+struct Context {
+  float *cells;
+  int size_x, size_y;
+  int table_size;
+  double resolution;
+  egrid::ModelParams model;
+  const Entry *table;      // null: computed on the fly
+};
+
+// The odds factor of a cell i, j cells from the start (0 <= i, j <
+// table_size) for a beam of range `range`; false where the oracle stops.
+inline bool evidence(const Context &c, int i, int j, double range, double *factor) {
+  if (c.table != nullptr) {
+    const Entry &e = c.table[static_cast<size_t>(i) * static_cast<size_t>(c.table_size) + j];
+    if (e.stop) return false;
+    *factor = e.d < range ? e.f_free : e.f_occ;
+    return true;
+  }
+  const double d = egrid::cell_distance(i, j, c.resolution);
+  double p;
+  if (!egrid::sensor_model(c.model, d, range, &p)) return false;
+  *factor = egrid::odds_factor(c.model.prior, p);
+  return true;
+}
+
+// Fills b.x_lo, b.x_hi, b.degenerate from the start cell and b.x2, b.y2;
+// returns the estimated work per column (steps walked / columns spanned).
+double place_beam(Beam &b, const oracle::ScanStart &s, int size_x, int size_y, int table_size) {
+  b.degenerate = 0;
+  b.x_lo = 0;
+  b.x_hi = -1;
+  if (table_size <= 0) return 0;  // the oracle's walk loop does not run
+  if (!egrid::is_closed_form_line(s.x1, s.y1, b.x2, b.y2)) {
+    b.degenerate = 1;
+    b.x_hi = size_x - 1;
+    return 0;
+  }
+  const egrid::LineParams p = egrid::line_params(s.x1, s.y1, b.x2, b.y2);
+  const int k_max = std::min(p.major_len, table_size - 1);
+  int ex, ey;
+  egrid::line_cell(p, k_max, &ex, &ey);
+  // x and y move monotonically from (x1, y1) to (ex, ey).
+  const int y_lo = std::min(s.y1, ey), y_hi = std::max(s.y1, ey);
+  if (y_hi < 0 || y_lo >= size_y) return 0;
+  const int x_lo = std::min(s.x1, ex), x_hi = std::max(s.x1, ex);
+  b.x_lo = std::max(x_lo, 0);
+  b.x_hi = std::min(x_hi, size_x - 1);
+  return static_cast<double>(k_max + 1) / (static_cast<double>(x_hi) - x_lo + 1);
+}
+
+// Applies, of a closed-form beam's updates, those in columns [xa, xb).
+uint64_t walk_closed(const Context &c, const Beam &b, const oracle::ScanStart &s, int xa, int xb) {
+  const int x1 = s.x1, y1 = s.y1;
+  const egrid::LineParams p = egrid::line_params(x1, y1, b.x2, b.y2);
+  const int k_max = std::min(p.major_len, c.table_size - 1);
+  // M: columns between x1 and the stripe's near edge; k0: first step that far.
+  const int64_t M = x1 < xa ? int64_t(xa) - x1 : (x1 >= xb ? int64_t(x1) - (xb - 1) : 0);
+  int64_t k0 = 0;
+  if (M > 0) {
+    if (!p.steep) {
+      k0 = M;
+    } else {
+      if (p.b == 0) return 0;  // x never moves (binning never sends this)
+      const int64_t need = 2 * static_cast<int64_t>(p.a) * M - p.a + (p.inc < 0 ? 1 : 0);
+      const int64_t two_b = 2 * static_cast<int64_t>(p.b);
+      k0 = need <= 0 ? 0 : (need + two_b - 1) / two_b;
+    }
+  }
+  if (k0 > k_max) return 0;  // does not reach the stripe (binning never sends this)
+  egrid::BresenhamLine l;
+  egrid::bresenham_init(l, x1, y1, b.x2, b.y2);
+  if (k0 > 0) {
+    const int k = static_cast<int>(k0);
+    const int m = egrid::line_minor_offset(p, k);
+    l.x = egrid::wrap_add(l.x, egrid::wrap_mul(k, l.inc));
+    l.y = egrid::wrap_add(l.y, egrid::wrap_mul(m, l.inc));
+    l.d = egrid::wrap_add(l.d, egrid::wrap_add(egrid::wrap_mul(k - m, l.incr_e),
+                                               egrid::wrap_mul(m, l.incr_ne)));
+  }
+  const double range = b.range;
+  uint64_t updates = 0;
+  for (int k = static_cast<int>(k0);; ++k) {
+    int cx, cy;
+    egrid::bresenham_current(l, &cx, &cy);
+    if (cx < xa || cx >= xb) {
+      // The first cell must be in the stripe; a later one beyond it means the
+      // walk has passed the stripe for good.
+      if (k == k0) throw std::logic_error("cpu_threads: a walk does not enter its stripe");
+      break;
+    }
+    if (cy >= 0 && cy < c.size_y) {
+      const int i = egrid::wrap_abs(egrid::wrap_sub(cx, x1));
+      const int j = egrid::wrap_abs(egrid::wrap_sub(cy, y1));
+      double factor;
+      if (!evidence(c, i, j, range, &factor)) break;  // and every later cell stops too
+      float &cell = c.cells[static_cast<size_t>(cx) * static_cast<size_t>(c.size_y) + cy];
+      cell = egrid::odds_apply(cell, c.model.prior, factor);
+      ++updates;
+    }
+    if (k >= k_max) break;
+    egrid::bresenham_next(l);
+  }
+  return updates;
+}
+
+// oracle::trace_beam, applying only the updates in columns [xa, xb).
+uint64_t walk_degenerate(const Context &c, const Beam &b, const oracle::ScanStart &s, int xa, int xb) {
+  const int x1 = s.x1, y1 = s.y1, T = c.table_size;
+  const double range = b.range;
+  egrid::BresenhamLine l;
+  egrid::bresenham_init(l, x1, y1, b.x2, b.y2);
+  uint64_t updates = 0;
+  for (int k = 0; k < T; ++k) {
+    int cx, cy;
+    egrid::bresenham_current(l, &cx, &cy);
+    if (cx >= 0 && cx < c.size_x && cy >= 0 && cy < c.size_y) {
+      const int i = egrid::wrap_abs(egrid::wrap_sub(cx, x1));
+      const int j = egrid::wrap_abs(egrid::wrap_sub(cy, y1));
+      double d;
+      if (i >= T || j >= T || i < 0 || j < 0) {
+        d = egrid::kFarDistance;
+      } else {
+        d = egrid::cell_distance(i, j, c.resolution);
+      }
+      double p;
+      if (!egrid::sensor_model(c.model, d, range, &p)) break;
+      if (cx >= xa && cx < xb) {
+        float &cell = c.cells[static_cast<size_t>(cx) * static_cast<size_t>(c.size_y) + cy];
+        cell = egrid::odds_update(cell, c.model.prior, p);
+        ++updates;
+      }
+    }
+    if (!egrid::bresenham_next(l)) break;
+  }
+  return updates;
+}
+
+class CpuThreadsBackend : public Backend {
+ public:
+  explicit CpuThreadsBackend(int threads)
+      : threads_(threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))) {}
+
+  std::string name() const override { return "cpu_threads"; }
+
+  const CpuThreadsLoad *load() const { return has_load_ ? &load_ : nullptr; }
+
+  std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
+                         const GridGeometry &geo, MapStats *stats) override {
+    const auto t0 = Clock::now();
+    const int nt = threads_;
+    const size_t ns = batch.num_scans();
+    const int size_x = geo.size_x, size_y = geo.size_y;
+    const int T = params.table_size();
+    MapStats st;
+    st.scans = ns;
+
+    // 1. Scans, placed in order.
+    std::vector<oracle::ScanStart> starts(ns);
+    {
+      oracle::GridFrame frame;
+      frame.size_x = size_x;
+      frame.size_y = size_y;
+      frame.resolution = geo.resolution;
+      frame.theta_offset = geo.theta_offset;
+      for (size_t s = 0; s < ns; ++s)
+        starts[s] = oracle::scan_start(frame, batch.x[s], batch.y[s], batch.theta[s]);
+    }
+    std::vector<uint64_t> used_before(ns + 1, 0);
+    for (size_t s = 0; s < ns; ++s) {
+      const float *r = batch.ranges_of(s);
+      uint64_t used = 0;
+      for (int k = 0; k < batch.beams_in(s); ++k) used += oracle::beam_used(r[k]) ? 1 : 0;
+      used_before[s + 1] = used_before[s] + used;
+    }
+    const uint64_t nb = used_before.back();
+    st.beams_used = nb;
+    st.beams_skipped = batch.num_beams() - nb;
+    if (nb > std::numeric_limits<uint32_t>::max())
+      throw std::runtime_error("cpu_threads: more than 2^32 used beams");
+
+    std::vector<float> cells(geo.num_cells(), egrid::kUnknown);
+    CpuThreadsLoad load;
+    load.threads = nt;
+    load.thread_updates.assign(nt, 0);
+    load.thread_busy_s.assign(nt, 0);
+    if (size_x <= 0 || size_y <= 0 || nb == 0 || T <= 0) {
+      st.prep_s = seconds_since(t0);
+      st.map_s = st.prep_s;
+      finish(stats, st, std::move(load));
+      return cells;
+    }
+
+    // 2. End cells and x ranges, in parallel over scans; a per-column work
+    //    histogram (difference array over buckets of columns) on the side.
+    std::unique_ptr<Beam[]> beams(new Beam[nb]);
+    const int bucket_w = static_cast<int>((static_cast<int64_t>(size_x) + kMaxBuckets - 1) / kMaxBuckets);
+    const int nbk = static_cast<int>((static_cast<int64_t>(size_x) + bucket_w - 1) / bucket_w);
+    std::vector<std::vector<double>> diff(nt);
+    {
+      std::atomic<size_t> next_scan{0};
+      constexpr size_t kScanChunk = 32;
+      run_on_threads(nt, [&](int t) {
+        std::vector<double> &h = diff[t];
+        h.assign(static_cast<size_t>(nbk) + 1, 0.0);
+        for (;;) {
+          const size_t s0 = next_scan.fetch_add(kScanChunk);
+          if (s0 >= ns) break;
+          const size_t s1 = std::min(ns, s0 + kScanChunk);
+          for (size_t s = s0; s < s1; ++s) {
+            oracle::SteppedAngles angles{batch.first_angle[s], batch.angle_step[s]};
+            const float *r = batch.ranges_of(s);
+            uint64_t o = used_before[s];
+            double angle = 0;
+            for (int k = 0; k < batch.beams_in(s); ++k) {
+              angles(k, starts[s].theta, &angle);
+              if (!oracle::beam_used(r[k])) continue;
+              Beam &b = beams[o++];
+              oracle::beam_end(starts[s], angle, r[k], params.wall_size, geo.resolution, &b.x2, &b.y2);
+              b.range = r[k];
+              b.scan = static_cast<uint32_t>(s);
+              const double w = place_beam(b, starts[s], size_x, size_y, T) * bucket_w;
+              if (b.x_lo <= b.x_hi && w > 0) {
+                h[b.x_lo / bucket_w] += w;
+                h[b.x_hi / bucket_w + 1] -= w;
+              }
+            }
+          }
+        }
+      });
+    }
+
+    // Distance / odds-factor table.
+    std::vector<Entry> table;
+    const egrid::ModelParams model{params.p_prior, params.p_occ, params.p_emp, params.range_sure,
+                                   params.range_max};
+    if (static_cast<int64_t>(T) * T <= kMaxTableEntries) {
+      table.resize(static_cast<size_t>(T) * static_cast<size_t>(T));
+      run_on_threads(std::min(nt, T), [&](int t) {
+        const int per = (T + nt - 1) / nt;
+        for (int i = t * per; i < std::min(T, (t + 1) * per); ++i) {
+          for (int j = 0; j < T; ++j) {
+            Entry &e = table[static_cast<size_t>(i) * T + j];
+            e.d = egrid::cell_distance(i, j, params.resolution);
+            double p;
+            e.stop = egrid::sensor_model(model, e.d, std::numeric_limits<double>::infinity(), &p) ? 0 : 1;
+            e.f_free = e.stop ? 0.0 : egrid::odds_factor(model.prior, p);
+            if (!e.stop) {
+              egrid::sensor_model(model, e.d, -std::numeric_limits<double>::infinity(), &p);
+              e.f_occ = egrid::odds_factor(model.prior, p);
+            } else {
+              e.f_occ = 0.0;
+            }
+          }
+        }
+      });
+    }
+
+    // Stripes of about equal estimated work.
+    std::vector<double> col_w(nbk);
+    {
+      double run = 0;
+      for (int k = 0; k < nbk; ++k) {
+        for (int t = 0; t < nt; ++t) run += diff[t][k];
+        col_w[k] = std::max(0.0, run);
+      }
+    }
+    double total = 0;
+    for (double w : col_w) total += w;
+    if (!(total > 0)) {
+      std::fill(col_w.begin(), col_w.end(), 1.0);
+      total = nbk;
+    }
+    const int want = nt == 1 ? 1 : std::min(nbk, nt * kStripesPerThread);
+    std::vector<int> sb = {0};
+    std::vector<double> stripe_w = {0};
+    {
+      double cum = 0;
+      for (int k = 0; k < nbk; ++k) {
+        cum += col_w[k];
+        stripe_w.back() += col_w[k];
+        const int edge = std::min(size_x, (k + 1) * bucket_w);
+        if (static_cast<int>(sb.size()) < want && edge < size_x &&
+            cum >= total * static_cast<double>(sb.size()) / want) {
+          sb.push_back(edge);
+          stripe_w.push_back(0);
+        }
+      }
+      sb.push_back(size_x);
+    }
+    const int nst = static_cast<int>(sb.size()) - 1;
+    auto stripe_of = [&](int x) {
+      return static_cast<int>(std::upper_bound(sb.begin(), sb.end(), x) - sb.begin()) - 1;
+    };
+
+    // 3. Per stripe, its beams in (scan, beam) order: count per (chunk,
+    //    stripe), then fill, chunks being contiguous ranges of beams.
+    const int nchunks = nt;
+    std::vector<uint64_t> counts(static_cast<size_t>(nchunks) * nst, 0);
+    auto chunk_range = [&](int c, uint64_t *b0, uint64_t *b1) {
+      *b0 = nb * static_cast<uint64_t>(c) / nchunks;
+      *b1 = nb * static_cast<uint64_t>(c + 1) / nchunks;
+    };
+    run_on_threads(nchunks, [&](int c) {
+      uint64_t b0, b1;
+      chunk_range(c, &b0, &b1);
+      uint64_t *cnt = &counts[static_cast<size_t>(c) * nst];
+      for (uint64_t i = b0; i < b1; ++i) {
+        const Beam &b = beams[i];
+        if (b.x_lo > b.x_hi) continue;
+        const int s_hi = stripe_of(b.x_hi);
+        for (int s = stripe_of(b.x_lo); s <= s_hi; ++s) ++cnt[s];
+      }
+    });
+    std::vector<uint64_t> bin_begin(static_cast<size_t>(nst) + 1, 0);
+    std::vector<uint64_t> offsets(counts.size());
+    {
+      uint64_t o = 0;
+      for (int s = 0; s < nst; ++s) {
+        bin_begin[s] = o;
+        for (int c = 0; c < nchunks; ++c) {
+          offsets[static_cast<size_t>(c) * nst + s] = o;
+          o += counts[static_cast<size_t>(c) * nst + s];
+        }
+      }
+      bin_begin[nst] = o;
+    }
+    std::unique_ptr<uint32_t[]> bins(new uint32_t[std::max<uint64_t>(bin_begin[nst], 1)]);
+    run_on_threads(nchunks, [&](int c) {
+      uint64_t b0, b1;
+      chunk_range(c, &b0, &b1);
+      uint64_t *off = &offsets[static_cast<size_t>(c) * nst];
+      for (uint64_t i = b0; i < b1; ++i) {
+        const Beam &b = beams[i];
+        if (b.x_lo > b.x_hi) continue;
+        const int s_hi = stripe_of(b.x_hi);
+        for (int s = stripe_of(b.x_lo); s <= s_hi; ++s) bins[off[s]++] = static_cast<uint32_t>(i);
+      }
+    });
+    st.prep_s = seconds_since(t0);
+
+    // 4. The stripes, heaviest first, handed out dynamically.
+    const auto t_stripes = Clock::now();
+    std::vector<int> order(nst);
+    for (int s = 0; s < nst; ++s) order[s] = s;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return stripe_w[a] > stripe_w[b]; });
+    load.stripe_begin = sb;
+    load.stripe_beams.assign(nst, 0);
+    load.stripe_updates.assign(nst, 0);
+    load.stripe_thread.assign(nst, -1);
+    const Context ctx{cells.data(), size_x, size_y, T, geo.resolution, model,
+                      table.empty() ? nullptr : table.data()};
+    std::atomic<int> next_stripe{0};
+    run_on_threads(std::min(nt, nst), [&](int t) {
+      const auto t_busy = Clock::now();
+      uint64_t mine = 0;
+      for (;;) {
+        const int q = next_stripe.fetch_add(1);
+        if (q >= nst) break;
+        const int s = order[q];
+        const int xa = sb[s], xb = sb[s + 1];
+        uint64_t n = 0;
+        for (uint64_t e = bin_begin[s]; e < bin_begin[s + 1]; ++e) {
+          const Beam &b = beams[bins[e]];
+          const oracle::ScanStart &start = starts[b.scan];
+          n += b.degenerate ? walk_degenerate(ctx, b, start, xa, xb) : walk_closed(ctx, b, start, xa, xb);
+        }
+        load.stripe_beams[s] = bin_begin[s + 1] - bin_begin[s];
+        load.stripe_updates[s] = n;
+        load.stripe_thread[s] = t;
+        mine += n;
+      }
+      load.thread_updates[t] = mine;
+      load.thread_busy_s[t] = seconds_since(t_busy);
+    });
+    load.stripes_s = seconds_since(t_stripes);
+    for (uint64_t n : load.thread_updates) st.cell_updates += n;
+    st.map_s = seconds_since(t0);
+    finish(stats, st, std::move(load));
+    return cells;
+  }
+
+ private:
+  void finish(MapStats *stats, const MapStats &st, CpuThreadsLoad &&load) {
+    if (stats != nullptr) *stats = st;
+    load_ = std::move(load);
+    has_load_ = true;
+  }
+
+  int threads_;
+  CpuThreadsLoad load_;
+  bool has_load_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> make_cpu_threads_backend(int threads) {
+  return std::make_unique<CpuThreadsBackend>(threads);
+}
+
+const CpuThreadsLoad *cpu_threads_load(const Backend &backend) {
+  const auto *b = dynamic_cast<const CpuThreadsBackend *>(&backend);
+  return b != nullptr ? b->load() : nullptr;
+}
+
+}  // namespace vasco
