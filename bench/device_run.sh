@@ -7,19 +7,19 @@ mkdir -p "$out"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv > "$out/gpu.txt" 2>&1
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release > "$out/configure.log" 2>&1 &&
   cmake --build build -j 16 > "$out/build.log" 2>&1 || { tail -40 "$out/build.log"; exit 1; }
-(cd build && ctest -j 8 --output-on-failure > "$out/ctest.log" 2>&1); echo "ctest rc=$?" >> "$out/summary.txt"
+(cd build && timeout 240 ctest -j 8 --timeout 120 --output-on-failure > "$out/ctest.log" 2>&1); echo "ctest rc=$?" >> "$out/summary.txt"
 tail -3 "$out/ctest.log" >> "$out/summary.txt"
 grep -E "Skipped|Failed|\*\*\*" "$out/ctest.log" | grep -v "^Test project" >> "$out/summary.txt"
 (cd build && ./bin/cuda_backend_test --gtest_filter='*FloatMode*' 2>&1 | grep -A4 "cuda float vs") >> "$out/summary.txt"
 small='CudaNoLostUpdates.*:CudaExact.*'
 for tool in memcheck racecheck; do
-  compute-sanitizer --tool $tool --error-exitcode 99 build/bin/cuda_backend_test --gtest_filter="$small" > "$out/sanitizer_$tool.log" 2>&1
+  timeout 150 compute-sanitizer --tool $tool --error-exitcode 99 build/bin/cuda_backend_test --gtest_filter="$small" > "$out/sanitizer_$tool.log" 2>&1
   echo "compute-sanitizer $tool rc=$? : $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer_$tool.log" | tail -1)" >> "$out/summary.txt"
 done
 for mode in float exact; do
   VASCO_CUDA_PROFILE=1 build/bin/log2map --backend cuda --cuda-mode $mode logs/fr079-complete.gfs.log.gz /tmp/fr079_$mode.map.gz >> "$out/profile.txt" 2>&1
 done
-build/bin/oracle_o2_bench > "$out/oracle_o2.txt" 2>&1
+build/bin/oracle_o2_bench --runs 3 > "$out/oracle_o2.txt" 2>&1
 build/bin/parse_bench > "$out/parse.txt" 2>&1
-build/bin/mapping_bench --runs "$runs" > "$out/bench.txt" 2> "$out/bench.err"
+timeout 300 build/bin/mapping_bench --runs "$runs" > "$out/bench.txt" 2> "$out/bench.err"
 cat "$out/summary.txt" "$out/profile.txt" "$out/oracle_o2.txt" "$out/parse.txt" "$out/bench.txt"
