@@ -16,6 +16,8 @@
 namespace vasco {
 namespace {
 
+using testing_support::random_batch;
+
 using testing_support::bundled_log;
 using testing_support::load_log;
 using testing_support::LoadedLog;
@@ -100,31 +102,6 @@ INSTANTIATE_TEST_SUITE_P(BundledLogs, CpuThreadsLog,
                            return std::string(info.param).substr(0, 5) == "fr079" ? std::string("fr079")
                                                                                   : std::string("intel");
                          });
-
-// Random scans with odd ranges: NaN, +-inf, negative, >= 50, 49.99.
-ScanBatch random_batch(std::mt19937 &rng, int num_scans, double spread) {
-  std::uniform_real_distribution<double> pos(-spread, spread), ang(-M_PI, M_PI), rr(0, 12);
-  std::uniform_int_distribution<int> odd(0, 40), nbeams(1, 400);
-  ScanBatch batch;
-  for (int s = 0; s < num_scans; ++s) {
-    const int n = nbeams(rng);
-    std::vector<float> r(n);
-    for (auto &v : r) {
-      switch (odd(rng)) {
-        case 0: v = NAN; break;
-        case 1: v = INFINITY; break;
-        case 2: v = -INFINITY; break;
-        case 3: v = -static_cast<float>(rr(rng)) / 4; break;
-        case 4: v = 50.0f + static_cast<float>(rr(rng)); break;
-        case 5: v = 49.99f; break;
-        case 6: v = 50.0f; break;
-        default: v = static_cast<float>(rr(rng));
-      }
-    }
-    batch.add_scan(pos(rng), pos(rng), ang(rng), ang(rng) / 2, 0.01 + 0.02 * (s % 3), r.data(), n, s + 1);
-  }
-  return batch;
-}
 
 struct RandomCase {
   double resolution;

@@ -152,27 +152,9 @@ TEST(CudaExact, RandomScansWithOddRangesMatchTheOracle) {
   std::random_device seed_source;
   const unsigned seed = seed_source();
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> pos(-8, 8), ang(-M_PI, M_PI), rr(0, 12);
-  std::uniform_int_distribution<int> odd(0, 40), nbeams(1, 400);
   MapperParams params;
   params.resolution = 0.05;
-  ScanBatch batch;
-  for (int s = 0; s < 150; ++s) {
-    const int n = nbeams(rng);
-    std::vector<float> r(n);
-    for (auto &v : r) {
-      switch (odd(rng)) {
-        case 0: v = NAN; break;
-        case 1: v = INFINITY; break;
-        case 2: v = -INFINITY; break;
-        case 3: v = -static_cast<float>(rr(rng)) / 4; break;
-        case 4: v = 50.0f + static_cast<float>(rr(rng)); break;
-        case 5: v = 49.99f; break;
-        default: v = static_cast<float>(rr(rng));
-      }
-    }
-    batch.add_scan(pos(rng), pos(rng), ang(rng), ang(rng) / 2, 0.01 + 0.02 * (s % 3), r.data(), n, s + 1);
-  }
+  const ScanBatch batch = testing_support::random_batch(rng, 150, 8);
   const GridGeometry geo = size_grid(batch, params);
   MapStats rs, gs;
   const auto ref = make_cpu_double_backend()->map(batch, params, geo, &rs);

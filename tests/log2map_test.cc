@@ -9,39 +9,19 @@
 
 #include "carmen_compat/map_file.h"
 #include "map_test_support.h"
+#include "tool_support.h"
 #include "test_support.h"
 
 namespace {
 
 using maptest::TempDir;
 
-struct ToolRun {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
-
-std::string quote(const std::string &s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using tooltest::contains;
+using tooltest::ToolRun;
 
 ToolRun log2map(const std::vector<std::string> &args, bool with_stderr = true) {
-  std::string cmd = quote(std::string(VASCO_BIN_DIR) + "/log2map");
-  for (const std::string &a : args) cmd += " " + quote(a);
-  cmd += with_stderr ? " 2>&1" : " 2>/dev/null";
-  ToolRun r;
-  FILE *p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
+  return tooltest::run_tool("log2map", args, with_stderr);
 }
-
-bool contains(const std::string &s, const std::string &part) { return s.find(part) != std::string::npos; }
 
 const std::string kIntel = std::string(VASCO_LOGS_DIR) + "/intel.gfs.log.gz";
 

@@ -7,6 +7,7 @@
 
 #include "carmen_compat/map_file.h"
 #include "map_test_support.h"
+#include "tool_support.h"
 
 namespace {
 
@@ -14,33 +15,12 @@ using maptest::map_fixture;
 using maptest::read_bytes;
 using maptest::TempDir;
 
-struct ToolRun {
-  int status = -1;     // exit code
-  std::string output;  // stdout and stderr
-};
+using tooltest::contains;
+using tooltest::ToolRun;
 
-std::string quote(const std::string &s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
+ToolRun mapconvert(const std::vector<std::string> &args, bool with_stderr = true) {
+  return tooltest::run_tool("mapconvert", args, with_stderr);
 }
-
-ToolRun mapconvert(const std::vector<std::string> &args) {
-  std::string cmd = quote(std::string(VASCO_BIN_DIR) + "/mapconvert");
-  for (const std::string &a : args) cmd += " " + quote(a);
-  cmd += " 2>&1";
-  ToolRun r;
-  FILE *p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
-
-bool contains(const std::string &s, const std::string &part) { return s.find(part) != std::string::npos; }
 
 class MapConvert : public ::testing::Test {
  protected:

@@ -72,7 +72,9 @@
 #include <string>
 #include <thread>
 
+#include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/oracle.h"
+#include "vasco_gpu/parallel.h"
 
 namespace vasco {
 namespace {
@@ -90,37 +92,6 @@ constexpr int kStripesPerThread = 4;
 constexpr int kMaxBuckets = 1 << 16;
 // Odds-factor tables only when small (as in the CUDA exact mode).
 constexpr int64_t kMaxTableEntries = int64_t(1) << 22;
-
-// Runs fn(t) for t in [0, n), fn(0) on the calling thread; rethrows the first
-// exception.
-template <class Fn>
-void run_on_threads(int n, Fn &&fn) {
-  if (n <= 1) {
-    fn(0);
-    return;
-  }
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto body = [&](int t) {
-    try {
-      fn(t);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (!error) error = std::current_exception();
-    }
-  };
-  std::vector<std::thread> pool;
-  pool.reserve(static_cast<size_t>(n - 1));
-  try {
-    for (int t = 1; t < n; ++t) pool.emplace_back(body, t);
-  } catch (...) {
-    for (auto &th : pool) th.join();
-    throw;
-  }
-  body(0);
-  for (auto &th : pool) th.join();
-  if (error) std::rethrow_exception(error);
-}
 
 // A used beam, in (scan, beam) order.
 struct Beam {
@@ -294,29 +265,12 @@ class CpuThreadsBackend : public Backend {
     MapStats st;
     st.scans = ns;
 
-    // 1. Scans, placed in order.
-    std::vector<oracle::ScanStart> starts(ns);
-    {
-      oracle::GridFrame frame;
-      frame.size_x = size_x;
-      frame.size_y = size_y;
-      frame.resolution = geo.resolution;
-      frame.theta_offset = geo.theta_offset;
-      for (size_t s = 0; s < ns; ++s)
-        starts[s] = oracle::scan_start(frame, batch.x[s], batch.y[s], batch.theta[s]);
-    }
-    std::vector<uint64_t> used_before(ns + 1, 0);
-    for (size_t s = 0; s < ns; ++s) {
-      const float *r = batch.ranges_of(s);
-      uint64_t used = 0;
-      for (int k = 0; k < batch.beams_in(s); ++k) used += oracle::beam_used(r[k]) ? 1 : 0;
-      used_before[s + 1] = used_before[s] + used;
-    }
-    const uint64_t nb = used_before.back();
+    // 1. Scans and beam end cells, placed by the oracle's own code.
+    const PlacedBeams placed = place_beams(batch, geo, params, nt);
+    const std::vector<oracle::ScanStart> &starts = placed.starts;
+    const uint64_t nb = placed.beams.size();
     st.beams_used = nb;
-    st.beams_skipped = batch.num_beams() - nb;
-    if (nb > std::numeric_limits<uint32_t>::max())
-      throw std::runtime_error("cpu_threads: more than 2^32 used beams");
+    st.beams_skipped = placed.skipped;
 
     std::vector<float> cells(geo.num_cells(), egrid::kUnknown);
     CpuThreadsLoad load;
@@ -330,44 +284,30 @@ class CpuThreadsBackend : public Backend {
       return cells;
     }
 
-    // 2. End cells and x ranges, in parallel over scans; a per-column work
-    //    histogram (difference array over buckets of columns) on the side.
+    // 2. x ranges, in parallel over beams; a per-column work histogram
+    //    (difference array over buckets of columns) on the side.
     std::unique_ptr<Beam[]> beams(new Beam[nb]);
     const int bucket_w = static_cast<int>((static_cast<int64_t>(size_x) + kMaxBuckets - 1) / kMaxBuckets);
     const int nbk = static_cast<int>((static_cast<int64_t>(size_x) + bucket_w - 1) / bucket_w);
     std::vector<std::vector<double>> diff(nt);
-    {
-      std::atomic<size_t> next_scan{0};
-      constexpr size_t kScanChunk = 32;
-      run_on_threads(nt, [&](int t) {
-        std::vector<double> &h = diff[t];
-        h.assign(static_cast<size_t>(nbk) + 1, 0.0);
-        for (;;) {
-          const size_t s0 = next_scan.fetch_add(kScanChunk);
-          if (s0 >= ns) break;
-          const size_t s1 = std::min(ns, s0 + kScanChunk);
-          for (size_t s = s0; s < s1; ++s) {
-            oracle::SteppedAngles angles{batch.first_angle[s], batch.angle_step[s]};
-            const float *r = batch.ranges_of(s);
-            uint64_t o = used_before[s];
-            double angle = 0;
-            for (int k = 0; k < batch.beams_in(s); ++k) {
-              angles(k, starts[s].theta, &angle);
-              if (!oracle::beam_used(r[k])) continue;
-              Beam &b = beams[o++];
-              oracle::beam_end(starts[s], angle, r[k], params.wall_size, geo.resolution, &b.x2, &b.y2);
-              b.range = r[k];
-              b.scan = static_cast<uint32_t>(s);
-              const double w = place_beam(b, starts[s], size_x, size_y, T) * bucket_w;
-              if (b.x_lo <= b.x_hi && w > 0) {
-                h[b.x_lo / bucket_w] += w;
-                h[b.x_hi / bucket_w + 1] -= w;
-              }
-            }
-          }
+    run_on_threads(nt, [&](int t) {
+      std::vector<double> &h = diff[t];
+      h.assign(static_cast<size_t>(nbk) + 1, 0.0);
+      const uint64_t per = (nb + nt - 1) / nt;
+      for (uint64_t o = t * per; o < std::min<uint64_t>(nb, (t + 1) * per); ++o) {
+        const PlacedBeam &p = placed.beams[o];
+        Beam &b = beams[o];
+        b.x2 = p.x2;
+        b.y2 = p.y2;
+        b.range = p.range;
+        b.scan = p.scan;
+        const double w = place_beam(b, starts[p.scan], size_x, size_y, T) * bucket_w;
+        if (b.x_lo <= b.x_hi && w > 0) {
+          h[b.x_lo / bucket_w] += w;
+          h[b.x_hi / bucket_w + 1] -= w;
         }
-      });
-    }
+      }
+    });
 
     // Distance / odds-factor table.
     std::vector<Entry> table;

@@ -3,6 +3,7 @@
 #include "vasco_gpu/cuda_backend.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include "cuda_check.h"
 #include "egrid_kernels.h"
 #include "paper_kernels.h"
+#include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/oracle.h"
 
 namespace vasco {
@@ -59,20 +61,6 @@ void check_fits(size_t bytes, const char *what) {
                              " (use a coarser vasco_resolution or a CPU backend)");
 }
 
-// Places every scan with the oracle's own code, in order (the first call
-// fixes the start pose).
-std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeometry &geo) {
-  oracle::GridFrame frame;
-  frame.size_x = geo.size_x;
-  frame.size_y = geo.size_y;
-  frame.resolution = geo.resolution;
-  frame.theta_offset = geo.theta_offset;
-  std::vector<oracle::ScanStart> starts(batch.num_scans());
-  for (size_t s = 0; s < batch.num_scans(); ++s)
-    starts[s] = oracle::scan_start(frame, batch.x[s], batch.y[s], batch.theta[s]);
-  return starts;
-}
-
 // With VASCO_CUDA_PROFILE set, prints the time of each GPU stage to stderr
 // (events between stages; for tuning, not for the benchmark table).
 class StageTimer {
@@ -97,24 +85,12 @@ class StageTimer {
   std::vector<std::pair<std::unique_ptr<Event>, const char *>> events_;
 };
 
-// Runs fn(begin, end) over [0, n) on all cores.
-template <class Fn>
-void parallel_for(size_t n, Fn fn) {
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const size_t workers = std::min<size_t>(hw, std::max<size_t>(1, n / 64));
-  if (workers <= 1) {
-    fn(size_t(0), n);
-    return;
-  }
-  std::vector<std::thread> pool;
-  const size_t chunk = (n + workers - 1) / workers;
-  for (size_t w = 0; w < workers; ++w) {
-    const size_t b = w * chunk, e = std::min(n, b + chunk);
-    if (b >= e) break;
-    pool.emplace_back([=] { fn(b, e); });
-  }
-  for (auto &t : pool) t.join();
-}
+static_assert(sizeof(PlacedBeam) == sizeof(cuda::ExactBeam) &&
+                  offsetof(PlacedBeam, x2) == offsetof(cuda::ExactBeam, x2) &&
+                  offsetof(PlacedBeam, y2) == offsetof(cuda::ExactBeam, y2) &&
+                  offsetof(PlacedBeam, scan) == offsetof(cuda::ExactBeam, scan) &&
+                  offsetof(PlacedBeam, range) == offsetof(cuda::ExactBeam, range),
+              "PlacedBeam is uploaded as cuda::ExactBeam");
 
 class CudaBackend : public Backend {
  public:
@@ -165,39 +141,14 @@ class CudaBackend : public Backend {
                                const GridGeometry &geo, MapStats *st) {
     const auto t_prep = Clock::now();
     const cuda::DeviceModel m = device_model(params, geo);
-    const std::vector<oracle::ScanStart> starts = place_scans(batch, geo);
     // Used beams only, in (scan, beam) order, their end cells computed by the
     // oracle's own code with the host's libm (DESIGN §2.2).
-    std::vector<uint32_t> used_before(batch.num_scans() + 1, 0);
-    for (size_t s = 0; s < batch.num_scans(); ++s) {
-      uint32_t used = 0;
-      const float *r = batch.ranges_of(s);
-      for (int b = 0; b < batch.beams_in(s); ++b) used += oracle::beam_used(r[b]);
-      used_before[s + 1] = used_before[s] + used;
-    }
-    const size_t nb = used_before.back();
+    const PlacedBeams placed = place_beams(batch, geo, params, 0);
+    const size_t nb = placed.beams.size();
     st->beams_used = nb;
-    st->beams_skipped = batch.num_beams() - nb;
-    PinnedBuffer<cuda::ExactBeam> h_beams(std::max<size_t>(nb, 1));
-    PinnedBuffer<cuda::StartCell> h_starts(std::max<size_t>(batch.num_scans(), 1));
-    for (size_t s = 0; s < batch.num_scans(); ++s) h_starts[s] = {starts[s].x1, starts[s].y1};
-    parallel_for(batch.num_scans(), [&](size_t s0, size_t s1) {
-      for (size_t s = s0; s < s1; ++s) {
-        oracle::SteppedAngles angles{batch.first_angle[s], batch.angle_step[s]};
-        const float *r = batch.ranges_of(s);
-        uint32_t o = used_before[s];
-        double angle = 0;
-        for (int b = 0; b < batch.beams_in(s); ++b) {
-          angles(b, starts[s].theta, &angle);
-          if (!oracle::beam_used(r[b])) continue;
-          cuda::ExactBeam e;
-          oracle::beam_end(starts[s], angle, r[b], params.wall_size, params.resolution, &e.x2, &e.y2);
-          e.scan = static_cast<int>(s);
-          e.range = r[b];
-          h_beams[o++] = e;
-        }
-      }
-    });
+    st->beams_skipped = placed.skipped;
+    std::vector<cuda::StartCell> h_starts(batch.num_scans());
+    for (size_t s = 0; s < batch.num_scans(); ++s) h_starts[s] = {placed.starts[s].x1, placed.starts[s].y1};
     st->prep_s = seconds(t_prep);
 
     const int tiles_x = (geo.size_x + cuda::kTile - 1) / cuda::kTile;
@@ -226,10 +177,11 @@ class CudaBackend : public Backend {
     DeviceBuffer<unsigned char> d_scan_tmp(std::max<size_t>(scan_tmp, 1));
 
     e0.record(stream.get());
-    if (nb) VG_CUDA_CHECK(cudaMemcpyAsync(d_beams.get(), h_beams.get(), nb * sizeof(cuda::ExactBeam),
+    // PlacedBeam and cuda::ExactBeam are the same 16 bytes (checked above).
+    if (nb) VG_CUDA_CHECK(cudaMemcpyAsync(d_beams.get(), placed.beams.data(), nb * sizeof(cuda::ExactBeam),
                                           cudaMemcpyHostToDevice, stream.get()));
     if (batch.num_scans())
-      VG_CUDA_CHECK(cudaMemcpyAsync(d_starts.get(), h_starts.get(),
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_starts.get(), h_starts.data(),
                                     batch.num_scans() * sizeof(cuda::StartCell),
                                     cudaMemcpyHostToDevice, stream.get()));
     e_up.record(stream.get());

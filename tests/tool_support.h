@@ -1,0 +1,47 @@
+// Running the project's command-line tools from tests.
+#ifndef VASCO_TESTS_TOOL_SUPPORT_H
+#define VASCO_TESTS_TOOL_SUPPORT_H
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace tooltest {
+
+struct ToolRun {
+  int status = -1;     // exit code (-1: did not exit normally)
+  std::string output;  // stdout, and stderr too unless discarded
+};
+
+inline std::string quote(const std::string &s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// Runs <build>/bin/TOOL with `args` (shell-quoted).
+inline ToolRun run_tool(const std::string &tool, const std::vector<std::string> &args,
+                        bool with_stderr = true) {
+  std::string cmd = quote(std::string(VASCO_BIN_DIR) + "/" + tool);
+  for (const std::string &a : args) cmd += " " + quote(a);
+  cmd += with_stderr ? " 2>&1" : " 2>/dev/null";
+  ToolRun r;
+  FILE *p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+inline bool contains(const std::string &s, const std::string &part) {
+  return s.find(part) != std::string::npos;
+}
+
+}  // namespace tooltest
+
+#endif  // VASCO_TESTS_TOOL_SUPPORT_H
