@@ -145,6 +145,26 @@ TEST(CudaNoLostUpdates, EveryBeamOfAScanUpdatesTheSharedCell) {
   EXPECT_LT(a.max_abs_diff, 1e-4);
 }
 
+// A grid that cannot fit in the GPU's memory is a clear error, not a crash
+// (nothing is allocated before the check).
+TEST(CudaBackend, AMapTooLargeForTheGpuIsAClearError) {
+  REQUIRE_GPU();
+  MapperParams params;
+  ScanBatch batch;
+  float r = 1.0f;
+  batch.add_scan(0, 0, 0, 0, 0, &r, 1, 1);
+  GridGeometry geo = size_grid(batch, params);
+  geo.size_x = geo.size_y = 200000;  // 4e10 cells: 160 GB of floats
+  for (CudaMode mode : {CudaMode::Float, CudaMode::Exact}) {
+    try {
+      cuda_backend(mode)->map(batch, params, geo, nullptr);
+      ADD_FAILURE() << "expected an error";
+    } catch (const std::runtime_error &e) {
+      EXPECT_NE(std::string(e.what()).find("does not fit in GPU memory"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // Fresh random scans, odd ranges included (NaN, +-inf, negative, >= 50):
 // exact mode still matches the oracle bit for bit.
 TEST(CudaExact, RandomScansWithOddRangesMatchTheOracle) {
