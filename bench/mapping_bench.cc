@@ -306,10 +306,11 @@ int main(int argc, char **argv) {
                 r.map > 0 ? threads_map / r.map : 0.0);
   }
   print_rule(width);
-  std::printf("map = the update itself: CPU rows wall time; GPU rows kernels only (CUDA events),\n"
-              "with host-side beam placement under prep. total = parse + prep + upload + map +\n"
-              "download + finish + write. x1core / xthreads: map-phase speed-up over cpu_double\n"
-              "and over cpu_threads on the same data in this run.\n");
+  std::printf("map = the update itself: CPU rows the wall time of the backend (cpu_threads'\n"
+              "prep included), GPU rows the kernels only (CUDA events; the host-side beam\n"
+              "placement is prep). total = parse + the wall time of map, finish and write (GPU\n"
+              "rows: prep, upload and download included). x1core / xthreads: map-phase\n"
+              "speed-up over cpu_double and over cpu_threads on the same data in this run.\n");
 
   if (!ablation_rows.empty()) {
     std::printf("\nAblation of the paper's kernel (float, no lost updates), map phase in ms:\n");
