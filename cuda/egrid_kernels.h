@@ -50,7 +50,11 @@ struct LineRec {
   int x2, y2;       // end cell (for the sequential fall-back of degenerate lines)
 };
 constexpr int kSteep = 1, kFlipped = 2, kBackward = 4, kDegenerate = 8;
-constexpr int kTile = 16;  // exact mode works on kTile x kTile cell tiles
+// Exact mode works on kTile x kTile cell tiles, a block of kTile^2 threads
+// each. Small tiles keep the longest tile lists (where the robot passed
+// often) short: a tile's blocks run its list sequentially, so the longest list
+// bounds the kernel.
+constexpr int kTile = 8;
 
 // Scratch sizes for the CUB calls of exact mode.
 size_t exact_scan_temp_bytes(size_t num_beams);
@@ -84,11 +88,21 @@ void exact_sort(const uint32_t *tile_in, uint32_t *tile_out, const uint32_t *bea
 void launch_exact_tile_ranges(const uint32_t *sorted_tile, size_t num_pairs, uint32_t *tile_begin,
                               uint32_t *tile_end, size_t num_tiles, cudaStream_t stream);
 
-// One block per tile, one thread per cell: applies every beam of the tile's
-// list, in order, to the thread's own cell, and writes the final grid
-// (x-major floats, -1 unknown). Tables may be null (distances on the fly).
+// The order in which to run the tiles: longest list first (so that the
+// longest ones do not start last and make the tail), as tile ids in `order`.
+// Scratch: three arrays of num_tiles and exact_order_temp_bytes(num_tiles) bytes.
+size_t exact_order_temp_bytes(size_t num_tiles);
+void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size_t num_tiles,
+                      uint32_t *order, uint32_t *scratch_keys, uint32_t *scratch_keys_out,
+                      uint32_t *scratch_ids, void *temp, size_t temp_bytes, cudaStream_t stream);
+
+// One block per tile (block i runs tile order[i]), one thread per cell:
+// applies every beam of the tile's list, in order, to the thread's own cell,
+// and writes the final grid (x-major floats, -1 unknown). Tables may be null
+// (distances on the fly).
 void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
-                        const uint32_t *tile_begin, const uint32_t *tile_end, const double *dist,
+                        const uint32_t *order, const uint32_t *tile_begin,
+                        const uint32_t *tile_end, const double *dist,
                         const double *factor_free, const double *factor_occ, float *grid,
                         unsigned long long *cell_updates, cudaStream_t stream);
 

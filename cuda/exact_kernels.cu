@@ -110,11 +110,12 @@ constexpr int kTileThreads = kTile * kTile;
 
 __global__ void __launch_bounds__(kTileThreads)
     tiles_kernel(DeviceModel m, const LineRec *lines, const uint32_t *sorted_beam,
-                 const uint32_t *tile_begin, const uint32_t *tile_end, const double *dist,
+                 const uint32_t *order, const uint32_t *tile_begin, const uint32_t *tile_end,
+                 const double *dist,
                  const double *ff, const double *fo, float *grid, unsigned long long *updates) {
   __shared__ LineRec sh[kTileThreads];
   const int tiles_y = (m.size_y + kTile - 1) / kTile;
-  const int tile = blockIdx.x;
+  const int tile = static_cast<int>(order[blockIdx.x]);
   const int cx = (tile / tiles_y) * kTile + threadIdx.x / kTile;
   const int cy = (tile % tiles_y) * kTile + threadIdx.x % kTile;
   const bool active = inside(cx, cy, m);
@@ -156,6 +157,14 @@ __global__ void __launch_bounds__(kTileThreads)
   if (active) grid[static_cast<size_t>(cx) * m.size_y + cy] = cell;
   const unsigned warp_sum = __reduce_add_sync(0xffffffffu, count);
   if ((threadIdx.x & 31) == 0 && warp_sum) atomicAdd(updates, static_cast<unsigned long long>(warp_sum));
+}
+
+__global__ void tile_keys_kernel(const uint32_t *begin, const uint32_t *end, size_t n,
+                                 uint32_t *keys, uint32_t *ids) {
+  const size_t t = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
+  if (t >= n) return;
+  keys[t] = end[t] - begin[t];
+  ids[t] = static_cast<uint32_t>(t);
 }
 
 unsigned blocks_for(size_t n, unsigned threads) {
@@ -231,15 +240,37 @@ void launch_exact_tile_ranges(const uint32_t *sorted_tile, size_t num_pairs, uin
   VG_CUDA_CHECK_LAUNCH();
 }
 
+size_t exact_order_temp_bytes(size_t num_tiles) {
+  size_t bytes = 0;
+  VG_CUDA_CHECK(cub::DeviceRadixSort::SortPairsDescending(
+      nullptr, bytes, static_cast<const uint32_t *>(nullptr), static_cast<uint32_t *>(nullptr),
+      static_cast<const uint32_t *>(nullptr), static_cast<uint32_t *>(nullptr),
+      static_cast<int64_t>(num_tiles)));
+  return bytes;
+}
+
+void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size_t num_tiles,
+                      uint32_t *order, uint32_t *keys, uint32_t *keys_out, uint32_t *ids, void *temp,
+                      size_t temp_bytes, cudaStream_t stream) {
+  if (num_tiles == 0) return;
+  tile_keys_kernel<<<blocks_for(num_tiles, 256), 256, 0, stream>>>(tile_begin, tile_end, num_tiles,
+                                                                   keys, ids);
+  VG_CUDA_CHECK_LAUNCH();
+  VG_CUDA_CHECK(cub::DeviceRadixSort::SortPairsDescending(temp, temp_bytes, keys, keys_out, ids, order,
+                                                          static_cast<int64_t>(num_tiles), 0, 32,
+                                                          stream));
+}
+
 void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
-                        const uint32_t *tile_begin, const uint32_t *tile_end, const double *dist,
+                        const uint32_t *order, const uint32_t *tile_begin,
+                        const uint32_t *tile_end, const double *dist,
                         const double *ff, const double *fo, float *grid,
                         unsigned long long *updates, cudaStream_t stream) {
   const size_t tiles = static_cast<size_t>((m.size_x + kTile - 1) / kTile) *
                        ((m.size_y + kTile - 1) / kTile);
   if (tiles == 0) return;
   tiles_kernel<<<static_cast<unsigned>(tiles), kTileThreads, 0, stream>>>(
-      m, lines, sorted_beam, tile_begin, tile_end, dist, ff, fo, grid, updates);
+      m, lines, sorted_beam, order, tile_begin, tile_end, dist, ff, fo, grid, updates);
   VG_CUDA_CHECK_LAUNCH();
 }
 

@@ -159,9 +159,11 @@ class CudaBackend : public Backend {
     const bool use_tables = T2 <= (size_t(1) << 22);
     const size_t cells = geo.num_cells();
     const size_t scan_tmp = cuda::exact_scan_temp_bytes(nb);
+    const size_t order_tmp = cuda::exact_order_temp_bytes(num_tiles);
     size_t fixed = nb * (sizeof(cuda::ExactBeam) + sizeof(cuda::LineRec) + 2 * sizeof(uint32_t)) +
                    batch.num_scans() * sizeof(cuda::StartCell) + cells * sizeof(float) +
-                   2 * num_tiles * sizeof(uint32_t) + scan_tmp + (use_tables ? 3 * T2 * sizeof(double) : 0);
+                   6 * num_tiles * sizeof(uint32_t) + scan_tmp + order_tmp +
+                   (use_tables ? 3 * T2 * sizeof(double) : 0);
     check_fits(fixed, "exact mode (beams, grid, tables)");
 
     Stream stream;
@@ -171,6 +173,9 @@ class CudaBackend : public Backend {
     DeviceBuffer<cuda::LineRec> d_lines(nb);
     DeviceBuffer<uint32_t> d_counts(nb + 1), d_offsets(nb + 1);
     DeviceBuffer<uint32_t> d_tile_begin(num_tiles), d_tile_end(num_tiles);
+    DeviceBuffer<uint32_t> d_order(num_tiles), d_order_keys(num_tiles), d_order_keys_out(num_tiles),
+        d_order_ids(num_tiles);
+    DeviceBuffer<unsigned char> d_order_tmp(std::max<size_t>(order_tmp, 1));
     DeviceBuffer<float> d_grid(cells);
     DeviceBuffer<double> d_dist(use_tables ? T2 : 0), d_ff(use_tables ? T2 : 0), d_fo(use_tables ? T2 : 0);
     DeviceBuffer<unsigned long long> d_updates(1);
@@ -219,7 +224,11 @@ class CudaBackend : public Backend {
     cuda::launch_exact_tile_ranges(d_sorted_tile.get(), num_pairs, d_tile_begin.get(),
                                    d_tile_end.get(), num_tiles, stream.get());
     timer.mark("ranges");
-    cuda::launch_exact_tiles(m, d_lines.get(), d_sorted_beam.get(), d_tile_begin.get(),
+    cuda::exact_tile_order(d_tile_begin.get(), d_tile_end.get(), num_tiles, d_order.get(),
+                           d_order_keys.get(), d_order_keys_out.get(), d_order_ids.get(),
+                           d_order_tmp.get(), order_tmp, stream.get());
+    timer.mark("order");
+    cuda::launch_exact_tiles(m, d_lines.get(), d_sorted_beam.get(), d_order.get(), d_tile_begin.get(),
                              d_tile_end.get(), use_tables ? d_dist.get() : nullptr,
                              use_tables ? d_ff.get() : nullptr, use_tables ? d_fo.get() : nullptr,
                              d_grid.get(), d_updates.get(), stream.get());
