@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# One device session: build, GPU tests, sanitizers, profile, benchmark.
-# Usage: bash bench/device_run.sh OUTDIR [bench runs]
+# Everything to run on a machine with a GPU, in one go: build, the whole test
+# suite, compute-sanitizer (memcheck, racecheck) on the small GPU tests, a
+# per-stage profile of both CUDA modes, and the benchmarks.
+# Usage: bash bench/gpu_run.sh OUTDIR [bench runs]
 set -uo pipefail
-out=${1:-/tmp/vasco_device}; runs=${2:-5}
+out=${1:-/tmp/vasco_gpu_run}; runs=${2:-5}
 mkdir -p "$out"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv > "$out/gpu.txt" 2>&1
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release > "$out/configure.log" 2>&1 &&
