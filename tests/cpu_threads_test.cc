@@ -22,24 +22,9 @@ using testing_support::bundled_log;
 using testing_support::load_log;
 using testing_support::LoadedLog;
 
-size_t first_difference(const std::vector<float> &a, const std::vector<float> &b) {
-  for (size_t i = 0; i < a.size(); ++i)
-    if (std::memcmp(&a[i], &b[i], sizeof(float)) != 0) return i;
-  return a.size();
-}
-
 void expect_bit_identical(const std::vector<float> &ref, const std::vector<float> &got,
                           const GridGeometry &geo) {
-  ASSERT_EQ(ref.size(), got.size());
-  EXPECT_EQ(std::memcmp(ref.data(), got.data(), ref.size() * sizeof(float)), 0);
-  const size_t i = first_difference(ref, got);
-  if (i < ref.size()) {
-    std::ostringstream msg;
-    msg.precision(9);
-    msg << "first difference at cell (" << i / geo.size_y << ", " << i % geo.size_y << "): oracle "
-        << ref[i] << ", cpu_threads " << got[i];
-    ADD_FAILURE() << msg.str();
-  }
+  testing_support::expect_bit_identical(ref, got, geo, "cpu_threads");
 }
 
 void expect_same_counts(const MapStats &ref, const MapStats &got) {

@@ -40,18 +40,9 @@ std::unique_ptr<Backend> cuda_backend(CudaMode mode) {
   return make_backend("cuda", o);
 }
 
-size_t first_difference(const std::vector<float> &a, const std::vector<float> &b) {
-  for (size_t i = 0; i < a.size(); ++i)
-    if (std::memcmp(&a[i], &b[i], sizeof(float)) != 0) return i;
-  return a.size();
-}
-
 void expect_bit_identical(const std::vector<float> &ref, const std::vector<float> &got,
                           const GridGeometry &geo) {
-  ASSERT_EQ(ref.size(), got.size());
-  const size_t i = first_difference(ref, got);
-  EXPECT_EQ(i, ref.size()) << "first difference at cell (" << i / geo.size_y << ", "
-                           << i % geo.size_y << "): oracle " << ref[i] << ", cuda " << got[i];
+  testing_support::expect_bit_identical(ref, got, geo, "cuda");
 }
 
 TEST(CudaBackend, WithoutAGpuCudaIsAClearError) {
@@ -84,7 +75,7 @@ TEST_P(CudaGolden, ExactModeIsBitIdenticalToTheOracle) {
   // The finished map (what is written) is then identical too.
   const auto fr = finish_grid(ref.data(), log.geo.size_x, log.geo.size_y, log.geo.resolution, 4, 20);
   const auto fg = finish_grid(got.data(), log.geo.size_x, log.geo.size_y, log.geo.resolution, 4, 20);
-  EXPECT_EQ(first_difference(fr.cells, fg.cells), fr.cells.size());
+  EXPECT_EQ(testing_support::first_difference(fr.cells, fg.cells), fr.cells.size());
 }
 
 // Float mode against the oracle: the agreement table of DESIGN §4.

@@ -2,8 +2,12 @@
 #ifndef VASCO_TESTS_TEST_SUPPORT_H
 #define VASCO_TESTS_TEST_SUPPORT_H
 
+#include <gtest/gtest.h>
+
 #include <cmath>
+#include <cstring>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -58,6 +62,28 @@ inline ScanBatch random_batch(std::mt19937 &rng, int num_scans, double spread) {
     batch.add_scan(pos(rng), pos(rng), ang(rng), ang(rng) / 2, 0.01 + 0.02 * (s % 3), r.data(), n, s + 1);
   }
   return batch;
+}
+
+// Index of the first cell whose bits differ, or a.size() if none does.
+inline size_t first_difference(const std::vector<float> &a, const std::vector<float> &b) {
+  for (size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(&a[i], &b[i], sizeof(float)) != 0) return i;
+  return a.size();
+}
+
+// Fails the test unless `got` is bit-identical to the oracle's `ref`, naming
+// the first differing cell.
+inline void expect_bit_identical(const std::vector<float> &ref, const std::vector<float> &got,
+                                 const GridGeometry &geo, const std::string &what) {
+  ASSERT_EQ(ref.size(), got.size());
+  const size_t i = first_difference(ref, got);
+  if (i < ref.size()) {
+    std::ostringstream msg;
+    msg.precision(9);
+    msg << "first difference at cell (" << i / geo.size_y << ", " << i % geo.size_y << "): oracle "
+        << ref[i] << ", " << what << " " << got[i];
+    ADD_FAILURE() << msg.str();
+  }
 }
 
 }  // namespace testing_support
