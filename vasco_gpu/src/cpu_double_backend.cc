@@ -8,11 +8,12 @@
 namespace vasco {
 namespace {
 
-// The distance table as egrid.c builds it, with row pointers.
+// The distance table as egrid.c builds it, with row pointers (none above
+// oracle::kMaxBuiltDistanceTable: trace_beam then computes distances).
 class DistanceTable {
  public:
   DistanceTable(int size, double resolution) : size_(size) {
-    if (size <= 0) return;
+    if (size <= 0 || size > oracle::kMaxBuiltDistanceTable) return;
     const size_t n = static_cast<size_t>(size);
     values_.resize(n * n);
     rows_.resize(n);

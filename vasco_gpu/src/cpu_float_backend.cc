@@ -6,6 +6,7 @@
 
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/oracle.h"
 
 namespace vasco {
 namespace {
@@ -27,8 +28,11 @@ class CpuFloatBackend : public Backend {
                                     static_cast<float>(params.range_sure),
                                     static_cast<float>(params.range_max)};
     const int table_size = params.table_size();
-    std::vector<float> table(static_cast<size_t>(table_size) * table_size);
-    for (int i = 0; i < table_size; ++i)
+    // A float distance table, as the paper's port has, unless it would be huge
+    // (then the same sqrtf on the fly).
+    const bool tabulated = table_size <= oracle::kMaxBuiltDistanceTable;
+    std::vector<float> table(tabulated ? static_cast<size_t>(table_size) * table_size : 0);
+    for (int i = 0; i < (tabulated ? table_size : 0); ++i)
       for (int j = 0; j < table_size; ++j)
         table[static_cast<size_t>(i) * table_size + j] =
             std::sqrt(static_cast<float>(i * i + j * j)) * res;
@@ -72,7 +76,8 @@ class CpuFloatBackend : public Backend {
             const int j = cy > y1 ? cy - y1 : y1 - cy;
             const float d = (i >= table_size || j >= table_size)
                                 ? static_cast<float>(egrid::kFarDistance)
-                                : table[static_cast<size_t>(i) * table_size + j];
+                            : tabulated ? table[static_cast<size_t>(i) * table_size + j]
+                                        : std::sqrt(static_cast<float>(i * i + j * j)) * res;
             float p;
             if (!egrid::sensor_model_f(model, d, r, &p)) break;
             float &cell = cells[static_cast<size_t>(cx) * sy + cy];

@@ -12,11 +12,6 @@
 
 namespace {
 
-// The distance table is allocated, as in CARMEN, when it is of sane size;
-// above this many entries per axis the oracle computes distances on the fly
-// (the same doubles) and leaves `distance_table` NULL.
-constexpr int kMaxTableEntries = 4096;
-
 float **alloc_columns(int size_x, int size_y) {
   const size_t n = static_cast<size_t>(size_x) * static_cast<size_t>(size_y);
   float *block = static_cast<float *>(std::malloc(n ? n * sizeof(float) : 1));
@@ -126,7 +121,7 @@ void carmen_mapper_initialize_evidence_grid(evidence_grid *grid, int size_x, int
 
   const int t = vasco::oracle::distance_table_size(max_range, resolution);
   grid->distance_table_size = t > 0 ? t : 0;
-  if (t > 0 && t <= kMaxTableEntries) {
+  if (t > 0 && t <= vasco::oracle::kMaxBuiltDistanceTable) {  // else NULL: on the fly
     const size_t tn = static_cast<size_t>(t);
     double *block = static_cast<double *>(std::malloc(tn * tn * sizeof(double)));
     double **rows = static_cast<double **>(std::malloc(tn * sizeof(double *)));

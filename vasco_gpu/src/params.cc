@@ -7,6 +7,7 @@
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/ini_file.h"
+#include "vasco_gpu/oracle.h"
 
 namespace vasco {
 namespace {
@@ -68,7 +69,7 @@ const std::vector<std::string> &mapper_param_keys() {
 }
 
 int MapperParams::table_size() const {
-  return static_cast<int>(range_max / resolution);
+  return oracle::distance_table_size(range_max, resolution);
 }
 
 void MapperParams::validate() const {

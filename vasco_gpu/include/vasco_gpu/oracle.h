@@ -66,6 +66,12 @@ inline int distance_table_size(double max_range, double resolution) {
   return egrid::trunc_to_int(max_range / resolution);
 }
 
+// The distance table is built, as in CARMEN, only up to this many entries per
+// axis (128 MiB of doubles); above it every backend computes the distance on
+// the fly, which gives the same value, instead of allocating size^2 entries
+// (8 GiB at the largest table_size the parameters allow).
+constexpr int kMaxBuiltDistanceTable = 4096;
+
 // Walks one beam and applies its updates to `cells` (x-major, size_y per
 // column), exactly as egrid.c does.
 //
