@@ -80,7 +80,10 @@ VG_HD void bresenham_init(BresenhamLine &l, int x1, int y1, int x2, int y2) {
     int t = x1; x1 = y1; y1 = t;
     t = x2; x2 = y2; y2 = t;
   }
-  l.flipped = static_cast<int64_t>(wrap_sub(x2, x1)) * static_cast<int64_t>(wrap_sub(y2, y1)) < 0;
+  // CARMEN tests (p2x - p1x) * (p2y - p1y) < 0 with int operands: the
+  // product wraps at 32 bits, so for far end points (a range of -inf) its
+  // sign is not the sign of the exact product.
+  l.flipped = wrap_mul(wrap_sub(x2, x1), wrap_sub(y2, y1)) < 0;
   if (l.flipped) {
     y1 = wrap_neg(y1);
     y2 = wrap_neg(y2);
@@ -125,7 +128,8 @@ VG_HD bool bresenham_next(BresenhamLine &l) {
 // ---------------------------------------------------------------------------
 // The same walk in closed form, for one thread per cell. Valid for lines whose
 // |dx| and |dy| are below 2^29 (then no intermediate value of the sequential
-// walk overflows); is_closed_form_line() says whether a line qualifies. The
+// walk overflows) and whose dx * dy fits an int (then CARMEN's wrapping flip
+// test gives the true sign); is_closed_form_line() says whether a line qualifies. The
 // cell at step k (0 <= k <= |major delta|) is the cell the sequential walk
 // emits after k calls to bresenham_next.
 // ---------------------------------------------------------------------------
@@ -141,7 +145,12 @@ VG_HD bool is_closed_form_line(int x1, int y1, int x2, int y2) {
   const int64_t dx = static_cast<int64_t>(x2) - x1;
   const int64_t dy = static_cast<int64_t>(y2) - y1;
   const int64_t lim = int64_t(1) << 29;
-  return dx > -lim && dx < lim && dy > -lim && dy < lim;
+  if (!(dx > -lim && dx < lim && dy > -lim && dy < lim)) return false;
+  // The closed form assumes the flip that the exact product's sign gives;
+  // CARMEN's product wraps at 32 bits, so lines whose |dx * dy| does not fit
+  // an int (possible from about 46341 cells per axis) are walked instead.
+  const int64_t product = dx * dy;
+  return product >= INT_MIN && product <= INT_MAX;
 }
 
 VG_HD LineParams line_params(int x1, int y1, int x2, int y2) {
@@ -237,7 +246,7 @@ VG_HD bool sensor_model(const ModelParams &m, double d, double r, double *p) {
 
 // Distance between two cells i and j cells apart, as the distance table holds it.
 VG_HD double cell_distance(int i, int j, double resolution) {
-  return sqrt(static_cast<double>(i * i + j * j)) * resolution;
+  return sqrt(static_cast<double>(wrap_add(wrap_mul(i, i), wrap_mul(j, j)))) * resolution;
 }
 
 // One odds update of a stored cell, exactly as egrid.c evaluates it:
