@@ -18,9 +18,11 @@ GridGeometry size_grid(const ScanBatch &batch, const MapperParams &params) {
   g.theta_offset = batch.theta[0];
   const double reach = params.range_max + params.resolution;
   double mx = 0, my = 0;
+  size_t far_x = 0, far_y = 0;  // the scans farthest from the first, for the error message
   for (size_t s = 0; s < batch.num_scans(); ++s) {
-    mx = std::max(mx, std::fabs(batch.x[s] - g.x0));
-    my = std::max(my, std::fabs(batch.y[s] - g.y0));
+    const double dx = std::fabs(batch.x[s] - g.x0), dy = std::fabs(batch.y[s] - g.y0);
+    if (dx > mx) mx = dx, far_x = s;
+    if (dy > my) my = dy, far_y = s;
   }
   mx += reach;
   my += reach;
@@ -30,8 +32,9 @@ GridGeometry size_grid(const ScanBatch &batch, const MapperParams &params) {
   if (!(sx * sy <= static_cast<double>(kMaxGridCells)) || !(sx < 2147483647.0) ||
       !(sy < 2147483647.0)) {
     std::ostringstream msg;
-    msg << "the poses span " << 2 * (mx - reach) << " m x " << 2 * (my - reach)
-        << " m: a grid of " << sx << " x " << sy << " cells at " << params.resolution
+    msg << "the poses span " << 2 * (mx - reach) << " m x " << 2 * (my - reach) << " m (from the scan at line "
+        << batch.line[0] << " to line " << batch.line[far_x] << " in x and line " << batch.line[far_y]
+        << " in y): a grid of " << sx << " x " << sy << " cells at " << params.resolution
         << " m is too large (limit " << kMaxGridCells
         << " cells); check the poses or raise vasco_resolution";
     throw std::runtime_error(msg.str());

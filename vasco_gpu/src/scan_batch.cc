@@ -1,5 +1,7 @@
 #include "vasco_gpu/scan_batch.h"
 
+#include <algorithm>
+
 #include "vasco_gpu/params.h"
 
 namespace vasco {
@@ -14,6 +16,16 @@ void ScanBatch::add_scan(double px, double py, double ptheta, double first, doub
   line.push_back(source_line);
   range.insert(range.end(), r, r + n);
   beam_offset.push_back(range.size());
+}
+
+ScanBatch ScanBatch::select(long first, long count) const {
+  ScanBatch out;
+  const long n = static_cast<long>(num_scans());
+  const long begin = std::min(std::max(first, 0L), n);
+  const long end = (count < 0 || count > n - begin) ? n : begin + count;
+  for (long s = begin; s < end; ++s)
+    out.add_scan(x[s], y[s], theta[s], first_angle[s], angle_step[s], ranges_of(s), beams_in(s), line[s]);
+  return out;
 }
 
 ScanBatch load_scans(const std::string &log_path, const MapperParams &params,

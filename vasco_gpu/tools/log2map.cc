@@ -25,6 +25,7 @@
 #include "carmen_compat/map_file.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
+#include "vasco_gpu/log_input.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"
 #include "vasco_gpu/version.h"
@@ -184,35 +185,27 @@ int run(const Options &opt) {
   }
 #endif
 
-  // Parameters: the ini (or vasco's defaults), then command-line overrides.
-  carmen::ParamFile params;
-  if (!opt.param_file.empty()) params = carmen::ParamFile::load(opt.param_file, opt.robot);
-  for (const auto &kv : opt.overrides) params.set_override(kv.first, kv.second);
-  std::vector<std::string> warnings;
-  for (const auto &w : params.warnings()) warnings.push_back(w.str());
-  vasco::MapperParams mp = vasco::MapperParams::from_params(params, &warnings);
-
-  // Parse.
+  // Parameters (command line > ini > the log's PARAM lines > defaults), the
+  // scans and the grid.
   const auto t_parse = Clock::now();
-  carmen::LogReaderOptions ropt;
-  ropt.strict = !opt.lenient;
-  vasco::LogLoadStats load;
-  vasco::ScanBatch batch;
+  vasco::LogInputOptions in_opt;
+  in_opt.log = opt.log;
+  in_opt.param_file = opt.param_file;
+  in_opt.robot = opt.robot;
+  in_opt.overrides = opt.overrides;
+  in_opt.lenient = opt.lenient;
+  vasco::LogInput input;
   {
     ProgressBar bar("parse", !opt.quiet && isatty(STDERR_FILENO));
-    batch = vasco::load_scans(opt.log, mp, ropt, &load,
-                              [&](uint64_t done, uint64_t total) { bar.update(done, total); });
+    in_opt.progress = [&](uint64_t done, uint64_t total) { bar.update(done, total); };
+    input = vasco::load_log_input(in_opt);
   }
-  // The log's PARAM lines are a second, lower-priority source.
-  for (size_t i = 0; i < load.params.size(); ++i)
-    params.add_fallback(load.params[i].first, load.params[i].second, opt.log, load.param_lines[i]);
-  mp = vasco::MapperParams::from_params(params, nullptr);
   const double parse_s = seconds_since(t_parse);
-  if (batch.num_scans() == 0)
-    throw carmen::FileError(opt.log, "no FLASER or ROBOTLASER1 scans to map" +
-                                         std::string(load.laser_messages > 0 ? " in the selected range (vasco_first_scan/vasco_num_scans)" : ""));
-
-  const vasco::GridGeometry geo = vasco::size_grid(batch, mp);
+  std::vector<std::string> &warnings = input.warnings;
+  const vasco::MapperParams &mp = input.params;
+  const vasco::ScanBatch &batch = input.batch;
+  const vasco::LogLoadStats &load = input.load;
+  const vasco::GridGeometry &geo = input.geo;
   if (gpu_ready.valid()) gpu_ready.wait();
   auto backend = vasco::make_backend(opt.backend, bopt);
 

@@ -32,6 +32,10 @@ struct ScanBatch {
 
   void add_scan(double px, double py, double ptheta, double first, double step, const float *r,
                 int n, long source_line);
+
+  // Scans [first, first + count) (count < 0: to the end), clipped to the
+  // batch: vasco_first_scan / vasco_num_scans.
+  ScanBatch select(long first, long count) const;
 };
 
 // What reading a log produced, besides the scans.
