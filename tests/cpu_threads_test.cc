@@ -10,6 +10,7 @@
 #include <sstream>
 #include <thread>
 
+#include "test_seed.h"
 #include "test_support.h"
 #include "vasco_gpu/cpu_threads_backend.h"
 
@@ -96,9 +97,7 @@ struct RandomCase {
 };
 
 TEST(CpuThreads, RandomScansWithOddRangesMatchTheOracle) {
-  std::random_device seed_source;
-  const unsigned seed = seed_source();
-  std::cout << "[ random seed " << seed << " ]" << std::endl;
+  const unsigned seed = testing_support::test_seed();
   SCOPED_TRACE("random seed " + std::to_string(seed));
   std::mt19937 rng(seed);
   const RandomCase cases[] = {
@@ -128,9 +127,7 @@ TEST(CpuThreads, RandomScansWithOddRangesMatchTheOracle) {
 // Scans crowded into a few columns (one thin vertical strip of poses) and a
 // single scan: stripes of very uneven work and grids of few columns.
 TEST(CpuThreads, UnevenAndTinyInputsMatchTheOracle) {
-  std::random_device seed_source;
-  const unsigned seed = seed_source();
-  std::cout << "[ random seed " << seed << " ]" << std::endl;
+  const unsigned seed = testing_support::test_seed();
   SCOPED_TRACE("random seed " + std::to_string(seed));
   std::mt19937 rng(seed);
   MapperParams params;

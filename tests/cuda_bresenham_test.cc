@@ -6,6 +6,7 @@
 #include <vector>
 
 #if defined(VASCO_HAVE_CUDA)
+#include "test_seed.h"
 #include "line_check.h"
 #include "vasco_gpu/cuda_backend.h"
 #endif
@@ -18,8 +19,7 @@ TEST(CudaBresenham, ClosedFormsMatchTheSequentialWalkOnAMillionSegments) {
 #else
   std::string why;
   if (!vasco::cuda_usable(0, &why)) GTEST_SKIP() << "no usable GPU: " << why;
-  std::random_device seed_source;
-  const unsigned seed = seed_source();
+  const unsigned seed = vasco::testing_support::test_seed();
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> small(-40, 40), large(-5000, 5000), coin(0, 3);
   std::vector<int4> segs(1000000);

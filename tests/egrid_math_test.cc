@@ -1,5 +1,6 @@
 // Tests of the shared per-cell math (egrid_math.h): the same functions the
 // CUDA kernels run.
+#include "test_seed.h"
 #include "vasco_gpu/egrid_math.h"
 
 #include <gtest/gtest.h>
@@ -80,7 +81,7 @@ TEST(Bresenham, EndsIncludedAndLengthIsMajorDeltaPlusOne) {
 
 // The per-thread closed form must give exactly the sequential walk's cells.
 TEST(Bresenham, ClosedFormMatchesSequentialWalkOnAMillionRandomSegments) {
-  std::mt19937 rng(20261123);
+  std::mt19937 rng(testing_support::test_seed(20261123));
   std::uniform_int_distribution<int> small(-40, 40);
   std::uniform_int_distribution<int> large(-3000, 3000);
   std::uniform_int_distribution<int> coin(0, 3);
@@ -105,8 +106,33 @@ TEST(Bresenham, ClosedFormMatchesSequentialWalkOnAMillionRandomSegments) {
 }
 
 TEST(Bresenham, ClosedFormQualification) {
-  EXPECT_TRUE(is_closed_form_line(0, 0, 100000, -100000));
+  EXPECT_TRUE(is_closed_form_line(0, 0, 46340, -46340));  // |dx * dy| = 2147395600 fits an int
+  EXPECT_FALSE(is_closed_form_line(0, 0, 46341, 46341));  // 2147488281 does not
   EXPECT_FALSE(is_closed_form_line(500, 500, INT_MIN, 3));
+}
+
+TEST(IntegerSemantics, FlipFollowsCarmensWrappedProduct) {
+  // dx * dy = 65536 * 32768 = 2^31, which CARMEN's int product wraps to
+  // INT_MIN: the line counts as "flipped" though both deltas are positive.
+  // Worked by hand from DESIGN 2.1: y is negated, DY = -32768, DX = 65536,
+  // inc = +1, D = 2DY - DX < 0 and IncrE = 2DY < 0, so D never turns
+  // non-negative and the walk never takes a minor step: CARMEN walks this
+  // line flat along y = 0, not along y = x / 2.
+  BresenhamLine l;
+  bresenham_init(l, 0, 0, 65536, 32768);
+  EXPECT_TRUE(l.flipped);
+  for (int k = 0; k < 100; ++k) ASSERT_TRUE(bresenham_next(l));
+  int cx, cy;
+  bresenham_current(l, &cx, &cy);
+  EXPECT_EQ(cx, 100);
+  EXPECT_EQ(cy, 0);
+}
+
+TEST(IntegerSemantics, DistanceOfTheTableWrapsLikeCarmensInt) {
+  // sqrt(i*i + j*j) with int i*i + j*j: 46341^2 = 2147488281 wraps to
+  // -2147479015 in 32 bits, whose sqrt is NaN, as CARMEN's table would hold.
+  EXPECT_TRUE(std::isnan(cell_distance(46341, 0, 1.0)));
+  EXPECT_EQ(cell_distance(3, 4, 0.5), 2.5);
 }
 
 TEST(IntegerSemantics, TruncToIntIsCvttsd2si) {

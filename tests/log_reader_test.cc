@@ -1,4 +1,5 @@
 // Tests of the streaming CARMEN log reader (carmen_compat/log_reader.h).
+#include "test_seed.h"
 #include "carmen_compat/log_reader.h"
 
 #include <dirent.h>
@@ -779,7 +780,7 @@ TEST(LogReaderParseLine, RandomDamageNeverCrashesAndNeverMisaligns) {
     lines.push_back(text.substr(p, nl - p));
     p = nl + 1;
   }
-  std::mt19937 rng(12345);
+  std::mt19937 rng(vasco::testing_support::test_seed(12345));
   LogMessage m;
   carmen::LineError err;
   int parsed = 0, bad = 0;
@@ -859,7 +860,7 @@ TEST(LogReaderParseLine, DispatchIsOnTheExactFirstToken) {
 TEST(LogReaderParseLine, FastNumberPathMatchesStrtod) {
   // Random decimals in the shapes logs use, through a FLASER line, compared
   // with strtod bit for bit (the C locale is in force here).
-  std::mt19937_64 rng(7);
+  std::mt19937_64 rng(vasco::testing_support::test_seed(7));
   LogMessage m;
   carmen::LineError err;
   for (int it = 0; it < 20000; ++it) {

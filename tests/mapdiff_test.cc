@@ -1,0 +1,390 @@
+// The mapdiff tool, run as a program, and the grid comparison behind it.
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <cstring>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/map_file.h"
+#include "map_test_support.h"
+#include "tool_support.h"
+#include "vasco_gpu/compare.h"
+
+namespace {
+
+using carmen::GlobalOffset;
+using carmen::GridMap;
+using maptest::TempDir;
+using tooltest::contains;
+using tooltest::ToolRun;
+
+ToolRun mapdiff(const std::vector<std::string> &args) { return tooltest::run_tool("mapdiff", args); }
+
+void write_grid(const std::string &path, const GridMap &g, std::optional<GlobalOffset> offset = std::nullopt) {
+  carmen::MapFile m;
+  m.gridmap = g;
+  m.offset = offset;
+  carmen::write_map_file(path, m);
+}
+
+// 6 x 4 cells at 0.1 m: free 0.125 everywhere but an unknown corner (0, 0),
+// an occupied (5, 3) and a 0.75 at (2, 1).
+GridMap base_grid() {
+  GridMap g = GridMap::filled(6, 4, 0.1, 0.125f);
+  g.at(0, 0) = carmen::kUnknownCell;
+  g.at(5, 3) = 1.0f;
+  g.at(2, 1) = 0.75f;
+  return g;
+}
+
+// A window of `g`: size_x x size_y cells starting at its cell (x0, y0).
+GridMap crop(const GridMap &g, int x0, int y0, int size_x, int size_y) {
+  GridMap c = GridMap::filled(size_x, size_y, g.resolution);
+  for (int x = 0; x < size_x; ++x)
+    for (int y = 0; y < size_y; ++y) c.at(x, y) = g.at(x0 + x, y0 + y);
+  return c;
+}
+
+// An RGB PNG read back with libpng's simplified API (not mapdiff's code).
+struct RgbImage {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+  const uint8_t *pixel(int col, int row) const { return &rgb[(size_t(row) * size_t(width) + size_t(col)) * 3]; }
+};
+
+bool read_png_rgb(const std::string &path, RgbImage *out) {
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str())) return false;
+  image.format = PNG_FORMAT_RGB;
+  out->rgb.resize(PNG_IMAGE_SIZE(image));
+  out->width = int(image.width);
+  out->height = int(image.height);
+  const bool ok = png_image_finish_read(&image, nullptr, out->rgb.data(), 0, nullptr) != 0;
+  png_image_free(&image);
+  return ok;
+}
+
+class MapDiff : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!maptest::file_exists(std::string(VASCO_BIN_DIR) + "/mapdiff"))
+      GTEST_SKIP() << "mapdiff is not built in " << VASCO_BIN_DIR;
+    a_ = dir_.file("a.map");
+    write_grid(a_, base_grid());
+  }
+  // Writes B = the base grid changed by `edit`, returns its path.
+  template <class Edit>
+  std::string write_b(Edit edit, const std::string &name = "b.map") {
+    GridMap g = base_grid();
+    edit(g);
+    write_grid(dir_.file(name), g);
+    return dir_.file(name);
+  }
+  TempDir dir_;
+  std::string a_;
+};
+
+TEST_F(MapDiff, Usage) {
+  const ToolRun help = mapdiff({"--help"});
+  EXPECT_EQ(help.status, 0);
+  EXPECT_TRUE(contains(help.output, "Usage:")) << help.output;
+  EXPECT_TRUE(contains(help.output, "--tolerance")) << help.output;
+  EXPECT_EQ(mapdiff({}).status, 2);
+  EXPECT_EQ(mapdiff({a_}).status, 2);
+  EXPECT_EQ(mapdiff({a_, a_, a_}).status, 2);
+  const ToolRun bogus = mapdiff({"--bogus", a_, a_});
+  EXPECT_EQ(bogus.status, 2);
+  EXPECT_TRUE(contains(bogus.output, "--bogus")) << bogus.output;
+  EXPECT_EQ(mapdiff({"--top", "-1", a_, a_}).status, 2);
+  EXPECT_EQ(mapdiff({"--tolerance", "x", a_, a_}).status, 2);
+  EXPECT_EQ(mapdiff({"--min-class-agreement", "1.5", a_, a_}).status, 2);
+  EXPECT_EQ(mapdiff({"--quiet", "--json", a_, a_}).status, 2);
+  EXPECT_EQ(mapdiff({"--png", a_, a_, a_}).status, 2);  // would overwrite A
+}
+
+TEST_F(MapDiff, IdenticalMaps) {
+  // The same grid, once gzipped: the files differ, the GRIDMAPs do not.
+  write_grid(dir_.file("b.map.gz"), base_grid());
+  const ToolRun r = mapdiff({a_, dir_.file("b.map.gz")});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "identical: yes")) << r.output;
+  EXPECT_TRUE(contains(r.output, "size 6 x 4 cells, resolution 0.100000001 m, offset none")) << r.output;
+  EXPECT_TRUE(contains(r.output, "verdict: identical\n")) << r.output;
+  const ToolRun quiet = mapdiff({"--quiet", a_, dir_.file("b.map.gz")});
+  EXPECT_EQ(quiet.status, 0);
+  EXPECT_EQ(quiet.output, "identical\n");
+  // The OFFSET chunk is not part of the GRIDMAP: a moved origin alone is noted, not judged.
+  write_grid(dir_.file("moved.map"), base_grid(), GlobalOffset{1, 2, 0});
+  const ToolRun moved = mapdiff({a_, dir_.file("moved.map")});
+  EXPECT_EQ(moved.status, 0) << moved.output;
+  EXPECT_TRUE(contains(moved.output, "offset x 1 y 2 theta 0\n")) << moved.output;
+  EXPECT_TRUE(contains(moved.output, "note: the OFFSET chunks differ\n")) << moved.output;
+}
+
+TEST_F(MapDiff, OneCellChanged) {
+  const std::string b = write_b([](GridMap &g) { g.at(3, 2) = 0.375f; });
+  const ToolRun r = mapdiff({a_, b});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "identical: no")) << r.output;
+  EXPECT_TRUE(contains(r.output, "(3, 2)  A 0.125  B 0.375  dp +0.25\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "max |dp| (known in both) 0.25")) << r.output;
+  EXPECT_TRUE(contains(r.output, "verdict: different: 1 cell differs (max |dp| 0.25,")) << r.output;
+  const ToolRun quiet = mapdiff({"-q", a_, b});
+  EXPECT_EQ(quiet.status, 1);
+  EXPECT_EQ(quiet.output.find('\n'), quiet.output.size() - 1) << quiet.output;  // one line
+}
+
+TEST_F(MapDiff, ToleranceOptions) {
+  const std::string b = write_b([](GridMap &g) { g.at(3, 2) = 0.375f; });
+  const ToolRun within = mapdiff({"--tolerance", "0.25", a_, b});
+  EXPECT_EQ(within.status, 0) << within.output;
+  EXPECT_TRUE(contains(within.output, "verdict: within tolerance: 1 cell differs")) << within.output;
+  const ToolRun outside = mapdiff({"--tolerance", "0.2", a_, b});
+  EXPECT_EQ(outside.status, 1) << outside.output;
+  EXPECT_TRUE(contains(outside.output, "outside tolerance: max |dp| 0.25 > 0.2")) << outside.output;
+  // A class flip (free 0.125 -> occupied 0.625): 23 of 24 cells agree.
+  const std::string flip = write_b([](GridMap &g) { g.at(3, 2) = 0.625f; }, "flip.map");
+  // Unless asked for, the class agreement is not checked: the flip is within --tolerance.
+  EXPECT_EQ(mapdiff({"--tolerance", "0.5", a_, flip}).status, 0);
+  EXPECT_EQ(mapdiff({"--tolerance", "0.4", a_, flip}).status, 1);
+  EXPECT_EQ(mapdiff({"--tolerance", "0.5", "--min-class-agreement", "0.95", a_, flip}).status, 0);
+  EXPECT_EQ(mapdiff({"--tolerance", "0.5", "--min-class-agreement", "0.96", a_, flip}).status, 1);
+}
+
+TEST_F(MapDiff, StatusChangeIsCounted) {
+  const std::string b = write_b([](GridMap &g) {
+    g.at(1, 1) = carmen::kUnknownCell;  // known -> unknown
+    g.at(0, 0) = 0.5f;                  // unknown -> known
+  });
+  const ToolRun r = mapdiff({a_, b});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "known/unknown differs 2 ")) << r.output;
+  EXPECT_TRUE(contains(r.output, "(0, 0)  A -1  B 0.5\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "(1, 1)  A 0.125  B -1\n")) << r.output;
+  EXPECT_EQ(mapdiff({"--max-status-differs", "2", a_, b}).status, 0);
+  EXPECT_EQ(mapdiff({"--max-status-differs", "1", a_, b}).status, 1);
+  const ToolRun classes = mapdiff({"--max-status-differs", "2", "--min-class-agreement", "1", a_, b});
+  EXPECT_EQ(classes.status, 1);
+  EXPECT_TRUE(contains(classes.output, "outside tolerance: class agreement 0.916667 < 1")) << classes.output;
+}
+
+TEST_F(MapDiff, TopListsLargestFirst) {
+  const std::string b = write_b([](GridMap &g) {
+    g.at(1, 0) = 0.25f;  // +0.125
+    g.at(4, 2) = 1.0f;   // +0.875
+    g.at(2, 1) = 0.25f;  // -0.5
+  });
+  const ToolRun r = mapdiff({"--top", "2", a_, b});
+  EXPECT_EQ(r.status, 1);
+  const size_t first = r.output.find("(4, 2)  A 0.125  B 1"), second = r.output.find("(2, 1)  A 0.75  B 0.25");
+  EXPECT_NE(first, std::string::npos) << r.output;
+  EXPECT_NE(second, std::string::npos) << r.output;
+  EXPECT_LT(first, second) << r.output;
+  EXPECT_FALSE(contains(r.output, "(1, 0)")) << r.output;
+  EXPECT_TRUE(contains(r.output, "2 of 3 cells that differ")) << r.output;
+  EXPECT_FALSE(contains(mapdiff({"--top", "0", a_, b}).output, "(4, 2)"));
+}
+
+TEST_F(MapDiff, DifferentSizesCompareTheOverlap) {
+  write_grid(dir_.file("small.map"), crop(base_grid(), 0, 0, 4, 3));
+  const ToolRun r = mapdiff({a_, dir_.file("small.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "size 4 x 3 cells")) << r.output;
+  EXPECT_TRUE(contains(r.output, "alignment: at cell (0, 0) (no OFFSET chunk in either)")) << r.output;
+  EXPECT_TRUE(contains(r.output, "compared: 4 x 3 cells, A's x 0..3, y 0..2; "
+                                 "outside the overlap 12 cells (12 known)")) << r.output;
+  EXPECT_TRUE(contains(r.output, "bit-identical 100.0000%")) << r.output;
+  EXPECT_TRUE(contains(r.output, "verdict: different: 12 cells differ")) << r.output;
+  // Outside cells share the known/unknown budget.
+  EXPECT_EQ(mapdiff({"--max-status-differs", "12", a_, dir_.file("small.map")}).status, 0);
+  EXPECT_EQ(mapdiff({"--max-status-differs", "11", a_, dir_.file("small.map")}).status, 1);
+}
+
+// Two windows of one 10 x 8 map (0.5 m cells, cell (0, 0) at (-2, 3)):
+// A = x 1..7, y 2..6; B = x 3..9, y 0..5. They overlap in x 3..7, y 2..5,
+// which is A's x 2..6, y 0..3; B's cell (0, 0) is A's cell (2, -2).
+class MapDiffOffsets : public MapDiff {
+ protected:
+  void SetUp() override {
+    MapDiff::SetUp();
+    world_ = GridMap::filled(10, 8, 0.5, 0.25f);
+    for (int x = 0; x < 10; ++x) world_.at(x, (x * 3) % 8) = 0.875f;
+    world_.at(4, 3) = carmen::kUnknownCell;
+    a_ = dir_.file("wa.map");
+    write_grid(a_, crop(world_, 1, 2, 7, 5), GlobalOffset{-2 + 0.5, 3 + 1.0, 0});
+  }
+  std::string write_window_b(const GridMap &world, double dx = 0) {
+    write_grid(dir_.file("wb.map"), crop(world, 3, 0, 7, 6), GlobalOffset{-2 + 1.5 + dx, 3, 0});
+    return dir_.file("wb.map");
+  }
+  GridMap world_;
+};
+
+TEST_F(MapDiffOffsets, AlignByOffset) {
+  const std::string b = write_window_b(world_);
+  const ToolRun r = mapdiff({a_, b});
+  EXPECT_EQ(r.status, 1) << r.output;  // the sizes differ
+  EXPECT_TRUE(contains(r.output, "alignment: by OFFSET: B's cell (0, 0) is A's cell (2, -2)")) << r.output;
+  EXPECT_TRUE(contains(r.output, "compared: 5 x 4 cells, A's x 2..6, y 0..3; outside the overlap 37 cells"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "bit-identical 100.0000%")) << r.output;
+  EXPECT_EQ(mapdiff({"--max-status-differs", "37", a_, b}).status, 0);
+  // Without the offsets the windows do not match.
+  const ToolRun plain = mapdiff({"--no-offset", a_, b});
+  EXPECT_TRUE(contains(plain.output, "alignment: at cell (0, 0) (--no-offset)")) << plain.output;
+  EXPECT_FALSE(contains(plain.output, "bit-identical 100.0000%")) << plain.output;
+}
+
+TEST_F(MapDiffOffsets, ChangedCellInAsCoordinates) {
+  GridMap world = world_;
+  world.at(5, 4) = 0.5f;  // A's (4, 2), B's (2, 4)
+  const ToolRun r = mapdiff({a_, write_window_b(world)});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "(4, 2)  A 0.25  B 0.5  dp +0.25  [B's cell (2, 4)]")) << r.output;
+}
+
+TEST_F(MapDiffOffsets, FractionalOffsetAlignsAtOrigin) {
+  const ToolRun r = mapdiff({a_, write_window_b(world_, 0.2)});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "at cell (0, 0), not by OFFSET: "
+                                 "the offsets are not a whole number of cells apart")) << r.output;
+}
+
+TEST_F(MapDiff, DifferentResolution) {
+  GridMap g = base_grid();
+  g.resolution = 0.05;
+  write_grid(dir_.file("fine.map"), g);
+  const ToolRun r = mapdiff({"--png", dir_.file("d.png"), a_, dir_.file("fine.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "resolution 0.0500000007 m")) << r.output;
+  EXPECT_TRUE(contains(r.output, "verdict: different: resolution 0.100000001 m vs 0.0500000007 m")) << r.output;
+  EXPECT_FALSE(maptest::file_exists(dir_.file("d.png")));
+}
+
+TEST_F(MapDiff, UnreadableFilesExitTwoNamingThem) {
+  const std::string missing = dir_.file("nope.map");
+  ToolRun r = mapdiff({a_, missing});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "mapdiff: " + missing + ": ")) << r.output;
+  r = mapdiff({missing, a_});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, missing)) << r.output;
+
+  const std::string garbage = dir_.file("garbage.map");
+  maptest::write_bytes(garbage, std::string("\x01\x02not a map at all\xff\xfe", 20));
+  r = mapdiff({a_, garbage});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "mapdiff: " + garbage + ": ")) << r.output;
+  maptest::write_bytes(dir_.file("garbage.map.gz"), "not gzip either");
+  r = mapdiff({dir_.file("garbage.map.gz"), a_});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, dir_.file("garbage.map.gz"))) << r.output;
+
+  carmen::write_map_file(dir_.file("nogrid.map"), carmen::MapFile{});
+  r = mapdiff({a_, dir_.file("nogrid.map")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, dir_.file("nogrid.map") + ": has no GRIDMAP chunk")) << r.output;
+}
+
+TEST_F(MapDiff, FailedRunLeavesNoPicture) {
+  const std::vector<std::string> before = dir_.entries();
+  const ToolRun r = mapdiff({"--png", dir_.file("d.png"), a_, dir_.file("nope.map")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(dir_.entries(), before);  // no picture, no temporary
+  const ToolRun unwritable = mapdiff({"--png", dir_.file("no/dir/d.png"), a_, a_});
+  EXPECT_EQ(unwritable.status, 2);
+  EXPECT_TRUE(contains(unwritable.output, dir_.file("no/dir/d.png"))) << unwritable.output;
+  EXPECT_EQ(dir_.entries(), before);
+}
+
+TEST_F(MapDiffOffsets, PngShowsTheOverlap) {
+  GridMap world = world_;
+  world.at(5, 4) = 0.5f;                   // B higher: A's (4, 2)
+  world.at(3, 3) = 0.125f;                 // B lower: A's (2, 1)
+  world.at(6, 5) = carmen::kUnknownCell;  // known in A only: A's (5, 3)
+  const std::string png = dir_.file("d.png");
+  const ToolRun r = mapdiff({"--png", png, a_, write_window_b(world)});
+  EXPECT_EQ(r.status, 1) << r.output;
+  RgbImage img;
+  ASSERT_TRUE(read_png_rgb(png, &img)) << r.output;
+  ASSERT_EQ(img.width, 5);  // the overlap: A's x 2..6, y 0..3
+  ASSERT_EQ(img.height, 4);
+  // Column = x - 2, row = 3 - y (row 0 is the highest y).
+  const uint8_t *higher = img.pixel(4 - 2, 3 - 2), *lower = img.pixel(2 - 2, 3 - 1);
+  const uint8_t *status = img.pixel(5 - 2, 3 - 3), *same = img.pixel(3 - 2, 3 - 0);
+  EXPECT_EQ(higher[0], 255);
+  EXPECT_LT(higher[1], 128);
+  EXPECT_EQ(higher[1], higher[2]);
+  EXPECT_EQ(lower[2], 255);
+  EXPECT_LT(lower[0], 128);
+  EXPECT_EQ(lower[0], lower[1]);
+  EXPECT_EQ(status[0], 255);
+  EXPECT_EQ(status[1], 0);
+  EXPECT_EQ(status[2], 255);
+  // An unchanged free cell (p = 0.25) is A's grey, round(255 * 0.75).
+  EXPECT_EQ(same[0], 191);
+  EXPECT_EQ(same[1], 191);
+  EXPECT_EQ(same[2], 191);
+  for (const std::string &name : dir_.entries()) EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
+}
+
+TEST_F(MapDiff, Json) {
+  const std::string b = write_b([](GridMap &g) { g.at(3, 2) = 0.375f; });
+  const ToolRun r = mapdiff({"--json", a_, b});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.output.substr(0, 6), "{\"a\":{") << r.output;
+  EXPECT_TRUE(contains(r.output, "\"max_abs_dp\":0.25,")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"largest\":[{\"x\":3,\"y\":2,\"a\":0.125,\"b\":0.375}]")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"identical\":false,\"offsets_equal\":true,")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"exit\":1}\n")) << r.output;
+}
+
+// ---- The library ----------------------------------------------------------
+
+TEST(CompareGrids, AgreesWithCompareMapsAtNoShift) {
+  GridMap a = base_grid(), b = base_grid();
+  b.at(3, 2) = 0.625f;
+  b.at(1, 1) = carmen::kUnknownCell;
+  const vasco::Agreement m = vasco::compare_maps(a.cells, b.cells);
+  const vasco::GridComparison g = vasco::compare_grids(a, b, 0, 0, 10);
+  EXPECT_EQ(g.agreement.cells, m.cells);
+  EXPECT_EQ(g.agreement.identical, m.identical);
+  EXPECT_EQ(g.agreement.status_differs, m.status_differs);
+  EXPECT_EQ(g.agreement.class_agree, m.class_agree);
+  EXPECT_EQ(g.agreement.max_abs_diff, m.max_abs_diff);
+  EXPECT_EQ(g.agreement.table("t"), m.table("t"));
+  EXPECT_EQ(g.outside, 0u);
+  EXPECT_EQ(g.differing_cells(), 2u);
+  ASSERT_EQ(g.largest.size(), 1u);
+  EXPECT_EQ(g.largest[0].x, 3);
+  ASSERT_EQ(g.status_changes.size(), 1u);
+  EXPECT_EQ(g.status_changes[0].y, 1);
+}
+
+TEST(CompareGrids, NoOverlap) {
+  const GridMap a = base_grid();
+  const vasco::GridComparison g = vasco::compare_grids(a, a, 6, 0, 10);
+  EXPECT_EQ(g.width, 0);
+  EXPECT_EQ(g.height, 0);
+  EXPECT_EQ(g.outside, 48u);
+  EXPECT_EQ(g.outside_known, 46u);
+  EXPECT_FALSE(g.same_cells());
+}
+
+TEST(CompareGrids, OffsetShift) {
+  int64_t sx = 0, sy = 0;
+  std::string why;
+  EXPECT_TRUE(vasco::offset_shift({1.0, 2.0, 0}, {1.5, 1.0, 0}, 0.25, &sx, &sy, &why));
+  EXPECT_EQ(sx, 2);
+  EXPECT_EQ(sy, -4);
+  EXPECT_FALSE(vasco::offset_shift({0, 0, 0}, {0.1, 0, 0}, 0.25, &sx, &sy, &why));
+  EXPECT_TRUE(contains(why, "whole number")) << why;
+  EXPECT_FALSE(vasco::offset_shift({0, 0, 0.5}, {0, 0, 0.5}, 0.25, &sx, &sy, &why));
+  EXPECT_TRUE(contains(why, "theta")) << why;
+}
+
+}  // namespace

@@ -1,0 +1,457 @@
+// mapdiff — compares the GRIDMAP chunks of two CARMEN maps, for regression
+// suites: is today's map the same as yesterday's (bit for bit, or within
+// tolerances), and if not, where and by how much (DESIGN §4's table).
+//
+//   mapdiff [options] A B
+//
+// Exit 0 same (or within tolerance), 1 different, 2 usage error or a file
+// that cannot be read (or the --png picture cannot be written). A regression
+// suite can then tell "the map changed" (1) from "the check broke" (2).
+#include <png.h>
+
+#include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "carmen_compat/atomic_file.h"
+#include "carmen_compat/error.h"
+#include "carmen_compat/map_file.h"
+#include "vasco_gpu/compare.h"
+#include "vasco_gpu/map_digest.h"
+#include "vasco_gpu/version.h"
+
+namespace {
+
+struct Options {
+  std::string a, b, png;
+  int top = 10;
+  double tolerance = 0;
+  long long max_status_differs = 0;
+  double min_class_agreement = 1.0;
+  bool quiet = false, json = false, no_offset = false;
+  bool tolerant = false;     // a tolerance option was given: judge by the limits
+  bool class_limit = false;  // --min-class-agreement was given
+};
+
+struct Input {
+  std::string path;
+  carmen::GridMap grid;
+  std::optional<carmen::GlobalOffset> offset;
+  std::string sha256;  // of the GRIDMAP payload (vasco/map_digest.h): what goldens are published with
+};
+
+// Where B lies on A and why; `compared` is false when the resolutions differ.
+struct Alignment {
+  int64_t shift_x = 0, shift_y = 0;
+  std::string how;
+  bool compared = true;
+};
+
+struct Verdict {
+  int exit_status = 1;
+  std::string line;  // "identical", "different: ...", ...
+};
+
+// ---------------------------------------------------------------------------
+// Reading
+// ---------------------------------------------------------------------------
+
+// Every failure becomes a carmen::FileError naming the file, so main can say
+// "mapdiff: PATH: what is wrong" and exit 2.
+Input load(const std::string &path) {
+  carmen::MapFile m;
+  try {
+    m = carmen::read_map_file(path);
+  } catch (const carmen::FileError &) {
+    throw;
+  } catch (const std::exception &e) {
+    throw carmen::FileError(path, e.what());
+  }
+  if (!m.gridmap) throw carmen::FileError(path, "has no GRIDMAP chunk: nothing to compare");
+  Input in{path, std::move(*m.gridmap), m.offset, {}};
+  in.sha256 = vasco::gridmap_payload_sha256(in.grid.size_x, in.grid.size_y, in.grid.resolution, in.grid.cells);
+  return in;
+}
+
+// "Identical": what the GRIDMAP chunk holds — size, resolution, cells bit for
+// bit. The OFFSET chunk is not part of it (reported separately).
+bool identical_grids(const carmen::GridMap &a, const carmen::GridMap &b) {
+  return a.size_x == b.size_x && a.size_y == b.size_y && a.resolution == b.resolution &&
+         a.cells.size() == b.cells.size() &&
+         (a.cells.empty() || std::memcmp(a.cells.data(), b.cells.data(), a.cells.size() * sizeof(float)) == 0);
+}
+
+bool same_offset(const std::optional<carmen::GlobalOffset> &a, const std::optional<carmen::GlobalOffset> &b) {
+  if (!a || !b) return !a && !b;
+  return a->x == b->x && a->y == b->y && a->theta == b->theta;
+}
+
+// ---------------------------------------------------------------------------
+// Alignment
+// ---------------------------------------------------------------------------
+
+// Identical grids are compared cell for cell even when their OFFSETs differ:
+// the verdict is about the GRIDMAP, and a shifted origin alone would
+// otherwise turn "identical" into a table full of differences.
+Alignment align(const Input &a, const Input &b, bool identical, bool no_offset) {
+  Alignment al;
+  if (a.grid.resolution != b.grid.resolution) {
+    al.compared = false;
+    al.how = "none: the resolutions differ, cells not compared";
+  } else if (identical) {
+    al.how = "cell for cell (identical GRIDMAPs)";
+  } else if (no_offset) {
+    al.how = "at cell (0, 0) (--no-offset)";
+  } else if (!a.offset || !b.offset) {
+    const char *missing = a.offset ? "B" : b.offset ? "A" : "either";
+    al.how = std::string("at cell (0, 0) (no OFFSET chunk in ") + missing + ")";
+  } else {
+    std::string why;
+    if (vasco::offset_shift(*a.offset, *b.offset, a.grid.resolution, &al.shift_x, &al.shift_y, &why)) {
+      al.how = "by OFFSET: B's cell (0, 0) is A's cell (" + std::to_string(al.shift_x) + ", " +
+               std::to_string(al.shift_y) + ")";
+    } else {
+      al.how = "at cell (0, 0), not by OFFSET: " + why;
+    }
+  }
+  return al;
+}
+
+// ---------------------------------------------------------------------------
+// Verdict
+// ---------------------------------------------------------------------------
+
+std::string fmt(const char *format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+std::string summary(const vasco::GridComparison &c) {
+  const vasco::Agreement &g = c.agreement;
+  const uint64_t n = c.differing_cells();
+  return std::to_string(n) + (n == 1 ? " cell differs" : " cells differ") + " (max |dp| " + fmt("%.9g", g.max_abs_diff) +
+         ", known/unknown differs " + std::to_string(g.status_differs) + ", outside the overlap " +
+         std::to_string(c.outside) + ", class agreement " + fmt("%.6f", g.class_agreement()) + ")";
+}
+
+// The reasons a comparison is outside the tolerances; empty when within.
+// Cells outside the overlap are in one map only, like a known/unknown change,
+// so they share --max-status-differs. The class agreement is checked only when
+// asked for: every class disagreement is a status change or a value change,
+// which the other two limits already bound, so a default of 1.0 would make
+// `--max-status-differs 5` fail on the very changes it allows.
+std::vector<std::string> tolerance_failures(const vasco::GridComparison &c, const Options &o) {
+  std::vector<std::string> f;
+  const vasco::Agreement &g = c.agreement;
+  if (!(g.max_abs_diff <= o.tolerance))
+    f.push_back("max |dp| " + fmt("%.9g", g.max_abs_diff) + " > " + fmt("%.9g", o.tolerance));
+  const unsigned long long status = g.status_differs + c.outside;
+  if (status > static_cast<unsigned long long>(o.max_status_differs))
+    f.push_back("known/unknown differs + outside the overlap " + std::to_string(status) + " > " +
+                std::to_string(o.max_status_differs));
+  if (o.class_limit && !(g.class_agreement() >= o.min_class_agreement))
+    f.push_back("class agreement " + fmt("%.6f", g.class_agreement()) + " < " +
+                fmt("%.9g", o.min_class_agreement));
+  return f;
+}
+
+Verdict judge(const Input &a, const Input &b, bool identical, const Alignment &al,
+              const vasco::GridComparison &c, const Options &o) {
+  if (!al.compared)
+    return {1, "different: resolution " + fmt("%.9g", a.grid.resolution) + " m vs " +
+                   fmt("%.9g", b.grid.resolution) + " m (cells not compared)"};
+  if (identical) return {0, "identical"};
+  if (!o.tolerant) return {1, "different: " + summary(c)};
+  const std::vector<std::string> f = tolerance_failures(c, o);
+  if (f.empty()) return {0, "within tolerance: " + summary(c)};
+  std::string line = "outside tolerance: ";
+  for (size_t i = 0; i < f.size(); ++i) line += (i ? "; " : "") + f[i];
+  return {1, line};
+}
+
+// ---------------------------------------------------------------------------
+// Text report
+// ---------------------------------------------------------------------------
+
+std::string offset_text(const std::optional<carmen::GlobalOffset> &o) {
+  if (!o) return "none";
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "x %.9g y %.9g theta %.9g", o->x, o->y, o->theta);
+  return buf;
+}
+
+void print_input(const char *label, const Input &in) {
+  std::printf("%s: %s\n   size %d x %d cells, resolution %.9g m, offset %s\n   GRIDMAP sha256 %s\n", label,
+              in.path.c_str(), in.grid.size_x, in.grid.size_y, in.grid.resolution, offset_text(in.offset).c_str(),
+              in.sha256.c_str());
+}
+
+void print_cell(const vasco::CellDifference &d, const vasco::GridComparison &c) {
+  std::printf("  (%d, %d)  A %.9g  B %.9g", d.x, d.y, d.a, d.b);
+  if (d.a != -1.0f && d.b != -1.0f) std::printf("  dp %+.9g", double(d.b) - double(d.a));
+  if (c.shift_x != 0 || c.shift_y != 0)
+    std::printf("  [B's cell (%lld, %lld)]", (long long)(d.x - c.shift_x), (long long)(d.y - c.shift_y));
+  std::printf("\n");
+}
+
+void print_differences(const vasco::GridComparison &c) {
+  const vasco::Agreement &g = c.agreement;
+  const uint64_t known_differ = g.cells - g.identical - g.status_differs;  // both -1: equal bits
+  if (!c.largest.empty()) {
+    std::printf("largest |dp| (known in both; %zu of %llu cells that differ):\n", c.largest.size(),
+                (unsigned long long)known_differ);
+    for (const auto &d : c.largest) print_cell(d, c);
+  }
+  if (!c.status_changes.empty()) {
+    std::printf("known/unknown changes (first %zu of %llu, -1 = unknown):\n", c.status_changes.size(),
+                (unsigned long long)g.status_differs);
+    for (const auto &d : c.status_changes) print_cell(d, c);
+  }
+}
+
+void print_comparison(const vasco::GridComparison &c) {
+  if (c.width == 0) {
+    std::printf("compared: nothing (the grids do not overlap); outside the overlap %llu cells (%llu known)\n",
+                (unsigned long long)c.outside, (unsigned long long)c.outside_known);
+    return;
+  }
+  std::printf("compared: %d x %d cells, A's x %d..%d, y %d..%d; outside the overlap %llu cells (%llu known)\n",
+              c.width, c.height, c.x0, c.x0 + c.width - 1, c.y0, c.y0 + c.height - 1,
+              (unsigned long long)c.outside, (unsigned long long)c.outside_known);
+  std::fputs(c.agreement.table("agreement (A reference, B test):").c_str(), stdout);
+  print_differences(c);
+}
+
+void print_text(const Input &a, const Input &b, bool identical, const Alignment &al,
+                const vasco::GridComparison &c, const Verdict &v) {
+  print_input("A", a);
+  print_input("B", b);
+  std::printf("identical: %s (GRIDMAP size, resolution and cells bit for bit)\n", identical ? "yes" : "no");
+  if (identical && !same_offset(a.offset, b.offset)) std::printf("note: the OFFSET chunks differ\n");
+  std::printf("alignment: %s\n", al.how.c_str());
+  if (al.compared) print_comparison(c);
+  std::printf("verdict: %s\n", v.line.c_str());
+}
+
+// ---------------------------------------------------------------------------
+// JSON report
+// ---------------------------------------------------------------------------
+
+std::string json_string(const std::string &s) {
+  std::string out = "\"";
+  for (unsigned char ch : s) {
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += char(ch);
+    } else if (ch < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", ch);
+      out += buf;
+    } else {
+      out += char(ch);
+    }
+  }
+  return out + "\"";
+}
+
+// JSON has no NaN or infinity.
+std::string json_number(double v, const char *format = "%.17g") {
+  return std::isfinite(v) ? fmt(format, v) : "null";
+}
+
+std::string json_input(const Input &in) {
+  std::ostringstream j;
+  j << "{\"path\":" << json_string(in.path) << ",\"size_x\":" << in.grid.size_x << ",\"size_y\":" << in.grid.size_y
+    << ",\"resolution\":" << json_number(in.grid.resolution) << ",\"offset\":";
+  if (in.offset) {
+    j << "{\"x\":" << json_number(in.offset->x) << ",\"y\":" << json_number(in.offset->y)
+      << ",\"theta\":" << json_number(in.offset->theta) << "}";
+  } else {
+    j << "null";
+  }
+  j << ",\"gridmap_sha256\":" << json_string(in.sha256) << "}";
+  return j.str();
+}
+
+std::string json_cells(const std::vector<vasco::CellDifference> &cells) {
+  std::string s = "[";
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const auto &d = cells[i];
+    s += (i ? "," : "") + std::string("{\"x\":") + std::to_string(d.x) + ",\"y\":" + std::to_string(d.y) +
+         ",\"a\":" + json_number(d.a, "%.9g") + ",\"b\":" + json_number(d.b, "%.9g") + "}";
+  }
+  return s + "]";
+}
+
+std::string json_comparison(const vasco::GridComparison &c) {
+  const vasco::Agreement &g = c.agreement;
+  std::ostringstream j;
+  j << "{\"shift_x\":" << c.shift_x << ",\"shift_y\":" << c.shift_y << ",\"x0\":" << c.x0 << ",\"y0\":" << c.y0
+    << ",\"width\":" << c.width << ",\"height\":" << c.height << ",\"outside\":" << c.outside
+    << ",\"outside_known\":" << c.outside_known << ",\"cells\":" << g.cells << ",\"both_known\":" << g.both_known
+    << ",\"bit_identical\":" << g.identical << ",\"differing_cells\":" << c.differing_cells()
+    << ",\"max_abs_dp\":" << json_number(g.max_abs_diff) << ",\"dp_over_0_1\":" << g.large_diffs
+    << ",\"status_differs\":" << g.status_differs << ",\"class_agreement\":" << json_number(g.class_agreement())
+    << ",\"occupied\":{\"in_a\":" << g.occupied_ref << ",\"agree\":" << g.occupied_agree << "}"
+    << ",\"free\":{\"in_a\":" << g.free_ref << ",\"agree\":" << g.free_agree << "}"
+    << ",\"unknown\":{\"in_a\":" << g.unknown_ref << ",\"agree\":" << g.unknown_agree << "}"
+    << ",\"largest\":" << json_cells(c.largest) << ",\"status_changes\":" << json_cells(c.status_changes) << "}";
+  return j.str();
+}
+
+void print_json(const Input &a, const Input &b, bool identical, const Alignment &al,
+                const vasco::GridComparison &c, const Verdict &v) {
+  std::printf("{\"a\":%s,\"b\":%s,\"identical\":%s,\"offsets_equal\":%s,\"alignment\":%s,"
+              "\"comparison\":%s,\"verdict\":%s,\"exit\":%d}\n",
+              json_input(a).c_str(), json_input(b).c_str(), identical ? "true" : "false",
+              same_offset(a.offset, b.offset) ? "true" : "false",
+              json_string(al.how).c_str(), al.compared ? json_comparison(c).c_str() : "null",
+              json_string(v.line).c_str(), v.exit_status);
+}
+
+// ---------------------------------------------------------------------------
+// The picture
+// ---------------------------------------------------------------------------
+
+// The project's write_png is greyscale only; this is its RGB twin, atomic in
+// the same way (temp file beside the target, renamed over it; removed on any
+// failure, so a failed run leaves nothing behind).
+void write_rgb_png(const std::string &path, int width, int height, const std::vector<uint8_t> &rgb) {
+  carmen::AtomicOutput out(path);
+  FILE *f = std::fopen(out.temp_path().c_str(), "wb");
+  if (f == nullptr)
+    throw carmen::FileError(path, "cannot create " + out.temp_path() + ": " + std::strerror(errno));
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  image.width = static_cast<png_uint_32>(width);
+  image.height = static_cast<png_uint_32>(height);
+  image.format = PNG_FORMAT_RGB;
+  const int ok = png_image_write_to_stdio(&image, f, 0, rgb.data(), static_cast<png_int_32>(3 * width), nullptr);
+  const std::string message = ok ? std::string() : std::string(image.message);
+  png_image_free(&image);
+  const bool closed = std::fclose(f) == 0;
+  if (!ok) throw carmen::FileError(path, "PNG write failed: " + message);
+  if (!closed) throw carmen::FileError(path, std::string("write failed: ") + std::strerror(errno));
+  out.commit();
+}
+
+// Writes the picture of the overlap; false (and a note) when there is none.
+bool write_picture(const std::string &path, const Input &a, const Input &b, const Alignment &al,
+                   const vasco::GridComparison &c) {
+  const char *why = !al.compared ? "the resolutions differ" : c.width == 0 ? "the grids do not overlap" : nullptr;
+  if (why != nullptr) {
+    std::fprintf(stderr, "mapdiff: %s: not written: %s\n", path.c_str(), why);
+    return false;
+  }
+  write_rgb_png(path, c.width, c.height, vasco::difference_image_rgb(a.grid, b.grid, c));
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Command line
+// ---------------------------------------------------------------------------
+
+const char kFooter[] =
+    "\nA is the reference, B the test; cells are given in A's coordinates (x, y).\n"
+    "Alignment: when both maps have an OFFSET chunk (theta 0) a whole number of\n"
+    "cells apart, B is laid on A by it; otherwise at cell (0, 0). Only the overlap\n"
+    "is compared; cells outside it count as differing.\n"
+    "Same: without tolerance options, equal size and resolution and bit-identical\n"
+    "cells. With any of --tolerance, --max-status-differs, --min-class-agreement:\n"
+    "within every limit (an unset --tolerance or --max-status-differs is 0).\n"
+    "PNG: the overlap, y up; A in grey (white free, black occupied, grey unknown);\n"
+    "red B higher, blue B lower (pale |dp| <= 1e-6 .. full |dp| >= 1, log scale);\n"
+    "magenta known in A only, green known in B only.\n"
+    "Exit status: 0 same or within tolerance, 1 different, 2 usage error or a file\n"
+    "that cannot be read (missing, damaged, no GRIDMAP) or written.";
+
+void add_options(CLI::App &app, Options &o) {
+  app.set_version_flag("--version", [] { return std::string("mapdiff (vasco_gpu) ") + vasco::version(); });
+  app.add_option("A", o.a, "reference map (.map or .map.gz)")->required();
+  app.add_option("B", o.b, "map to compare with A")->required();
+  app.add_option("--top", o.top, "list the N largest differences (default 10)")
+      ->type_name("N")->check(CLI::NonNegativeNumber);
+  app.add_option("--tolerance", o.tolerance, "max |dp| over cells known in both (default 0)")
+      ->type_name("DP")->check(CLI::NonNegativeNumber);
+  app.add_option("--max-status-differs", o.max_status_differs,
+                 "max cells known in one map only, or outside the overlap (default 0)")
+      ->type_name("N")->check(CLI::NonNegativeNumber);
+  app.add_option("--min-class-agreement", o.min_class_agreement,
+                 "min fraction of compared cells in the same occupied/free/unknown class, "
+                 "e.g. 0.999 (default: not checked)")
+      ->type_name("FRAC")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--png", o.png, "write a picture of the differences")->type_name("FILE");
+  app.add_flag("--no-offset", o.no_offset, "ignore OFFSET chunks: align at cell (0, 0)");
+  app.add_flag("--quiet,-q", o.quiet, "print the verdict line only");
+  app.add_flag("--json", o.json, "print the report as one JSON object (not with --quiet)");
+  app.footer(kFooter);
+}
+
+// Parses the command line; returns -1 to go on, else the exit status.
+int parse(int argc, char **argv, Options &o) {
+  CLI::App app{"mapdiff: compares the GRIDMAPs of two CARMEN maps (exit 0 same, 1 different, 2 error)."};
+  add_options(app, o);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError &e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::fprintf(stderr, "mapdiff: %s\nRun 'mapdiff --help' for usage.\n", e.what());
+    return 2;
+  }
+  if (o.quiet && o.json) {
+    std::fprintf(stderr, "mapdiff: --quiet and --json exclude each other\nRun 'mapdiff --help' for usage.\n");
+    return 2;
+  }
+  if (!o.png.empty() && (o.png == o.a || o.png == o.b)) {
+    std::fprintf(stderr, "mapdiff: --png %s would overwrite an input map\n", o.png.c_str());
+    return 2;
+  }
+  o.class_limit = app.count("--min-class-agreement") > 0;
+  o.tolerant = o.class_limit || app.count("--tolerance") + app.count("--max-status-differs") > 0;
+  return -1;
+}
+
+int run(const Options &o) {
+  // Both maps are read before anything is written: a bad input leaves no picture.
+  const Input a = load(o.a);
+  const Input b = load(o.b);
+  const bool identical = identical_grids(a.grid, b.grid);
+  const Alignment al = align(a, b, identical, o.no_offset);
+  vasco::GridComparison c;
+  if (al.compared) c = vasco::compare_grids(a.grid, b.grid, al.shift_x, al.shift_y, size_t(o.top));
+  const Verdict v = judge(a, b, identical, al, c, o);
+  const bool pictured = !o.png.empty() && write_picture(o.png, a, b, al, c);
+  if (o.json) {
+    print_json(a, b, identical, al, c, v);
+  } else if (o.quiet) {
+    std::printf("%s\n", v.line.c_str());
+  } else {
+    print_text(a, b, identical, al, c, v);
+    if (pictured) std::printf("picture: %s (%d x %d)\n", o.png.c_str(), c.width, c.height);
+  }
+  return v.exit_status;
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  Options o;
+  const int rc = parse(argc, argv, o);
+  if (rc >= 0) return rc;
+  try {
+    return run(o);
+  } catch (const std::exception &e) {  // a carmen::FileError names the file itself
+    std::fprintf(stderr, "mapdiff: %s\n", e.what());
+  }
+  return 2;
+}
