@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -144,6 +145,42 @@ TEST(Log2Map, CudaWithoutAGpuIsAClearError) {
   EXPECT_EQ(v.status, 1);
   EXPECT_TRUE(contains(v.output, "--backend cuda")) << v.output;
   EXPECT_TRUE(dir.entries().empty());
+}
+
+
+// The precedence every key follows, end to end: the log's PARAM lines select
+// the scans unless the ini or the command line says otherwise.
+TEST(Log2Map, LogParamsSelectScansBelowIniAndCommandLine) {
+  TempDir dir;
+  std::string text = "PARAM vasco_num_scans 3 nohost 0\n";
+  for (int i = 0; i < 10; ++i)
+    text += "FLASER 3 1.0 2.0 3.0 " + std::to_string(0.1 * i) + " 0 0 0 0 0 " + std::to_string(100 + i) + " t 0\n";
+  const std::string log = write_text(dir, "p.log", text);
+  const std::string ini = write_text(dir, "c.ini", "[*]\nvasco_num_scans 5\n");
+  auto scans = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), {"--backend", "cpu_double", "--json", "--quiet"});
+    args.push_back(log);
+    args.push_back(dir.file("out.map"));
+    const ToolRun r = log2map(args, false);
+    EXPECT_EQ(r.status, 0) << r.output;
+    const size_t at = r.output.find("\"scans\":");
+    return at == std::string::npos ? -1 : std::atoi(r.output.c_str() + at + 8);
+  };
+  EXPECT_EQ(scans({}), 3);
+  EXPECT_EQ(scans({"--param-file", ini}), 5);
+  EXPECT_EQ(scans({"--param-file", ini, "--vasco_num_scans", "7"}), 7);
+}
+
+TEST(Log2Map, PosesTooFarApartNameTheLogAndLines) {
+  TempDir dir;
+  const std::string log = write_text(dir, "far.log",
+                                     "FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1 t 0\n"
+                                     "FLASER 3 1.0 2.0 3.0 50000000 0 0 0 0 0 2 t 0\n");
+  const ToolRun r = log2map({"--backend", "cpu_double", log, dir.file("out.map")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(contains(r.output, log + ": the poses span")) << r.output;
+  EXPECT_TRUE(contains(r.output, "from the scan at line 1 to line 2 in x")) << r.output;
+  EXPECT_TRUE(dir.entries() == (std::vector<std::string>{"far.log"}));
 }
 
 }  // namespace
