@@ -127,6 +127,13 @@ struct FloatModel {
 // Sets every cell to -0.0f, float mode's "never updated".
 void launch_float_clear(float *logodds, size_t num_cells, cudaStream_t stream);
 
+// Every cell to `value` (exact mode: a fresh grid is all kUnknown).
+void launch_fill(float *cells, size_t num_cells, float value, cudaStream_t stream);
+
+// Probabilities (-1 unknown) to float mode's log-odds sums, in place: the
+// inverse of launch_float_finalize, for continuing a grid mapped earlier.
+void launch_float_from_prob(const FloatModel &m, float *grid, size_t num_cells, cudaStream_t stream);
+
 // Adds every beam's log-odds evidence to `logodds` (atomics: no update is
 // lost). counters: beams used, beams skipped, cell updates.
 void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans,

@@ -121,7 +121,9 @@ __global__ void __launch_bounds__(kTileThreads)
   const bool active = inside(cx, cy, m);
   const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
   const int T = m.table_size;
-  float cell = egrid::kUnknown;
+  // The grid holds the result of earlier scans (all unknown for a fresh map):
+  // this launch's updates come after theirs, as in the oracle's order.
+  float cell = active ? grid[static_cast<size_t>(cx) * m.size_y + cy] : egrid::kUnknown;
   unsigned count = 0;
   const uint32_t begin = tile_begin[tile], end = tile_end[tile];
   for (uint32_t base = begin; base < end; base += kTileThreads) {

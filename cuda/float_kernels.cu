@@ -136,7 +136,30 @@ __global__ void finalize_kernel(FloatModel m, float *grid, const uint8_t *touche
   }
 }
 
+__global__ void from_prob_kernel(FloatModel m, float *grid, size_t n) {
+  for (size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x; c < n;
+       c += static_cast<size_t>(gridDim.x) * blockDim.x) {
+    const float p = grid[c];
+    // -1: untouched (-0.0f); 0 and 1 give -inf and +inf, which stay saturated.
+    grid[c] = p == egrid::kUnknown ? -0.0f : logf(p / (1.0f - p)) - m.logodds_prior;
+  }
+}
+
+unsigned fill_blocks(size_t n) { return static_cast<unsigned>(std::min<size_t>((n + 255) / 256, 65536)); }
+
 }  // namespace
+
+void launch_fill(float *cells, size_t num_cells, float value, cudaStream_t stream) {
+  if (num_cells == 0) return;
+  fill_kernel<<<fill_blocks(num_cells), 256, 0, stream>>>(cells, num_cells, value);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+void launch_float_from_prob(const FloatModel &m, float *grid, size_t num_cells, cudaStream_t stream) {
+  if (num_cells == 0) return;
+  from_prob_kernel<<<fill_blocks(num_cells), 256, 0, stream>>>(m, grid, num_cells);
+  VG_CUDA_CHECK_LAUNCH();
+}
 
 void launch_float_clear(float *logodds, size_t num_cells, cudaStream_t stream) {
   if (num_cells == 0) return;

@@ -3,8 +3,10 @@
 //
 //   golden_check [--golden DIR] [--data DIR] [--paths LIST] [--case SUBSTRING]
 //
-// Exact paths (cpu_double, cpu_threads/1, /2, /7, egrid_c_api, and
-// cuda_exact when a GPU is usable) must give CARMEN's GRIDMAP payload digest.
+// Exact paths (cpu_double, cpu_threads/1, /2, /7, egrid_c_api, a mapping
+// session fed the scans in pieces (mapper/cpu_threads), and cuda_exact and
+// mapper/cuda in exact mode when a GPU is usable) must give CARMEN's GRIDMAP
+// payload digest.
 // Float paths (cpu_float, cuda_float) are reported against the golden map with
 // the DESIGN §4 table; the golden cells are those of cpu_double once its
 // digest has matched CARMEN's. Exit 0 when every exact path matched every
@@ -55,6 +57,10 @@ std::vector<golden::Path> select_paths(const Options &opt, std::vector<golden::P
     float_names.push_back("cuda_float");
     all.emplace("cuda_exact", golden::cuda_path(CudaMode::Exact));
     all.emplace("cuda_float", golden::cuda_path(CudaMode::Float));
+    BackendOptions exact;
+    exact.cuda_mode = CudaMode::Exact;
+    exact_names.push_back("mapper/cuda");
+    all.emplace("mapper/cuda", golden::mapper_path("cuda", exact));
   }
   std::vector<golden::Path> exact;
   const std::vector<std::string> wanted = opt.paths.empty() ? exact_names : opt.paths;
@@ -158,8 +164,8 @@ int main(int argc, char **argv) {
     else {
       std::fprintf(stderr,
                    "usage: golden_check [--golden DIR] [--data DIR] [--paths a,b,...] [--case SUBSTRING]\n"
-                   "paths: cpu_double cpu_threads/1 cpu_threads/2 cpu_threads/7 egrid_c_api cuda_exact "
-                   "cpu_float cuda_float\n");
+                   "paths: cpu_double cpu_threads/1 cpu_threads/2 cpu_threads/7 egrid_c_api mapper/cpu_threads "
+                   "cuda_exact mapper/cuda cpu_float cuda_float\n");
       return 2;
     }
   }

@@ -22,6 +22,12 @@ TEST_P(GoldenCuda, ExactModeMatchesCarmen) {
   golden::expect_golden(GetParam(), golden::cuda_path(CudaMode::Exact));
 }
 
+TEST_P(GoldenCuda, ExactModeMapperSessionMatchesCarmen) {
+  BackendOptions exact;
+  exact.cuda_mode = CudaMode::Exact;
+  golden::expect_golden(GetParam(), golden::mapper_path("cuda", exact));
+}
+
 TEST_P(GoldenCuda, FloatModeWithinTheFloatBounds) {
   golden::expect_float_within_bounds(GetParam(), golden::cuda_path(CudaMode::Float));
 }

@@ -27,6 +27,7 @@
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/log_input.h"
 #include "vasco_gpu/map_digest.h"
+#include "vasco_gpu/mapper.hpp"
 #if defined(VASCO_HAVE_CUDA)
 #include "vasco_gpu/cuda_backend.h"
 #endif
@@ -156,10 +157,24 @@ inline bool cuda_available(std::string *why) {
 #endif
 }
 
+// A mapping session fed the case's scans in pieces of 97 (vasco::Mapper):
+// incremental inserts, frame growth and the renderer's finish.
+inline Path mapper_path(const std::string &backend, BackendOptions opt = {}) {
+  return Path{"mapper/" + backend, [backend, opt](const LogInput &in) {
+                Mapper m(in.params, backend, opt);
+                for (size_t a = 0; a < in.batch.num_scans(); a += 97)
+                  m.insert(in.batch.select(static_cast<long>(a), 97));
+                FinishedMap f = m.finish();
+                if (m.frame().size_x != in.geo.size_x || m.frame().size_y != in.geo.size_y)
+                  throw std::runtime_error("the session's frame is not the PROTOCOL frame");
+                return f;
+              }};
+}
+
 // The paths DESIGN §4 promises CARMEN's bytes from, CPU ones first.
 inline std::vector<Path> exact_cpu_paths() {
   return {backend_path("cpu_double", "cpu_double"), cpu_threads_path(1), cpu_threads_path(2),
-          cpu_threads_path(7), Path{"egrid_c_api", run_egrid_c_api}};
+          cpu_threads_path(7), Path{"egrid_c_api", run_egrid_c_api}, mapper_path("cpu_threads")};
 }
 
 // Re-indexes two finished maps of one grid (same downsample; crops given by

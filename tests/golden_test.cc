@@ -1,6 +1,7 @@
 // CARMEN's own maps, bit for bit: every exact CPU path (cpu_double,
 // cpu_threads with 1, 2 and 7 threads, the egrid.h C API driven by the golden
-// PROTOCOL's steps) on every golden case the project carries, compared by
+// PROTOCOL's steps, a mapping session fed the scans in pieces) on every
+// golden case the project carries, compared by
 // GRIDMAP payload digest with the map CARMEN 0.7.4 computed (tests/data/golden).
 #include <map>
 

@@ -21,13 +21,15 @@ std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeo
 }
 
 PlacedBeams place_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                        int threads) {
-  const size_t ns = batch.num_scans();
+                        int threads, size_t first, size_t last) {
+  last = std::min(last, batch.num_scans());
+  first = std::min(first, last);
+  const size_t ns = last;
   PlacedBeams out;
   out.starts = place_scans(batch, geo);
 
   std::vector<uint64_t> used_before(ns + 1, 0);
-  for (size_t s = 0; s < ns; ++s) {
+  for (size_t s = first; s < ns; ++s) {
     const float *r = batch.ranges_of(s);
     uint64_t used = 0;
     for (int b = 0; b < batch.beams_in(s); ++b) used += oracle::beam_used(r[b]) ? 1 : 0;
@@ -36,13 +38,13 @@ PlacedBeams place_beams(const ScanBatch &batch, const GridGeometry &geo, const M
   const uint64_t nb = used_before.back();
   if (nb > std::numeric_limits<uint32_t>::max())
     throw std::runtime_error("more than 2^32 used beams in one batch");
-  out.skipped = batch.num_beams() - nb;
+  out.skipped = (batch.beam_offset[ns] - batch.beam_offset[first]) - nb;
   out.beams.resize(nb);
 
-  std::atomic<size_t> next{0};
+  std::atomic<size_t> next{first};
   constexpr size_t kChunk = 32;
   const int nt = threads > 0 ? threads : hardware_threads();
-  run_on_threads(ns < 256 ? 1 : nt, [&](int) {
+  run_on_threads(ns - first < 256 ? 1 : nt, [&](int) {
     for (;;) {
       const size_t s0 = next.fetch_add(kChunk);
       if (s0 >= ns) break;

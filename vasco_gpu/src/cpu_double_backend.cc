@@ -35,33 +35,40 @@ class CpuDoubleBackend : public Backend {
  public:
   std::string name() const override { return "cpu_double"; }
 
-  std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
-                         const GridGeometry &geo, MapStats *stats) override {
+  void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+             const GridGeometry &geo, float *cells, MapStats *stats) override {
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<float> cells(geo.num_cells(), egrid::kUnknown);
     oracle::GridFrame frame;
     frame.size_x = geo.size_x;
     frame.size_y = geo.size_y;
     frame.resolution = geo.resolution;
     frame.theta_offset = geo.theta_offset;
+    // CARMEN's first update call records the start pose: that is scan 0's.
+    if (first > 0 && batch.num_scans() > 0) oracle::scan_start(frame, batch.x[0], batch.y[0], batch.theta[0]);
     const egrid::ModelParams model{params.p_prior, params.p_occ, params.p_emp, params.range_sure,
                                    params.range_max};
-    const DistanceTable table(params.table_size(), params.resolution);
+    if (table_.size() != params.table_size() || table_resolution_ != params.resolution) {
+      table_ = DistanceTable(params.table_size(), params.resolution);
+      table_resolution_ = params.resolution;
+    }
     MapStats st;
-    for (size_t s = 0; s < batch.num_scans(); ++s) {
+    for (size_t s = first; s < last; ++s) {
       const auto c = oracle::update_scan(
-          cells.data(), frame, model, params.wall_size, table.size(), table.rows(), batch.x[s],
+          cells, frame, model, params.wall_size, table_.size(), table_.rows(), batch.x[s],
           batch.y[s], batch.theta[s], batch.beams_in(s), batch.ranges_of(s),
           oracle::SteppedAngles{batch.first_angle[s], batch.angle_step[s]});
       st.beams_used += c.beams_used;
       st.beams_skipped += c.beams_skipped;
       st.cell_updates += c.cell_updates;
     }
-    st.scans = batch.num_scans();
+    st.scans = last - first;
     st.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (stats != nullptr) *stats = st;
-    return cells;
   }
+
+ private:
+  DistanceTable table_{0, 0.0};  // kept between calls: built once per parameter set
+  double table_resolution_ = 0;
 };
 
 }  // namespace

@@ -15,10 +15,9 @@ class CpuFloatBackend : public Backend {
  public:
   std::string name() const override { return "cpu_float"; }
 
-  std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
-                         const GridGeometry &geo, MapStats *stats) override {
+  void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+             const GridGeometry &geo, float *cells, MapStats *stats) override {
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<float> cells(geo.num_cells(), egrid::kUnknown);
     const int sx = geo.size_x, sy = geo.size_y;
     const float res = static_cast<float>(params.resolution);
     const float wall = static_cast<float>(params.wall_size);
@@ -38,13 +37,16 @@ class CpuFloatBackend : public Backend {
             std::sqrt(static_cast<float>(i * i + j * j)) * res;
 
     MapStats st;
-    st.scans = batch.num_scans();
-    if (batch.num_scans() == 0) return cells;
+    st.scans = last - first;
+    if (first >= last) {
+      if (stats != nullptr) *stats = st;
+      return;
+    }
     const float start_x = static_cast<float>(batch.x[0]) / res;
     const float start_y = static_cast<float>(batch.y[0]) / res;
     const float c = static_cast<float>(geo.theta_offset) - static_cast<float>(batch.theta[0]);
     const float cos_c = std::cos(c), sin_c = std::sin(c);
-    for (size_t s = 0; s < batch.num_scans(); ++s) {
+    for (size_t s = first; s < last; ++s) {
       const float px = static_cast<float>(batch.x[s]), py = static_cast<float>(batch.y[s]);
       const float xr = px * cos_c - py * sin_c;
       const float yr = px * sin_c + py * cos_c;
@@ -90,7 +92,6 @@ class CpuFloatBackend : public Backend {
     }
     st.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (stats != nullptr) *stats = st;
-    return cells;
   }
 };
 

@@ -255,24 +255,23 @@ class CpuThreadsBackend : public Backend {
 
   const CpuThreadsLoad *load() const { return has_load_ ? &load_ : nullptr; }
 
-  std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
-                         const GridGeometry &geo, MapStats *stats) override {
+  void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+             const GridGeometry &geo, float *cells, MapStats *stats) override {
     const auto t0 = Clock::now();
     const int nt = threads_;
-    const size_t ns = batch.num_scans();
+    const size_t ns = last > first ? last - first : 0;
     const int size_x = geo.size_x, size_y = geo.size_y;
     const int T = params.table_size();
     MapStats st;
     st.scans = ns;
 
     // 1. Scans and beam end cells, placed by the oracle's own code.
-    const PlacedBeams placed = place_beams(batch, geo, params, nt);
+    const PlacedBeams placed = place_beams(batch, geo, params, nt, first, last);
     const std::vector<oracle::ScanStart> &starts = placed.starts;
     const uint64_t nb = placed.beams.size();
     st.beams_used = nb;
     st.beams_skipped = placed.skipped;
 
-    std::vector<float> cells(geo.num_cells(), egrid::kUnknown);
     CpuThreadsLoad load;
     load.threads = nt;
     load.thread_updates.assign(nt, 0);
@@ -281,7 +280,7 @@ class CpuThreadsBackend : public Backend {
       st.prep_s = seconds_since(t0);
       st.map_s = st.prep_s;
       finish(stats, st, std::move(load));
-      return cells;
+      return;
     }
 
     // 2. x ranges, in parallel over beams; a per-column work histogram
@@ -428,7 +427,7 @@ class CpuThreadsBackend : public Backend {
     load.stripe_beams.assign(nst, 0);
     load.stripe_updates.assign(nst, 0);
     load.stripe_thread.assign(nst, -1);
-    const Context ctx{cells.data(), size_x, size_y, T, geo.resolution, model,
+    const Context ctx{cells, size_x, size_y, T, geo.resolution, model,
                       table.empty() ? nullptr : table.data()};
     std::atomic<int> next_stripe{0};
     run_on_threads(std::min(nt, nst), [&](int t) {
@@ -457,7 +456,6 @@ class CpuThreadsBackend : public Backend {
     for (uint64_t n : load.thread_updates) st.cell_updates += n;
     st.map_s = seconds_since(t0);
     finish(stats, st, std::move(load));
-    return cells;
   }
 
  private:

@@ -9,31 +9,43 @@
 
 namespace vasco {
 
-GridGeometry size_grid(const ScanBatch &batch, const MapperParams &params) {
-  if (batch.num_scans() == 0) throw std::runtime_error("no laser scans to map");
-  GridGeometry g;
-  g.resolution = params.resolution;
-  g.x0 = batch.x[0];
-  g.y0 = batch.y[0];
-  g.theta_offset = batch.theta[0];
-  const double reach = params.range_max + params.resolution;
-  double mx = 0, my = 0;
-  size_t far_x = 0, far_y = 0;  // the scans farthest from the first, for the error message
-  for (size_t s = 0; s < batch.num_scans(); ++s) {
-    const double dx = std::fabs(batch.x[s] - g.x0), dy = std::fabs(batch.y[s] - g.y0);
+void PoseExtent::add(const ScanBatch &batch, size_t first, size_t last) {
+  for (size_t s = first; s < last; ++s) {
+    if (scans++ == 0) {
+      x0 = batch.x[s];
+      y0 = batch.y[s];
+      theta0 = batch.theta[s];
+    }
+    const double dx = std::fabs(batch.x[s] - x0), dy = std::fabs(batch.y[s] - y0);
     if (dx > mx) mx = dx, far_x = s;
     if (dy > my) my = dy, far_y = s;
   }
-  mx += reach;
-  my += reach;
+}
+
+GridGeometry size_grid(const ScanBatch &batch, const MapperParams &params) {
+  PoseExtent e;
+  e.add(batch, 0, batch.num_scans());
+  return size_grid(e, batch, params);
+}
+
+GridGeometry size_grid(const PoseExtent &e, const ScanBatch &batch, const MapperParams &params) {
+  if (e.scans == 0) throw std::runtime_error("no laser scans to map");
+  GridGeometry g;
+  g.resolution = params.resolution;
+  g.x0 = e.x0;
+  g.y0 = e.y0;
+  g.theta_offset = e.theta0;
+  const double reach = params.range_max + params.resolution;
+  const double mx = e.mx + reach, my = e.my + reach;
   const double half_x = std::ceil(mx / params.resolution);
   const double half_y = std::ceil(my / params.resolution);
   const double sx = 2 * half_x + 2, sy = 2 * half_y + 2;
   if (!(sx * sy <= static_cast<double>(kMaxGridCells)) || !(sx < 2147483647.0) ||
       !(sy < 2147483647.0)) {
+    auto line = [&](size_t s) { return s < batch.line.size() ? batch.line[s] : static_cast<long>(s); };
     std::ostringstream msg;
-    msg << "the poses span " << 2 * (mx - reach) << " m x " << 2 * (my - reach) << " m (from the scan at line "
-        << batch.line[0] << " to line " << batch.line[far_x] << " in x and line " << batch.line[far_y]
+    msg << "the poses span " << 2 * e.mx << " m x " << 2 * e.my << " m (from the scan at line "
+        << line(0) << " to line " << line(e.far_x) << " in x and line " << line(e.far_y)
         << " in y): a grid of " << sx << " x " << sy << " cells at " << params.resolution
         << " m is too large (limit " << kMaxGridCells
         << " cells); check the poses or raise vasco_resolution";

@@ -43,11 +43,21 @@ class Backend {
  public:
   virtual ~Backend() = default;
   virtual std::string name() const = 0;
-  // Applies every scan of `batch`, in order, to a fresh evidence grid of
-  // geometry `geo` (all cells unknown) and returns it: x-major floats,
-  // cells[x * size_y + y], -1 for unknown.
+  // Applies scans [first, last) of `batch`, in order, to `cells` (x-major,
+  // cells[x * size_y + y], a grid of geometry `geo`), which holds the result
+  // of scans [0, first): all unknown (-1) when first == 0. Scan 0 of the
+  // batch fixes CARMEN's start pose whatever `first` is, so for the exact
+  // backends applying 0..k in several calls gives the bytes of one call.
+  virtual void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+                     const GridGeometry &geo, float *cells, MapStats *stats) = 0;
+  // Applies every scan of `batch` to a fresh evidence grid of geometry `geo`
+  // (all cells unknown) and returns it.
   virtual std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
-                                 const GridGeometry &geo, MapStats *stats) = 0;
+                                 const GridGeometry &geo, MapStats *stats) {
+    std::vector<float> cells(geo.num_cells(), -1.0f);
+    apply(batch, 0, batch.num_scans(), params, geo, cells.data(), stats);
+    return cells;
+  }
 };
 
 // Backend names accepted by make_backend: cpu_double, cpu_threads, cpu_float,

@@ -33,9 +33,11 @@ struct PlacedBeams {
 // Places every scan, in order (the first call fixes the start pose).
 std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeometry &geo);
 
-// Scans and end cells of every used beam; threads <= 0: all cores. Throws std::runtime_error past 2^32 used beams.
+// Every scan's start, and the end cells of the used beams of scans [first,
+// last) (all scans by default); threads <= 0: all cores. Throws
+// std::runtime_error past 2^32 used beams.
 PlacedBeams place_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                        int threads);
+                        int threads, size_t first = 0, size_t last = SIZE_MAX);
 
 }  // namespace vasco
 

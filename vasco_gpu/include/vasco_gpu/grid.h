@@ -3,6 +3,7 @@
 #ifndef VASCO_GPU_GRID_H
 #define VASCO_GPU_GRID_H
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -30,9 +31,23 @@ struct GridGeometry {
 // than allocated (4 GiB of floats).
 constexpr uint64_t kMaxGridCells = uint64_t(1) << 30;
 
+// How far the scans of a batch lie from its first scan: what the PROTOCOL
+// frame is sized by, kept up to date scan by scan by a mapping session.
+struct PoseExtent {
+  size_t scans = 0;
+  double x0 = 0, y0 = 0, theta0 = 0;  // the first scan's laser pose
+  double mx = 0, my = 0;              // max |x - x0|, max |y - y0|
+  size_t far_x = 0, far_y = 0;        // the scans where they are reached
+  // Adds scans [first, last) of `batch` (scan 0 of the batch is the first
+  // scan when the extent is empty).
+  void add(const ScanBatch &batch, size_t first, size_t last);
+};
+
 // Sizes the grid for a batch (DESIGN §3 step 2). Throws std::runtime_error
-// when the batch is empty or the grid would be absurdly large.
+// when the batch is empty or the grid would be absurdly large (naming the
+// source lines of the first and the farthest scans).
 GridGeometry size_grid(const ScanBatch &batch, const MapperParams &params);
+GridGeometry size_grid(const PoseExtent &extent, const ScanBatch &batch, const MapperParams &params);
 
 // The result of finish: a downsampled, cropped grid.
 struct FinishedMap {

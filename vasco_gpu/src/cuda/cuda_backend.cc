@@ -111,17 +111,64 @@ class CudaBackend : public Backend {
 
   std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
                          const GridGeometry &geo, MapStats *stats) override {
-    VG_CUDA_CHECK(cudaSetDevice(options_.cuda_device));
-    MapStats st;
-    std::vector<float> grid = options_.cuda_mode == CudaMode::Exact
-                                  ? map_exact(batch, params, geo, &st)
-                                  : map_float(batch, params, geo, &st);
-    st.scans = batch.num_scans();
-    if (stats != nullptr) *stats = st;
+    std::vector<float> grid(geo.num_cells());
+    run(batch, 0, batch.num_scans(), params, geo, grid.data(), true, stats);
     return grid;
   }
 
+  // Uploads `cells`, applies the scans on the GPU, downloads the grid back.
+  void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+             const GridGeometry &geo, float *cells, MapStats *stats) override {
+    run(batch, first, last, params, geo, cells, false, stats);
+  }
+
  private:
+  // fresh: the grid starts all unknown (nothing uploaded); else from `cells`.
+  void run(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+           const GridGeometry &geo, float *cells, bool fresh, MapStats *stats) {
+    VG_CUDA_CHECK(cudaSetDevice(options_.cuda_device));
+    MapStats st;
+    last = std::min(last, batch.num_scans());
+    first = std::min(first, last);
+    if (options_.cuda_mode == CudaMode::Exact) {
+      // Exact mode counts (tile, beam) pairs in 32 bits: a run of scans whose
+      // pairs could pass 2^32 goes in several launches, each continuing the
+      // grid of the one before (the same order of updates per cell).
+      const uint64_t max_beams = exact_beams_per_launch(params);
+      size_t a = first;
+      do {
+        size_t b = a;
+        while (b < last && (b == a || batch.beam_offset[b + 1] - batch.beam_offset[a] <= max_beams)) ++b;
+        MapStats part;
+        map_exact(batch, a, b, params, geo, cells, fresh && a == first, &part);
+        add_stats(&st, part);
+        a = b;
+      } while (a < last);
+    } else {
+      map_float(batch, first, last, params, geo, cells, fresh, &st);
+    }
+    st.scans = last - first;
+    if (stats != nullptr) *stats = st;
+  }
+
+  // Beams per exact-mode launch such that the (tile, beam) pairs, at most
+  // 2 * (table_size / kTile + 2) per beam (a monotone walk of table_size
+  // cells enters that many tiles at most), stay below 2^32.
+  static uint64_t exact_beams_per_launch(const MapperParams &p) {
+    const uint64_t per_beam = 2 * (static_cast<uint64_t>(std::max(p.table_size(), 0)) / cuda::kTile + 2);
+    return std::max<uint64_t>(1, (uint64_t(UINT32_MAX) - 1) / per_beam);
+  }
+
+  static void add_stats(MapStats *sum, const MapStats &part) {
+    sum->beams_used += part.beams_used;
+    sum->beams_skipped += part.beams_skipped;
+    sum->cell_updates += part.cell_updates;
+    sum->prep_s += part.prep_s;
+    sum->upload_s += part.upload_s;
+    sum->map_s += part.map_s;
+    sum->download_s += part.download_s;
+  }
+
   cuda::DeviceModel device_model(const MapperParams &p, const GridGeometry &geo) const {
     cuda::DeviceModel m;
     m.prior = p.p_prior;
@@ -137,13 +184,13 @@ class CudaBackend : public Backend {
     return m;
   }
 
-  std::vector<float> map_exact(const ScanBatch &batch, const MapperParams &params,
-                               const GridGeometry &geo, MapStats *st) {
+  void map_exact(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+                 const GridGeometry &geo, float *host_grid, bool fresh, MapStats *st) {
     const auto t_prep = Clock::now();
     const cuda::DeviceModel m = device_model(params, geo);
     // Used beams only, in (scan, beam) order, their end cells computed by the
     // oracle's own code with the host's libm (DESIGN §2.2).
-    const PlacedBeams placed = place_beams(batch, geo, params, 0);
+    const PlacedBeams placed = place_beams(batch, geo, params, 0, first, last);
     const size_t nb = placed.beams.size();
     st->beams_used = nb;
     st->beams_skipped = placed.skipped;
@@ -182,6 +229,11 @@ class CudaBackend : public Backend {
     DeviceBuffer<unsigned char> d_scan_tmp(std::max<size_t>(scan_tmp, 1));
 
     e0.record(stream.get());
+    if (fresh)
+      cuda::launch_fill(d_grid.get(), cells, egrid::kUnknown, stream.get());
+    else
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_grid.get(), host_grid, cells * sizeof(float), cudaMemcpyHostToDevice,
+                                    stream.get()));
     // PlacedBeam and cuda::ExactBeam are the same 16 bytes (checked above).
     if (nb) VG_CUDA_CHECK(cudaMemcpyAsync(d_beams.get(), placed.beams.data(), nb * sizeof(cuda::ExactBeam),
                                           cudaMemcpyHostToDevice, stream.get()));
@@ -235,9 +287,8 @@ class CudaBackend : public Backend {
     timer.mark("tiles");
     e_map.record(stream.get());
 
-    std::vector<float> grid(cells);
     unsigned long long updates = 0;
-    VG_CUDA_CHECK(cudaMemcpyAsync(grid.data(), d_grid.get(), cells * sizeof(float),
+    VG_CUDA_CHECK(cudaMemcpyAsync(host_grid, d_grid.get(), cells * sizeof(float),
                                   cudaMemcpyDeviceToHost, stream.get()));
     VG_CUDA_CHECK(cudaMemcpyAsync(&updates, d_updates.get(), sizeof(updates), cudaMemcpyDeviceToHost,
                                   stream.get()));
@@ -250,15 +301,16 @@ class CudaBackend : public Backend {
     st->upload_s = e_up.since(e0) / 1e3;
     st->map_s = e_map.since(e_up) / 1e3;
     st->download_s = e_down.since(e_map) / 1e3;
-    return grid;
   }
 
-  std::vector<float> map_float(const ScanBatch &batch, const MapperParams &params,
-                               const GridGeometry &geo, MapStats *st) {
+  void map_float(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+                 const GridGeometry &geo, float *host_grid, bool fresh, MapStats *st) {
     const auto t_prep = Clock::now();
     const std::vector<oracle::ScanStart> starts = place_scans(batch, geo);
-    PinnedBuffer<cuda::FloatScan> h_scans(std::max<size_t>(batch.num_scans(), 1));
-    for (size_t s = 0; s < batch.num_scans(); ++s) {
+    const size_t nscans = last - first;
+    const uint64_t beam0 = batch.beam_offset[first];
+    PinnedBuffer<cuda::FloatScan> h_scans(std::max<size_t>(nscans, 1));
+    for (size_t s = first; s < last; ++s) {
       cuda::FloatScan f;
       f.lx = static_cast<float>(starts[s].lx);
       f.ly = static_cast<float>(starts[s].ly);
@@ -267,9 +319,9 @@ class CudaBackend : public Backend {
       f.y1 = starts[s].y1;
       f.first = static_cast<float>(batch.first_angle[s]);
       f.step = static_cast<float>(batch.angle_step[s]);
-      f.beam_begin = static_cast<uint32_t>(batch.beam_offset[s]);
+      f.beam_begin = static_cast<uint32_t>(batch.beam_offset[s] - beam0);
       f.beam_count = batch.beams_in(s);
-      h_scans[s] = f;
+      h_scans[s - first] = f;
     }
     cuda::FloatModel m;
     m.prior = static_cast<float>(params.p_prior);
@@ -285,7 +337,8 @@ class CudaBackend : public Backend {
     m.size_y = geo.size_y;
     st->prep_s = seconds(t_prep);
 
-    const size_t cells = geo.num_cells(), nbeams = batch.num_beams(), nscans = batch.num_scans();
+    const size_t cells = geo.num_cells(), nbeams = batch.beam_offset[last] - beam0;
+    if (nbeams > UINT32_MAX) throw std::runtime_error("cuda float mode: more than 2^32 beams in one call");
     check_fits(cells * (sizeof(float) + 1) + nbeams * sizeof(float) + nscans * sizeof(cuda::FloatScan),
                "float mode (grid and beams)");
     Stream stream;
@@ -301,15 +354,20 @@ class CudaBackend : public Backend {
       VG_CUDA_CHECK(cudaMemcpyAsync(d_scans.get(), h_scans.get(), nscans * sizeof(cuda::FloatScan),
                                     cudaMemcpyHostToDevice, stream.get()));
     if (nbeams)
-      VG_CUDA_CHECK(cudaMemcpyAsync(d_ranges.get(), batch.range.data(), nbeams * sizeof(float),
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_ranges.get(), batch.range.data() + beam0, nbeams * sizeof(float),
                                     cudaMemcpyHostToDevice, stream.get()));
     e_up.record(stream.get());
     StageTimer timer(stream.get());
     timer.mark("start");
     const bool ours = options_.cuda_kernel == CudaKernel::Ours;
-    if (ours) {
+    if (ours && fresh) {
       cuda::launch_float_clear(d_grid.get(), cells, stream.get());
+    } else if (ours) {
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_grid.get(), host_grid, cells * sizeof(float), cudaMemcpyHostToDevice,
+                                    stream.get()));
+      cuda::launch_float_from_prob(m, d_grid.get(), cells, stream.get());
     } else {
+      if (!fresh) throw std::logic_error("the paper's kernels map whole batches only");
       VG_CUDA_CHECK(cudaMemsetAsync(d_grid.get(), 0, cells * sizeof(float), stream.get()));
       VG_CUDA_CHECK(cudaMemsetAsync(d_touched.get(), 0, cells, stream.get()));
     }
@@ -333,9 +391,8 @@ class CudaBackend : public Backend {
                                 stream.get());
     timer.mark("finalize");
     e_map.record(stream.get());
-    std::vector<float> grid(cells);
     unsigned long long counters[3] = {0, 0, 0};
-    VG_CUDA_CHECK(cudaMemcpyAsync(grid.data(), d_grid.get(), cells * sizeof(float),
+    VG_CUDA_CHECK(cudaMemcpyAsync(host_grid, d_grid.get(), cells * sizeof(float),
                                   cudaMemcpyDeviceToHost, stream.get()));
     VG_CUDA_CHECK(cudaMemcpyAsync(counters, d_counters.get(), sizeof counters, cudaMemcpyDeviceToHost,
                                   stream.get()));
@@ -350,7 +407,6 @@ class CudaBackend : public Backend {
     st->upload_s = e_up.since(e0) / 1e3;
     st->map_s = e_map.since(e_up) / 1e3;
     st->download_s = e_down.since(e_map) / 1e3;
-    return grid;
   }
 
   BackendOptions options_;

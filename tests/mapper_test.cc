@@ -1,0 +1,199 @@
+// vasco::Mapper, the mapping session: incremental inserts equal one-shot
+// maps, a render with new poses equals a fresh map of a log carrying them,
+// growth, a fixed frame equals CARMEN's own API, and errors leave the
+// session as it was. Exact backends are compared bit for bit.
+#include "vasco_gpu/mapper.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+
+#include "carmen/egrid.h"
+#include "golden_support.h"
+#include "map_test_support.h"
+#include "test_seed.h"
+#include "test_support.h"
+
+namespace vasco {
+namespace {
+
+using testing_support::bundled_log;
+
+// fr079 at full resolution (downsample 1), its first `n` scans.
+struct Fixture {
+  MapperParams params;
+  ScanBatch scans;
+};
+
+Fixture fr079(size_t n) {
+  Fixture f;
+  f.params.downsample = 1;
+  LogLoadStats st;
+  f.scans = load_scans(bundled_log("fr079-complete.gfs.log.gz"), f.params, carmen::LogReaderOptions{}, &st)
+                .select(0, static_cast<long>(n));
+  return f;
+}
+
+// Scans [a, b) of a batch.
+ScanBatch part(const ScanBatch &s, size_t a, size_t b) { return s.select(static_cast<long>(a), static_cast<long>(b - a)); }
+
+struct ExactCase {
+  const char *name;
+  const char *backend;
+  int threads;
+};
+
+class MapperExact : public ::testing::TestWithParam<ExactCase> {
+ protected:
+  Mapper make(const MapperParams &p) {
+    BackendOptions o;
+    o.threads = GetParam().threads;
+    return Mapper(p, GetParam().backend, o);
+  }
+};
+
+TEST_P(MapperExact, InsertsInPiecesEqualOneShot) {
+  const Fixture f = fr079(400);
+  std::mt19937 rng(testing_support::test_seed(9));
+  std::uniform_int_distribution<int> piece(1, 40);
+  Mapper m = make(f.params);
+  for (size_t a = 0; a < f.scans.num_scans();) {
+    const size_t b = std::min(f.scans.num_scans(), a + piece(rng));
+    m.insert(part(f.scans, a, b));
+    a = b;
+  }
+  const GridGeometry geo = size_grid(f.scans, f.params);
+  ASSERT_EQ(m.frame().size_x, geo.size_x);
+  ASSERT_EQ(m.frame().size_y, geo.size_y);
+  EXPECT_GT(m.renders(), 1u) << "fr079's first scans should grow the frame";
+  const auto one_shot = make_cpu_double_backend()->map(f.scans, f.params, geo, nullptr);
+  testing_support::expect_bit_identical(one_shot, m.read(), geo, m.backend_name());
+}
+
+TEST_P(MapperExact, RenderWithNewPosesEqualsAFreshMapOfALogCarryingThem) {
+  const Fixture f = fr079(600);
+  Mapper m = make(f.params);
+  m.insert(f.scans);
+  // A loop-closure correction: the second half of the trajectory rotated by
+  // 2 degrees about the pose of scan 300.
+  std::vector<Pose> poses = m.poses();
+  const Pose pivot = poses[300];
+  const double a = 2.0 * M_PI / 180.0, c = std::cos(a), s = std::sin(a);
+  for (size_t i = 300; i < poses.size(); ++i) {
+    const double dx = poses[i].x - pivot.x, dy = poses[i].y - pivot.y;
+    poses[i] = {pivot.x + c * dx - s * dy, pivot.y + s * dx + c * dy, poses[i].theta + a};
+  }
+  m.render(poses);
+
+  // The same poses written into a CARMEN log (17 significant digits round-trip
+  // a double, 9 a float), read back as log2map reads a log, mapped afresh.
+  maptest::TempDir dir;
+  const std::string log = dir.file("moved.log");
+  {
+    std::FILE *out = std::fopen(log.c_str(), "w");
+    ASSERT_NE(out, nullptr);
+    for (size_t i = 0; i < poses.size(); ++i) {
+      std::fprintf(out, "FLASER %d", m.scans().beams_in(i));
+      for (int b = 0; b < m.scans().beams_in(i); ++b) std::fprintf(out, " %.9g", m.scans().ranges_of(i)[b]);
+      std::fprintf(out, " %.17g %.17g %.17g 0 0 0 %zu test 0\n", poses[i].x, poses[i].y, poses[i].theta, i);
+    }
+    std::fclose(out);
+  }
+  LogInputOptions in_opt;
+  in_opt.log = log;
+  in_opt.overrides = {{"vasco_downsample", "1"}};
+  const LogInput in = load_log_input(in_opt);
+  ASSERT_EQ(in.geo.size_x, m.frame().size_x);
+  ASSERT_EQ(in.geo.size_y, m.frame().size_y);
+  const FinishedMap fresh = golden::finish(make_cpu_double_backend()->map(in.batch, in.params, in.geo, nullptr), in);
+  EXPECT_EQ(golden::digest(m.finish()), golden::digest(fresh));
+}
+
+TEST_P(MapperExact, FixedFrameEqualsCarmensApiCallByCall) {
+  const Fixture f = fr079(200);
+  GridGeometry frame;
+  frame.size_x = 900;  // smaller than the PROTOCOL frame: cells outside are skipped, as in CARMEN
+  frame.size_y = 700;
+  frame.resolution = f.params.resolution;
+  frame.theta_offset = 0.3;
+  Mapper m(f.params, frame, GetParam().backend);
+  evidence_grid g;
+  const MapperParams &p = f.params;
+  carmen_mapper_initialize_evidence_grid(&g, frame.size_x, frame.size_y, p.resolution, frame.theta_offset,
+                                         p.p_prior, p.p_occ, p.p_emp, 0.99, p.range_sure, p.range_max,
+                                         p.wall_size);
+  for (size_t s = 0; s < f.scans.num_scans(); ++s) {
+    m.insert(part(f.scans, s, s + 1));
+    std::vector<float> r(f.scans.ranges_of(s), f.scans.ranges_of(s) + f.scans.beams_in(s));
+    carmen_mapper_update_evidence_grid(&g, f.scans.x[s], f.scans.y[s], f.scans.theta[s], f.scans.beams_in(s),
+                                       r.data(), f.scans.angle_step[s], f.scans.first_angle[s]);
+  }
+  EXPECT_EQ(m.renders(), 1u);  // a fixed frame never grows
+  std::vector<float> carmen(static_cast<size_t>(frame.size_x) * frame.size_y);
+  for (int x = 0; x < frame.size_x; ++x)
+    for (int y = 0; y < frame.size_y; ++y) carmen[static_cast<size_t>(x) * frame.size_y + y] = g.prob[x][y];
+  carmen_mapper_free_evidence_grid(&g);
+  testing_support::expect_bit_identical(carmen, m.read(), m.frame(), m.backend_name());
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, MapperExact,
+                         ::testing::Values(ExactCase{"cpu_double", "cpu_double", 0},
+                                           ExactCase{"cpu_threads_3", "cpu_threads", 3}),
+                         [](const ::testing::TestParamInfo<ExactCase> &i) { return std::string(i.param.name); });
+
+TEST(MapperSession, CpuFloatInsertsEqualItsOneShot) {
+  // cpu_float applies the same float operations in the same order whether
+  // the scans come in one call or many: the same bytes.
+  const Fixture f = fr079(150);
+  Mapper m(f.params, "cpu_float");
+  for (size_t a = 0; a < f.scans.num_scans(); a += 7) m.insert(part(f.scans, a, std::min(a + 7, f.scans.num_scans())));
+  const auto one_shot = make_cpu_float_backend()->map(f.scans, f.params, m.frame(), nullptr);
+  testing_support::expect_bit_identical(one_shot, m.read(), m.frame(), "cpu_float incremental");
+}
+
+TEST(MapperSession, ReadsAWindowOfTheGrid) {
+  const Fixture f = fr079(50);
+  Mapper m(f.params);
+  m.insert(f.scans);
+  const std::vector<float> all = m.read();
+  const GridWindow w{m.frame().size_x / 2 - 10, m.frame().size_y / 2 - 5, 20, 12};
+  const std::vector<float> win = m.read(w);
+  ASSERT_EQ(win.size(), 240u);
+  for (int x = 0; x < w.width; ++x)
+    for (int y = 0; y < w.height; ++y)
+      ASSERT_EQ(win[static_cast<size_t>(x) * w.height + y],
+                all[static_cast<size_t>(w.x0 + x) * m.frame().size_y + (w.y0 + y)]);
+  EXPECT_THROW(m.read(GridWindow{m.frame().size_x - 5, 0, 10, 10}), std::invalid_argument);
+  EXPECT_THROW(m.read(GridWindow{-1, 0, 1, 1}), std::invalid_argument);
+}
+
+TEST(MapperSession, ErrorsLeaveTheSessionAsItWas) {
+  const Fixture f = fr079(30);
+  Mapper m(f.params);
+  EXPECT_THROW(m.finish(), std::logic_error);
+  m.insert(f.scans);
+  const std::vector<float> before = m.read();
+  const GridGeometry geo = m.frame();
+  EXPECT_THROW(m.render(std::vector<Pose>(3)), std::invalid_argument);
+  // A scan 10^7 m away: the PROTOCOL frame would be far too large.
+  ScanBatch far = part(f.scans, 0, 1);
+  far.x[0] += 1e7;
+  EXPECT_THROW(m.insert(far), std::runtime_error);
+  std::vector<Pose> poses = m.poses();
+  poses.back().x += 1e7;
+  EXPECT_THROW(m.render(poses), std::runtime_error);
+  EXPECT_EQ(m.num_scans(), 30u);
+  EXPECT_EQ(m.frame().size_x, geo.size_x);
+  EXPECT_EQ(m.poses()[29].x, f.scans.x[29]);
+  testing_support::expect_bit_identical(before, m.read(), geo, "after the errors");
+  MapperParams bad = f.params;
+  bad.p_occ = 1.5;
+  EXPECT_THROW(Mapper m2(bad), std::invalid_argument);
+  EXPECT_THROW(Mapper m3(f.params, "gpu9000"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace vasco
