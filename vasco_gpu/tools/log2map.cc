@@ -26,6 +26,7 @@
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/log_input.h"
+#include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"
 #include "vasco_gpu/version.h"
@@ -207,21 +208,18 @@ int run(const Options &opt) {
   const vasco::LogLoadStats &load = input.load;
   const vasco::GridGeometry &geo = input.geo;
   if (gpu_ready.valid()) gpu_ready.wait();
-  auto backend = vasco::make_backend(opt.backend, bopt);
+  // A mapping session in the PROTOCOL frame, fed every scan at once.
+  vasco::Mapper mapper(mp, opt.backend, bopt);
 
   // Map.
   const auto t_map = Clock::now();
-  vasco::MapStats ms;
-  std::vector<float> cells = backend->map(batch, mp, geo, &ms);
+  mapper.insert(batch);
+  const vasco::MapStats ms = mapper.last_stats();
   const double map_total_s = seconds_since(t_map);
 
   // Finish.
   const auto t_finish = Clock::now();
-  const vasco::FinishedMap fin =
-      vasco::finish_grid(cells.data(), geo.size_x, geo.size_y, geo.resolution,
-                         static_cast<int>(mp.downsample), static_cast<int>(mp.border));
-  cells.clear();
-  cells.shrink_to_fit();
+  const vasco::FinishedMap fin = mapper.finish();
   const double finish_s = seconds_since(t_finish);
   uint64_t known = 0;
   for (float v : fin.cells) known += v != -1.0f;
@@ -245,7 +243,7 @@ int run(const Options &opt) {
   try {
     for (size_t i = 0; i < opt.outputs.size(); ++i) {
       const std::string &out = opt.outputs[i];
-      write_output(out, kinds[i], grid, origin, opt.log, backend->name());
+      write_output(out, kinds[i], grid, origin, opt.log, mapper.backend_name());
       written.push_back(out);
       if (kinds[i] == OutputKind::Pgm) written.push_back(yaml_beside(out));
     }
@@ -280,13 +278,13 @@ int run(const Options &opt) {
     std::fprintf(stderr,
                  "log2map: backend %s; parse %.3f s, prep %.3f s, upload %.3f s, map %.3f s, "
                  "download %.3f s, finish %.3f s, write %.3f s, total %.3f s\n",
-                 backend->name().c_str(), parse_s, ms.prep_s, ms.upload_s, ms.map_s, ms.download_s,
+                 mapper.backend_name().c_str(), parse_s, ms.prep_s, ms.upload_s, ms.map_s, ms.download_s,
                  finish_s, write_s, total_s);
   }
   if (opt.json) {
     std::ostringstream j;
     j.precision(9);
-    j << "{\"log\":\"" << json_escape(opt.log) << "\",\"backend\":\"" << backend->name()
+    j << "{\"log\":\"" << json_escape(opt.log) << "\",\"backend\":\"" << mapper.backend_name()
       << "\",\"scans\":" << batch.num_scans() << ",\"laser_messages\":" << load.laser_messages
       << ",\"beams_used\":" << ms.beams_used << ",\"beams_skipped\":" << ms.beams_skipped
       << ",\"cell_updates\":" << ms.cell_updates << ",\"nan_ranges\":" << ls.nan_ranges
