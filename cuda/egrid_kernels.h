@@ -146,6 +146,44 @@ void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans
 void launch_float_finalize(const FloatModel &m, float *grid_logodds, const uint8_t *touched,
                            size_t num_cells, cudaStream_t stream);
 
+// ---------------------------------------------------------------------------
+// CARMEN's finish on the device (finish_kernels.cu): block means summed in
+// double in CARMEN's order, the known bounding box, the crop. Only the
+// finished map then crosses the bus.
+// ---------------------------------------------------------------------------
+
+// How the grid's cells are stored: probabilities (exact mode) or float
+// mode's log-odds sums (-0.0f: untouched), converted as launch_float_finalize does.
+struct GridEncoding {
+  bool logodds = false;
+  float logodds_prior = 0;
+};
+
+// blocks[bx * ny + by] for nx = size_x / ds, ny = size_y / ds, and bbox =
+// {min_x, max_x, min_y, max_y} widened by every known block (initialised by
+// the caller to CARMEN's start values).
+void launch_finish_blocks(const float *grid, int size_x, int size_y, int ds, GridEncoding enc,
+                          float *blocks, int *bbox, cudaStream_t stream);
+
+// out[x * out_y + y] = blocks[(x + min_x) * ny + (y + min_y)].
+void launch_crop(const float *blocks, int ny, int min_x, int min_y, int out_x, int out_y, float *out,
+                 cudaStream_t stream);
+
+// A window of the grid as probabilities: out[x * height + y].
+void launch_read_window(const float *grid, int size_y, GridEncoding enc, int x0, int y0, int width, int height,
+                        float *out, cudaStream_t stream);
+
+// Probabilities from float mode's log-odds sum (the one expression finalize,
+// finish and read use, so they agree bit for bit).
+#if defined(__CUDACC__)
+__device__ __forceinline__ float prob_of_logodds(float logodds_prior, float sum) {
+  if (__float_as_uint(sum) == 0x80000000u) return -1.0f;  // untouched
+  // p = 1 - 1/(1 + odds), odds = exp(L): saturates to exactly 1 or 0.
+  const float odds = expf(logodds_prior + sum);
+  return 1.0f - 1.0f / (1.0f + odds);
+}
+#endif
+
 }  // namespace cuda
 }  // namespace vasco
 

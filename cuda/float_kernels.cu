@@ -30,8 +30,7 @@ constexpr int kWarpsPerBlock = 8;
 // Untouched cells hold -0.0f. A term of the sum is never -0.0 (logf of a
 // positive ratio minus logit(prior) is +0.0 at worst), and -0.0 + x == x for
 // every x, +0.0 included; so after the sum, "-0.0" means "never updated" —
-// no separate touched array and none of its stores.
-__device__ __forceinline__ bool is_untouched(float v) { return __float_as_uint(v) == 0x80000000u; }
+// no separate touched array and none of its stores (prob_of_logodds).
 
 __device__ __forceinline__ void add_evidence(const FloatModel &m, int cx, int cy, int x1, int y1,
                                              float r, float *logodds, unsigned *count, bool *stop) {
@@ -126,13 +125,10 @@ __global__ void fill_kernel(float *grid, size_t n, float value) {
 __global__ void finalize_kernel(FloatModel m, float *grid, const uint8_t *touched, size_t n) {
   for (size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x; c < n;
        c += static_cast<size_t>(gridDim.x) * blockDim.x) {
-    if (touched ? !touched[c] : is_untouched(grid[c])) {
+    if (touched && !touched[c])
       grid[c] = egrid::kUnknown;
-    } else {
-      // p = 1 - 1/(1 + odds), odds = exp(L): saturates to exactly 1 or 0.
-      const float odds = expf(m.logodds_prior + grid[c]);
-      grid[c] = 1.0f - 1.0f / (1.0f + odds);
-    }
+    else
+      grid[c] = prob_of_logodds(m.logodds_prior, grid[c]);
   }
 }
 

@@ -1,5 +1,9 @@
 #include "vasco_gpu/mapper.hpp"
 
+#if defined(VASCO_HAVE_CUDA)
+#include "vasco_gpu/cuda_backend.h"
+#endif
+
 #include <chrono>
 #include <stdexcept>
 #include <string>
@@ -57,6 +61,12 @@ void check_window(const GridWindow &w, const GridGeometry &geo) {
 }  // namespace
 
 std::unique_ptr<Renderer> make_renderer(const std::string &backend, const BackendOptions &options) {
+#if defined(VASCO_HAVE_CUDA)
+  std::string why;
+  if ((backend == "cuda" || backend == "auto") && options.cuda_kernel == CudaKernel::Ours &&
+      cuda_usable(options.cuda_device, &why))
+    return make_cuda_renderer(options);
+#endif
   return std::make_unique<HostRenderer>(make_backend(backend, options));
 }
 

@@ -22,6 +22,11 @@ std::string cuda_device_description(int device);
 // bit-identical to cpu_double. Throws std::runtime_error without a usable GPU.
 std::unique_ptr<Backend> make_cuda_backend(const BackendOptions &options);
 
+class Renderer;
+// A mapping session's renderer on the GPU (vasco::Mapper with backend "cuda"):
+// grid, ranges and scratch resident between calls. Throws without a usable GPU.
+std::unique_ptr<Renderer> make_cuda_renderer(const BackendOptions &options);
+
 }  // namespace vasco
 
 #endif  // VASCO_GPU_CUDA_BACKEND_H

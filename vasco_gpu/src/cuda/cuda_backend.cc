@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "cuda_check.h"
+#include "cuda_host_support.h"
+#include "cuda_renderer.h"
 #include "egrid_kernels.h"
 #include "paper_kernels.h"
 #include "vasco_gpu/beam_placement.h"
@@ -24,6 +26,8 @@ namespace vasco {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using cuda_host::check_fits;
+using cuda_host::StageTimer;
 using cuda::DeviceBuffer;
 using cuda::Event;
 using cuda::PinnedBuffer;
@@ -43,47 +47,6 @@ UsableState &usable_state() {
 double seconds(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
-
-std::string mib(size_t bytes) {
-  std::ostringstream s;
-  s << (bytes + (1 << 20) - 1) / (1 << 20) << " MiB";
-  return s.str();
-}
-
-// Refuses, with a clear message, a job whose device memory would not fit.
-void check_fits(size_t bytes, const char *what) {
-  size_t free_b = 0, total_b = 0;
-  VG_CUDA_CHECK(cudaMemGetInfo(&free_b, &total_b));
-  // Keep a margin for CUB scratch rounding and the context.
-  if (bytes + (size_t(64) << 20) > free_b)
-    throw std::runtime_error(std::string("the map does not fit in GPU memory: ") + what + " needs " +
-                             mib(bytes) + ", " + mib(free_b) + " free of " + mib(total_b) +
-                             " (use a coarser vasco_resolution or a CPU backend)");
-}
-
-// With VASCO_CUDA_PROFILE set, prints the time of each GPU stage to stderr
-// (events between stages; for tuning, not for the benchmark table).
-class StageTimer {
- public:
-  explicit StageTimer(cudaStream_t s) : stream_(s), on_(std::getenv("VASCO_CUDA_PROFILE") != nullptr) {}
-  void mark(const char *name) {
-    if (!on_) return;
-    events_.emplace_back(std::make_unique<Event>(), name);
-    events_.back().first->record(stream_);
-  }
-  void report() {
-    if (!on_ || events_.size() < 2) return;
-    VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
-    for (size_t i = 1; i < events_.size(); ++i)
-      std::fprintf(stderr, "  [cuda] %-14s %8.3f ms\n", events_[i].second,
-                   events_[i].first->since(*events_[i - 1].first));
-  }
-
- private:
-  cudaStream_t stream_;
-  bool on_;
-  std::vector<std::pair<std::unique_ptr<Event>, const char *>> events_;
-};
 
 static_assert(sizeof(PlacedBeam) == sizeof(cuda::ExactBeam) &&
                   offsetof(PlacedBeam, x2) == offsetof(cuda::ExactBeam, x2) &&
@@ -130,187 +93,39 @@ class CudaBackend : public Backend {
     MapStats st;
     last = std::min(last, batch.num_scans());
     first = std::min(first, last);
-    if (options_.cuda_mode == CudaMode::Exact) {
-      // Exact mode counts (tile, beam) pairs in 32 bits: a run of scans whose
-      // pairs could pass 2^32 goes in several launches, each continuing the
-      // grid of the one before (the same order of updates per cell).
-      const uint64_t max_beams = exact_beams_per_launch(params);
-      size_t a = first;
-      do {
-        size_t b = a;
-        while (b < last && (b == a || batch.beam_offset[b + 1] - batch.beam_offset[a] <= max_beams)) ++b;
-        MapStats part;
-        map_exact(batch, a, b, params, geo, cells, fresh && a == first, &part);
-        add_stats(&st, part);
-        a = b;
-      } while (a < last);
+    if (options_.cuda_mode == CudaMode::Exact || options_.cuda_kernel == CudaKernel::Ours) {
+      run_renderer(batch, first, last, params, geo, cells, fresh, &st);
     } else {
-      map_float(batch, first, last, params, geo, cells, fresh, &st);
+      if (!fresh) throw std::logic_error("the paper's kernels map whole batches only");
+      map_paper(batch, params, geo, cells, &st);
     }
     st.scans = last - first;
     if (stats != nullptr) *stats = st;
   }
 
-  // Beams per exact-mode launch such that the (tile, beam) pairs, at most
-  // 2 * (table_size / kTile + 2) per beam (a monotone walk of table_size
-  // cells enters that many tiles at most), stay below 2^32.
-  static uint64_t exact_beams_per_launch(const MapperParams &p) {
-    const uint64_t per_beam = 2 * (static_cast<uint64_t>(std::max(p.table_size(), 0)) / cuda::kTile + 2);
-    return std::max<uint64_t>(1, (uint64_t(UINT32_MAX) - 1) / per_beam);
+  // Our kernels, through a mapping session's renderer: the grid goes up (when
+  // continued) and comes back whole.
+  void run_renderer(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+                    const GridGeometry &geo, float *cells, bool fresh, MapStats *st) {
+    if (!renderer_) renderer_ = std::make_unique<CudaRenderer>(options_);
+    renderer_->forget_scans();
+    renderer_->reset(geo, params);
+    if (!fresh) renderer_->upload_grid(cells);
+    renderer_->apply(batch, first, last, st);
+    const auto t_down = Clock::now();
+    const std::vector<float> grid = renderer_->read(GridWindow{0, 0, geo.size_x, geo.size_y});
+    std::copy(grid.begin(), grid.end(), cells);
+    st->download_s = seconds(t_down);
   }
 
-  static void add_stats(MapStats *sum, const MapStats &part) {
-    sum->beams_used += part.beams_used;
-    sum->beams_skipped += part.beams_skipped;
-    sum->cell_updates += part.cell_updates;
-    sum->prep_s += part.prep_s;
-    sum->upload_s += part.upload_s;
-    sum->map_s += part.map_s;
-    sum->download_s += part.download_s;
-  }
-
-  cuda::DeviceModel device_model(const MapperParams &p, const GridGeometry &geo) const {
-    cuda::DeviceModel m;
-    m.prior = p.p_prior;
-    m.occ = p.p_occ;
-    m.emp = p.p_emp;
-    m.sure = p.range_sure;
-    m.max = p.range_max;
-    m.resolution = p.resolution;
-    m.wall = p.wall_size;
-    m.table_size = p.table_size();
-    m.size_x = geo.size_x;
-    m.size_y = geo.size_y;
-    return m;
-  }
-
-  void map_exact(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
-                 const GridGeometry &geo, float *host_grid, bool fresh, MapStats *st) {
-    const auto t_prep = Clock::now();
-    const cuda::DeviceModel m = device_model(params, geo);
-    // Used beams only, in (scan, beam) order, their end cells computed by the
-    // oracle's own code with the host's libm (DESIGN §2.2).
-    const PlacedBeams placed = place_beams(batch, geo, params, 0, first, last);
-    const size_t nb = placed.beams.size();
-    st->beams_used = nb;
-    st->beams_skipped = placed.skipped;
-    std::vector<cuda::StartCell> h_starts(batch.num_scans());
-    for (size_t s = 0; s < batch.num_scans(); ++s) h_starts[s] = {placed.starts[s].x1, placed.starts[s].y1};
-    st->prep_s = seconds(t_prep);
-
-    const int tiles_x = (geo.size_x + cuda::kTile - 1) / cuda::kTile;
-    const int tiles_y = (geo.size_y + cuda::kTile - 1) / cuda::kTile;
-    const size_t num_tiles = static_cast<size_t>(tiles_x) * tiles_y;
-    const size_t T2 = static_cast<size_t>(m.table_size) * m.table_size;
-    // Tables only when small (they replace a sqrt and two divisions per update).
-    const bool use_tables = T2 <= (size_t(1) << 22);
-    const size_t cells = geo.num_cells();
-    const size_t scan_tmp = cuda::exact_scan_temp_bytes(nb);
-    const size_t order_tmp = cuda::exact_order_temp_bytes(num_tiles);
-    size_t fixed = nb * (sizeof(cuda::ExactBeam) + sizeof(cuda::LineRec) + 2 * sizeof(uint32_t)) +
-                   batch.num_scans() * sizeof(cuda::StartCell) + cells * sizeof(float) +
-                   6 * num_tiles * sizeof(uint32_t) + scan_tmp + order_tmp +
-                   (use_tables ? 3 * T2 * sizeof(double) : 0);
-    check_fits(fixed, "exact mode (beams, grid, tables)");
-
-    Stream stream;
-    Event e0, e_up, e_map, e_down;
-    DeviceBuffer<cuda::ExactBeam> d_beams(nb);
-    DeviceBuffer<cuda::StartCell> d_starts(batch.num_scans());
-    DeviceBuffer<cuda::LineRec> d_lines(nb);
-    DeviceBuffer<uint32_t> d_counts(nb + 1), d_offsets(nb + 1);
-    DeviceBuffer<uint32_t> d_tile_begin(num_tiles), d_tile_end(num_tiles);
-    DeviceBuffer<uint32_t> d_order(num_tiles), d_order_keys(num_tiles), d_order_keys_out(num_tiles),
-        d_order_ids(num_tiles);
-    DeviceBuffer<unsigned char> d_order_tmp(std::max<size_t>(order_tmp, 1));
-    DeviceBuffer<float> d_grid(cells);
-    DeviceBuffer<double> d_dist(use_tables ? T2 : 0), d_ff(use_tables ? T2 : 0), d_fo(use_tables ? T2 : 0);
-    DeviceBuffer<unsigned long long> d_updates(1);
-    DeviceBuffer<unsigned char> d_scan_tmp(std::max<size_t>(scan_tmp, 1));
-
-    e0.record(stream.get());
-    if (fresh)
-      cuda::launch_fill(d_grid.get(), cells, egrid::kUnknown, stream.get());
-    else
-      VG_CUDA_CHECK(cudaMemcpyAsync(d_grid.get(), host_grid, cells * sizeof(float), cudaMemcpyHostToDevice,
-                                    stream.get()));
-    // PlacedBeam and cuda::ExactBeam are the same 16 bytes (checked above).
-    if (nb) VG_CUDA_CHECK(cudaMemcpyAsync(d_beams.get(), placed.beams.data(), nb * sizeof(cuda::ExactBeam),
-                                          cudaMemcpyHostToDevice, stream.get()));
-    if (batch.num_scans())
-      VG_CUDA_CHECK(cudaMemcpyAsync(d_starts.get(), h_starts.data(),
-                                    batch.num_scans() * sizeof(cuda::StartCell),
-                                    cudaMemcpyHostToDevice, stream.get()));
-    e_up.record(stream.get());
-
-    StageTimer timer(stream.get());
-    timer.mark("start");
-    VG_CUDA_CHECK(cudaMemsetAsync(d_updates.get(), 0, sizeof(unsigned long long), stream.get()));
-    VG_CUDA_CHECK(cudaMemsetAsync(d_counts.get(), 0, (nb + 1) * sizeof(uint32_t), stream.get()));
-    if (use_tables) cuda::launch_exact_tables(m, d_dist.get(), d_ff.get(), d_fo.get(), stream.get());
-    timer.mark("tables");
-    cuda::launch_exact_lines(m, d_beams.get(), d_starts.get(), nb, d_lines.get(), d_counts.get(),
-                             stream.get());
-    timer.mark("lines");
-    cuda::exact_scan(d_counts.get(), d_offsets.get(), nb, d_scan_tmp.get(), scan_tmp, stream.get());
-    timer.mark("scan");
-    uint32_t num_pairs = 0;
-    VG_CUDA_CHECK(cudaMemcpyAsync(&num_pairs, d_offsets.get() + nb, sizeof(uint32_t),
-                                  cudaMemcpyDeviceToHost, stream.get()));
-    stream.synchronize();
-    const size_t sort_tmp = cuda::exact_sort_temp_bytes(num_pairs);
-    check_fits(4 * size_t(num_pairs) * sizeof(uint32_t) + sort_tmp, "exact mode (tile lists)");
-    DeviceBuffer<uint32_t> d_pair_tile(num_pairs), d_pair_beam(num_pairs);
-    DeviceBuffer<uint32_t> d_sorted_tile(num_pairs), d_sorted_beam(num_pairs);
-    DeviceBuffer<unsigned char> d_sort_tmp(std::max<size_t>(sort_tmp, 1));
-    timer.mark("sync+alloc");
-    cuda::launch_exact_pairs(m, d_lines.get(), d_offsets.get(), nb, d_pair_tile.get(),
-                             d_pair_beam.get(), stream.get());
-    timer.mark("pairs");
-    int tile_bits = 1;
-    while ((size_t(1) << tile_bits) < num_tiles) ++tile_bits;
-    if (num_pairs)
-      cuda::exact_sort(d_pair_tile.get(), d_sorted_tile.get(), d_pair_beam.get(), d_sorted_beam.get(),
-                       num_pairs, tile_bits, d_sort_tmp.get(), sort_tmp, stream.get());
-    timer.mark("sort");
-    cuda::launch_exact_tile_ranges(d_sorted_tile.get(), num_pairs, d_tile_begin.get(),
-                                   d_tile_end.get(), num_tiles, stream.get());
-    timer.mark("ranges");
-    cuda::exact_tile_order(d_tile_begin.get(), d_tile_end.get(), num_tiles, d_order.get(),
-                           d_order_keys.get(), d_order_keys_out.get(), d_order_ids.get(),
-                           d_order_tmp.get(), order_tmp, stream.get());
-    timer.mark("order");
-    cuda::launch_exact_tiles(m, d_lines.get(), d_sorted_beam.get(), d_order.get(), d_tile_begin.get(),
-                             d_tile_end.get(), use_tables ? d_dist.get() : nullptr,
-                             use_tables ? d_ff.get() : nullptr, use_tables ? d_fo.get() : nullptr,
-                             d_grid.get(), d_updates.get(), stream.get());
-    timer.mark("tiles");
-    e_map.record(stream.get());
-
-    unsigned long long updates = 0;
-    VG_CUDA_CHECK(cudaMemcpyAsync(host_grid, d_grid.get(), cells * sizeof(float),
-                                  cudaMemcpyDeviceToHost, stream.get()));
-    VG_CUDA_CHECK(cudaMemcpyAsync(&updates, d_updates.get(), sizeof(updates), cudaMemcpyDeviceToHost,
-                                  stream.get()));
-    e_down.record(stream.get());
-    stream.synchronize();
-    timer.report();
-    if (std::getenv("VASCO_CUDA_PROFILE"))
-      std::fprintf(stderr, "  [cuda] %zu beams, %u tile pairs, %zu tiles\n", nb, num_pairs, num_tiles);
-    st->cell_updates = updates;
-    st->upload_s = e_up.since(e0) / 1e3;
-    st->map_s = e_map.since(e_up) / 1e3;
-    st->download_s = e_down.since(e_map) / 1e3;
-  }
-
-  void map_float(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
-                 const GridGeometry &geo, float *host_grid, bool fresh, MapStats *st) {
+  // The paper's kernel and its ablation variants (benchmark baselines).
+  void map_paper(const ScanBatch &batch, const MapperParams &params, const GridGeometry &geo,
+                 float *host_grid, MapStats *st) {
     const auto t_prep = Clock::now();
     const std::vector<oracle::ScanStart> starts = place_scans(batch, geo);
-    const size_t nscans = last - first;
-    const uint64_t beam0 = batch.beam_offset[first];
+    const size_t nscans = batch.num_scans();
     PinnedBuffer<cuda::FloatScan> h_scans(std::max<size_t>(nscans, 1));
-    for (size_t s = first; s < last; ++s) {
+    for (size_t s = 0; s < nscans; ++s) {
       cuda::FloatScan f;
       f.lx = static_cast<float>(starts[s].lx);
       f.ly = static_cast<float>(starts[s].ly);
@@ -319,9 +134,9 @@ class CudaBackend : public Backend {
       f.y1 = starts[s].y1;
       f.first = static_cast<float>(batch.first_angle[s]);
       f.step = static_cast<float>(batch.angle_step[s]);
-      f.beam_begin = static_cast<uint32_t>(batch.beam_offset[s] - beam0);
+      f.beam_begin = static_cast<uint32_t>(batch.beam_offset[s]);
       f.beam_count = batch.beams_in(s);
-      h_scans[s - first] = f;
+      h_scans[s] = f;
     }
     cuda::FloatModel m;
     m.prior = static_cast<float>(params.p_prior);
@@ -337,15 +152,15 @@ class CudaBackend : public Backend {
     m.size_y = geo.size_y;
     st->prep_s = seconds(t_prep);
 
-    const size_t cells = geo.num_cells(), nbeams = batch.beam_offset[last] - beam0;
-    if (nbeams > UINT32_MAX) throw std::runtime_error("cuda float mode: more than 2^32 beams in one call");
+    const size_t cells = geo.num_cells(), nbeams = batch.num_beams();
+    if (nbeams > UINT32_MAX) throw std::runtime_error("the paper's kernels: more than 2^32 beams");
     check_fits(cells * (sizeof(float) + 1) + nbeams * sizeof(float) + nscans * sizeof(cuda::FloatScan),
                "float mode (grid and beams)");
     Stream stream;
     Event e0, e_up, e_map, e_down;
     DeviceBuffer<cuda::FloatScan> d_scans(nscans);
     DeviceBuffer<float> d_ranges(nbeams), d_grid(cells);
-    DeviceBuffer<uint8_t> d_touched(options_.cuda_kernel == CudaKernel::Ours ? 0 : cells);
+    DeviceBuffer<uint8_t> d_touched(cells);
     DeviceBuffer<unsigned long long> d_counters(3);
     DeviceBuffer<cuda::FloatModel> d_model(1);
 
@@ -354,62 +169,38 @@ class CudaBackend : public Backend {
       VG_CUDA_CHECK(cudaMemcpyAsync(d_scans.get(), h_scans.get(), nscans * sizeof(cuda::FloatScan),
                                     cudaMemcpyHostToDevice, stream.get()));
     if (nbeams)
-      VG_CUDA_CHECK(cudaMemcpyAsync(d_ranges.get(), batch.range.data() + beam0, nbeams * sizeof(float),
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_ranges.get(), batch.range.data(), nbeams * sizeof(float),
                                     cudaMemcpyHostToDevice, stream.get()));
     e_up.record(stream.get());
     StageTimer timer(stream.get());
     timer.mark("start");
-    const bool ours = options_.cuda_kernel == CudaKernel::Ours;
-    if (ours && fresh) {
-      cuda::launch_float_clear(d_grid.get(), cells, stream.get());
-    } else if (ours) {
-      VG_CUDA_CHECK(cudaMemcpyAsync(d_grid.get(), host_grid, cells * sizeof(float), cudaMemcpyHostToDevice,
-                                    stream.get()));
-      cuda::launch_float_from_prob(m, d_grid.get(), cells, stream.get());
-    } else {
-      if (!fresh) throw std::logic_error("the paper's kernels map whole batches only");
-      VG_CUDA_CHECK(cudaMemsetAsync(d_grid.get(), 0, cells * sizeof(float), stream.get()));
-      VG_CUDA_CHECK(cudaMemsetAsync(d_touched.get(), 0, cells, stream.get()));
-    }
+    VG_CUDA_CHECK(cudaMemsetAsync(d_grid.get(), 0, cells * sizeof(float), stream.get()));
+    VG_CUDA_CHECK(cudaMemsetAsync(d_touched.get(), 0, cells, stream.get()));
     timer.mark("clear");
     VG_CUDA_CHECK(cudaMemsetAsync(d_counters.get(), 0, 3 * sizeof(unsigned long long), stream.get()));
-    if (ours) {
-      cuda::launch_float_map(m, d_scans.get(), static_cast<int>(nscans), d_ranges.get(),
-                             d_grid.get(), d_counters.get(), stream.get());
-    } else {
-      cuda::PaperVariant v = cuda::PaperVariant::PerScan;
-      if (options_.cuda_kernel == CudaKernel::PaperPerScanNoShared) v = cuda::PaperVariant::PerScanNoShared;
-      if (options_.cuda_kernel == CudaKernel::PaperPerScanNoConst) v = cuda::PaperVariant::PerScanNoConst;
-      if (options_.cuda_kernel == CudaKernel::PaperFused) v = cuda::PaperVariant::Fused;
-      VG_CUDA_CHECK(cudaMemcpyAsync(d_model.get(), &m, sizeof m, cudaMemcpyHostToDevice, stream.get()));
-      cuda::run_paper_variant(v, m, d_model.get(), h_scans.get(), d_scans.get(),
-                              static_cast<int>(nscans), d_ranges.get(), d_grid.get(),
-                              d_touched.get(), stream.get());
-    }
+    cuda::PaperVariant v = cuda::PaperVariant::PerScan;
+    if (options_.cuda_kernel == CudaKernel::PaperPerScanNoShared) v = cuda::PaperVariant::PerScanNoShared;
+    if (options_.cuda_kernel == CudaKernel::PaperPerScanNoConst) v = cuda::PaperVariant::PerScanNoConst;
+    if (options_.cuda_kernel == CudaKernel::PaperFused) v = cuda::PaperVariant::Fused;
+    VG_CUDA_CHECK(cudaMemcpyAsync(d_model.get(), &m, sizeof m, cudaMemcpyHostToDevice, stream.get()));
+    cuda::run_paper_variant(v, m, d_model.get(), h_scans.get(), d_scans.get(), static_cast<int>(nscans),
+                            d_ranges.get(), d_grid.get(), d_touched.get(), stream.get());
     timer.mark("map");
-    cuda::launch_float_finalize(m, d_grid.get(), ours ? nullptr : d_touched.get(), cells,
-                                stream.get());
+    cuda::launch_float_finalize(m, d_grid.get(), d_touched.get(), cells, stream.get());
     timer.mark("finalize");
     e_map.record(stream.get());
-    unsigned long long counters[3] = {0, 0, 0};
     VG_CUDA_CHECK(cudaMemcpyAsync(host_grid, d_grid.get(), cells * sizeof(float),
                                   cudaMemcpyDeviceToHost, stream.get()));
-    VG_CUDA_CHECK(cudaMemcpyAsync(counters, d_counters.get(), sizeof counters, cudaMemcpyDeviceToHost,
-                                  stream.get()));
     e_down.record(stream.get());
     stream.synchronize();
     timer.report();
-    if (options_.cuda_kernel == CudaKernel::Ours) {
-      st->beams_used = counters[0];
-      st->beams_skipped = counters[1];
-      st->cell_updates = counters[2];
-    }
     st->upload_s = e_up.since(e0) / 1e3;
     st->map_s = e_map.since(e_up) / 1e3;
     st->download_s = e_down.since(e_map) / 1e3;
   }
 
   BackendOptions options_;
+  std::unique_ptr<CudaRenderer> renderer_;
 };
 
 }  // namespace

@@ -1,0 +1,79 @@
+// cuda_host_support.h — host-side helpers shared by the CUDA backend and the
+// CUDA renderer: the GPU-memory check and the per-stage profile.
+#ifndef VASCO_GPU_SRC_CUDA_HOST_SUPPORT_H
+#define VASCO_GPU_SRC_CUDA_HOST_SUPPORT_H
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cuda_check.h"
+
+namespace vasco {
+namespace cuda_host {
+
+using cuda::Event;
+
+inline std::string mib(size_t bytes) {
+  std::ostringstream s;
+  s << (bytes + (1 << 20) - 1) / (1 << 20) << " MiB";
+  return s.str();
+}
+
+// Refuses, with a clear message, a job whose device memory would not fit.
+inline void check_fits(size_t bytes, const char *what) {
+  size_t free_b = 0, total_b = 0;
+  VG_CUDA_CHECK(cudaMemGetInfo(&free_b, &total_b));
+  // Keep a margin for CUB scratch rounding and the context.
+  if (bytes + (size_t(64) << 20) > free_b)
+    throw std::runtime_error(std::string("the map does not fit in GPU memory: ") + what + " needs " +
+                             mib(bytes) + ", " + mib(free_b) + " free of " + mib(total_b) +
+                             " (use a coarser vasco_resolution or a CPU backend)");
+}
+
+// With VASCO_CUDA_PROFILE set, prints the time of each GPU stage to stderr
+// (events between stages; for tuning, not for the benchmark table).
+class StageTimer {
+ public:
+  explicit StageTimer(cudaStream_t s) : stream_(s), on_(std::getenv("VASCO_CUDA_PROFILE") != nullptr) {}
+  void mark(const char *name) {
+    if (!on_) return;
+    events_.emplace_back(std::make_unique<Event>(), name);
+    events_.back().first->record(stream_);
+  }
+  void report() {
+    if (!on_ || events_.size() < 2) return;
+    VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
+    for (size_t i = 1; i < events_.size(); ++i)
+      std::fprintf(stderr, "  [cuda] %-14s %8.3f ms\n", events_[i].second,
+                   events_[i].first->since(*events_[i - 1].first));
+  }
+
+ private:
+  cudaStream_t stream_;
+  bool on_;
+  std::vector<std::pair<std::unique_ptr<Event>, const char *>> events_;
+};
+
+
+// Grows a device buffer to at least n elements (half as much again, so that
+// a session appending scans reallocates rarely); its contents are dropped.
+template <class T>
+void reserve(cuda::DeviceBuffer<T> &b, size_t n) {
+  if (n > b.size()) b.resize(std::max(n, b.size() + b.size() / 2));
+}
+template <class T>
+void reserve(cuda::PinnedBuffer<T> &b, size_t n) {
+  if (n > b.size()) b.resize(std::max(n, b.size() + b.size() / 2));
+}
+
+}  // namespace cuda_host
+}  // namespace vasco
+
+#endif  // VASCO_GPU_SRC_CUDA_HOST_SUPPORT_H

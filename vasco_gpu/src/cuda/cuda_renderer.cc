@@ -1,0 +1,357 @@
+// The CUDA renderer of a mapping session: the evidence grid, the scans'
+// ranges (float mode) and every scratch buffer stay on the GPU between calls,
+// grown to a high-water mark and then reused; one stream per renderer.
+//   insert  (apply of new scans): float mode uploads their ranges once and a
+//           32-byte record per scan; exact mode places their beams on the host
+//           with the oracle's own code (DESIGN §2.2) and uploads 16 bytes per
+//           beam, then continues the grid in (scan, beam) order.
+//   render  (reset + apply of every scan): float mode uploads the per-scan
+//           records only (the poses, placed); the ranges are already there.
+//   finish  CARMEN's finish on the device; only the finished map comes back,
+//           into pinned memory.
+#include "cuda_renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "cuda_check.h"
+#include "cuda_host_support.h"
+#include "egrid_kernels.h"
+#include "vasco_gpu/beam_placement.h"
+#include "vasco_gpu/oracle.h"
+
+namespace vasco {
+
+using cuda_host::check_fits;
+using cuda_host::reserve;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+static_assert(sizeof(PlacedBeam) == sizeof(cuda::ExactBeam), "PlacedBeam is uploaded as cuda::ExactBeam");
+
+}  // namespace
+
+CudaRenderer::CudaRenderer(const BackendOptions &options) : options_(options) {
+  VG_CUDA_CHECK(cudaSetDevice(options.cuda_device));
+  stream_ = std::make_unique<cuda::Stream>();
+}
+
+CudaRenderer::~CudaRenderer() = default;
+
+std::string CudaRenderer::name() const { return exact() ? "cuda_exact" : "cuda_float"; }
+
+void CudaRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
+  VG_CUDA_CHECK(cudaSetDevice(options_.cuda_device));
+  geo_ = geo;
+  params_ = params;
+  const size_t cells = geo.num_cells();
+  if (cells > grid_.size()) check_fits(cells * sizeof(float) - grid_.bytes(), "the evidence grid");
+  reserve(grid_, cells);
+  if (exact()) {
+    cuda::launch_fill(grid_.get(), cells, egrid::kUnknown, stream_->get());
+    build_tables();
+  } else {
+    cuda::launch_float_clear(grid_.get(), cells, stream_->get());
+  }
+}
+
+cuda::DeviceModel CudaRenderer::exact_model() const {
+  cuda::DeviceModel m;
+  m.prior = params_.p_prior;
+  m.occ = params_.p_occ;
+  m.emp = params_.p_emp;
+  m.sure = params_.range_sure;
+  m.max = params_.range_max;
+  m.resolution = params_.resolution;
+  m.wall = params_.wall_size;
+  m.table_size = params_.table_size();
+  m.size_x = geo_.size_x;
+  m.size_y = geo_.size_y;
+  return m;
+}
+
+cuda::FloatModel CudaRenderer::float_model() const {
+  cuda::FloatModel m;
+  m.prior = static_cast<float>(params_.p_prior);
+  m.occ = static_cast<float>(params_.p_occ);
+  m.emp = static_cast<float>(params_.p_emp);
+  m.sure = static_cast<float>(params_.range_sure);
+  m.max = static_cast<float>(params_.range_max);
+  m.resolution = static_cast<float>(params_.resolution);
+  m.wall = static_cast<float>(params_.wall_size);
+  m.logodds_prior = static_cast<float>(std::log(params_.p_prior / (1 - params_.p_prior)));
+  m.table_size = params_.table_size();
+  m.size_x = geo_.size_x;
+  m.size_y = geo_.size_y;
+  return m;
+}
+
+cuda::GridEncoding CudaRenderer::encoding() const {
+  cuda::GridEncoding e;
+  e.logodds = !exact();
+  e.logodds_prior = float_model().logodds_prior;
+  return e;
+}
+
+// The exact mode's distance and odds-factor tables, built once per
+// parameter set (they replace a sqrt and two divisions per update).
+void CudaRenderer::build_tables() {
+  const int T = params_.table_size();
+  const size_t t2 = static_cast<size_t>(std::max(T, 0)) * static_cast<size_t>(std::max(T, 0));
+  use_tables_ = t2 > 0 && t2 <= (size_t(1) << 22);
+  const auto key = std::make_tuple(T, params_.resolution, params_.p_prior, params_.p_occ, params_.p_emp,
+                                   params_.range_sure, params_.range_max);
+  if (!use_tables_ || (tables_built_ && key == tables_key_)) return;
+  reserve(dist_, t2);
+  reserve(factor_free_, t2);
+  reserve(factor_occ_, t2);
+  cuda::launch_exact_tables(exact_model(), dist_.get(), factor_free_.get(), factor_occ_.get(), stream_->get());
+  tables_key_ = key;
+  tables_built_ = true;
+}
+
+void CudaRenderer::apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) {
+  VG_CUDA_CHECK(cudaSetDevice(options_.cuda_device));
+  last = std::min(last, scans.num_scans());
+  first = std::min(first, last);
+  MapStats st;
+  st.scans = last - first;
+  if (exact()) {
+    // (tile, beam) pairs are counted in 32 bits: a run of scans that could
+    // pass 2^32 of them goes in several launches, each continuing the grid.
+    const uint64_t max_beams = exact_beams_per_launch();
+    for (size_t a = first; a < last;) {
+      size_t b = a + 1;
+      while (b < last && scans.beam_offset[b + 1] - scans.beam_offset[a] <= max_beams) ++b;
+      apply_exact(scans, a, b, &st);
+      a = b;
+    }
+  } else if (last > first) {
+    apply_float(scans, first, last, &st);
+  }
+  if (stats != nullptr) *stats = st;
+}
+
+// Beams per exact-mode launch such that the pairs, at most 2 * (table_size /
+// kTile + 2) per beam (a monotone walk of table_size cells enters no more
+// tiles), stay below 2^32.
+uint64_t CudaRenderer::exact_beams_per_launch() const {
+  const uint64_t per_beam = 2 * (static_cast<uint64_t>(std::max(params_.table_size(), 0)) / cuda::kTile + 2);
+  return std::max<uint64_t>(1, (uint64_t(UINT32_MAX) - 1) / per_beam);
+}
+
+// Float mode's device copy of the scans' ranges, append-only: scans already
+// there are not sent again (a render sends none).
+void CudaRenderer::upload_ranges(const ScanBatch &scans, size_t last) {
+  const uint64_t need = scans.beam_offset[last];
+  if (need <= stored_beams_) return;
+  if (need > ranges_.size()) {
+    const size_t grown = std::max<size_t>(need, ranges_.size() + ranges_.size() / 2);
+    check_fits((grown - ranges_.size()) * sizeof(float), "the scans' ranges");
+    cuda::DeviceBuffer<float> bigger(grown);
+    if (stored_beams_)
+      VG_CUDA_CHECK(cudaMemcpyAsync(bigger.get(), ranges_.get(), stored_beams_ * sizeof(float),
+                                    cudaMemcpyDeviceToDevice, stream_->get()));
+    VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // the old buffer is freed next
+    ranges_ = std::move(bigger);
+  }
+  const size_t n = need - stored_beams_;
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // the staging buffer is free
+  reserve(staging_ranges_, n);
+  std::memcpy(staging_ranges_.get(), scans.range.data() + stored_beams_, n * sizeof(float));
+  VG_CUDA_CHECK(cudaMemcpyAsync(ranges_.get() + stored_beams_, staging_ranges_.get(), n * sizeof(float),
+                                cudaMemcpyHostToDevice, stream_->get()));
+  stored_beams_ = need;
+}
+
+void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
+  const auto t_prep = Clock::now();
+  if (scans.beam_offset[last] > UINT32_MAX)
+    throw std::runtime_error("cuda float mode: more than 2^32 beams stored");
+  upload_ranges(scans, last);
+  // Scan records of [first, last), placed with scan 0 fixing the start pose.
+  oracle::GridFrame frame;
+  frame.size_x = geo_.size_x;
+  frame.size_y = geo_.size_y;
+  frame.resolution = geo_.resolution;
+  frame.theta_offset = geo_.theta_offset;
+  oracle::scan_start(frame, scans.x[0], scans.y[0], scans.theta[0]);
+  const size_t n = last - first;
+  reserve(staging_scans_, n);
+  for (size_t s = first; s < last; ++s) {
+    const oracle::ScanStart p = oracle::scan_start(frame, scans.x[s], scans.y[s], scans.theta[s]);
+    cuda::FloatScan &f = staging_scans_[s - first];
+    f.lx = static_cast<float>(p.lx);
+    f.ly = static_cast<float>(p.ly);
+    f.theta = static_cast<float>(p.theta);
+    f.x1 = p.x1;
+    f.y1 = p.y1;
+    f.first = static_cast<float>(scans.first_angle[s]);
+    f.step = static_cast<float>(scans.angle_step[s]);
+    f.beam_begin = static_cast<uint32_t>(scans.beam_offset[s]);
+    f.beam_count = scans.beams_in(s);
+  }
+  reserve(scan_records_, n);
+  reserve(counters_, 3);
+  st->prep_s += seconds_since(t_prep);
+  cuda::Event e0, e_up, e_map;
+  e0.record(stream_->get());
+  VG_CUDA_CHECK(cudaMemcpyAsync(scan_records_.get(), staging_scans_.get(), n * sizeof(cuda::FloatScan),
+                                cudaMemcpyHostToDevice, stream_->get()));
+  VG_CUDA_CHECK(cudaMemsetAsync(counters_.get(), 0, 3 * sizeof(unsigned long long), stream_->get()));
+  e_up.record(stream_->get());
+  cuda::launch_float_map(float_model(), scan_records_.get(), static_cast<int>(n), ranges_.get(), grid_.get(),
+                         counters_.get(), stream_->get());
+  e_map.record(stream_->get());
+  reserve(staging_counters_, 3);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), counters_.get(), 3 * sizeof(unsigned long long),
+                                cudaMemcpyDeviceToHost, stream_->get()));
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // the call's result is complete
+  st->beams_used += staging_counters_[0];
+  st->beams_skipped += staging_counters_[1];
+  st->cell_updates += staging_counters_[2];
+  st->upload_s += e_up.since(e0) / 1e3;
+  st->map_s += e_map.since(e_up) / 1e3;
+}
+
+void CudaRenderer::apply_exact(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
+  const auto t_prep = Clock::now();
+  const PlacedBeams placed = place_beams(scans, geo_, params_, 0, first, last);
+  const size_t nb = placed.beams.size(), ns = scans.num_scans();
+  st->beams_used += nb;
+  st->beams_skipped += placed.skipped;
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // staging buffers are free
+  reserve(staging_beams_, std::max<size_t>(nb, 1));
+  std::memcpy(staging_beams_.get(), placed.beams.data(), nb * sizeof(cuda::ExactBeam));
+  reserve(staging_starts_, ns);
+  for (size_t s = 0; s < ns; ++s) staging_starts_[s] = {placed.starts[s].x1, placed.starts[s].y1};
+  st->prep_s += seconds_since(t_prep);
+  if (nb == 0) return;
+
+  const cuda::DeviceModel m = exact_model();
+  const size_t tiles = static_cast<size_t>((geo_.size_x + cuda::kTile - 1) / cuda::kTile) *
+                       ((geo_.size_y + cuda::kTile - 1) / cuda::kTile);
+  reserve(beams_, nb);
+  reserve(starts_, ns);
+  reserve(lines_, nb);
+  reserve(counts_, nb + 1);
+  reserve(offsets_, nb + 1);
+  for (auto *b : {&tile_begin_, &tile_end_, &order_, &order_keys_, &order_keys_out_, &order_ids_}) reserve(*b, tiles);
+  reserve(scan_tmp_, std::max<size_t>(cuda::exact_scan_temp_bytes(nb), 1));
+  reserve(order_tmp_, std::max<size_t>(cuda::exact_order_temp_bytes(tiles), 1));
+  reserve(updates_, 1);
+
+  cuda::Event e0, e_up, e_map;
+  cudaStream_t s = stream_->get();
+  e0.record(s);
+  VG_CUDA_CHECK(cudaMemcpyAsync(beams_.get(), staging_beams_.get(), nb * sizeof(cuda::ExactBeam),
+                                cudaMemcpyHostToDevice, s));
+  VG_CUDA_CHECK(cudaMemcpyAsync(starts_.get(), staging_starts_.get(), ns * sizeof(cuda::StartCell),
+                                cudaMemcpyHostToDevice, s));
+  e_up.record(s);
+  VG_CUDA_CHECK(cudaMemsetAsync(updates_.get(), 0, sizeof(unsigned long long), s));
+  VG_CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, (nb + 1) * sizeof(uint32_t), s));
+  cuda::launch_exact_lines(m, beams_.get(), starts_.get(), nb, lines_.get(), counts_.get(), s);
+  cuda::exact_scan(counts_.get(), offsets_.get(), nb, scan_tmp_.get(), scan_tmp_.size(), s);
+  // The pair count sizes the lists: the one wait inside an exact apply.
+  reserve(staging_pairs_, 1);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_pairs_.get(), offsets_.get() + nb, sizeof(uint32_t),
+                                cudaMemcpyDeviceToHost, s));
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));
+  const size_t pairs = staging_pairs_[0];
+  const size_t sort_tmp = cuda::exact_sort_temp_bytes(pairs);
+  if (pairs > pair_tile_.size())
+    check_fits(4 * (pairs - pair_tile_.size()) * sizeof(uint32_t), "exact mode (tile lists)");
+  for (auto *b : {&pair_tile_, &pair_beam_, &sorted_tile_, &sorted_beam_}) reserve(*b, std::max<size_t>(pairs, 1));
+  reserve(sort_tmp_, std::max<size_t>(sort_tmp, 1));
+  cuda::launch_exact_pairs(m, lines_.get(), offsets_.get(), nb, pair_tile_.get(), pair_beam_.get(), s);
+  int tile_bits = 1;
+  while ((size_t(1) << tile_bits) < tiles) ++tile_bits;
+  if (pairs)
+    cuda::exact_sort(pair_tile_.get(), sorted_tile_.get(), pair_beam_.get(), sorted_beam_.get(), pairs, tile_bits,
+                     sort_tmp_.get(), sort_tmp_.size(), s);
+  cuda::launch_exact_tile_ranges(sorted_tile_.get(), pairs, tile_begin_.get(), tile_end_.get(), tiles, s);
+  cuda::exact_tile_order(tile_begin_.get(), tile_end_.get(), tiles, order_.get(), order_keys_.get(),
+                         order_keys_out_.get(), order_ids_.get(), order_tmp_.get(), order_tmp_.size(), s);
+  cuda::launch_exact_tiles(m, lines_.get(), sorted_beam_.get(), order_.get(), tile_begin_.get(), tile_end_.get(),
+                           use_tables_ ? dist_.get() : nullptr, use_tables_ ? factor_free_.get() : nullptr,
+                           use_tables_ ? factor_occ_.get() : nullptr, grid_.get(), updates_.get(), s);
+  e_map.record(s);
+  reserve(staging_counters_, 1);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), updates_.get(), sizeof(unsigned long long),
+                                cudaMemcpyDeviceToHost, s));
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));
+  st->cell_updates += staging_counters_[0];
+  st->upload_s += e_up.since(e0) / 1e3;
+  st->map_s += e_map.since(e_up) / 1e3;
+}
+
+FinishedMap CudaRenderer::finish(int downsample, int border) {
+  if (downsample < 1) throw std::invalid_argument("downsample must be at least 1");
+  if (border < 0) throw std::invalid_argument("border must not be negative");
+  const int ds = downsample, nx = geo_.size_x / ds, ny = geo_.size_y / ds;
+  cudaStream_t s = stream_->get();
+  reserve(blocks_, std::max<size_t>(static_cast<size_t>(nx) * ny, 1));
+  reserve(bbox_, 4);
+  reserve(staging_bbox_, 4);
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));
+  // CARMEN's start values; every known block widens them.
+  staging_bbox_[0] = nx - border - 1;
+  staging_bbox_[1] = border;
+  staging_bbox_[2] = ny - border - 1;
+  staging_bbox_[3] = border;
+  VG_CUDA_CHECK(cudaMemcpyAsync(bbox_.get(), staging_bbox_.get(), 4 * sizeof(int), cudaMemcpyHostToDevice, s));
+  cuda::launch_finish_blocks(grid_.get(), geo_.size_x, geo_.size_y, ds, encoding(), blocks_.get(), bbox_.get(), s);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_bbox_.get(), bbox_.get(), 4 * sizeof(int), cudaMemcpyDeviceToHost, s));
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));
+  const int min_x = std::max(staging_bbox_[0] - border, 0), max_x = std::min(staging_bbox_[1] + border, nx - 1);
+  const int min_y = std::max(staging_bbox_[2] - border, 0), max_y = std::min(staging_bbox_[3] + border, ny - 1);
+  FinishedMap m;
+  m.downsample = ds;
+  m.resolution = geo_.resolution * ds;
+  m.min_x = min_x;
+  m.min_y = min_y;
+  m.size_x = std::max(max_x - min_x, 0);  // CARMEN's max - min, no +1
+  m.size_y = std::max(max_y - min_y, 0);
+  const size_t n = static_cast<size_t>(m.size_x) * m.size_y;
+  reserve(finished_, std::max<size_t>(n, 1));
+  reserve(staging_out_, std::max<size_t>(n, 1));
+  cuda::launch_crop(blocks_.get(), ny, min_x, min_y, m.size_x, m.size_y, finished_.get(), s);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_out_.get(), finished_.get(), n * sizeof(float), cudaMemcpyDeviceToHost, s));
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));
+  m.cells.assign(staging_out_.get(), staging_out_.get() + n);
+  return m;
+}
+
+std::vector<float> CudaRenderer::read(const GridWindow &w) {
+  const size_t n = static_cast<size_t>(w.width) * static_cast<size_t>(w.height);
+  cudaStream_t s = stream_->get();
+  reserve(window_, std::max<size_t>(n, 1));
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));
+  reserve(staging_out_, std::max<size_t>(n, 1));
+  cuda::launch_read_window(grid_.get(), geo_.size_y, encoding(), w.x0, w.y0, w.width, w.height, window_.get(), s);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_out_.get(), window_.get(), n * sizeof(float), cudaMemcpyDeviceToHost, s));
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));
+  return std::vector<float>(staging_out_.get(), staging_out_.get() + n);
+}
+
+void CudaRenderer::upload_grid(const float *probabilities) {
+  const size_t cells = geo_.num_cells();
+  VG_CUDA_CHECK(cudaMemcpy(grid_.get(), probabilities, cells * sizeof(float), cudaMemcpyHostToDevice));
+  if (!exact()) cuda::launch_float_from_prob(float_model(), grid_.get(), cells, stream_->get());
+}
+
+void CudaRenderer::forget_scans() { stored_beams_ = 0; }
+
+std::unique_ptr<Renderer> make_cuda_renderer(const BackendOptions &options) {
+  std::string why;
+  if (!cuda_usable(options.cuda_device, &why)) throw std::runtime_error("no usable GPU: " + why);
+  return std::make_unique<CudaRenderer>(options);
+}
+
+}  // namespace vasco
