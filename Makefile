@@ -27,11 +27,13 @@ golden: all
 demo: all
 	$(BUILD)/bin/log2map logs/fr079-complete.gfs.log.gz $(BUILD)/fr079.png $(BUILD)/fr079.map.gz
 
-# Parse speed, the -O2 reference, then the mapping table (GPU rows when a GPU is usable).
+# Parse speed, the -O2 reference, the mapping table, then the mapping-session
+# table (GPU rows when a GPU is usable).
 bench: all
 	$(BUILD)/bin/parse_bench
 	$(BUILD)/bin/oracle_o2_bench
 	$(BUILD)/bin/mapping_bench
+	$(BUILD)/bin/session_bench
 
 # Installs what is missing through apt-get (Debian/Ubuntu; needs root or
 # sudo); a no-op when everything is there. Every build runs it first.

@@ -74,6 +74,10 @@ class CudaBackend : public Backend {
 
   std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
                          const GridGeometry &geo, MapStats *stats) override {
+    // The grid on the device and its copy for the download, checked before
+    // the host's copy is allocated.
+    VG_CUDA_CHECK(cudaSetDevice(options_.cuda_device));
+    check_fits(2 * geo.num_cells() * sizeof(float), "the evidence grid");
     std::vector<float> grid(geo.num_cells());
     run(batch, 0, batch.num_scans(), params, geo, grid.data(), true, stats);
     return grid;

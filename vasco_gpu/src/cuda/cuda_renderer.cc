@@ -50,7 +50,7 @@ void CudaRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
   geo_ = geo;
   params_ = params;
   const size_t cells = geo.num_cells();
-  if (cells > grid_.size()) check_fits(cells * sizeof(float) - grid_.bytes(), "the evidence grid");
+  if (cells > grid_.size()) check_fits((cells - grid_.size()) * sizeof(float), "the evidence grid");
   reserve(grid_, cells);
   if (exact()) {
     cuda::launch_fill(grid_.get(), cells, egrid::kUnknown, stream_->get());
