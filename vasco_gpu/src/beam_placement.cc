@@ -8,15 +8,19 @@
 
 namespace vasco {
 
-std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeometry &geo) {
+std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeometry &geo, size_t first,
+                                           size_t last) {
+  last = std::min(last, batch.num_scans());
+  first = std::min(first, last);
   oracle::GridFrame frame;
   frame.size_x = geo.size_x;
   frame.size_y = geo.size_y;
   frame.resolution = geo.resolution;
   frame.theta_offset = geo.theta_offset;
-  std::vector<oracle::ScanStart> starts(batch.num_scans());
-  for (size_t s = 0; s < batch.num_scans(); ++s)
-    starts[s] = oracle::scan_start(frame, batch.x[s], batch.y[s], batch.theta[s]);
+  if (first > 0) oracle::scan_start(frame, batch.x[0], batch.y[0], batch.theta[0]);
+  std::vector<oracle::ScanStart> starts(last - first);
+  for (size_t s = first; s < last; ++s)
+    starts[s - first] = oracle::scan_start(frame, batch.x[s], batch.y[s], batch.theta[s]);
   return starts;
 }
 
@@ -26,7 +30,8 @@ PlacedBeams place_beams(const ScanBatch &batch, const GridGeometry &geo, const M
   first = std::min(first, last);
   const size_t ns = last;
   PlacedBeams out;
-  out.starts = place_scans(batch, geo);
+  out.first_scan = first;
+  out.starts = place_scans(batch, geo, first, last);
 
   std::vector<uint64_t> used_before(ns + 1, 0);
   for (size_t s = first; s < ns; ++s) {
@@ -54,11 +59,11 @@ PlacedBeams place_beams(const ScanBatch &batch, const GridGeometry &geo, const M
         uint64_t o = used_before[s];
         double angle = 0;
         for (int b = 0; b < batch.beams_in(s); ++b) {
-          angles(b, out.starts[s].theta, &angle);
+          angles(b, out.starts[s - first].theta, &angle);
           if (!oracle::beam_used(r[b])) continue;
           PlacedBeam &p = out.beams[o++];
-          oracle::beam_end(out.starts[s], angle, r[b], params.wall_size, geo.resolution, &p.x2, &p.y2);
-          p.scan = static_cast<uint32_t>(s);
+          oracle::beam_end(out.starts[s - first], angle, r[b], params.wall_size, geo.resolution, &p.x2, &p.y2);
+          p.scan = static_cast<uint32_t>(s - first);
           p.range = r[b];
         }
       }

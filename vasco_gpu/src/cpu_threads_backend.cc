@@ -71,6 +71,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <tuple>
 
 #include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/oracle.h"
@@ -308,31 +309,11 @@ class CpuThreadsBackend : public Backend {
       }
     });
 
-    // Distance / odds-factor table.
-    std::vector<Entry> table;
+    // Distance / odds-factor table, kept between calls (a session's inserts).
     const egrid::ModelParams model{params.p_prior, params.p_occ, params.p_emp, params.range_sure,
                                    params.range_max};
-    if (static_cast<int64_t>(T) * T <= kMaxTableEntries) {
-      table.resize(static_cast<size_t>(T) * static_cast<size_t>(T));
-      run_on_threads(std::min(nt, T), [&](int t) {
-        const int per = (T + nt - 1) / nt;
-        for (int i = t * per; i < std::min(T, (t + 1) * per); ++i) {
-          for (int j = 0; j < T; ++j) {
-            Entry &e = table[static_cast<size_t>(i) * T + j];
-            e.d = egrid::cell_distance(i, j, params.resolution);
-            double p;
-            e.stop = egrid::sensor_model(model, e.d, std::numeric_limits<double>::infinity(), &p) ? 0 : 1;
-            e.f_free = e.stop ? 0.0 : egrid::odds_factor(model.prior, p);
-            if (!e.stop) {
-              egrid::sensor_model(model, e.d, -std::numeric_limits<double>::infinity(), &p);
-              e.f_occ = egrid::odds_factor(model.prior, p);
-            } else {
-              e.f_occ = 0.0;
-            }
-          }
-        }
-      });
-    }
+    build_table(params, nt);
+    const std::vector<Entry> &table = table_;
 
     // Stripes of about equal estimated work.
     std::vector<double> col_w(nbk);
@@ -459,6 +440,39 @@ class CpuThreadsBackend : public Backend {
   }
 
  private:
+  // The per-(i, j) distance, stop flag and odds factors, when small enough;
+  // rebuilt only when the parameters change.
+  void build_table(const MapperParams &params, int nt) {
+    const int T = params.table_size();
+    const auto key = std::make_tuple(T, params.resolution, params.p_prior, params.p_occ, params.p_emp,
+                                     params.range_sure, params.range_max);
+    if (table_built_ && key == table_key_) return;
+    table_.clear();
+    table_key_ = key;
+    table_built_ = true;
+    if (static_cast<int64_t>(T) * T > kMaxTableEntries || T <= 0) return;
+    const egrid::ModelParams model{params.p_prior, params.p_occ, params.p_emp, params.range_sure,
+                                   params.range_max};
+    table_.resize(static_cast<size_t>(T) * static_cast<size_t>(T));
+    run_on_threads(std::min(nt, T), [&](int t) {
+      const int per = (T + nt - 1) / nt;
+      for (int i = t * per; i < std::min(T, (t + 1) * per); ++i) {
+        for (int j = 0; j < T; ++j) {
+          Entry &e = table_[static_cast<size_t>(i) * T + j];
+          e.d = egrid::cell_distance(i, j, params.resolution);
+          double p;
+          e.stop = egrid::sensor_model(model, e.d, std::numeric_limits<double>::infinity(), &p) ? 0 : 1;
+          e.f_free = e.stop ? 0.0 : egrid::odds_factor(model.prior, p);
+          e.f_occ = 0.0;
+          if (!e.stop) {
+            egrid::sensor_model(model, e.d, -std::numeric_limits<double>::infinity(), &p);
+            e.f_occ = egrid::odds_factor(model.prior, p);
+          }
+        }
+      }
+    });
+  }
+
   void finish(MapStats *stats, const MapStats &st, CpuThreadsLoad &&load) {
     if (stats != nullptr) *stats = st;
     load_ = std::move(load);
@@ -466,6 +480,9 @@ class CpuThreadsBackend : public Backend {
   }
 
   int threads_;
+  std::vector<Entry> table_;
+  bool table_built_ = false;
+  std::tuple<int, double, double, double, double, double, double> table_key_;
   CpuThreadsLoad load_;
   bool has_load_ = false;
 };

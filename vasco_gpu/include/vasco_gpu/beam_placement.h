@@ -20,22 +20,25 @@ namespace vasco {
 // A used beam (range < 50 m): 16 bytes, the layout the CUDA exact mode uploads.
 struct PlacedBeam {
   int x2, y2;      // end cell (oracle::beam_end)
-  uint32_t scan;   // its scan; the start cell is starts[scan].x1, .y1
+  uint32_t scan;   // its scan, counted from the first placed one: starts[scan]
   float range;
 };
 
 struct PlacedBeams {
-  std::vector<oracle::ScanStart> starts;  // per scan
+  size_t first_scan = 0;                  // starts[i] is scan first_scan + i
+  std::vector<oracle::ScanStart> starts;  // per placed scan
   std::vector<PlacedBeam> beams;          // used beams only, in (scan, beam) order
   uint64_t skipped = 0;                   // beams not used (>= 50 m, NaN, +inf)
 };
 
-// Places every scan, in order (the first call fixes the start pose).
-std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeometry &geo);
+// Places scans [first, last) (all by default); scan 0 of the batch fixes the
+// start pose, as CARMEN's first update call does.
+std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeometry &geo, size_t first = 0,
+                                           size_t last = SIZE_MAX);
 
-// Every scan's start, and the end cells of the used beams of scans [first,
-// last) (all scans by default); threads <= 0: all cores. Throws
-// std::runtime_error past 2^32 used beams.
+// The starts of scans [first, last) (all scans by default) and the end cells
+// of their used beams; threads <= 0: all cores. Throws std::runtime_error
+// past 2^32 used beams.
 PlacedBeams place_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
                         int threads, size_t first = 0, size_t last = SIZE_MAX);
 

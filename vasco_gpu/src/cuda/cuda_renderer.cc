@@ -222,7 +222,7 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
 void CudaRenderer::apply_exact(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
   const auto t_prep = Clock::now();
   const PlacedBeams placed = place_beams(scans, geo_, params_, 0, first, last);
-  const size_t nb = placed.beams.size(), ns = scans.num_scans();
+  const size_t nb = placed.beams.size(), ns = placed.starts.size();  // beams index the placed scans
   st->beams_used += nb;
   st->beams_skipped += placed.skipped;
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // staging buffers are free
