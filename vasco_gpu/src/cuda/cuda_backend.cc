@@ -142,18 +142,7 @@ class CudaBackend : public Backend {
       f.beam_count = batch.beams_in(s);
       h_scans[s] = f;
     }
-    cuda::FloatModel m;
-    m.prior = static_cast<float>(params.p_prior);
-    m.occ = static_cast<float>(params.p_occ);
-    m.emp = static_cast<float>(params.p_emp);
-    m.sure = static_cast<float>(params.range_sure);
-    m.max = static_cast<float>(params.range_max);
-    m.resolution = static_cast<float>(params.resolution);
-    m.wall = static_cast<float>(params.wall_size);
-    m.logodds_prior = static_cast<float>(std::log(params.p_prior / (1 - params.p_prior)));
-    m.table_size = params.table_size();
-    m.size_x = geo.size_x;
-    m.size_y = geo.size_y;
+    const cuda::FloatModel m = float_model_of(params, geo);
     st->prep_s = seconds(t_prep);
 
     const size_t cells = geo.num_cells(), nbeams = batch.num_beams();

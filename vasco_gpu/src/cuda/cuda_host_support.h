@@ -4,6 +4,7 @@
 #define VASCO_GPU_SRC_CUDA_HOST_SUPPORT_H
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -14,6 +15,9 @@
 #include <vector>
 
 #include "cuda_check.h"
+#include "egrid_kernels.h"
+#include "vasco_gpu/grid.h"
+#include "vasco_gpu/params.h"
 
 namespace vasco {
 namespace cuda_host {
@@ -74,6 +78,24 @@ void reserve(cuda::PinnedBuffer<T> &b, size_t n) {
 }
 
 }  // namespace cuda_host
+
+// Float mode's parameters for a grid (the kernels' single-precision copy).
+inline cuda::FloatModel float_model_of(const MapperParams &p, const GridGeometry &geo) {
+  cuda::FloatModel m;
+  m.prior = static_cast<float>(p.p_prior);
+  m.occ = static_cast<float>(p.p_occ);
+  m.emp = static_cast<float>(p.p_emp);
+  m.sure = static_cast<float>(p.range_sure);
+  m.max = static_cast<float>(p.range_max);
+  m.resolution = static_cast<float>(p.resolution);
+  m.wall = static_cast<float>(p.wall_size);
+  m.logodds_prior = static_cast<float>(std::log(p.p_prior / (1 - p.p_prior)));
+  m.table_size = p.table_size();
+  m.size_x = geo.size_x;
+  m.size_y = geo.size_y;
+  return m;
+}
+
 }  // namespace vasco
 
 #endif  // VASCO_GPU_SRC_CUDA_HOST_SUPPORT_H

@@ -75,21 +75,7 @@ cuda::DeviceModel CudaRenderer::exact_model() const {
   return m;
 }
 
-cuda::FloatModel CudaRenderer::float_model() const {
-  cuda::FloatModel m;
-  m.prior = static_cast<float>(params_.p_prior);
-  m.occ = static_cast<float>(params_.p_occ);
-  m.emp = static_cast<float>(params_.p_emp);
-  m.sure = static_cast<float>(params_.range_sure);
-  m.max = static_cast<float>(params_.range_max);
-  m.resolution = static_cast<float>(params_.resolution);
-  m.wall = static_cast<float>(params_.wall_size);
-  m.logodds_prior = static_cast<float>(std::log(params_.p_prior / (1 - params_.p_prior)));
-  m.table_size = params_.table_size();
-  m.size_x = geo_.size_x;
-  m.size_y = geo_.size_y;
-  return m;
-}
+cuda::FloatModel CudaRenderer::float_model() const { return float_model_of(params_, geo_); }
 
 cuda::GridEncoding CudaRenderer::encoding() const {
   cuda::GridEncoding e;
