@@ -4,9 +4,10 @@
 //   golden_check [--golden DIR] [--data DIR] [--paths LIST] [--case SUBSTRING]
 //
 // Exact paths (cpu_double, cpu_threads/1, /2, /7, egrid_c_api, a mapping
-// session fed the scans in pieces (mapper/cpu_threads), and cuda_exact and
-// mapper/cuda in exact mode when a GPU is usable) must give CARMEN's GRIDMAP
-// payload digest.
+// session fed the scans in pieces (mapper/cpu_threads), egrid.h on a
+// cpu_threads session, and cuda_exact, mapper/cuda and egrid_c_api/cuda_exact
+// in exact mode when a GPU is usable) must give CARMEN's GRIDMAP payload
+// digest.
 // Float paths (cpu_float, cuda_float) are reported against the golden map with
 // the DESIGN §4 table; the golden cells are those of cpu_double once its
 // digest has matched CARMEN's. Exit 0 when every exact path matched every
@@ -61,6 +62,8 @@ std::vector<golden::Path> select_paths(const Options &opt, std::vector<golden::P
     exact.cuda_mode = CudaMode::Exact;
     exact_names.push_back("mapper/cuda");
     all.emplace("mapper/cuda", golden::mapper_path("cuda", exact));
+    exact_names.push_back("egrid_c_api/cuda_exact");
+    all.emplace("egrid_c_api/cuda_exact", golden::egrid_path("cuda_exact"));
   }
   std::vector<golden::Path> exact;
   const std::vector<std::string> wanted = opt.paths.empty() ? exact_names : opt.paths;
@@ -165,7 +168,7 @@ int main(int argc, char **argv) {
       std::fprintf(stderr,
                    "usage: golden_check [--golden DIR] [--data DIR] [--paths a,b,...] [--case SUBSTRING]\n"
                    "paths: cpu_double cpu_threads/1 cpu_threads/2 cpu_threads/7 egrid_c_api mapper/cpu_threads "
-                   "cuda_exact mapper/cuda cpu_float cuda_float\n");
+                   "egrid_c_api/cpu_threads cuda_exact mapper/cuda egrid_c_api/cuda_exact cpu_float cuda_float\n");
       return 2;
     }
   }

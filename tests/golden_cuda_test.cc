@@ -28,6 +28,10 @@ TEST_P(GoldenCuda, ExactModeMapperSessionMatchesCarmen) {
   golden::expect_golden(GetParam(), golden::mapper_path("cuda", exact));
 }
 
+TEST_P(GoldenCuda, ExactModeUnderCarmensApiMatchesCarmen) {
+  golden::expect_golden(GetParam(), golden::egrid_path("cuda_exact"));
+}
+
 TEST_P(GoldenCuda, FloatModeWithinTheFloatBounds) {
   golden::expect_float_within_bounds(GetParam(), golden::cuda_path(CudaMode::Float));
 }

@@ -122,6 +122,20 @@ inline FinishedMap run_egrid_c_api(const LogInput &in) {
   return m;
 }
 
+// The egrid.h C API on another backend's mapping session
+// (vasco_egrid_set_backend), the default restored afterwards.
+inline FinishedMap run_egrid_c_api_on(const std::string &backend, const LogInput &in) {
+  vasco_egrid_set_backend(backend.c_str());
+  try {
+    FinishedMap m = run_egrid_c_api(in);
+    vasco_egrid_set_backend("");
+    return m;
+  } catch (...) {
+    vasco_egrid_set_backend("");
+    throw;
+  }
+}
+
 // A way of computing a case's map.
 struct Path {
   std::string name;
@@ -171,10 +185,15 @@ inline Path mapper_path(const std::string &backend, BackendOptions opt = {}) {
               }};
 }
 
+inline Path egrid_path(const std::string &backend) {
+  return Path{"egrid_c_api/" + backend, [backend](const LogInput &in) { return run_egrid_c_api_on(backend, in); }};
+}
+
 // The paths DESIGN §4 promises CARMEN's bytes from, CPU ones first.
 inline std::vector<Path> exact_cpu_paths() {
   return {backend_path("cpu_double", "cpu_double"), cpu_threads_path(1), cpu_threads_path(2),
-          cpu_threads_path(7), Path{"egrid_c_api", run_egrid_c_api}, mapper_path("cpu_threads")};
+          cpu_threads_path(7), Path{"egrid_c_api", run_egrid_c_api}, mapper_path("cpu_threads"),
+          egrid_path("cpu_threads")};
 }
 
 // Re-indexes two finished maps of one grid (same downsample; crops given by

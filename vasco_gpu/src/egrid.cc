@@ -1,16 +1,119 @@
-// CARMEN's evidence-grid C API on top of the oracle (oracle.h, grid.h).
+// CARMEN's evidence-grid C API: on the oracle (oracle.h, grid.h) by default,
+// or on a mapping session of another backend (vasco_egrid_set_backend,
+// VASCO_GPU_BACKEND), g->prob being brought up to date after every update.
 #include "carmen/egrid.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <new>
+#include <string>
 #include <vector>
 
 #include "vasco_gpu/grid.h"
+#include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/oracle.h"
 
 namespace {
+
+// ---------------------------------------------------------------------------
+// Sessions: the mapping session behind a grid that runs on another backend.
+// The C struct is CARMEN's and has no room for one, so they live here, keyed
+// by the grid's address.
+// ---------------------------------------------------------------------------
+struct Session {
+  std::unique_ptr<vasco::Mapper> mapper;
+  bool cleared = false;  // cells the session calls unknown are prior_occ in g->prob
+  bool has_first = false;
+  vasco::Pose first;     // the first update's pose, as given: CARMEN's start pose
+};
+
+std::mutex sessions_mutex;
+std::map<const evidence_grid *, std::unique_ptr<Session>> &sessions() {
+  static std::map<const evidence_grid *, std::unique_ptr<Session>> s;
+  return s;
+}
+
+std::string &chosen_backend() {
+  static std::string b;
+  return b;
+}
+
+bool known_backend(const std::string &b) {
+  return b == "cpu_double" || b == "cpu_threads" || b == "cpu_float" || b == "cuda" || b == "cuda_exact" ||
+         b == "auto";
+}
+
+// The backend for a grid initialised now: the call's, else the environment's.
+std::string backend_for_new_grid() {
+  std::lock_guard<std::mutex> lock(sessions_mutex);
+  if (!chosen_backend().empty()) return chosen_backend();
+  const char *env = std::getenv("VASCO_GPU_BACKEND");
+  return env != nullptr ? env : "cpu_double";
+}
+
+Session *session_of(const evidence_grid *g) {
+  std::lock_guard<std::mutex> lock(sessions_mutex);
+  auto it = sessions().find(g);
+  return it == sessions().end() ? nullptr : it->second.get();
+}
+
+void drop_session(const evidence_grid *g) {
+  std::lock_guard<std::mutex> lock(sessions_mutex);
+  sessions().erase(g);
+}
+
+vasco::MapperParams mapper_params_of(const evidence_grid *g) {
+  vasco::MapperParams p;
+  p.resolution = g->resolution;
+  p.p_prior = g->prior_occ;
+  p.p_occ = g->occ_evidence;
+  p.p_emp = g->emp_evidence;
+  p.range_sure = g->max_sure_range;
+  p.range_max = g->max_range;
+  p.wall_size = g->wall_thickness;
+  p.max_prob = g->max_prob;
+  return p;
+}
+
+// A session for a freshly initialised (or cleared) grid, or none for the
+// oracle. `anchor`: the start pose CARMEN recorded before a clear, given to
+// the session as a scan without beams so that it keeps fixing the frame.
+std::unique_ptr<Session> open_session(const evidence_grid *g, const std::string &backend,
+                                      const vasco::Pose *anchor) {
+  if (backend == "cpu_double") return nullptr;
+  try {
+    vasco::BackendOptions opt;
+    std::string name = backend;
+    if (name == "cuda_exact") {
+      name = "cuda";
+      opt.cuda_mode = vasco::CudaMode::Exact;
+    }
+    vasco::GridGeometry frame;
+    frame.size_x = g->size_x;
+    frame.size_y = g->size_y;
+    frame.resolution = g->resolution;
+    frame.theta_offset = g->theta_offset;
+    auto s = std::make_unique<Session>();
+    s->mapper = std::make_unique<vasco::Mapper>(mapper_params_of(g), frame, name, opt);
+    if (anchor != nullptr) {
+      vasco::ScanBatch start;
+      start.add_scan(anchor->x, anchor->y, anchor->theta, 0, 0, nullptr, 0, 0);
+      s->mapper->insert(start);
+      s->has_first = true;
+      s->first = *anchor;
+    }
+    return s;
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "carmen_mapper_initialize_evidence_grid: backend %s: %s; using the CPU oracle\n",
+                 backend.c_str(), e.what());
+    return nullptr;
+  }
+}
 
 float **alloc_columns(int size_x, int size_y) {
   const size_t n = static_cast<size_t>(size_x) * static_cast<size_t>(size_y);
@@ -65,7 +168,7 @@ vasco::egrid::ModelParams model_of(const evidence_grid *g) {
   return {g->prior_occ, g->occ_evidence, g->emp_evidence, g->max_sure_range, g->max_range};
 }
 
-// The update shared by both entry points.
+// The update shared by both entry points, on the oracle.
 template <class AngleOf>
 void update(evidence_grid *g, double x, double y, double theta, int n, const float *range,
             AngleOf &&angle_of) {
@@ -76,6 +179,37 @@ void update(evidence_grid *g, double x, double y, double theta, int n, const flo
                              g->distance_table_size, g->distance_table, x, y, theta, n, range,
                              angle_of);
   store_frame(g, frame);
+}
+
+// The update on a session: the scan goes to the mapper, then the square of
+// cells it can have changed comes back into g->prob. A cell the walk updates
+// is fewer than table_size steps from the laser's cell, and each step moves
+// each coordinate by at most one, so the square is the laser's cell +-
+// (table_size - 1), clipped to the grid.
+void update_on_session(evidence_grid *g, Session &s, double x, double y, double theta, int n,
+                       const float *range, double step, double first_angle) {
+  vasco::ScanBatch scan;
+  scan.add_scan(x, y, theta, first_angle, step, range, n, 0);
+  s.mapper->insert(scan);
+  if (!s.has_first) s.has_first = true, s.first = {x, y, theta};
+  vasco::oracle::GridFrame frame = frame_of(g);
+  const vasco::oracle::ScanStart start = vasco::oracle::scan_start(frame, x, y, theta);
+  store_frame(g, frame);
+  const int reach = std::max(g->distance_table_size - 1, 0);
+  const long x0 = std::max<long>(0, static_cast<long>(start.x1) - reach);
+  const long x1 = std::min<long>(g->size_x - 1, static_cast<long>(start.x1) + reach);
+  const long y0 = std::max<long>(0, static_cast<long>(start.y1) - reach);
+  const long y1 = std::min<long>(g->size_y - 1, static_cast<long>(start.y1) + reach);
+  if (x0 > x1 || y0 > y1) return;
+  const vasco::GridWindow w{static_cast<int>(x0), static_cast<int>(y0), static_cast<int>(x1 - x0 + 1),
+                            static_cast<int>(y1 - y0 + 1)};
+  const std::vector<float> cells = s.mapper->read(w);
+  const float prior = static_cast<float>(g->prior_occ);
+  for (int i = 0; i < w.width; ++i) {
+    const float *col = cells.data() + static_cast<size_t>(i) * w.height;
+    float *dst = g->prob[w.x0 + i] + w.y0;
+    for (int j = 0; j < w.height; ++j) dst[j] = (s.cleared && col[j] == vasco::egrid::kUnknown) ? prior : col[j];
+  }
 }
 
 }  // namespace
@@ -136,11 +270,29 @@ void carmen_mapper_initialize_evidence_grid(evidence_grid *grid, int size_x, int
       std::free(rows);
     }
   }
+  drop_session(grid);  // a grid re-initialised without a free
+  std::unique_ptr<Session> s = open_session(grid, backend_for_new_grid(), nullptr);
+  if (s) {
+    std::lock_guard<std::mutex> lock(sessions_mutex);
+    sessions()[grid] = std::move(s);
+  }
 }
 
 void carmen_mapper_update_evidence_grid(evidence_grid *grid, double laser_x, double laser_y,
                                         double laser_theta, int num_readings, float *laser_range,
                                         double angular_resolution, double first_beam_angle) {
+  Session *s = session_of(grid);
+  if (s != nullptr && grid->prob != nullptr && num_readings >= 0 && (num_readings == 0 || laser_range != nullptr)) {
+    try {
+      update_on_session(grid, *s, laser_x, laser_y, laser_theta, num_readings, laser_range, angular_resolution,
+                        first_beam_angle);
+      return;
+    } catch (const std::exception &e) {
+      // g->prob holds every update before this one: the oracle carries on.
+      std::fprintf(stderr, "carmen_mapper_update_evidence_grid: %s; continuing on the CPU oracle\n", e.what());
+      drop_session(grid);
+    }
+  }
   update(grid, laser_x, laser_y, laser_theta, num_readings, laser_range,
          vasco::oracle::SteppedAngles{first_beam_angle, angular_resolution});
 }
@@ -150,6 +302,7 @@ void carmen_mapper_update_evidence_grid_general(evidence_grid *grid, double lase
                                                 int num_readings, float *laser_range,
                                                 float *laser_angle) {
   if (laser_angle == nullptr) return;
+  drop_session(grid);  // per-beam angles: the oracle, from now on (g->prob is current)
   update(grid, laser_x, laser_y, laser_theta, num_readings, laser_range,
          [&](int i, double theta, double *angle) { *angle = theta + laser_angle[i]; });
 }
@@ -159,10 +312,27 @@ void carmen_mapper_clear_evidence_grid(evidence_grid *grid) {
   const size_t n = static_cast<size_t>(grid->size_x) * grid->size_y;
   const float prior = static_cast<float>(grid->prior_occ);
   for (size_t i = 0; i < n; ++i) grid->prob[0][i] = prior;
+  // A session starts over; CARMEN keeps the start pose, so the new one is
+  // anchored on it.
+  Session *s = session_of(grid);
+  if (s != nullptr) {
+    const std::string backend = s->mapper->backend_name();
+    const bool has_first = s->has_first;
+    const vasco::Pose first = s->first;
+    drop_session(grid);
+    std::unique_ptr<Session> fresh = open_session(grid, backend == "cuda_float" ? "cuda" : backend,
+                                                  has_first ? &first : nullptr);
+    if (fresh) {
+      fresh->cleared = true;
+      std::lock_guard<std::mutex> lock(sessions_mutex);
+      sessions()[grid] = std::move(fresh);
+    }
+  }
 }
 
 void carmen_mapper_finish_evidence_grid(evidence_grid *grid, int downsample, int border) {
   if (grid == nullptr || grid->prob == nullptr) return;
+  drop_session(grid);  // g->prob is current; the finished grid is CARMEN's alone
   vasco::FinishedMap m;
   try {
     m = vasco::finish_grid(grid->prob[0], grid->size_x, grid->size_y, grid->resolution, downsample,
@@ -186,9 +356,27 @@ void carmen_mapper_finish_evidence_grid(evidence_grid *grid, int downsample, int
 
 void carmen_mapper_free_evidence_grid(evidence_grid *grid) {
   if (grid == nullptr) return;
+  drop_session(grid);
   free_columns(grid->prob);
   grid->prob = nullptr;
   free_table(grid);
+}
+
+int vasco_egrid_set_backend(const char *backend) {
+  if (backend == nullptr || (*backend != '\0' && !known_backend(backend))) return -1;
+  std::lock_guard<std::mutex> lock(sessions_mutex);
+  chosen_backend() = backend;
+  return 0;
+}
+
+const char *vasco_egrid_grid_backend(const evidence_grid *grid) {
+  static const char *const names[] = {"cpu_double", "cpu_threads", "cpu_float", "cuda_float", "cuda_exact"};
+  const Session *s = session_of(grid);
+  if (s == nullptr) return names[0];
+  const std::string b = s->mapper->backend_name();
+  for (const char *n : names)
+    if (b == n) return n;
+  return names[0];
 }
 
 }  // extern "C"

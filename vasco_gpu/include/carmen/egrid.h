@@ -55,6 +55,28 @@ void carmen_mapper_finish_evidence_grid(evidence_grid *grid, int downsample, int
 
 void carmen_mapper_free_evidence_grid(evidence_grid *grid);
 
+/* vasco_gpu extension: the backend that grids initialised from now on run on
+ * ("cpu_double", the default; "cpu_threads"; "cpu_float"; "cuda" (float
+ * mode); "cuda_exact"; "auto"). Without a call (or after one with ""), the
+ * environment variable VASCO_GPU_BACKEND chooses. Returns 0, or -1 for an
+ * unknown name.
+ *
+ * How g->prob stays what CARMEN holds: every update runs on the backend's
+ * mapping session and then copies back into g->prob the square of cells the
+ * scan can have changed (the laser's cell +- max_range / resolution), so
+ * g->prob is current after each call, as in CARMEN; finish runs on g->prob.
+ * cpu_double, cpu_threads and cuda_exact keep CARMEN's bytes. Write cells
+ * only through these functions while a backend other than cpu_double is in
+ * use (the session would not see the writes).
+ * carmen_mapper_update_evidence_grid_general runs on the CPU oracle, and the
+ * grid stays there from then on. A backend that cannot start (no GPU) is
+ * reported on stderr and the grid runs on the oracle. */
+int vasco_egrid_set_backend(const char *backend);
+
+/* vasco_gpu extension: the backend `grid` runs on now ("cpu_double" for the
+ * oracle, "cpu_threads", "cpu_float", "cuda_float", "cuda_exact"). */
+const char *vasco_egrid_grid_backend(const evidence_grid *grid);
+
 #ifdef __cplusplus
 }
 #endif
