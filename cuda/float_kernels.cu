@@ -51,13 +51,16 @@ __device__ __forceinline__ void add_evidence(const FloatModel &m, int cx, int cy
 }
 
 __global__ void __launch_bounds__(kWarpsPerBlock * 32)
-    float_map_kernel(FloatModel m, const FloatScan *scans, int num_scans, const float *ranges,
+    float_map_kernel(FloatModel m, const FloatScan *scans, int num_scans, int parts, const float *ranges,
                      float *logodds, unsigned long long *counters) {
   const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
   unsigned used = 0, skipped = 0, updates = 0;
-  for (int s = blockIdx.x; s < num_scans; s += gridDim.x) {
-    const FloatScan sc = scans[s];
-    for (int b = warp; b < sc.beam_count; b += kWarpsPerBlock) {
+  // `parts` blocks share a scan (several when a few scans are inserted, so
+  // that one scan still fills the GPU), each taking every parts-th warp's beams.
+  for (int sp = blockIdx.x; sp < num_scans * parts; sp += gridDim.x) {
+    const FloatScan sc = scans[sp / parts];
+    const int part = sp % parts;
+    for (int b = part * kWarpsPerBlock + warp; b < sc.beam_count; b += kWarpsPerBlock * parts) {
       const float r = ranges[sc.beam_begin + b];
       if (!(r < 50.0f)) {
         skipped += lane == 0;
@@ -168,8 +171,11 @@ void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans
                       const float *ranges, float *logodds, unsigned long long *counters,
                       cudaStream_t stream) {
   if (num_scans <= 0) return;
-  float_map_kernel<<<num_scans, kWarpsPerBlock * 32, 0, stream>>>(m, scans, num_scans, ranges,
-                                                                   logodds, counters);
+  // A full render has thousands of scans: a block each. An insert of a few
+  // scans splits each over up to 48 blocks (a warp per beam either way).
+  const int parts = num_scans >= 1024 ? 1 : std::min(48, (1024 + num_scans - 1) / num_scans);
+  float_map_kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, scans, num_scans, parts, ranges,
+                                                                           logodds, counters);
   VG_CUDA_CHECK_LAUNCH();
 }
 

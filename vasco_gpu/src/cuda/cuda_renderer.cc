@@ -39,6 +39,9 @@ static_assert(sizeof(PlacedBeam) == sizeof(cuda::ExactBeam), "PlacedBeam is uplo
 CudaRenderer::CudaRenderer(const BackendOptions &options) : options_(options) {
   VG_CUDA_CHECK(cudaSetDevice(options.cuda_device));
   stream_ = std::make_unique<cuda::Stream>();
+  e_start_ = std::make_unique<cuda::Event>();
+  e_uploaded_ = std::make_unique<cuda::Event>();
+  e_mapped_ = std::make_unique<cuda::Event>();
 }
 
 CudaRenderer::~CudaRenderer() = default;
@@ -147,8 +150,7 @@ void CudaRenderer::upload_ranges(const ScanBatch &scans, size_t last) {
     ranges_ = std::move(bigger);
   }
   const size_t n = need - stored_beams_;
-  VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // the staging buffer is free
-  reserve(staging_ranges_, n);
+  reserve(staging_ranges_, n);  // free: every call ends with the stream idle
   std::memcpy(staging_ranges_.get(), scans.range.data() + stored_beams_, n * sizeof(float));
   VG_CUDA_CHECK(cudaMemcpyAsync(ranges_.get() + stored_beams_, staging_ranges_.get(), n * sizeof(float),
                                 cudaMemcpyHostToDevice, stream_->get()));
@@ -185,7 +187,7 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
   reserve(scan_records_, n);
   reserve(counters_, 3);
   st->prep_s += seconds_since(t_prep);
-  cuda::Event e0, e_up, e_map;
+  cuda::Event &e0 = *e_start_, &e_up = *e_uploaded_, &e_map = *e_mapped_;
   e0.record(stream_->get());
   VG_CUDA_CHECK(cudaMemcpyAsync(scan_records_.get(), staging_scans_.get(), n * sizeof(cuda::FloatScan),
                                 cudaMemcpyHostToDevice, stream_->get()));
@@ -232,7 +234,7 @@ void CudaRenderer::apply_exact(const ScanBatch &scans, size_t first, size_t last
   reserve(order_tmp_, std::max<size_t>(cuda::exact_order_temp_bytes(tiles), 1));
   reserve(updates_, 1);
 
-  cuda::Event e0, e_up, e_map;
+  cuda::Event &e0 = *e_start_, &e_up = *e_uploaded_, &e_map = *e_mapped_;
   cudaStream_t s = stream_->get();
   e0.record(s);
   VG_CUDA_CHECK(cudaMemcpyAsync(beams_.get(), staging_beams_.get(), nb * sizeof(cuda::ExactBeam),

@@ -42,6 +42,7 @@ class CudaRenderer : public Renderer {
 
   BackendOptions options_;
   std::unique_ptr<cuda::Stream> stream_;
+  std::unique_ptr<cuda::Event> e_start_, e_uploaded_, e_mapped_;  // phase times of an apply
   GridGeometry geo_;
   MapperParams params_;
   cuda::DeviceBuffer<float> grid_;  // probabilities (exact) or log-odds sums (float)
