@@ -159,150 +159,160 @@ struct Options {
   std::map<std::string, std::string> overrides;  // --vasco_KEY VALUE
 };
 
-int run(const Options &opt) {
-  const auto t_start = Clock::now();
-  std::vector<OutputKind> kinds;
-  for (const auto &out : opt.outputs) {
-    OutputKind k;
-    output_kind(out, &k);
-    kinds.push_back(k);
-  }
+// What one run produced, for the summary and --json.
+struct RunResult {
+  vasco::LogInput input;
+  vasco::MapStats stats;
+  vasco::FinishedMap map;
+  carmen::GlobalOffset origin;
+  std::string backend;
+  uint64_t known = 0;
+  double parse_s = 0, map_total_s = 0, finish_s = 0, write_s = 0, total_s = 0;
+};
 
-  for (const auto &out : opt.outputs) check_writable(out);
-
-  vasco::BackendOptions bopt;
-  bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
-  bopt.threads = opt.threads;
-
-  // CUDA initialisation costs a few tenths of a second: start it now, on
-  // another thread, while the log is parsed.
-  std::future<bool> gpu_ready;
+// CUDA initialisation costs a few tenths of a second: started on another
+// thread while the log is parsed.
+std::future<bool> start_cuda(const Options &opt, const vasco::BackendOptions &bopt) {
+  std::future<bool> ready;
 #if defined(VASCO_HAVE_CUDA)
   if (opt.backend == "cuda" || opt.backend == "auto") {
-    gpu_ready = std::async(std::launch::async, [dev = bopt.cuda_device] {
+    ready = std::async(std::launch::async, [dev = bopt.cuda_device] {
       std::string why;
       return vasco::cuda_usable(dev, &why);
     });
   }
+#else
+  (void)opt;
+  (void)bopt;
 #endif
+  return ready;
+}
 
-  // Parameters (command line > ini > the log's PARAM lines > defaults), the
-  // scans and the grid.
-  const auto t_parse = Clock::now();
-  vasco::LogInputOptions in_opt;
-  in_opt.log = opt.log;
-  in_opt.param_file = opt.param_file;
-  in_opt.robot = opt.robot;
-  in_opt.overrides = opt.overrides;
-  in_opt.lenient = opt.lenient;
-  vasco::LogInput input;
-  {
-    ProgressBar bar("parse", !opt.quiet && isatty(STDERR_FILENO));
-    in_opt.progress = [&](uint64_t done, uint64_t total) { bar.update(done, total); };
-    input = vasco::load_log_input(in_opt);
-  }
-  const double parse_s = seconds_since(t_parse);
-  std::vector<std::string> &warnings = input.warnings;
-  const vasco::MapperParams &mp = input.params;
-  const vasco::ScanBatch &batch = input.batch;
-  const vasco::LogLoadStats &load = input.load;
-  const vasco::GridGeometry &geo = input.geo;
-  if (gpu_ready.valid()) gpu_ready.wait();
-  // A mapping session in the PROTOCOL frame, fed every scan at once.
-  vasco::Mapper mapper(mp, opt.backend, bopt);
+// Parameters (command line > ini > the log's PARAM lines > defaults), the
+// scans and the grid, with a progress bar on a terminal.
+vasco::LogInput read_input(const Options &opt) {
+  vasco::LogInputOptions in;
+  in.log = opt.log;
+  in.param_file = opt.param_file;
+  in.robot = opt.robot;
+  in.overrides = opt.overrides;
+  in.lenient = opt.lenient;
+  ProgressBar bar("parse", !opt.quiet && isatty(STDERR_FILENO));
+  in.progress = [&](uint64_t done, uint64_t total) { bar.update(done, total); };
+  return vasco::load_log_input(in);
+}
 
-  // Map.
-  const auto t_map = Clock::now();
-  mapper.insert(batch);
-  const vasco::MapStats ms = mapper.last_stats();
-  const double map_total_s = seconds_since(t_map);
-
-  // Finish.
-  const auto t_finish = Clock::now();
-  const vasco::FinishedMap fin = mapper.finish();
-  const double finish_s = seconds_since(t_finish);
-  uint64_t known = 0;
-  for (float v : fin.cells) known += v != -1.0f;
-  if (known == 0) warnings.push_back(opt.log + ": no cell was updated: the map is all unknown");
-
-  // Write.
-  const auto t_write = Clock::now();
+// Every output, each atomically (temporary file + rename); should a later
+// one fail, those this run already wrote are removed too, so a failure leaves
+// no map behind.
+void write_outputs(const Options &opt, const std::vector<OutputKind> &kinds, const RunResult &r) {
   carmen::GridMap grid;
-  grid.size_x = fin.size_x;
-  grid.size_y = fin.size_y;
-  grid.resolution = fin.resolution;
-  grid.cells = fin.cells;
-  carmen::GlobalOffset origin;
-  origin.x = geo.world_x(static_cast<double>(fin.min_x) * fin.downsample);
-  origin.y = geo.world_y(static_cast<double>(fin.min_y) * fin.downsample);
-  origin.theta = 0;  // theta_offset is the first scan's heading, so the grid axes are the world axes
-  // Each writer is atomic (temporary file + rename); should a later output
-  // fail, the ones this run already wrote are removed too, so a failure
-  // leaves no map behind.
+  grid.size_x = r.map.size_x;
+  grid.size_y = r.map.size_y;
+  grid.resolution = r.map.resolution;
+  grid.cells = r.map.cells;
   std::vector<std::string> written;
   try {
     for (size_t i = 0; i < opt.outputs.size(); ++i) {
-      const std::string &out = opt.outputs[i];
-      write_output(out, kinds[i], grid, origin, opt.log, mapper.backend_name());
-      written.push_back(out);
-      if (kinds[i] == OutputKind::Pgm) written.push_back(yaml_beside(out));
+      write_output(opt.outputs[i], kinds[i], grid, r.origin, opt.log, r.backend);
+      written.push_back(opt.outputs[i]);
+      if (kinds[i] == OutputKind::Pgm) written.push_back(yaml_beside(opt.outputs[i]));
     }
   } catch (...) {
     for (const auto &w : written) std::remove(w.c_str());
     throw;
   }
-  const double write_s = seconds_since(t_write);
-  const double total_s = seconds_since(t_start);
+}
 
-  for (const auto &w : warnings) std::fprintf(stderr, "log2map: warning: %s\n", w.c_str());
-  const auto &ls = load.log;
-  const uint64_t odd_ranges = ls.nan_ranges + ls.inf_ranges + ls.negative_ranges;
-  if (!opt.quiet) {
-    std::fprintf(stderr,
-                 "log2map: %s: %zu scans (of %ld laser messages), %llu beams used, %llu skipped "
-                 "(>= 50 m, NaN or inf), %llu cell updates\n",
-                 opt.log.c_str(), batch.num_scans(), load.laser_messages,
-                 (unsigned long long)ms.beams_used, (unsigned long long)ms.beams_skipped,
-                 (unsigned long long)ms.cell_updates);
-    if (odd_ranges)
-      std::fprintf(stderr, "log2map: odd ranges kept as data: %llu NaN, %llu inf, %llu negative\n",
-                   (unsigned long long)ls.nan_ranges, (unsigned long long)ls.inf_ranges,
-                   (unsigned long long)ls.negative_ranges);
-    if (ls.total_bad_lines())
-      std::fprintf(stderr, "log2map: lenient: skipped %llu bad lines\n%s",
-                   (unsigned long long)ls.total_bad_lines(), ls.summary().c_str());
-    std::fprintf(stderr,
-                 "log2map: grid %d x %d at %g m -> map %d x %d at %g m (%llu known cells)\n",
-                 geo.size_x, geo.size_y, geo.resolution, fin.size_x, fin.size_y, fin.resolution,
-                 (unsigned long long)known);
-    std::fprintf(stderr,
-                 "log2map: backend %s; parse %.3f s, prep %.3f s, upload %.3f s, map %.3f s, "
-                 "download %.3f s, finish %.3f s, write %.3f s, total %.3f s\n",
-                 mapper.backend_name().c_str(), parse_s, ms.prep_s, ms.upload_s, ms.map_s, ms.download_s,
-                 finish_s, write_s, total_s);
-  }
-  if (opt.json) {
-    std::ostringstream j;
-    j.precision(9);
-    j << "{\"log\":\"" << json_escape(opt.log) << "\",\"backend\":\"" << mapper.backend_name()
-      << "\",\"scans\":" << batch.num_scans() << ",\"laser_messages\":" << load.laser_messages
-      << ",\"beams_used\":" << ms.beams_used << ",\"beams_skipped\":" << ms.beams_skipped
-      << ",\"cell_updates\":" << ms.cell_updates << ",\"nan_ranges\":" << ls.nan_ranges
-      << ",\"inf_ranges\":" << ls.inf_ranges << ",\"negative_ranges\":" << ls.negative_ranges
-      << ",\"bad_lines\":" << ls.total_bad_lines() << ",\"grid\":[" << geo.size_x << ","
-      << geo.size_y << "],\"map\":[" << fin.size_x << "," << fin.size_y
-      << "],\"map_resolution\":" << fin.resolution << ",\"known_cells\":" << known
-      << ",\"origin\":[" << origin.x << "," << origin.y << "]"
-      << ",\"seconds\":{\"parse\":" << parse_s << ",\"prep\":" << ms.prep_s
-      << ",\"upload\":" << ms.upload_s
-      << ",\"map\":" << ms.map_s << ",\"map_total\":" << map_total_s
-      << ",\"download\":" << ms.download_s << ",\"finish\":" << finish_s
-      << ",\"write\":" << write_s << ",\"total\":" << total_s << "},\"outputs\":[";
-    for (size_t i = 0; i < opt.outputs.size(); ++i)
-      j << (i ? "," : "") << "\"" << json_escape(opt.outputs[i]) << "\"";
-    j << "]}\n";
-    std::fputs(j.str().c_str(), stdout);
-  }
+void print_summary(const Options &opt, const RunResult &r) {
+  const auto &ls = r.input.load.log;
+  const vasco::MapStats &ms = r.stats;
+  const vasco::GridGeometry &geo = r.input.geo;
+  std::fprintf(stderr,
+               "log2map: %s: %zu scans (of %ld laser messages), %llu beams used, %llu skipped "
+               "(>= 50 m, NaN or inf), %llu cell updates\n",
+               opt.log.c_str(), r.input.batch.num_scans(), r.input.load.laser_messages,
+               (unsigned long long)ms.beams_used, (unsigned long long)ms.beams_skipped,
+               (unsigned long long)ms.cell_updates);
+  if (ls.nan_ranges + ls.inf_ranges + ls.negative_ranges)
+    std::fprintf(stderr, "log2map: odd ranges kept as data: %llu NaN, %llu inf, %llu negative\n",
+                 (unsigned long long)ls.nan_ranges, (unsigned long long)ls.inf_ranges,
+                 (unsigned long long)ls.negative_ranges);
+  if (ls.total_bad_lines())
+    std::fprintf(stderr, "log2map: lenient: skipped %llu bad lines\n%s", (unsigned long long)ls.total_bad_lines(),
+                 ls.summary().c_str());
+  std::fprintf(stderr, "log2map: grid %d x %d at %g m -> map %d x %d at %g m (%llu known cells)\n", geo.size_x,
+               geo.size_y, geo.resolution, r.map.size_x, r.map.size_y, r.map.resolution,
+               (unsigned long long)r.known);
+  std::fprintf(stderr,
+               "log2map: backend %s; parse %.3f s, prep %.3f s, upload %.3f s, map %.3f s, "
+               "download %.3f s, finish %.3f s, write %.3f s, total %.3f s\n",
+               r.backend.c_str(), r.parse_s, ms.prep_s, ms.upload_s, ms.map_s, ms.download_s, r.finish_s,
+               r.write_s, r.total_s);
+}
+
+void print_json(const Options &opt, const RunResult &r) {
+  const auto &ls = r.input.load.log;
+  const vasco::MapStats &ms = r.stats;
+  const vasco::GridGeometry &geo = r.input.geo;
+  std::ostringstream j;
+  j.precision(9);
+  j << "{\"log\":\"" << json_escape(opt.log) << "\",\"backend\":\"" << r.backend
+    << "\",\"scans\":" << r.input.batch.num_scans() << ",\"laser_messages\":" << r.input.load.laser_messages
+    << ",\"beams_used\":" << ms.beams_used << ",\"beams_skipped\":" << ms.beams_skipped
+    << ",\"cell_updates\":" << ms.cell_updates << ",\"nan_ranges\":" << ls.nan_ranges
+    << ",\"inf_ranges\":" << ls.inf_ranges << ",\"negative_ranges\":" << ls.negative_ranges
+    << ",\"bad_lines\":" << ls.total_bad_lines() << ",\"grid\":[" << geo.size_x << "," << geo.size_y
+    << "],\"map\":[" << r.map.size_x << "," << r.map.size_y << "],\"map_resolution\":" << r.map.resolution
+    << ",\"known_cells\":" << r.known << ",\"origin\":[" << r.origin.x << "," << r.origin.y << "]"
+    << ",\"seconds\":{\"parse\":" << r.parse_s << ",\"prep\":" << ms.prep_s << ",\"upload\":" << ms.upload_s
+    << ",\"map\":" << ms.map_s << ",\"map_total\":" << r.map_total_s << ",\"download\":" << ms.download_s
+    << ",\"finish\":" << r.finish_s << ",\"write\":" << r.write_s << ",\"total\":" << r.total_s
+    << "},\"outputs\":[";
+  for (size_t i = 0; i < opt.outputs.size(); ++i) j << (i ? "," : "") << "\"" << json_escape(opt.outputs[i]) << "\"";
+  j << "]}\n";
+  std::fputs(j.str().c_str(), stdout);
+}
+
+int run(const Options &opt) {
+  const auto t_start = Clock::now();
+  std::vector<OutputKind> kinds(opt.outputs.size());
+  for (size_t i = 0; i < opt.outputs.size(); ++i) output_kind(opt.outputs[i], &kinds[i]);
+  for (const auto &out : opt.outputs) check_writable(out);
+  vasco::BackendOptions bopt;
+  bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
+  bopt.threads = opt.threads;
+  std::future<bool> gpu_ready = start_cuda(opt, bopt);
+
+  RunResult r;
+  auto t = Clock::now();
+  r.input = read_input(opt);
+  r.parse_s = seconds_since(t);
+  if (gpu_ready.valid()) gpu_ready.wait();
+  // A mapping session in the PROTOCOL frame, fed every scan at once.
+  vasco::Mapper mapper(r.input.params, opt.backend, bopt);
+  r.backend = mapper.backend_name();
+  t = Clock::now();
+  mapper.insert(r.input.batch);
+  r.stats = mapper.last_stats();
+  r.map_total_s = seconds_since(t);
+  t = Clock::now();
+  r.map = mapper.finish();
+  r.finish_s = seconds_since(t);
+  for (float v : r.map.cells) r.known += v != -1.0f;
+  if (r.known == 0) r.input.warnings.push_back(opt.log + ": no cell was updated: the map is all unknown");
+  const vasco::GridGeometry &geo = r.input.geo;
+  r.origin.x = geo.world_x(static_cast<double>(r.map.min_x) * r.map.downsample);
+  r.origin.y = geo.world_y(static_cast<double>(r.map.min_y) * r.map.downsample);
+  r.origin.theta = 0;  // theta_offset is the first scan's heading, so the grid axes are the world axes
+  t = Clock::now();
+  write_outputs(opt, kinds, r);
+  r.write_s = seconds_since(t);
+  r.total_s = seconds_since(t_start);
+
+  for (const auto &w : r.input.warnings) std::fprintf(stderr, "log2map: warning: %s\n", w.c_str());
+  if (!opt.quiet) print_summary(opt, r);
+  if (opt.json) print_json(opt, r);
   return 0;
 }
 
