@@ -247,6 +247,163 @@ uint64_t walk_degenerate(const Context &c, const Beam &b, const oracle::ScanStar
   return updates;
 }
 
+// The work per column, in buckets of columns (at most kMaxBuckets).
+struct ColumnWork {
+  int bucket_w = 1, buckets = 0;
+  std::vector<double> weight;  // per bucket
+};
+
+// Fills `beams` from the placed ones (x ranges, degenerate flags), in
+// parallel over beams, and estimates the work per column on the side (a
+// difference array per thread).
+ColumnWork place_all(const PlacedBeams &placed, int size_x, int size_y, int T, int nt, Beam *beams) {
+  const uint64_t nb = placed.beams.size();
+  ColumnWork cw;
+  cw.bucket_w = static_cast<int>((static_cast<int64_t>(size_x) + kMaxBuckets - 1) / kMaxBuckets);
+  cw.buckets = static_cast<int>((static_cast<int64_t>(size_x) + cw.bucket_w - 1) / cw.bucket_w);
+  std::vector<std::vector<double>> diff(nt);
+  run_on_threads(nt, [&](int t) {
+    std::vector<double> &h = diff[t];
+    h.assign(static_cast<size_t>(cw.buckets) + 1, 0.0);
+    const uint64_t per = (nb + nt - 1) / nt;
+    for (uint64_t o = t * per; o < std::min<uint64_t>(nb, (t + 1) * per); ++o) {
+      const PlacedBeam &p = placed.beams[o];
+      Beam &b = beams[o];
+      b.x2 = p.x2;
+      b.y2 = p.y2;
+      b.range = p.range;
+      b.scan = p.scan;
+      const double w = place_beam(b, placed.starts[p.scan], size_x, size_y, T) * cw.bucket_w;
+      if (b.x_lo <= b.x_hi && w > 0) {
+        h[b.x_lo / cw.bucket_w] += w;
+        h[b.x_hi / cw.bucket_w + 1] -= w;
+      }
+    }
+  });
+  cw.weight.assign(cw.buckets, 0.0);
+  double run = 0;
+  for (int k = 0; k < cw.buckets; ++k) {
+    for (int t = 0; t < nt; ++t) run += diff[t][k];
+    cw.weight[k] = std::max(0.0, run);
+  }
+  return cw;
+}
+
+// Stripes of whole columns: stripe s is [begin[s], begin[s + 1]).
+struct Stripes {
+  std::vector<int> begin;
+  std::vector<double> weight;
+  int count() const { return static_cast<int>(begin.size()) - 1; }
+  int of(int x) const { return static_cast<int>(std::upper_bound(begin.begin(), begin.end(), x) - begin.begin()) - 1; }
+};
+
+// About nt * kStripesPerThread stripes of about equal estimated work.
+Stripes cut_stripes(ColumnWork cw, int size_x, int nt) {
+  double total = 0;
+  for (double w : cw.weight) total += w;
+  if (!(total > 0)) {
+    std::fill(cw.weight.begin(), cw.weight.end(), 1.0);
+    total = cw.buckets;
+  }
+  const int want = nt == 1 ? 1 : std::min(cw.buckets, nt * kStripesPerThread);
+  Stripes st;
+  st.begin = {0};
+  st.weight = {0};
+  double cum = 0;
+  for (int k = 0; k < cw.buckets; ++k) {
+    cum += cw.weight[k];
+    st.weight.back() += cw.weight[k];
+    const int edge = std::min(size_x, (k + 1) * cw.bucket_w);
+    if (static_cast<int>(st.begin.size()) < want && edge < size_x &&
+        cum >= total * static_cast<double>(st.begin.size()) / want) {
+      st.begin.push_back(edge);
+      st.weight.push_back(0);
+    }
+  }
+  st.begin.push_back(size_x);
+  return st;
+}
+
+// Per stripe, the beams whose columns meet it, in (scan, beam) order:
+// counted per (chunk, stripe), then filled, chunks being contiguous ranges
+// of beams, so that each stripe's list keeps the beams' order.
+struct Bins {
+  std::vector<uint64_t> begin;  // stripe s: beams[begin[s] .. begin[s + 1])
+  std::unique_ptr<uint32_t[]> beams;
+};
+
+Bins bin_beams(const Beam *beams, uint64_t nb, const Stripes &stripes, int nt) {
+  const int nst = stripes.count(), nchunks = nt;
+  std::vector<uint64_t> counts(static_cast<size_t>(nchunks) * nst, 0);
+  auto for_each_in_chunk = [&](int c, auto &&visit) {
+    for (uint64_t i = nb * static_cast<uint64_t>(c) / nchunks; i < nb * static_cast<uint64_t>(c + 1) / nchunks; ++i) {
+      const Beam &b = beams[i];
+      if (b.x_lo > b.x_hi) continue;
+      const int s_hi = stripes.of(b.x_hi);
+      for (int s = stripes.of(b.x_lo); s <= s_hi; ++s) visit(i, s);
+    }
+  };
+  run_on_threads(nchunks, [&](int c) {
+    uint64_t *cnt = &counts[static_cast<size_t>(c) * nst];
+    for_each_in_chunk(c, [&](uint64_t, int s) { ++cnt[s]; });
+  });
+  Bins bins;
+  bins.begin.assign(static_cast<size_t>(nst) + 1, 0);
+  std::vector<uint64_t> offsets(counts.size());
+  uint64_t o = 0;
+  for (int s = 0; s < nst; ++s) {
+    bins.begin[s] = o;
+    for (int c = 0; c < nchunks; ++c) {
+      offsets[static_cast<size_t>(c) * nst + s] = o;
+      o += counts[static_cast<size_t>(c) * nst + s];
+    }
+  }
+  bins.begin[nst] = o;
+  bins.beams.reset(new uint32_t[std::max<uint64_t>(o, 1)]);
+  run_on_threads(nchunks, [&](int c) {
+    uint64_t *off = &offsets[static_cast<size_t>(c) * nst];
+    for_each_in_chunk(c, [&](uint64_t i, int s) { bins.beams[off[s]++] = static_cast<uint32_t>(i); });
+  });
+  return bins;
+}
+
+// Walks the stripes, heaviest first, handed out dynamically; fills `load`.
+void run_stripes(const Context &ctx, const Beam *beams, const std::vector<oracle::ScanStart> &starts,
+                 const Stripes &stripes, const Bins &bins, int nt, CpuThreadsLoad *load) {
+  const int nst = stripes.count();
+  std::vector<int> order(nst);
+  for (int s = 0; s < nst; ++s) order[s] = s;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return stripes.weight[a] > stripes.weight[b]; });
+  load->stripe_begin = stripes.begin;
+  load->stripe_beams.assign(nst, 0);
+  load->stripe_updates.assign(nst, 0);
+  load->stripe_thread.assign(nst, -1);
+  std::atomic<int> next_stripe{0};
+  run_on_threads(std::min(nt, nst), [&](int t) {
+    const auto t_busy = Clock::now();
+    uint64_t mine = 0;
+    for (;;) {
+      const int q = next_stripe.fetch_add(1);
+      if (q >= nst) break;
+      const int s = order[q];
+      const int xa = stripes.begin[s], xb = stripes.begin[s + 1];
+      uint64_t n = 0;
+      for (uint64_t e = bins.begin[s]; e < bins.begin[s + 1]; ++e) {
+        const Beam &b = beams[bins.beams[e]];
+        const oracle::ScanStart &start = starts[b.scan];
+        n += b.degenerate ? walk_degenerate(ctx, b, start, xa, xb) : walk_closed(ctx, b, start, xa, xb);
+      }
+      load->stripe_beams[s] = bins.begin[s + 1] - bins.begin[s];
+      load->stripe_updates[s] = n;
+      load->stripe_thread[s] = t;
+      mine += n;
+    }
+    load->thread_updates[t] = mine;
+    load->thread_busy_s[t] = seconds_since(t_busy);
+  });
+}
+
 class CpuThreadsBackend : public Backend {
  public:
   explicit CpuThreadsBackend(int threads)
@@ -284,155 +441,19 @@ class CpuThreadsBackend : public Backend {
       return;
     }
 
-    // 2. x ranges, in parallel over beams; a per-column work histogram
-    //    (difference array over buckets of columns) on the side.
+    // 2. Column ranges and the work estimate; 3. stripes and their beams.
     std::unique_ptr<Beam[]> beams(new Beam[nb]);
-    const int bucket_w = static_cast<int>((static_cast<int64_t>(size_x) + kMaxBuckets - 1) / kMaxBuckets);
-    const int nbk = static_cast<int>((static_cast<int64_t>(size_x) + bucket_w - 1) / bucket_w);
-    std::vector<std::vector<double>> diff(nt);
-    run_on_threads(nt, [&](int t) {
-      std::vector<double> &h = diff[t];
-      h.assign(static_cast<size_t>(nbk) + 1, 0.0);
-      const uint64_t per = (nb + nt - 1) / nt;
-      for (uint64_t o = t * per; o < std::min<uint64_t>(nb, (t + 1) * per); ++o) {
-        const PlacedBeam &p = placed.beams[o];
-        Beam &b = beams[o];
-        b.x2 = p.x2;
-        b.y2 = p.y2;
-        b.range = p.range;
-        b.scan = p.scan;
-        const double w = place_beam(b, starts[p.scan], size_x, size_y, T) * bucket_w;
-        if (b.x_lo <= b.x_hi && w > 0) {
-          h[b.x_lo / bucket_w] += w;
-          h[b.x_hi / bucket_w + 1] -= w;
-        }
-      }
-    });
-
-    // Distance / odds-factor table, kept between calls (a session's inserts).
-    const egrid::ModelParams model{params.p_prior, params.p_occ, params.p_emp, params.range_sure,
-                                   params.range_max};
-    build_table(params, nt);
-    const std::vector<Entry> &table = table_;
-
-    // Stripes of about equal estimated work.
-    std::vector<double> col_w(nbk);
-    {
-      double run = 0;
-      for (int k = 0; k < nbk; ++k) {
-        for (int t = 0; t < nt; ++t) run += diff[t][k];
-        col_w[k] = std::max(0.0, run);
-      }
-    }
-    double total = 0;
-    for (double w : col_w) total += w;
-    if (!(total > 0)) {
-      std::fill(col_w.begin(), col_w.end(), 1.0);
-      total = nbk;
-    }
-    const int want = nt == 1 ? 1 : std::min(nbk, nt * kStripesPerThread);
-    std::vector<int> sb = {0};
-    std::vector<double> stripe_w = {0};
-    {
-      double cum = 0;
-      for (int k = 0; k < nbk; ++k) {
-        cum += col_w[k];
-        stripe_w.back() += col_w[k];
-        const int edge = std::min(size_x, (k + 1) * bucket_w);
-        if (static_cast<int>(sb.size()) < want && edge < size_x &&
-            cum >= total * static_cast<double>(sb.size()) / want) {
-          sb.push_back(edge);
-          stripe_w.push_back(0);
-        }
-      }
-      sb.push_back(size_x);
-    }
-    const int nst = static_cast<int>(sb.size()) - 1;
-    auto stripe_of = [&](int x) {
-      return static_cast<int>(std::upper_bound(sb.begin(), sb.end(), x) - sb.begin()) - 1;
-    };
-
-    // 3. Per stripe, its beams in (scan, beam) order: count per (chunk,
-    //    stripe), then fill, chunks being contiguous ranges of beams.
-    const int nchunks = nt;
-    std::vector<uint64_t> counts(static_cast<size_t>(nchunks) * nst, 0);
-    auto chunk_range = [&](int c, uint64_t *b0, uint64_t *b1) {
-      *b0 = nb * static_cast<uint64_t>(c) / nchunks;
-      *b1 = nb * static_cast<uint64_t>(c + 1) / nchunks;
-    };
-    run_on_threads(nchunks, [&](int c) {
-      uint64_t b0, b1;
-      chunk_range(c, &b0, &b1);
-      uint64_t *cnt = &counts[static_cast<size_t>(c) * nst];
-      for (uint64_t i = b0; i < b1; ++i) {
-        const Beam &b = beams[i];
-        if (b.x_lo > b.x_hi) continue;
-        const int s_hi = stripe_of(b.x_hi);
-        for (int s = stripe_of(b.x_lo); s <= s_hi; ++s) ++cnt[s];
-      }
-    });
-    std::vector<uint64_t> bin_begin(static_cast<size_t>(nst) + 1, 0);
-    std::vector<uint64_t> offsets(counts.size());
-    {
-      uint64_t o = 0;
-      for (int s = 0; s < nst; ++s) {
-        bin_begin[s] = o;
-        for (int c = 0; c < nchunks; ++c) {
-          offsets[static_cast<size_t>(c) * nst + s] = o;
-          o += counts[static_cast<size_t>(c) * nst + s];
-        }
-      }
-      bin_begin[nst] = o;
-    }
-    std::unique_ptr<uint32_t[]> bins(new uint32_t[std::max<uint64_t>(bin_begin[nst], 1)]);
-    run_on_threads(nchunks, [&](int c) {
-      uint64_t b0, b1;
-      chunk_range(c, &b0, &b1);
-      uint64_t *off = &offsets[static_cast<size_t>(c) * nst];
-      for (uint64_t i = b0; i < b1; ++i) {
-        const Beam &b = beams[i];
-        if (b.x_lo > b.x_hi) continue;
-        const int s_hi = stripe_of(b.x_hi);
-        for (int s = stripe_of(b.x_lo); s <= s_hi; ++s) bins[off[s]++] = static_cast<uint32_t>(i);
-      }
-    });
+    const Stripes stripes = cut_stripes(place_all(placed, size_x, size_y, T, nt, beams.get()), size_x, nt);
+    build_table(params, nt);  // kept between calls (a session's inserts)
+    const Bins bins = bin_beams(beams.get(), nb, stripes, nt);
     st.prep_s = seconds_since(t0);
 
-    // 4. The stripes, heaviest first, handed out dynamically.
+    // 4. The stripes.
     const auto t_stripes = Clock::now();
-    std::vector<int> order(nst);
-    for (int s = 0; s < nst; ++s) order[s] = s;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](int a, int b) { return stripe_w[a] > stripe_w[b]; });
-    load.stripe_begin = sb;
-    load.stripe_beams.assign(nst, 0);
-    load.stripe_updates.assign(nst, 0);
-    load.stripe_thread.assign(nst, -1);
-    const Context ctx{cells, size_x, size_y, T, geo.resolution, model,
-                      table.empty() ? nullptr : table.data()};
-    std::atomic<int> next_stripe{0};
-    run_on_threads(std::min(nt, nst), [&](int t) {
-      const auto t_busy = Clock::now();
-      uint64_t mine = 0;
-      for (;;) {
-        const int q = next_stripe.fetch_add(1);
-        if (q >= nst) break;
-        const int s = order[q];
-        const int xa = sb[s], xb = sb[s + 1];
-        uint64_t n = 0;
-        for (uint64_t e = bin_begin[s]; e < bin_begin[s + 1]; ++e) {
-          const Beam &b = beams[bins[e]];
-          const oracle::ScanStart &start = starts[b.scan];
-          n += b.degenerate ? walk_degenerate(ctx, b, start, xa, xb) : walk_closed(ctx, b, start, xa, xb);
-        }
-        load.stripe_beams[s] = bin_begin[s + 1] - bin_begin[s];
-        load.stripe_updates[s] = n;
-        load.stripe_thread[s] = t;
-        mine += n;
-      }
-      load.thread_updates[t] = mine;
-      load.thread_busy_s[t] = seconds_since(t_busy);
-    });
+    const egrid::ModelParams model{params.p_prior, params.p_occ, params.p_emp, params.range_sure,
+                                   params.range_max};
+    const Context ctx{cells, size_x, size_y, T, geo.resolution, model, table_.empty() ? nullptr : table_.data()};
+    run_stripes(ctx, beams.get(), starts, stripes, bins, nt, &load);
     load.stripes_s = seconds_since(t_stripes);
     for (uint64_t n : load.thread_updates) st.cell_updates += n;
     st.map_s = seconds_since(t0);
