@@ -2,10 +2,15 @@
 #include "carmen_compat/atomic_file.h"
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "carmen_compat/error.h"
 #include "map_test_support.h"
@@ -15,6 +20,8 @@ namespace {
 using maptest::read_bytes;
 using maptest::TempDir;
 using maptest::write_bytes;
+
+std::string read_text(const std::string &path) { return read_bytes(path); }
 
 void write_text(const std::string &path, const std::string &text) {
   FILE *f = std::fopen(path.c_str(), "wb");
@@ -87,9 +94,10 @@ TEST(MapAtomicOutput, AbandonRemovesTheTempFile) {
   EXPECT_TRUE(dir.entries().empty());
 }
 
-TEST(MapAtomicOutput, CommitWithoutDataFails) {
+TEST(MapAtomicOutput, CommitFailsWhenTheTemporaryVanished) {
   TempDir dir;
   carmen::AtomicOutput out(dir.file("never.txt"));
+  ::unlink(out.temp_path().c_str());
   try {
     out.commit();
     ADD_FAILURE() << "commit succeeded without a file";
@@ -98,6 +106,90 @@ TEST(MapAtomicOutput, CommitWithoutDataFails) {
     EXPECT_NE(std::string(e.what()).find("nothing was written"), std::string::npos) << e.what();
   }
   EXPECT_TRUE(dir.entries().empty());
+}
+
+// Another user who can write the directory plants a symlink where the
+// temporary would go: it is never opened (O_EXCL | O_NOFOLLOW), its target is
+// untouched, another name is drawn.
+TEST(MapAtomicOutput, APlantedSymlinkIsNeverFollowed) {
+  TempDir dir;
+  const std::string victim = dir.file("victim.txt");
+  write_text(victim, "precious");
+  const std::string planted = dir.file(".out.map.tmp." + std::to_string(::getpid()) + ".planted");
+  ASSERT_EQ(::symlink(victim.c_str(), planted.c_str()), 0);
+  int calls = 0;
+  carmen::AtomicOutput::set_name_source_for_testing([&] { return ++calls == 1 ? "planted" : "fresh"; });
+  {
+    carmen::AtomicOutput out(dir.file("out.map"));
+    carmen::AtomicOutput::set_name_source_for_testing(nullptr);
+    EXPECT_NE(out.temp_path().find(".fresh"), std::string::npos) << out.temp_path();
+    FILE *f = out.take_stdio();
+    std::fputs("new map", f);
+    std::fclose(f);
+    out.commit();
+  }
+  carmen::AtomicOutput::set_name_source_for_testing(nullptr);
+  EXPECT_EQ(read_text(victim), "precious");
+  EXPECT_EQ(read_text(dir.file("out.map")), "new map");
+}
+
+TEST(MapAtomicOutput, TheTemporaryIsAPrivateRegularFileModeFromTheUmask) {
+  TempDir dir;
+  const mode_t old = ::umask(027);
+  carmen::AtomicOutput out(dir.file("m.map"));
+  ::umask(old);
+  struct stat st;
+  ASSERT_EQ(::lstat(out.temp_path().c_str(), &st), 0);
+  EXPECT_TRUE(S_ISREG(st.st_mode));
+  EXPECT_EQ(st.st_mode & 0777, 0640u);
+}
+
+// SIGTERM while an output is being written: the temporary goes, the process
+// dies of the signal.
+TEST(MapAtomicOutput, SignalsRemoveTheTemporaries) {
+  TempDir dir;
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    carmen::remove_temporaries_on_signals();
+    carmen::AtomicOutput a(dir.file("a.map")), b(dir.file("b.png"));
+    ::raise(SIGTERM);
+    ::_exit(3);  // not reached
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(MapOutputTransaction, AFailureBeforeCommitTouchesNoOutput) {
+  TempDir dir;
+  write_text(dir.file("keep.map"), "old map");
+  try {
+    carmen::OutputTransaction tx;
+    carmen::AtomicOutput &a = tx.add(dir.file("keep.map"));
+    FILE *f = a.take_stdio();
+    std::fputs("new map", f);
+    std::fclose(f);
+    tx.add(dir.file("x.png"));
+    throw std::runtime_error("the second writer failed");
+  } catch (const std::runtime_error &) {
+  }
+  EXPECT_EQ(read_text(dir.file("keep.map")), "old map");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.map"});
+}
+
+TEST(MapOutputTransaction, CommitRenamesEveryOutput) {
+  TempDir dir;
+  carmen::OutputTransaction tx;
+  for (const char *name : {"a.map", "a.yaml"}) {
+    FILE *f = tx.add(dir.file(name)).take_stdio();
+    std::fputs(name, f);
+    std::fclose(f);
+  }
+  tx.commit();
+  EXPECT_EQ(read_text(dir.file("a.yaml")), "a.yaml");
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"a.map", "a.yaml"}));
 }
 
 TEST(MapAtomicOutput, RenameFailureIsReportedAndCleanedUp) {

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cctype>
 #include <cstring>
 #include <stdexcept>
 
@@ -63,10 +64,9 @@ std::string file_name_of(const std::string &path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-void write_all(const std::string &final_path, const std::string &temp_path, const std::string &header,
-               const std::vector<uint8_t> &body) {
-  FILE *f = std::fopen(temp_path.c_str(), "wb");
-  if (f == nullptr) throw FileError(final_path, "cannot create " + temp_path + ": " + std::strerror(errno));
+void write_all(AtomicOutput &out, const std::string &header, const std::vector<uint8_t> &body) {
+  const std::string &final_path = out.final_path();
+  FILE *f = out.take_stdio();
   bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size();
   if (ok && !body.empty()) ok = std::fwrite(body.data(), 1, body.size(), f) == body.size();
   const int err = errno;
@@ -139,17 +139,36 @@ std::string yaml_path_for(const std::string &pgm_path) {
   return pgm_path.substr(0, dot) + ".yaml";
 }
 
-void write_pgm_with_yaml(const std::string &pgm_path, const GridMap &map,
+// A file name as a YAML scalar: plain when it is made of letters, digits and
+// "._+-/" only, else double-quoted with escapes, so that a name with quotes,
+// colons or line breaks cannot add keys.
+std::string yaml_quoted(const std::string &text) {
+  bool plain = !text.empty() && text[0] != '-' && text[0] != '.';
+  for (unsigned char c : text) plain = plain && (std::isalnum(c) || c == '.' || c == '_' || c == '+' || c == '-' || c == '/');
+  if (plain) return text;
+  std::string q = "\"";
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') {
+      q += '\\';
+      q += static_cast<char>(c);
+    } else if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      q += buf;
+    } else {
+      q += static_cast<char>(c);
+    }
+  }
+  return q + "\"";
+}
+
+void write_pgm_with_yaml(AtomicOutput &pgm, AtomicOutput &yaml_out, const GridMap &map,
                          const GlobalOffset &origin_of_cell00, PgmMode mode) {
   const std::vector<uint8_t> pixels = map_to_pgm_pixels(map, mode);
-  const std::string yaml_path = yaml_path_for(pgm_path);
-  if (yaml_path == pgm_path)
-    throw std::invalid_argument(pgm_path + ": the image and its YAML would be one file");
-
   const std::string header =
       "P5\n" + std::to_string(map.size_x) + " " + std::to_string(map.size_y) + "\n255\n";
   std::string yaml;
-  yaml += "image: " + file_name_of(pgm_path) + "\n";
+  yaml += "image: " + yaml_quoted(file_name_of(pgm.final_path())) + "\n";
   yaml += "mode: " + std::string(pgm_mode_name(mode)) + "\n";
   yaml += "resolution: " + number_text(map.resolution) + "\n";
   yaml += "origin: [" + number_text(origin_of_cell00.x) + ", " + number_text(origin_of_cell00.y) + ", " +
@@ -157,20 +176,26 @@ void write_pgm_with_yaml(const std::string &pgm_path, const GridMap &map,
   yaml += "negate: 0\n";
   yaml += "occupied_thresh: " + number_text(kOccupiedThresh) + "\n";
   yaml += "free_thresh: " + number_text(kFreeThresh) + "\n";
-
-  AtomicOutput pgm_out(pgm_path);
-  AtomicOutput yaml_out(yaml_path);
-  write_all(pgm_path, pgm_out.temp_path(), header, pixels);
-  write_all(yaml_path, yaml_out.temp_path(), yaml, {});
-  pgm_out.commit();
-  yaml_out.commit();
+  write_all(pgm, header, pixels);
+  write_all(yaml_out, yaml, {});
 }
 
-void write_png(const std::string &path, const GridMap &map) {
+void write_pgm_with_yaml(const std::string &pgm_path, const GridMap &map,
+                         const GlobalOffset &origin_of_cell00, PgmMode mode) {
+  const std::string yaml_path = yaml_path_for(pgm_path);
+  if (yaml_path == pgm_path)
+    throw std::invalid_argument(pgm_path + ": the image and its YAML would be one file");
+  OutputTransaction tx;  // both files, or neither; the pair from one run
+  AtomicOutput &pgm = tx.add(pgm_path);
+  AtomicOutput &yaml = tx.add(yaml_path);
+  write_pgm_with_yaml(pgm, yaml, map, origin_of_cell00, mode);
+  tx.commit();
+}
+
+void write_png(AtomicOutput &out, const GridMap &map) {
+  const std::string &path = out.final_path();
   const std::vector<uint8_t> pixels = map_to_png_pixels(map);
-  AtomicOutput out(path);
-  FILE *f = std::fopen(out.temp_path().c_str(), "wb");
-  if (f == nullptr) throw FileError(path, "cannot create " + out.temp_path() + ": " + std::strerror(errno));
+  FILE *f = out.take_stdio();
   png_image image;
   std::memset(&image, 0, sizeof image);
   image.version = PNG_IMAGE_VERSION;
@@ -184,6 +209,11 @@ void write_png(const std::string &path, const GridMap &map) {
   const bool closed = std::fclose(f) == 0;
   if (!ok) throw FileError(path, "PNG write failed: " + message);
   if (!closed) throw FileError(path, std::string("write failed: ") + std::strerror(errno));
+}
+
+void write_png(const std::string &path, const GridMap &map) {
+  AtomicOutput out(path);
+  write_png(out, map);
   out.commit();
 }
 

@@ -1,6 +1,8 @@
 // CARMEN map files: a defensive reader and an atomic writer.
 #include "carmen_compat/map_file.h"
 
+#include <unistd.h>
+
 #include <sys/stat.h>
 #include <zlib.h>
 
@@ -865,17 +867,17 @@ struct PayloadEncoder {
 // Output to a temporary file, plain or gzip.
 class Sink {
  public:
-  Sink(const std::string &final_path, const std::string &temp_path, bool gzip)
-      : final_(final_path), gzip_(gzip) {
+  Sink(AtomicOutput &out, bool gzip) : final_(out.final_path()), gzip_(gzip) {
     if (gzip_) {
-      gz_ = gzopen(temp_path.c_str(), "wb");
+      const int fd = out.take_fd();
+      gz_ = gzdopen(fd, "wb");
       if (gz_ == nullptr) {
-        throw FileError(final_,
-                        "cannot create " + temp_path + ": " + std::strerror(errno != 0 ? errno : ENOMEM));
+        ::close(fd);
+        throw FileError(final_, "cannot write " + out.temp_path() + ": " +
+                                    std::strerror(errno != 0 ? errno : ENOMEM));
       }
     } else {
-      fp_ = std::fopen(temp_path.c_str(), "wb");
-      if (fp_ == nullptr) throw FileError(final_, "cannot create " + temp_path + ": " + std::strerror(errno));
+      fp_ = out.take_stdio();
     }
   }
   ~Sink() {
@@ -1074,8 +1076,8 @@ std::string encode_chunk(const ChunkPayload &payload, const std::string &name) {
   return chunk_bytes(type, !name.empty(), name, bytes);
 }
 
-void write_map_file(const std::string &path, const MapFile &map) {
-  // Encode everything first: an invalid MapFile throws before any file exists.
+void write_map_file(AtomicOutput &out, const MapFile &map) {
+  // Encode everything first: an invalid MapFile throws before anything is written.
   std::vector<std::string> parts;
   parts.push_back(encode_comment_lines(map.comments) + encode_map_id());
   if (map.creator) parts.push_back(encode_creator_chunk(*map.creator));
@@ -1088,12 +1090,14 @@ void write_map_file(const std::string &path, const MapFile &map) {
     if (nc.name.empty()) throw std::invalid_argument("a named chunk needs a non-empty name");
     parts.push_back(encode_chunk(nc.payload, nc.name));
   }
+  Sink sink(out, ends_with(out.final_path(), ".gz"));
+  for (const std::string &p : parts) sink.write(p);
+  sink.close();
+}
+
+void write_map_file(const std::string &path, const MapFile &map) {
   AtomicOutput out(path);
-  {
-    Sink sink(path, out.temp_path(), ends_with(path, ".gz"));
-    for (const std::string &p : parts) sink.write(p);
-    sink.close();
-  }
+  write_map_file(out, map);
   out.commit();
 }
 

@@ -327,9 +327,7 @@ void print_json(const Input &a, const Input &b, bool identical, const Alignment 
 // failure, so a failed run leaves nothing behind).
 void write_rgb_png(const std::string &path, int width, int height, const std::vector<uint8_t> &rgb) {
   carmen::AtomicOutput out(path);
-  FILE *f = std::fopen(out.temp_path().c_str(), "wb");
-  if (f == nullptr)
-    throw carmen::FileError(path, "cannot create " + out.temp_path() + ": " + std::strerror(errno));
+  FILE *f = out.take_stdio();
   png_image image;
   std::memset(&image, 0, sizeof image);
   image.version = PNG_IMAGE_VERSION;

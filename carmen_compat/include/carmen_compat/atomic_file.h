@@ -4,27 +4,34 @@
 #ifndef CARMEN_COMPAT_ATOMIC_FILE_H
 #define CARMEN_COMPAT_ATOMIC_FILE_H
 
+#include <cstdio>
+#include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace carmen {
 
 // Usage:
-//   AtomicOutput out(path);
-//   FILE *f = fopen(out.temp_path().c_str(), "wb");  ... write, fclose, check ...
-//   out.commit();            // rename(temp, path); throws carmen::FileError
+//   AtomicOutput out(path);          // creates the temporary file
+//   FILE *f = out.take_stdio();      ... write, fclose, check ...
+//   out.commit();                    // rename(temp, path); throws carmen::FileError
 // If commit() is never reached (an exception, an early return), the
 // destructor removes the temporary file.
 //
 // The temporary file lies in the target's directory (rename() is atomic only
-// within one file system) and is named ".NAME.tmp.PID.N": hidden, unique per
-// process (N counts up) and never ending in the target's extension, so
-// extension-based tools ignore it. Open it yourself with the format you want
-// (for gzip, open it with gzopen: carmen_fopen would judge by the temp name).
+// within one file system) and is named ".NAME.tmp.PID.RANDOM": hidden and
+// never ending in the target's extension, so extension-based tools ignore it.
+// It is created exclusively (O_CREAT | O_EXCL | O_NOFOLLOW, mode 0666 less the
+// umask), so a name planted by someone else who can write the directory (a
+// file or a symlink) is never opened: another name is drawn instead. Write
+// through the descriptor it was created with (take_stdio, take_fd), never by
+// reopening the name.
 class AtomicOutput {
  public:
   // Throws carmen::FileError(final_path, ...) when the path has no file name
-  // (empty, or ending in '/').
+  // (empty, or ending in '/') or the temporary file cannot be created.
   explicit AtomicOutput(std::string final_path);
   ~AtomicOutput();  // removes the temporary file unless committed
   AtomicOutput(const AtomicOutput &) = delete;
@@ -33,26 +40,58 @@ class AtomicOutput {
   const std::string &final_path() const noexcept { return final_path_; }
   const std::string &temp_path() const noexcept { return temp_path_; }
 
+  // The temporary file, open for writing; the caller owns what it gets
+  // (fclose / close it before commit). Each may be taken once.
+  FILE *take_stdio();
+  int take_fd();
+
   // Renames the temporary file over the final path. The file must be
   // complete and closed. With durable = true the data and the directory entry
   // are fsync'ed too (slower; for files that must survive a power cut).
-  // Throws carmen::FileError naming the final path when the temporary file is
-  // missing or the rename fails (the temporary file is then removed).
-  // Calling it twice is an error (std::logic_error).
+  // Throws carmen::FileError naming the final path when the rename fails (the
+  // temporary file is then removed). Calling it twice is an error
+  // (std::logic_error).
   void commit(bool durable = false);
   bool committed() const noexcept { return committed_; }
 
   // Removes the temporary file now and gives up (what the destructor does).
   void abandon() noexcept;
 
+  // Tests only: where temporary names' random parts come from (nullptr: the
+  // default source).
+  static void set_name_source_for_testing(std::function<std::string()> source);
+
  private:
   std::string final_path_;
   std::string temp_path_;
+  int fd_ = -1;
+  int slot_ = -1;  // in the registry of live temporaries (signal clean-up)
   bool committed_ = false;
+};
+
+// Several outputs as one transaction: every file is written to its
+// temporary first and renamed only by commit(), when all are written; until
+// then (an exception, a signal) no target is touched and the temporaries go.
+// The renames of one commit run under an exclusive lock on each directory
+// involved (flock), so two concurrent runs writing the same pair of files
+// (an image and its YAML) leave both files from the same run.
+class OutputTransaction {
+ public:
+  AtomicOutput &add(const std::string &final_path);
+  void commit();
+
+ private:
+  std::vector<std::unique_ptr<AtomicOutput>> outputs_;
 };
 
 // Writes `contents` to `path` atomically (binary). Throws carmen::FileError.
 void write_file_atomically(const std::string &path, std::string_view contents, bool durable = false);
+
+// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove every live
+// temporary file of this process and then end it as the signal would have
+// (SIGKILL cannot be caught: it can leave a ".NAME.tmp.PID.RANDOM" behind).
+// Idempotent.
+void remove_temporaries_on_signals();
 
 }  // namespace carmen
 

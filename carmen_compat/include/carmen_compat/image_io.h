@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "carmen_compat/atomic_file.h"
 #include "carmen_compat/map_file.h"
 
 namespace carmen {
@@ -60,10 +61,16 @@ std::vector<uint8_t> map_to_png_pixels(const GridMap &map);
 //   occupied_thresh: 0.65  free_thresh: 0.196  mode: trinary|scale|raw
 // `origin_of_cell00` is the world pose of the lower-left corner of cell
 // (0, 0) — map_server's "origin" — and is written to the YAML as it is.
-// Each file is written atomically (temp + rename); the PGM is moved into
-// place first. Throws carmen::FileError naming the file on failure and
-// std::invalid_argument for an empty or inconsistent map.
+// The image name is a YAML double-quoted string (a name with a line break or
+// a quote cannot add keys). Both files are one transaction (temporaries,
+// renamed together under a directory lock): both or neither, and the pair
+// from one run even when two runs write it at once. Throws carmen::FileError
+// naming the file on failure and std::invalid_argument for an empty or
+// inconsistent map.
 void write_pgm_with_yaml(const std::string &pgm_path, const GridMap &map,
+                         const GlobalOffset &origin_of_cell00, PgmMode mode = PgmMode::Trinary);
+// The same into two outputs the caller commits (of an OutputTransaction).
+void write_pgm_with_yaml(AtomicOutput &pgm, AtomicOutput &yaml, const GridMap &map,
                          const GlobalOffset &origin_of_cell00, PgmMode mode = PgmMode::Trinary);
 // The YAML's path for a PGM path (see above).
 std::string yaml_path_for(const std::string &pgm_path);
@@ -71,6 +78,7 @@ std::string yaml_path_for(const std::string &pgm_path);
 // Writes an 8-bit greyscale PNG (no alpha), oriented as above, pixels from
 // png_pixel(). Atomic. Throws like write_pgm_with_yaml.
 void write_png(const std::string &path, const GridMap &map);
+void write_png(AtomicOutput &out, const GridMap &map);
 
 }  // namespace carmen
 

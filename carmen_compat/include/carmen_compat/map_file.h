@@ -23,6 +23,8 @@
 
 namespace carmen {
 
+class AtomicOutput;
+
 // ---------------------------------------------------------------------------
 // Chunk codes (the values of CARMEN's CARMEN_MAP_*_CHUNK macros).
 // ---------------------------------------------------------------------------
@@ -200,6 +202,8 @@ bool is_map_file(const std::string &path);
 // size_x*size_y, a chunk over 2 GiB, an empty chunk name, bad place type or
 // time width) and carmen::FileError for I/O failures.
 void write_map_file(const std::string &path, const MapFile &map);
+// The same into an output the caller commits (one of an OutputTransaction's).
+void write_map_file(AtomicOutput &out, const MapFile &map);
 
 // The comment block CARMEN's writer puts at the top of a map (author, date,
 // size, resolution, origin, description), as MapFile::comments lines.
