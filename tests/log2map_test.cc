@@ -1,6 +1,10 @@
 // The log2map tool, run as a program: outputs, exit codes, messages.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <iterator>
+#include <unistd.h>
+#include <sys/stat.h>
+#include <signal.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -181,6 +185,57 @@ TEST(Log2Map, PosesTooFarApartNameTheLogAndLines) {
   EXPECT_TRUE(contains(r.output, log + ": the poses span")) << r.output;
   EXPECT_TRUE(contains(r.output, "from the scan at line 1 to line 2 in x")) << r.output;
   EXPECT_TRUE(dir.entries() == (std::vector<std::string>{"far.log"}));
+}
+
+
+// A failing run touches no output: `keep.map` exists, `bad.png` is a
+// directory; the run is refused before any work and keep.map stays as it was.
+TEST(Log2Map, AFailingRunTouchesNoOutput) {
+  TempDir dir;
+  write_text(dir, "keep.map", "old contents");
+  ASSERT_EQ(::mkdir(dir.file("bad.png").c_str(), 0755), 0);
+  const ToolRun r = log2map({"--backend", "cpu_double", kIntel, dir.file("keep.map"), dir.file("bad.png")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(contains(r.output, "bad.png: is a directory")) << r.output;
+  std::ifstream in(dir.file("keep.map"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "old contents");
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"bad.png", "keep.map"}));
+}
+
+// A PGM whose YAML cannot be written: neither file appears.
+TEST(Log2Map, APgmWithoutItsYamlIsNeverWritten) {
+  TempDir dir;
+  ASSERT_EQ(::mkdir(dir.file("out.yaml").c_str(), 0755), 0);
+  const ToolRun r = log2map({"--backend", "cpu_double", kIntel, dir.file("out.pgm")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(contains(r.output, "out.yaml: is a directory")) << r.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"out.yaml"}));
+}
+
+// SIGTERM during a run: no temporary is left, the process dies of the signal.
+TEST(Log2Map, SigtermLeavesNoTemporary) {
+  TempDir dir;
+  const std::string fr079 = std::string(VASCO_LOGS_DIR) + "/fr079-complete.gfs.log.gz";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const std::string bin = std::string(VASCO_BIN_DIR) + "/log2map";
+    ::execl(bin.c_str(), bin.c_str(), "--quiet", "--backend", "cpu_double", fr079.c_str(),
+            dir.file("a.map").c_str(), dir.file("b.pgm").c_str(), static_cast<char *>(nullptr));
+    ::_exit(127);
+  }
+  ::usleep(300 * 1000);  // parsing or mapping by now; the temporaries exist from the start of writing
+  ::kill(child, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  const std::vector<std::string> left = dir.entries();
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+    EXPECT_EQ(left, (std::vector<std::string>{"a.map", "b.pgm", "b.yaml"}));  // it finished first
+  } else {
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+    for (const auto &f : left) EXPECT_EQ(f.find(".tmp."), std::string::npos) << f;
+  }
 }
 
 }  // namespace

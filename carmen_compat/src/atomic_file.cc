@@ -225,6 +225,13 @@ void OutputTransaction::commit() {
   }
   std::vector<std::unique_ptr<DirectoryLock>> locks;  // in a fixed order: no deadlock between runs
   for (const std::string &d : dirs) locks.push_back(std::make_unique<DirectoryLock>(d));
+  // What would make a rename fail is checked for every output before the
+  // first one moves, so that a refused commit touches none.
+  for (const auto &o : outputs_) {
+    struct stat st;
+    if (::stat(o->final_path().c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+      throw FileError(o->final_path(), "is a directory: cannot write there");
+  }
   for (const auto &o : outputs_) o->commit();
 }
 

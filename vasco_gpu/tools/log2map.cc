@@ -5,6 +5,7 @@
 //
 // Outputs by extension: .map / .map.gz (CARMEN), .pgm (+ .yaml, ROS
 // map_server), .png. Exit 0 ok, 1 bad input or runtime error, 2 usage error.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
 #include "carmen_compat/image_io.h"
 #include "carmen_compat/ini_file.h"
@@ -108,8 +110,10 @@ std::string basename_of(const std::string &path) {
 
 std::string yaml_beside(const std::string &pgm) { return pgm.substr(0, pgm.size() - 4) + ".yaml"; }
 
-void write_output(const std::string &out, OutputKind kind, const carmen::GridMap &grid,
-                  const carmen::GlobalOffset &origin, const std::string &log,
+// Writes one output (two for a PGM: the image and its YAML) into `tx`; the
+// transaction renames them all at the end.
+void write_output(carmen::OutputTransaction &tx, const std::string &out, OutputKind kind,
+                  const carmen::GridMap &grid, const carmen::GlobalOffset &origin, const std::string &log,
                   const std::string &backend_name) {
   switch (kind) {
     case OutputKind::CarmenMap: {
@@ -126,20 +130,26 @@ void write_output(const std::string &out, OutputKind kind, const carmen::GridMap
       mf.creator = creator;
       mf.gridmap = grid;
       mf.offset = origin;
-      carmen::write_map_file(out, mf);
+      carmen::write_map_file(tx.add(out), mf);
       break;
     }
-    case OutputKind::Pgm:
-      carmen::write_pgm_with_yaml(out, grid, origin);
+    case OutputKind::Pgm: {
+      carmen::AtomicOutput &pgm = tx.add(out);
+      carmen::write_pgm_with_yaml(pgm, tx.add(yaml_beside(out)), grid, origin);
       break;
+    }
     case OutputKind::Png:
-      carmen::write_png(out, grid);
+      carmen::write_png(tx.add(out), grid);
       break;
   }
 }
 
-// Refuses, before any work is done, an output whose directory cannot be written.
+// Refuses, before any work is done, an output that is a directory or whose
+// directory cannot be written.
 void check_writable(const std::string &out) {
+  struct stat st;
+  if (::stat(out.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw carmen::FileError(out, "is a directory: cannot write a map there");
   const size_t slash = out.find_last_of('/');
   const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : out.substr(0, slash));
   if (access(dir.c_str(), W_OK) != 0)
@@ -202,26 +212,19 @@ vasco::LogInput read_input(const Options &opt) {
   return vasco::load_log_input(in);
 }
 
-// Every output, each atomically (temporary file + rename); should a later
-// one fail, those this run already wrote are removed too, so a failure leaves
-// no map behind.
+// Every output as one transaction: all are written to temporaries first and
+// renamed only when every one is written, so a failure touches no output
+// (an existing file stays as it was) and leaves no temporary.
 void write_outputs(const Options &opt, const std::vector<OutputKind> &kinds, const RunResult &r) {
   carmen::GridMap grid;
   grid.size_x = r.map.size_x;
   grid.size_y = r.map.size_y;
   grid.resolution = r.map.resolution;
   grid.cells = r.map.cells;
-  std::vector<std::string> written;
-  try {
-    for (size_t i = 0; i < opt.outputs.size(); ++i) {
-      write_output(opt.outputs[i], kinds[i], grid, r.origin, opt.log, r.backend);
-      written.push_back(opt.outputs[i]);
-      if (kinds[i] == OutputKind::Pgm) written.push_back(yaml_beside(opt.outputs[i]));
-    }
-  } catch (...) {
-    for (const auto &w : written) std::remove(w.c_str());
-    throw;
-  }
+  carmen::OutputTransaction tx;
+  for (size_t i = 0; i < opt.outputs.size(); ++i)
+    write_output(tx, opt.outputs[i], kinds[i], grid, r.origin, opt.log, r.backend);
+  tx.commit();
 }
 
 void print_summary(const Options &opt, const RunResult &r) {
@@ -276,9 +279,13 @@ void print_json(const Options &opt, const RunResult &r) {
 
 int run(const Options &opt) {
   const auto t_start = Clock::now();
+  carmen::remove_temporaries_on_signals();
   std::vector<OutputKind> kinds(opt.outputs.size());
   for (size_t i = 0; i < opt.outputs.size(); ++i) output_kind(opt.outputs[i], &kinds[i]);
-  for (const auto &out : opt.outputs) check_writable(out);
+  for (size_t i = 0; i < opt.outputs.size(); ++i) {
+    check_writable(opt.outputs[i]);
+    if (kinds[i] == OutputKind::Pgm) check_writable(yaml_beside(opt.outputs[i]));
+  }
   vasco::BackendOptions bopt;
   bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
   bopt.threads = opt.threads;
