@@ -532,6 +532,30 @@ TEST(LogReaderBadInput, HugeLineWithoutNewlineIsCappedNotBuffered) {
   EXPECT_EQ(s.bad_lines[static_cast<int>(BadLine::TOO_LONG)], 1u);
   EXPECT_EQ(s.bytes, (3u << 20) + 9u);
 }
+// Strict mode: after the error for a line too long to hold, next() goes on
+// with the line after it (it used to throw again and again, never advancing).
+TEST(LogReaderBadInput, AfterAnOverlongLineStrictReadingGoesOn) {
+  TempDir tmp;
+  const std::string path = tmp.file("long_then_good.log");
+  const std::string good = "ODOM 1.0 2.0 0.5 0 0 0 100.0 host 0.0\n";
+  write_file(path, good + "FLASER 5 " + std::string(3 << 20, '7') + "\n" + good);
+  LogReaderOptions opt;
+  opt.max_line_length = 1 << 16;
+  LogReader r(path, opt);
+  LogMessage m;
+  ASSERT_TRUE(r.next(m));
+  EXPECT_EQ(m.line, 1);
+  try {
+    r.next(m);
+    ADD_FAILURE() << "no error for the long line";
+  } catch (const FileError &e) {
+    EXPECT_EQ(e.line(), 2);
+  }
+  ASSERT_TRUE(r.next(m));
+  EXPECT_EQ(m.line, 3);
+  EXPECT_EQ(m.type, MessageType::ODOM);
+  EXPECT_FALSE(r.next(m));
+}
 TEST(LogReaderBadInput, EmptyFile) {
   expect_file_error(bad_log("empty.log"), 0, "empty file");
   expect_file_error(bad_log("empty.log.gz"), 0, "empty log");

@@ -986,12 +986,15 @@ struct LogReader::Impl {
       }
       scan = lim;
       if (binary_at != kNoBinary && binary_at < base + lim) binary_error(line_no + 1);
-      if (!skipping && lim - pos > opt.max_line_length) {
-        ++line_no;
-        too_long();
-        skipping = true;
-      }
       if (skipping) pos = scan = lim;  // discard what we have of the long line
+      if (!skipping && lim - pos > opt.max_line_length) {
+        // Skip it before reporting it: in strict mode too_long() throws, and a
+        // later next() must go on after this line, not report it again.
+        ++line_no;
+        skipping = true;
+        pos = scan = lim;
+        too_long();
+      }
       if (!src_error.empty()) fail(line_no + (skipping ? 0 : 1), src_error);
       if (src_eof) {
         if (pos < lim && !skipping) {  // a last line without '\n'

@@ -314,9 +314,17 @@ carmen_logfile_index_p carmen_logfile_index_messages(carmen_FILE *infile) {
     if (n < chunk.size()) break;
   }
   if (carmen_ferror(infile)) {
-    set_error(infile->compressed ? "read error or corrupt / truncated gzip stream"
-                                 : "read error");
-    return nullptr;
+    // As CARMEN: index what could be read, and say what is wrong. A last
+    // message cut by the damage is dropped (it would be half a line).
+    const std::string what = infile->compressed ? "corrupt or truncated gzip stream" : "read error";
+    if (!after_newline && !offsets.empty()) {
+      total = offsets.back();
+      offsets.pop_back();
+    }
+    set_error(what + " after " + std::to_string(offsets.size()) + " messages: the rest of the log is lost");
+    std::fprintf(stderr, "carmen_logfile_index_messages: %s\n", g_last_error.c_str());
+    if (infile->compressed) gzclearerr(infile->comp_fp);
+    else std::clearerr(infile->fp);
   }
   if (offsets.size() >= static_cast<std::size_t>(INT_MAX)) {
     set_error("too many messages");
@@ -360,6 +368,17 @@ float carmen_logfile_percent_read(carmen_logfile_index_p index) {
   return static_cast<float>(index->current_position) / static_cast<float>(index->num_messages);
 }
 
+// Positions the index (and the file) at message `next`; when the file cannot
+// get there, at the end, so that carmen_logfile_eof() ends a reading loop.
+static void skip_to(carmen_logfile_index_p index, carmen_FILE *infile, int next) {
+  if (next < index->num_messages &&
+      carmen_fseek(infile, static_cast<long>(index->offset[next]), SEEK_SET) == 0) {
+    index->current_position = next;
+  } else {
+    index->current_position = index->num_messages;
+  }
+}
+
 int carmen_logfile_read_line(carmen_logfile_index_p index, carmen_FILE *infile, int message_num,
                              int max_line_length, char *line) {
   g_last_error.clear();
@@ -375,8 +394,12 @@ int carmen_logfile_read_line(carmen_logfile_index_p index, carmen_FILE *infile, 
   const off_t start = index->offset[message_num];
   const off_t length = index->offset[message_num + 1] - start;
   if (length >= static_cast<off_t>(max_line_length)) {
+    // CARMEN exits here; we skip the message, so that a loop of
+    // carmen_logfile_read_next_line until carmen_logfile_eof goes on.
     set_error("message " + std::to_string(message_num) + " has " + std::to_string(length) +
-              " bytes, more than the buffer of " + std::to_string(max_line_length) + " allows");
+              " bytes, more than the buffer of " + std::to_string(max_line_length) + " allows: skipped");
+    std::fprintf(stderr, "carmen_logfile_read_line: %s\n", g_last_error.c_str());
+    skip_to(index, infile, message_num + 1);
     return -1;
   }
   if (message_num != index->current_position) {
@@ -390,7 +413,7 @@ int carmen_logfile_read_line(carmen_logfile_index_p index, carmen_FILE *infile, 
   line[n] = '\0';
   if (n != static_cast<std::size_t>(length)) {
     set_error("short read: the log changed or is damaged");
-    index->current_position = -1;  // position unknown: seek next time
+    skip_to(index, infile, message_num + 1);  // the next call goes on, never spins
     return -1;
   }
   index->current_position = message_num + 1;

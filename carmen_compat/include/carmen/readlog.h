@@ -13,11 +13,13 @@
  *     above 100000, a NaN/inf pose or timestamp, or extra fields; the message
  *     struct is then left untouched, and carmen_readlog_last_error() says why.
  *     NaN, inf and negative ranges are accepted, as data.
- *   - carmen_logfile_index_messages() returns NULL on a read error or a
- *     corrupt / truncated gzip stream instead of indexing a short log.
+ *   - carmen_logfile_index_messages() indexes what precedes a read error or
+ *     a corrupt / truncated gzip stream, as CARMEN does, and says so.
  *   - carmen_logfile_read_line() returns -1 (instead of dying) for a message
  *     number out of range, a message of max_line_length bytes or more, or a
- *     failed seek or short read.
+ *     failed seek or short read; for the last two kinds it also moves on to
+ *     the next message (or to the end), so a loop of
+ *     carmen_logfile_read_next_line() until carmen_logfile_eof() never spins.
  */
 #ifndef CARMEN_READLOG_H
 #define CARMEN_READLOG_H
@@ -124,8 +126,11 @@ typedef struct {
   off_t *offset;
 } carmen_logfile_index_t, *carmen_logfile_index_p;
 
-/* Reads the whole stream, then rewinds it. NULL on a read error, a corrupt or
- * truncated gzip stream, or more than INT_MAX messages. */
+/* Reads the whole stream, then rewinds it. On a read error or a corrupt or
+ * truncated gzip stream it indexes, as CARMEN does, the messages read before
+ * the damage (a message cut by it is dropped) and reports the damage on
+ * stderr and in carmen_readlog_last_error(). NULL for a NULL file, a file
+ * that cannot be rewound, or more than INT_MAX messages. */
 carmen_logfile_index_p carmen_logfile_index_messages(carmen_FILE *infile);
 /* Frees the index and sets *pindex to NULL. */
 void carmen_logfile_free_index(carmen_logfile_index_p *pindex);
