@@ -648,3 +648,35 @@ TEST(IniVascoDefault, HoldsTheVascoDefaults) {
 }
 
 }  // namespace
+
+namespace {
+
+// A device that never ends (or a huge file) is refused at 16 MiB instead of
+// being read into memory without bound.
+TEST(IniLimits, AnEndlessFileIsRefusedAtTheSizeCap) {
+  try {
+    carmen::ParamFile::load("/dev/zero");
+    ADD_FAILURE() << "no error";
+  } catch (const carmen::FileError &e) {
+    EXPECT_EQ(e.file(), "/dev/zero");
+    EXPECT_NE(std::string(e.what()).find("larger than 16 MiB"), std::string::npos) << e.what();
+  }
+}
+
+// 10^5 robot sections: linear, and the message lists a few of them.
+TEST(IniLimits, ManyRobotSectionsAreCheapAndTheMessageBounded) {
+  std::string text;
+  for (int i = 0; i < 100000; ++i) text += "[robot" + std::to_string(i) + "]\nvasco_p_occ 0.6\n";
+  const carmen::ParamFile pf = carmen::ParamFile::parse(text, "many.ini", "robot99999");
+  EXPECT_EQ(pf.robots().size(), 100000u);
+  EXPECT_EQ(pf.selected_robot(), "robot99999");
+  try {
+    carmen::ParamFile::parse(text, "many.ini");
+    ADD_FAILURE() << "no error";
+  } catch (const carmen::FileError &e) {
+    EXPECT_LT(std::string(e.what()).size(), 400u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("and 99990 more"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace

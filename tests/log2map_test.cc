@@ -238,4 +238,22 @@ TEST(Log2Map, SigtermLeavesNoTemporary) {
   }
 }
 
+
+// Two scans 399 m apart (diagonally) ask for a grid of 10^9 cells, 4 GiB:
+// refused by the default memory budget before anything is allocated.
+TEST(Log2Map, AGridBeyondTheMemoryBudgetIsRefusedNamingTheLog) {
+  TempDir dir;
+  const std::string log = write_text(dir, "far.log",
+                                     "FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1 t 0\n"
+                                     "FLASER 3 1.0 2.0 3.0 399 399 0 0 0 0 2 t 0\n");
+  const ToolRun r = log2map({"--backend", "cpu_double", log, dir.file("out.map")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(contains(r.output, log + ": the map needs about")) << r.output;
+  EXPECT_TRUE(contains(r.output, "--max-memory")) << r.output;
+  const ToolRun small = log2map({"--backend", "cpu_double", "--max-memory", "1", kIntel, dir.file("out.map")});
+  EXPECT_EQ(small.status, 1);
+  EXPECT_TRUE(contains(small.output, "more than the budget of 1 MiB")) << small.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"far.log"}));
+}
+
 }  // namespace

@@ -761,3 +761,30 @@ TEST(MapFileCells, AtIsBoundsChecked) {
 }
 
 }  // namespace
+
+namespace {
+
+// Named GRIDMAP chunks are all parsed and kept: a file of many of them (a
+// few KB of .gz can claim gigabytes) is refused at MapReadOptions'
+// max_kept_bytes instead of being allocated.
+TEST(MapFileLimits, ChunkDataBeyondTheBudgetIsRefused) {
+  maptest::TempDir dir;
+  carmen::MapFile m;
+  m.gridmap = carmen::GridMap::filled(300, 300, 0.1, 0.5f);  // 360 KB of cells
+  for (int i = 0; i < 3; ++i) m.named.push_back({"copy" + std::to_string(i), *m.gridmap});
+  const std::string path = dir.file("many.map.gz");
+  carmen::write_map_file(path, m);
+  EXPECT_EQ(carmen::MapReadOptions{}.max_kept_bytes, uint64_t(1) << 30);
+  EXPECT_EQ(carmen::read_map_file(path).named.size(), 3u);  // well inside the default
+  carmen::MapReadOptions small;
+  small.max_kept_bytes = 1 << 20;
+  try {
+    carmen::read_map_file(path, small);
+    ADD_FAILURE() << "no error";
+  } catch (const carmen::FileError &e) {
+    EXPECT_EQ(e.file(), path);
+    EXPECT_NE(std::string(e.what()).find("max_kept_bytes"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace

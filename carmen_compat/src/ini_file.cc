@@ -3,6 +3,7 @@
 #include "carmen_compat/ini_file.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <clocale>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <cstring>
 #include <locale.h>
 #include <stdlib.h>
+#include <unordered_set>
 #include <utility>
 
 namespace carmen {
@@ -50,12 +52,15 @@ std::size_t module_split(const std::string &name) {
   return us;
 }
 
+// The first few items, for messages ("a, b, c and 99997 more").
 std::string join(const std::vector<std::string> &items) {
+  constexpr std::size_t kShown = 10;
   std::string out;
-  for (const std::string &s : items) {
+  for (std::size_t i = 0; i < items.size() && i < kShown; ++i) {
     if (!out.empty()) out += ", ";
-    out += s;
+    out += items[i];
   }
+  if (items.size() > kShown) out += " and " + std::to_string(items.size() - kShown) + " more";
   return out;
 }
 
@@ -197,7 +202,14 @@ ParamFile ParamFile::load(const std::string &path, const std::string &robot) {
   std::string text;
   char buffer[1 << 16];
   std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, fp)) > 0) text.append(buffer, n);
+  while ((n = std::fread(buffer, 1, sizeof buffer, fp)) > 0) {
+    text.append(buffer, n);
+    if (text.size() > kMaxFileBytes) {
+      std::fclose(fp);
+      throw FileError(path, "larger than " + std::to_string(kMaxFileBytes >> 20) +
+                                " MiB: not a carmen.ini (a parameter file is a few hundred KiB)");
+    }
+  }
   const bool failed = std::ferror(fp) != 0;
   const int err = errno;
   std::fclose(fp);
@@ -250,12 +262,12 @@ ParamFile ParamFile::parse(const std::string &text, const std::string &name_for_
     }
   }
 
-  // Robots: every section other than [*] and [expert...], each once.
+  // Robots: every section other than [*] and [expert...], each once (a set
+  // of lower-cased names: linear in the number of sections).
+  std::unordered_set<std::string> seen;
   for (const Line &l : lines) {
     if (!l.is_section || classify(l.text) != SectionKind::kRobot) continue;
-    const bool seen = std::any_of(pf.robots_.begin(), pf.robots_.end(),
-                                  [&](const std::string &r) { return iequals(r, l.text); });
-    if (!seen) pf.robots_.push_back(l.text);
+    if (seen.insert(lower(l.text)).second) pf.robots_.push_back(l.text);
   }
   if (!robot.empty()) {
     const auto it = std::find_if(pf.robots_.begin(), pf.robots_.end(),

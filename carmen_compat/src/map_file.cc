@@ -609,6 +609,7 @@ class Reader {
   // Reads `n` bytes in bounded pieces: a short file fails before the
   // claimed size is allocated (the size was already checked for plain files).
   std::vector<unsigned char> payload(uint64_t n) {
+    keep(n);
     std::vector<unsigned char> out;
     const bool known = in_.remaining() >= 0;
     if (known) out.reserve(static_cast<size_t>(n));
@@ -625,8 +626,17 @@ class Reader {
     return out;
   }
 
+  // Counts bytes about to be kept against MapReadOptions::max_kept_bytes.
+  void keep(uint64_t bytes) {
+    kept_ += bytes;
+    if (kept_ > opts_.max_kept_bytes)
+      fail("makes the map hold more than " + std::to_string(opts_.max_kept_bytes >> 20) +
+           " MiB of chunk data (MapReadOptions::max_kept_bytes): refused rather than allocated");
+  }
+
   GridMap read_gridmap(uint64_t left) {
     if (left < 12) fail("has " + std::to_string(left) + " payload bytes, too few for the map size");
+    keep(left);
     unsigned char hdr[12];
     const size_t hgot = in_.read(hdr, 12);
     if (hgot < 12) fail_short("the map size");
@@ -706,6 +716,7 @@ class Reader {
 
   Input in_;
   MapReadOptions opts_;
+  uint64_t kept_ = 0;  // chunk bytes kept so far
   bool headers_only_;
   MapFile map_;
   const ChunkInfo *chunk_ = nullptr;

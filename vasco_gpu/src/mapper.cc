@@ -5,6 +5,7 @@
 #endif
 
 #include <chrono>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -71,7 +72,7 @@ std::unique_ptr<Renderer> make_renderer(const std::string &backend, const Backen
 }
 
 Mapper::Mapper(const MapperParams &params, const std::string &backend, const BackendOptions &options)
-    : params_(params), renderer_(make_renderer(backend, options)) {
+    : params_(params), options_(options), renderer_(make_renderer(backend, options)) {
   params_.validate();
 }
 
@@ -95,6 +96,23 @@ GridGeometry Mapper::frame_for(const PoseExtent &extent, const ScanBatch &scans)
   return g;
 }
 
+// What the session keeps in host memory, estimated before it is allocated:
+// the grid (4 bytes a cell; CPU renderers), the stored scans (4 bytes a beam)
+// and a renderer's per-beam scratch (placement and stripe lists of the CPU
+// backends, the CUDA renderer's pinned staging: 64 bytes a beam at most).
+void Mapper::check_memory(const GridGeometry &geo, uint64_t beams) const {
+  if (options_.max_memory_bytes == 0) return;
+  const bool device_grid = renderer_->name().rfind("cuda", 0) == 0;
+  const double need = (device_grid ? 0.0 : 4.0 * static_cast<double>(geo.num_cells())) + 68.0 * beams;
+  if (need <= static_cast<double>(options_.max_memory_bytes)) return;
+  std::ostringstream m;
+  m << "the map needs about " << static_cast<uint64_t>(need / (1 << 20)) << " MiB of memory (a grid of "
+    << geo.size_x << " x " << geo.size_y << " cells at " << geo.resolution << " m and " << beams
+    << " beams), more than the budget of " << (options_.max_memory_bytes >> 20)
+    << " MiB: raise it (log2map --max-memory MiB), or use a coarser vasco_resolution";
+  throw std::runtime_error(m.str());
+}
+
 void Mapper::rerender() {
   renderer_->reset(geo_, params_);
   renderer_->apply(scans_, 0, scans_.num_scans(), &stats_);
@@ -106,6 +124,7 @@ void Mapper::insert(const ScanBatch &scans) {
   PoseExtent extent = extent_;
   extent.add(scans, 0, scans.num_scans());
   const GridGeometry geo = frame_for(extent, scans);  // throws before anything changes
+  check_memory(geo, scans_.num_beams() + scans.num_beams());
   const size_t before = scans_.num_scans();
   for (size_t s = 0; s < scans.num_scans(); ++s)
     scans_.add_scan(scans.x[s], scans.y[s], scans.theta[s], scans.first_angle[s], scans.angle_step[s],
@@ -140,6 +159,7 @@ void Mapper::render(const std::vector<Pose> &poses) {
   GridGeometry geo;
   try {
     geo = frame_for(extent, scans_);
+    check_memory(geo, scans_.num_beams());
   } catch (...) {  // the old poses stay
     x.swap(scans_.x);
     y.swap(scans_.y);

@@ -165,6 +165,7 @@ struct Options {
   std::string backend = "auto";
   std::string cuda_mode = "float";
   int threads = 0;
+  uint64_t max_memory_mib = vasco::kDefaultMaxMemoryBytes >> 20;
   bool lenient = false, json = false, quiet = false;
   std::map<std::string, std::string> overrides;  // --vasco_KEY VALUE
 };
@@ -289,6 +290,7 @@ int run(const Options &opt) {
   vasco::BackendOptions bopt;
   bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
   bopt.threads = opt.threads;
+  bopt.max_memory_bytes = opt.max_memory_mib << 20;
   std::future<bool> gpu_ready = start_cuda(opt, bopt);
 
   RunResult r;
@@ -300,7 +302,13 @@ int run(const Options &opt) {
   vasco::Mapper mapper(r.input.params, opt.backend, bopt);
   r.backend = mapper.backend_name();
   t = Clock::now();
-  mapper.insert(r.input.batch);
+  try {
+    mapper.insert(r.input.batch);
+  } catch (const std::runtime_error &e) {
+    // Too large for the memory budget: the log's poses decide, so name it.
+    if (std::string(e.what()).rfind("the map needs about", 0) == 0) throw carmen::FileError(opt.log, e.what());
+    throw;
+  }
   r.stats = mapper.last_stats();
   r.map_total_s = seconds_since(t);
   t = Clock::now();
@@ -346,6 +354,9 @@ int main(int argc, char **argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
       ->check(CLI::IsMember({"float", "exact"}));
+  app.add_option("--max-memory", opt.max_memory_mib,
+                 "host memory the map may use, in MiB (default 2048; 0: no limit)")
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("--lenient", opt.lenient, "skip bad log lines (and report them) instead of stopping");
   app.add_flag("--json", opt.json, "print machine-readable statistics on stdout");
   app.add_flag("--quiet", opt.quiet, "no progress and no summary");

@@ -83,6 +83,9 @@ struct ParamWarning {
 class ParamFile {
  public:
   static constexpr std::size_t kMaxLineLength = 2047;  // longer lines are errors
+  // load() refuses a larger file before reading on (a carmen.ini is a few
+  // hundred KiB; a device such as /dev/urandom would otherwise never end).
+  static constexpr std::size_t kMaxFileBytes = std::size_t(16) << 20;
   static constexpr std::size_t kMaxNameLength = 254;   // longer names are errors
   static constexpr const char *kCommandLine = "command line";
 

@@ -172,6 +172,11 @@ struct MapReadOptions {
   // Reject gridmaps holding values outside valid_cell_value(). On: a damaged
   // map (NaN, huge or negative garbage) is reported, not passed on.
   bool check_cells = true;
+  // The most chunk data a read keeps in memory (every chunk parsed, named
+  // ones included). A few kilobytes of .gz can claim gigabytes of cells; a
+  // file that needs more is refused with the number to raise. 1 GiB holds a
+  // 16000 x 16000 grid.
+  uint64_t max_kept_bytes = uint64_t(1) << 30;
 };
 
 // Reads a whole map file; ".gz" names are gunzipped (as carmen_fopen does:

@@ -83,7 +83,8 @@ class Mapper {
 
   // Stores `scans` (ranges, beam geometry and poses) after those stored and
   // applies them to the current grid. Throws std::runtime_error when the
-  // PROTOCOL frame would be too large (nothing is stored then).
+  // PROTOCOL frame would be too large, or the session would need more host
+  // memory than BackendOptions::max_memory_bytes (nothing is stored then).
   void insert(const ScanBatch &scans);
   // New poses for every stored scan (poses.size() == num_scans()), and the
   // grid recomputed from scratch with them.
@@ -107,9 +108,11 @@ class Mapper {
 
  private:
   GridGeometry frame_for(const PoseExtent &extent, const ScanBatch &scans) const;
+  void check_memory(const GridGeometry &geo, uint64_t beams) const;
   void rerender();
 
   MapperParams params_;
+  BackendOptions options_;
   bool fixed_frame_ = false;
   GridGeometry geo_;
   ScanBatch scans_;
