@@ -256,4 +256,44 @@ TEST(Log2Map, AGridBeyondTheMemoryBudgetIsRefusedNamingTheLog) {
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"far.log"}));
 }
 
+
+// The small defects of the reliability audit, each with its reproduction.
+TEST(Log2Map, SmallDefectsGiveClearErrors) {
+  TempDir dir;
+  // --threads 100000: a usage error, not a raw errno.
+  EXPECT_EQ(log2map({"--threads", "100000", kIntel, dir.file("a.map")}).status, 2);
+  // vasco_downsample larger than the grid and range_max 0 name the key.
+  const ToolRun ds = log2map({"--vasco_downsample", "1000000", kIntel, dir.file("a.map")});
+  EXPECT_EQ(ds.status, 1);
+  EXPECT_TRUE(contains(ds.output, "command line: vasco_downsample = 1000000 is larger than the grid")) << ds.output;
+  const ToolRun rm = log2map({"--vasco_range_max", "0", kIntel, dir.file("a.map")});
+  EXPECT_EQ(rm.status, 1);
+  EXPECT_TRUE(contains(rm.output, "vasco_range_max = 0")) << rm.output;
+  // vasco_first_scan near LONG_MAX: no overflow, a clear "nothing selected".
+  const ToolRun fs = log2map({"--vasco_first_scan", "9223372036854775800", "--vasco_num_scans", "100", kIntel,
+                              dir.file("a.map")});
+  EXPECT_EQ(fs.status, 1);
+  EXPECT_TRUE(contains(fs.output, "no FLASER or ROBOTLASER1 scans to map in the selected range")) << fs.output;
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(Log2Map, JsonToAFullStdoutFails) {
+  TempDir dir;
+  const std::string cmd = tooltest::quote(std::string(VASCO_BIN_DIR) + "/log2map") + " --json --quiet " +
+                          tooltest::quote(kIntel) + " " + tooltest::quote(dir.file("a.map")) +
+                          " > /dev/full 2>/dev/null";
+  const int st = std::system(cmd.c_str());
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << st;
+}
+
+// A hostile file's escape sequences reach the terminal escaped.
+TEST(Log2Map, EscapeCodesFromAFileAreNotEchoedRaw) {
+  TempDir dir;
+  const std::string ini = write_text(dir, "esc.ini", "[*]\nvasco_p_occ \x1b[31mRED\n");
+  const ToolRun r = log2map({"--backend", "cpu_double", "--param-file", ini, kIntel, dir.file("out.map")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << r.output;
+  EXPECT_TRUE(contains(r.output, "\\x1b[31mRED")) << r.output;
+}
+
 }  // namespace

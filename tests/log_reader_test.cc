@@ -556,6 +556,23 @@ TEST(LogReaderBadInput, AfterAnOverlongLineStrictReadingGoesOn) {
   EXPECT_EQ(m.type, MessageType::ODOM);
   EXPECT_FALSE(r.next(m));
 }
+// Zero bytes after the gzip stream are padding (gzip -t accepts them);
+// anything else after them is still an error.
+TEST(LogReaderBadInput, GzipWithTrailingZeroPaddingIsRead) {
+  TempDir tmp;
+  const std::string text = read_file(bad_log("good.log"));
+  const std::string plain_gz = tmp.file("plain.log.gz");
+  gzFile out = gzopen(plain_gz.c_str(), "wb");
+  ASSERT_NE(out, nullptr);
+  gzwrite(out, text.data(), static_cast<unsigned>(text.size()));
+  gzclose(out);
+  const std::string gz = read_file(plain_gz);
+  const std::string padded = tmp.file("padded.log.gz"), garbage = tmp.file("garbage.log.gz");
+  write_file(padded, gz + std::string(4096, '\0'));
+  write_file(garbage, gz + std::string(16, '\0') + "X");
+  EXPECT_EQ(read_all(padded).size(), read_all(bad_log("good.log")).size());
+  EXPECT_THROW(read_all(garbage), FileError);
+}
 TEST(LogReaderBadInput, EmptyFile) {
   expect_file_error(bad_log("empty.log"), 0, "empty file");
   expect_file_error(bad_log("empty.log.gz"), 0, "empty log");

@@ -68,10 +68,19 @@ TEST(MapperParams, ValidationNamesKeyAndLine) {
   expect_error_at("[*]\nvasco_resolution abc\n", "test.ini:2", "vasco_resolution");
 }
 
-TEST(MapperParams, RangeSureMayEqualRangeMaxAndZeroIsAllowed) {
+TEST(MapperParams, RangeSureMayEqualRangeMaxOrBeZero) {
   EXPECT_NO_THROW(from_text("[*]\nvasco_range_sure 10\n"));
-  EXPECT_NO_THROW(from_text("[*]\nvasco_range_sure 0\nvasco_range_max 0\n"));
+  EXPECT_NO_THROW(from_text("[*]\nvasco_range_sure 0\n"));
   EXPECT_NO_THROW(from_text("[*]\nvasco_border 0\nvasco_downsample 1\n"));
+}
+
+// Values whose map could not be written or read back: a range_max of 0 (no
+// cell is ever updated: an empty map), resolutions whose float in the file is
+// inf or 0 (our own readers refuse such maps).
+TEST(MapperParams, ValuesThatMakeUnwritableMapsNameTheirKey) {
+  expect_error_at("[*]\nvasco_range_sure 0\nvasco_range_max 0\n", "test.ini:3", "vasco_range_max");
+  expect_error_at("[*]\nvasco_resolution 1e39\n", "test.ini:2", "vasco_resolution");
+  expect_error_at("[*]\nvasco_resolution 1e-46\n", "test.ini:2", "vasco_resolution");
 }
 
 TEST(MapperParams, AbsurdTableIsRefused) {

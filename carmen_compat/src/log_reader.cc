@@ -894,6 +894,15 @@ struct LogReader::Impl {
         zs.next_in = zin.data();
         zs.avail_in = static_cast<uInt>(n);
       }
+      if (after_member) {
+        // Zero bytes after a member are padding (tape and block devices add
+        // them; gzip -t accepts them): skipped.
+        while (zs.avail_in > 0 && *zs.next_in == 0) {
+          ++zs.next_in;
+          --zs.avail_in;
+        }
+        if (zs.avail_in == 0 && !in_eof) continue;
+      }
       if (after_member && zs.avail_in == 0 && in_eof) {
         src_eof = true;
         break;

@@ -44,6 +44,16 @@ LogInput load_log_input(const LogInputOptions &options) {
   } catch (const std::runtime_error &e) {
     throw carmen::FileError(options.log, e.what());
   }
+  // A block larger than the grid leaves nothing to finish: say so, naming
+  // where the value came from.
+  if (in.params.downsample > in.geo.size_x || in.params.downsample > in.geo.size_y) {
+    const std::string m = "vasco_downsample = " + std::to_string(in.params.downsample) + " is larger than the grid (" +
+                          std::to_string(in.geo.size_x) + " x " + std::to_string(in.geo.size_y) +
+                          " cells): the finished map would be empty";
+    const auto where = params.find("vasco_downsample");
+    if (where && where->line > 0) throw carmen::FileError(where->file, where->line, m);
+    throw carmen::FileError(where ? where->file : options.log, m);
+  }
   return in;
 }
 

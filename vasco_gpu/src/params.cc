@@ -36,10 +36,13 @@ std::string check(const MapperParams &p) {
   if (!(e = prob("vasco_p_prior", p.p_prior)).empty()) return e;
   if (!(e = prob("vasco_p_occ", p.p_occ)).empty()) return e;
   if (!(e = prob("vasco_p_emp", p.p_emp)).empty()) return e;
-  if (!(p.resolution > 0) || !std::isfinite(p.resolution))
-    return "vasco_resolution = " + fmt(p.resolution) + ": must be a finite number > 0";
-  if (!(p.range_max >= 0) || !(p.range_max <= kMaxRange))
-    return "vasco_range_max = " + fmt(p.range_max) + ": must be between 0 and " + fmt(kMaxRange) + " m";
+  // The map file stores the resolution (times the downsample) as a float:
+  // it must stay a positive, finite float there.
+  if (!(p.resolution >= 1e-6) || !(p.resolution <= 1e6))
+    return "vasco_resolution = " + fmt(p.resolution) + ": must be between 1e-6 and 1e6 m per cell";
+  if (!(p.range_max > 0) || !(p.range_max <= kMaxRange))
+    return "vasco_range_max = " + fmt(p.range_max) + ": must be > 0 and at most " + fmt(kMaxRange) +
+           " m (with 0 no cell is ever updated)";
   if (!(p.range_sure >= 0) || !(p.range_sure <= p.range_max))
     return "vasco_range_sure = " + fmt(p.range_sure) + ": must satisfy 0 <= range_sure <= range_max (" +
            fmt(p.range_max) + ")";

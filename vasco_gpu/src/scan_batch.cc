@@ -1,6 +1,7 @@
 #include "vasco_gpu/scan_batch.h"
 
 #include <algorithm>
+#include <climits>
 
 #include "vasco_gpu/params.h"
 
@@ -36,7 +37,8 @@ ScanBatch load_scans(const std::string &log_path, const MapperParams &params,
   ScanBatch batch;
   LogLoadStats st;
   const long first = params.first_scan;
-  const long last = params.num_scans < 0 ? -1 : first + params.num_scans;  // exclusive
+  // exclusive; first + num_scans may not fit a long (vasco_first_scan near LONG_MAX)
+  const long last = params.num_scans < 0 || params.num_scans > LONG_MAX - first ? -1 : first + params.num_scans;
   long since_progress = 0;
   while (reader.next(msg)) {
     if (progress && ++since_progress >= 2048) {

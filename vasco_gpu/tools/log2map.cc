@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <future>
 #include <iostream>
@@ -325,9 +326,12 @@ int run(const Options &opt) {
   r.write_s = seconds_since(t);
   r.total_s = seconds_since(t_start);
 
-  for (const auto &w : r.input.warnings) std::fprintf(stderr, "log2map: warning: %s\n", w.c_str());
+  for (const auto &w : r.input.warnings)
+    std::fprintf(stderr, "log2map: warning: %s\n", carmen::printable(w).c_str());
   if (!opt.quiet) print_summary(opt, r);
   if (opt.json) print_json(opt, r);
+  if (std::fflush(stdout) != 0 || std::ferror(stdout))
+    throw std::runtime_error(std::string("cannot write to standard output: ") + std::strerror(errno));
   return 0;
 }
 
@@ -350,8 +354,8 @@ int main(int argc, char **argv) {
                  "cpu_double | cpu_threads | cpu_float | cuda | auto (default: auto = cuda if a GPU "
                  "is usable, else cpu_double)")
       ->check(CLI::IsMember({"cpu_double", "cpu_threads", "cpu_float", "cuda", "auto"}));
-  app.add_option("--threads", opt.threads, "threads of cpu_threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", opt.threads, "threads of cpu_threads, 1 to 1024 (default: all cores)")
+      ->check(CLI::Range(0, 1024));
   app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
       ->check(CLI::IsMember({"float", "exact"}));
   app.add_option("--max-memory", opt.max_memory_mib,
@@ -381,12 +385,10 @@ int main(int argc, char **argv) {
   }
   try {
     return run(opt);
-  } catch (const carmen::FileError &e) {
-    std::fprintf(stderr, "log2map: %s\n", e.what());
   } catch (const std::bad_alloc &) {
     std::fprintf(stderr, "log2map: out of memory\n");
   } catch (const std::exception &e) {
-    std::fprintf(stderr, "log2map: %s\n", e.what());
+    std::fprintf(stderr, "log2map: %s\n", carmen::printable(e.what()).c_str());
   }
   return 1;
 }

@@ -30,6 +30,24 @@ class FileError : public std::runtime_error {
   std::string message_;
 };
 
+// `text` fit for a terminal: control characters (escape sequences from a
+// hostile file among them) shown as \xNN instead of being sent raw.
+inline std::string printable(const std::string &text) {
+  static const char hex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(text.size());
+  for (unsigned char c : text) {
+    if (c < 0x20 || c == 0x7f) {
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
 }  // namespace carmen
 
 #endif  // CARMEN_COMPAT_ERROR_H
