@@ -1,13 +1,14 @@
 # Thin wrapper around CMake. `make` builds (Release) in build/, `make test`
 # builds and runs the test suite, `make golden` checks every public CARMEN
-# golden map, `make demo` maps the bundled fr079 log.
+# golden map, `make test-sanitize` and `make fuzz` run the suite under
+# ASan/UBSan and the libFuzzer targets, `make demo` maps the bundled fr079 log.
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 GOLDEN_DIR ?= ../shared/golden
 GOLDEN_DATA ?= ../shared/data
 
-.PHONY: all configure test golden demo bench deps clean
+.PHONY: all configure test test-sanitize fuzz fuzz-smoke golden demo bench deps clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -17,6 +18,33 @@ configure: deps
 
 test: all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow
+
+# The CPU test suite under AddressSanitizer + UndefinedBehaviorSanitizer
+# (a separate build in build-asan).
+test-sanitize: deps
+	@test -f build-asan/CMakeCache.txt || cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DVASCO_GPU_CUDA=OFF -DVASCO_GPU_SANITIZE=ON -DVASCO_GPU_BUILD_BENCH=OFF
+	cmake --build build-asan -j $(JOBS)
+	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS) -LE slow
+
+# libFuzzer targets (clang), seeded from the test data: each runs
+# FUZZ_SECONDS (default 300; CI's fuzz-smoke: 20). New inputs go to build-fuzz/corpus.
+FUZZ_SECONDS ?= 300
+FUZZ_TARGETS = fuzz_log_reader fuzz_ini fuzz_map_reader fuzz_readlog fuzz_egrid fuzz_pipeline
+fuzz: deps
+	@test -f build-fuzz/CMakeCache.txt || CC=clang CXX=clang++ cmake -S . -B build-fuzz \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVASCO_GPU_CUDA=OFF -DVASCO_GPU_FUZZ=ON \
+	  -DVASCO_GPU_BUILD_TESTS=OFF -DVASCO_GPU_BUILD_BENCH=OFF
+	cmake --build build-fuzz -j $(JOBS) --target $(FUZZ_TARGETS)
+	@set -e; for t in $(FUZZ_TARGETS); do \
+	  mkdir -p build-fuzz/corpus/$$t; \
+	  echo "== $$t ($(FUZZ_SECONDS) s)"; \
+	  build-fuzz/bin/$$t -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 -timeout=20 -print_final_stats=1 \
+	    build-fuzz/corpus/$$t fuzz/seeds/$$t 2>&1 | tail -4; \
+	done
+
+fuzz-smoke:
+	$(MAKE) fuzz FUZZ_SECONDS=20
 
 # Every public CARMEN golden case (../shared/golden) through every exact path,
 # a line per case and path, then a summary; float paths reported against them.
