@@ -40,7 +40,8 @@ fuzz: deps
 	  mkdir -p build-fuzz/corpus/$$t; \
 	  echo "== $$t ($(FUZZ_SECONDS) s)"; \
 	  build-fuzz/bin/$$t -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 -timeout=20 -print_final_stats=1 \
-	    build-fuzz/corpus/$$t fuzz/seeds/$$t 2>&1 | tail -4; \
+	    build-fuzz/corpus/$$t fuzz/seeds/$$t > build-fuzz/$$t.log 2>&1 || { tail -60 build-fuzz/$$t.log; exit 1; }; \
+	  grep -E "executed_units|new_units_added" build-fuzz/$$t.log; \
 	done
 
 fuzz-smoke:

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <thread>
 
 #include "carmen_compat/error.h"
 #include "map_test_support.h"
@@ -231,6 +232,38 @@ TEST(MapImagePng, FreiburgOrientation) {
     }
   }
   EXPECT_GT(checked, 500u);
+}
+
+
+// A PGM name with a line break (or quotes, or a colon) cannot add keys to
+// the YAML: the image name is a quoted YAML string then.
+TEST(MapImagePgm, ANameWithALineBreakCannotInjectKeys) {
+  TempDir dir;
+  const std::string pgm = dir.file("evil\nnegate: 1.pgm");
+  carmen::write_pgm_with_yaml(pgm, tiny_map(), {});
+  const std::string yaml = maptest::read_bytes(carmen::yaml_path_for(pgm));
+  EXPECT_NE(yaml.find("image: \"evil\\x0anegate: 1.pgm\"\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("\nnegate: 0\n"), std::string::npos) << yaml;
+  EXPECT_EQ(yaml.find("\nnegate: 1"), std::string::npos) << yaml;
+}
+
+// Two writers of the same PGM and YAML at once: every time, the pair on disk
+// comes from one of them (the image's width matches the YAML's resolution).
+TEST(MapImagePgm, ConcurrentWritersLeaveAConsistentPair) {
+  TempDir dir;
+  const std::string pgm = dir.file("shared.pgm");
+  carmen::GridMap a = carmen::GridMap::filled(10, 4, 0.1, 0.5f), b = carmen::GridMap::filled(20, 4, 0.2, 0.5f);
+  for (int round = 0; round < 100; ++round) {
+    std::thread t1([&] { carmen::write_pgm_with_yaml(pgm, a, {}); });
+    std::thread t2([&] { carmen::write_pgm_with_yaml(pgm, b, {}); });
+    t1.join();
+    t2.join();
+    const std::string image = maptest::read_bytes(pgm);
+    const std::string yaml = maptest::read_bytes(carmen::yaml_path_for(pgm));
+    const bool from_a = image.rfind("P5\n10 4\n", 0) == 0;
+    ASSERT_NE(yaml.find(from_a ? "resolution: 0.1\n" : "resolution: 0.2\n"), std::string::npos)
+        << "round " << round << ": image from " << (from_a ? "a" : "b") << ", yaml:\n" << yaml;
+  }
 }
 
 }  // namespace
