@@ -67,27 +67,19 @@ class CpuFloatBackend : public Backend {
         ++st.beams_used;
         const int x2 = egrid::trunc_to_int(lx + (r + wall) * std::cos(angle) / res);
         const int y2 = egrid::trunc_to_int(ly + (r + wall) * std::sin(angle) / res);
-        egrid::BresenhamLine line;
-        egrid::bresenham_init(line, x1, y1, x2, y2);
-        // Cut after table_size steps: no later cell is updated (see oracle.h).
-        for (int k = 0; k < table_size; ++k) {
-          int cx, cy;
-          egrid::bresenham_current(line, &cx, &cy);
-          if (cx >= 0 && cx < sx && cy >= 0 && cy < sy) {
-            const int i = cx > x1 ? cx - x1 : x1 - cx;
-            const int j = cy > y1 ? cy - y1 : y1 - cy;
-            const float d = (i >= table_size || j >= table_size)
-                                ? static_cast<float>(egrid::kFarDistance)
-                            : tabulated ? table[static_cast<size_t>(i) * table_size + j]
-                                        : std::sqrt(static_cast<float>(i * i + j * j)) * res;
-            float p;
-            if (!egrid::sensor_model_f(model, d, r, &p)) break;
-            float &cell = cells[static_cast<size_t>(cx) * sy + cy];
-            cell = egrid::odds_update_f(cell, model.prior, p);
-            ++st.cell_updates;
-          }
-          if (!egrid::bresenham_next(line)) break;
-        }
+        // The oracle's walk; the distance and the update in single precision.
+        egrid::walk_beam_cells(x1, y1, x2, y2, table_size, sx, sy, [&](int cx, int cy, int i, int j) {
+          const float d = (i >= table_size || j >= table_size || i < 0 || j < 0)
+                              ? static_cast<float>(egrid::kFarDistance)
+                          : tabulated ? table[static_cast<size_t>(i) * table_size + j]
+                                      : std::sqrt(static_cast<float>(i * i + j * j)) * res;
+          float p;
+          if (!egrid::sensor_model_f(model, d, r, &p)) return false;
+          float &cell = cells[static_cast<size_t>(cx) * sy + cy];
+          cell = egrid::odds_update_f(cell, model.prior, p);
+          ++st.cell_updates;
+          return true;
+        });
       }
     }
     st.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -217,33 +217,18 @@ uint64_t walk_closed(const Context &c, const Beam &b, const oracle::ScanStart &s
 
 // oracle::trace_beam, applying only the updates in columns [xa, xb).
 uint64_t walk_degenerate(const Context &c, const Beam &b, const oracle::ScanStart &s, int xa, int xb) {
-  const int x1 = s.x1, y1 = s.y1, T = c.table_size;
-  const double range = b.range;
-  egrid::BresenhamLine l;
-  egrid::bresenham_init(l, x1, y1, b.x2, b.y2);
   uint64_t updates = 0;
-  for (int k = 0; k < T; ++k) {
-    int cx, cy;
-    egrid::bresenham_current(l, &cx, &cy);
-    if (cx >= 0 && cx < c.size_x && cy >= 0 && cy < c.size_y) {
-      const int i = egrid::wrap_abs(egrid::wrap_sub(cx, x1));
-      const int j = egrid::wrap_abs(egrid::wrap_sub(cy, y1));
-      double d;
-      if (i >= T || j >= T || i < 0 || j < 0) {
-        d = egrid::kFarDistance;
-      } else {
-        d = egrid::cell_distance(i, j, c.resolution);
-      }
-      double p;
-      if (!egrid::sensor_model(c.model, d, range, &p)) break;
-      if (cx >= xa && cx < xb) {
-        float &cell = c.cells[static_cast<size_t>(cx) * static_cast<size_t>(c.size_y) + cy];
-        cell = egrid::odds_update(cell, c.model.prior, p);
-        ++updates;
-      }
+  egrid::walk_beam_cells(s.x1, s.y1, b.x2, b.y2, c.table_size, c.size_x, c.size_y, [&](int cx, int cy, int i, int j) {
+    double p;
+    const double d = oracle::table_distance(i, j, c.table_size, nullptr, c.resolution);
+    if (!egrid::sensor_model(c.model, d, b.range, &p)) return false;
+    if (cx >= xa && cx < xb) {
+      float &cell = c.cells[static_cast<size_t>(cx) * static_cast<size_t>(c.size_y) + cy];
+      cell = egrid::odds_update(cell, c.model.prior, p);
+      ++updates;
     }
-    if (!egrid::bresenham_next(l)) break;
-  }
+    return true;
+  });
   return updates;
 }
 

@@ -125,6 +125,26 @@ VG_HD bool bresenham_next(BresenhamLine &l) {
   return true;
 }
 
+// The sequential walk of one beam over the cells it can update, written once
+// for every backend that walks beams step by step: steps k < table_size (no
+// later cell is ever updated: see oracle::trace_beam), cells inside the grid
+// only, with i = |cx - x1| and j = |cy - y1| as CARMEN's int arithmetic gives
+// them. visit(cx, cy, i, j) returns false to stop the beam there.
+template <class Visit>
+VG_HD void walk_beam_cells(int x1, int y1, int x2, int y2, int table_size, int size_x, int size_y,
+                           Visit &&visit) {
+  BresenhamLine line;
+  bresenham_init(line, x1, y1, x2, y2);
+  for (int k = 0; k < table_size; ++k) {
+    int cx, cy;
+    bresenham_current(line, &cx, &cy);
+    if (cx >= 0 && cx < size_x && cy >= 0 && cy < size_y) {
+      if (!visit(cx, cy, wrap_abs(wrap_sub(cx, x1)), wrap_abs(wrap_sub(cy, y1)))) return;
+    }
+    if (!bresenham_next(line)) return;
+  }
+}
+
 // ---------------------------------------------------------------------------
 // The same walk in closed form, for one thread per cell. Valid for lines whose
 // |dx| and |dy| are below 2^29 (then no intermediate value of the sequential

@@ -83,34 +83,28 @@ constexpr int kMaxBuiltDistanceTable = 4096;
 // of -inf gives an end cell 2^31 cells away, which CARMEN walks cell by cell).
 // `distance_table` may be null: the distance is then computed on the fly,
 // which gives the same double.
+// The distance CARMEN looks up for a cell i, j cells from the start: the
+// table's value, 1e6 beyond it (an i or j of INT_MIN, which CARMEN's abs()
+// gives for a wrapped coordinate, counts as beyond). `table` may be null: the
+// same double is then computed.
+inline double table_distance(int i, int j, int table_size, const double *const *table, double resolution) {
+  if (i >= table_size || j >= table_size || i < 0 || j < 0) return egrid::kFarDistance;
+  return table != nullptr ? table[i][j] : egrid::cell_distance(i, j, resolution);
+}
+
 inline long trace_beam(float *cells, int size_x, int size_y, int x1, int y1, int x2, int y2,
                        double range, const egrid::ModelParams &model, double resolution,
                        int table_size, const double *const *distance_table) {
-  egrid::BresenhamLine line;
-  egrid::bresenham_init(line, x1, y1, x2, y2);
   long updates = 0;
-  for (int k = 0; k < table_size; ++k) {
-    int cx, cy;
-    egrid::bresenham_current(line, &cx, &cy);
-    if (cx >= 0 && cx < size_x && cy >= 0 && cy < size_y) {
-      const int i = egrid::wrap_abs(egrid::wrap_sub(cx, x1));
-      const int j = egrid::wrap_abs(egrid::wrap_sub(cy, y1));
-      double d;
-      if (i >= table_size || j >= table_size || i < 0 || j < 0) {
-        d = egrid::kFarDistance;
-      } else if (distance_table != nullptr) {
-        d = distance_table[i][j];
-      } else {
-        d = egrid::cell_distance(i, j, resolution);
-      }
-      double p;
-      if (!egrid::sensor_model(model, d, range, &p)) break;
-      float &cell = cells[static_cast<long>(cx) * size_y + cy];
-      cell = egrid::odds_update(cell, model.prior, p);
-      ++updates;
-    }
-    if (!egrid::bresenham_next(line)) break;
-  }
+  egrid::walk_beam_cells(x1, y1, x2, y2, table_size, size_x, size_y, [&](int cx, int cy, int i, int j) {
+    double p;
+    if (!egrid::sensor_model(model, table_distance(i, j, table_size, distance_table, resolution), range, &p))
+      return false;
+    float &cell = cells[static_cast<long>(cx) * size_y + cy];
+    cell = egrid::odds_update(cell, model.prior, p);
+    ++updates;
+    return true;
+  });
   return updates;
 }
 
