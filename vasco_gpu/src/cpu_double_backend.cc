@@ -17,10 +17,8 @@ class DistanceTable {
     const size_t n = static_cast<size_t>(size);
     values_.resize(n * n);
     rows_.resize(n);
-    for (int i = 0; i < size; ++i) {
-      rows_[i] = values_.data() + static_cast<size_t>(i) * n;
-      for (int j = 0; j < size; ++j) rows_[i][j] = egrid::cell_distance(i, j, resolution);
-    }
+    for (int i = 0; i < size; ++i) rows_[i] = values_.data() + static_cast<size_t>(i) * n;
+    oracle::fill_distance_table(rows_.data(), size, resolution);
   }
   const double *const *rows() const { return rows_.empty() ? nullptr : rows_.data(); }
   int size() const { return size_; }

@@ -260,10 +260,8 @@ void carmen_mapper_initialize_evidence_grid(evidence_grid *grid, int size_x, int
     double *block = static_cast<double *>(std::malloc(tn * tn * sizeof(double)));
     double **rows = static_cast<double **>(std::malloc(tn * sizeof(double *)));
     if (block != nullptr && rows != nullptr) {
-      for (int i = 0; i < t; ++i) {
-        rows[i] = block + static_cast<size_t>(i) * tn;
-        for (int j = 0; j < t; ++j) rows[i][j] = vasco::egrid::cell_distance(i, j, resolution);
-      }
+      for (int i = 0; i < t; ++i) rows[i] = block + static_cast<size_t>(i) * tn;
+      vasco::oracle::fill_distance_table(rows, t, resolution);
       grid->distance_table = rows;
     } else {
       std::free(block);

@@ -83,6 +83,13 @@ constexpr int kMaxBuiltDistanceTable = 4096;
 // of -inf gives an end cell 2^31 cells away, which CARMEN walks cell by cell).
 // `distance_table` may be null: the distance is then computed on the fly,
 // which gives the same double.
+// Fills CARMEN's distance table: rows[i][j] = sqrt(i*i + j*j) * resolution
+// for 0 <= i, j < size (egrid.c's, built by every CPU user of the oracle).
+inline void fill_distance_table(double *const *rows, int size, double resolution) {
+  for (int i = 0; i < size; ++i)
+    for (int j = 0; j < size; ++j) rows[i][j] = egrid::cell_distance(i, j, resolution);
+}
+
 // The distance CARMEN looks up for a cell i, j cells from the start: the
 // table's value, 1e6 beyond it (an i or j of INT_MIN, which CARMEN's abs()
 // gives for a wrapped coordinate, counts as beyond). `table` may be null: the
