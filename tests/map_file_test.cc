@@ -423,7 +423,7 @@ TEST(MapFile, HandMadeFileDecodes) {
   TempDir dir;
   const std::string grid = i32(2) + i32(3) + f32(0.5f) + f32(-1) + f32(0.25f) + f32(0.5f) + f32(0.75f) +
                            f32(1) + f32(0);  // x-major: (0,0) (0,1) (0,2) (1,0) (1,1) (1,2)
-  const std::string places = i32(2) + i32(1) + field("a", 20, '\0') + f32(1) + f32(2) + i32(3) +
+  const std::string places = i32(2) + i32(0) + field("a", 20, '\0') + f32(1) + f32(2) + i32(2) +
                              field("b", 20, '\0') + f32(1) + f32(2) + f32(3) + f32(4) + f32(5) + f32(6);
   const std::string offl = i32(1) + i32(7) + i32(8) + i32(1) + i32(1) + i32(2) + i32(3) + i32(4) + i32(0);
   const std::string scans = i32(1) + f32(1) + f32(2) + f32(3) + i32(2) + f32(4) + f32(5);
@@ -448,7 +448,7 @@ TEST(MapFile, HandMadeFileDecodes) {
   ASSERT_EQ(m.places->size(), 2u);
   EXPECT_EQ((*m.places)[0].name, "a");
   EXPECT_EQ((*m.places)[0].y, 2.0);
-  EXPECT_EQ((*m.places)[1].type, 3);
+  EXPECT_EQ((*m.places)[1].type, 2);  // CARMEN_LOCALIZATION_INIT_TYPE
   EXPECT_EQ((*m.places)[1].theta_std, 6.0);
   ASSERT_TRUE(m.offlimits);
   ASSERT_EQ(m.offlimits->points.size(), 1u);
@@ -585,10 +585,10 @@ TEST(MapFileBad, InconsistentChunks) {
         {"invalid cell values", "1 of 2", "(0, 1)"});
   check(chunk(4, "PLACES", i32(1) + i32(9) + field("p", 20, '\0') + f32(0) + f32(0)),
         {"PLACES", "unknown type 9"});
-  check(chunk(4, "PLACES", i32(1) + i32(1) + field("p", 20, '\0') + f32(0) + f32(0) + "zz"),
+  check(chunk(4, "PLACES", i32(1) + i32(0) + field("p", 20, '\0') + f32(0) + f32(0) + "zz"),
         {"PLACES", "2 unexpected bytes"});
   check(chunk(4, "PLACES", i32(-1)), {"negative"});
-  check(chunk(4, "PLACES", i32(2) + i32(2) + field("p", 20, '\0') + f32(0) + f32(0)), {"claims 2 places"});
+  check(chunk(4, "PLACES", i32(2) + i32(0) + field("p", 20, '\0') + f32(0) + f32(0)), {"claims 2 places"});
   check(chunk(2, "OFFLIMITS", i32(1) + i32(1) + i32(1)), {"OFFLIMITS", "ends inside"});
   check(chunk(16, "LASERSCANS", i32(1) + f32(0) + f32(0) + f32(0) + i32(1000)), {"claims 1000 readings"});
   check(chunk(64, "OFFSET", f64(1) + f64(2)), {"OFFSET", "24"});
@@ -785,6 +785,39 @@ TEST(MapFileLimits, ChunkDataBeyondTheBudgetIsRefused) {
     EXPECT_EQ(e.file(), path);
     EXPECT_NE(std::string(e.what()).find("max_kept_bytes"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+
+namespace {
+
+// PLACES type codes are CARMEN's map.h values (carmen-formats.md §3.3):
+// 0 position (x y), 1 pose (x y theta), 2 localization init (6 floats).
+// A chunk laid out by hand as CARMEN writes a pose reads as a pose, and ours
+// puts the int 1 on disk for one.
+TEST(MapFilePlaces, TypeCodesAreCarmens) {
+  maptest::TempDir dir;
+  carmen::MapFile m;
+  m.gridmap = carmen::GridMap::filled(2, 2, 0.1, 0.5f);
+  m.places = carmen::PlaceList{{carmen::kNamedPose, "desk", 1.0, 2.0, 0.5, 0, 0, 0}};
+  const std::string path = dir.file("p.map");
+  carmen::write_map_file(path, m);
+  const std::string bytes = maptest::read_bytes(path);
+  const size_t at = bytes.find("PLACES    ");
+  ASSERT_NE(at, std::string::npos);
+  int32_t count, type;
+  std::memcpy(&count, bytes.data() + at + 10, 4);
+  std::memcpy(&type, bytes.data() + at + 14, 4);
+  EXPECT_EQ(count, 1);
+  EXPECT_EQ(type, 1);  // CARMEN_NAMED_POSE_TYPE
+  // Chunk size: 10 (description) + 4 (count) + 4 (type) + 20 (name) + 3 floats.
+  int32_t size;
+  std::memcpy(&size, bytes.data() + at - 4, 4);
+  EXPECT_EQ(size, 10 + 4 + 4 + 20 + 12);
+  const carmen::MapFile back = carmen::read_map_file(path);
+  ASSERT_TRUE(back.places);
+  EXPECT_EQ((*back.places)[0].type, 1);
+  EXPECT_EQ((*back.places)[0].theta, 0.5);
 }
 
 }  // namespace

@@ -292,7 +292,7 @@ TEST(MapIoWriters, RejectBadArguments) {
   EXPECT_EQ(carmen_map_write_offlimits_chunk(fp, &bad, 1), -1);
   carmen_place_t place;
   std::memset(&place, 0, sizeof place);
-  place.type = 0;
+  place.type = 7;  // CARMEN knows 0, 1 and 2
   EXPECT_EQ(carmen_map_write_places_chunk(fp, &place, 1), -1);
   EXPECT_EQ(carmen_map_write_id(nullptr), -1);
   const std::string err = testing::internal::GetCapturedStderr();

@@ -330,7 +330,7 @@ PlaceList parse_places(const std::vector<unsigned char> &b) {
     }
     if (p.type != kNamedPosition && p.type != kNamedPose && p.type != kLocalizationInit) {
       throw ParseError{"has place " + std::to_string(i) + " with unknown type " + std::to_string(p.type) +
-                       " (expected 1 position, 2 pose or 3 localization init)"};
+                       " (expected 0 position, 1 pose or 2 localization init, as CARMEN's map.h)"};
     }
     places.push_back(std::move(p));
   }

@@ -56,9 +56,9 @@ typedef struct {
 
 /* Place types. A position stores x y, a pose x y theta, a localization init
  * x y theta x_std y_std theta_std. */
-#define CARMEN_NAMED_POSITION_TYPE 1
-#define CARMEN_NAMED_POSE_TYPE 2
-#define CARMEN_LOCALIZATION_INIT_TYPE 3
+#define CARMEN_NAMED_POSITION_TYPE 0
+#define CARMEN_NAMED_POSE_TYPE 1
+#define CARMEN_LOCALIZATION_INIT_TYPE 2
 
 typedef struct {
   int type;

@@ -93,9 +93,9 @@ struct CreatorInfo {
 // x y, a pose x y theta, a localization init x y theta x_std y_std theta_std
 // (all as float32 in the file).
 enum PlaceType : int {
-  kNamedPosition = 1,
-  kNamedPose = 2,
-  kLocalizationInit = 3,
+  kNamedPosition = 0,
+  kNamedPose = 1,
+  kLocalizationInit = 2,
 };
 struct Place {
   int type = kNamedPosition;
