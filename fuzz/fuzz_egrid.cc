@@ -25,7 +25,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     switch (b.u8() % 8) {
       case 0: carmen_mapper_clear_evidence_grid(&g); break;
-      case 1: carmen_mapper_update_evidence_grid_general(&g, x, y, t, n, r.data(), a.data()); break;
+      case 1: carmen_mapper_update_evidence_grid_general(&g, x, y, t, n, r.data(), a.data(), 0.0, 0.0); break;
       default: carmen_mapper_update_evidence_grid(&g, x, y, t, n, r.data(), b.in(-0.1, 0.1), b.in(-4, 4));
     }
   }

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <type_traits>
+
 #include <cmath>
 
 namespace {
@@ -94,7 +96,7 @@ TEST_F(EgridApi, MinusInfinityRangeEndsQuickly) {
 TEST_F(EgridApi, GeneralUpdateUsesPerBeamAngles) {
   float r[2] = {2.0f, 2.0f};
   float a[2] = {0.0f, static_cast<float>(M_PI)};
-  carmen_mapper_update_evidence_grid_general(&g, 0.0, 0.0, 0.0, 2, r, a);
+  carmen_mapper_update_evidence_grid_general(&g, 0.0, 0.0, 0.0, 2, r, a, 0.0, 0.0);
   EXPECT_EQ(g.prob[12][10], kOcc1);
   // (float)pi is a little above pi, so sin is about -8.7e-8 and the end cell's
   // y is (int)(10 - 1.7e-7) = 9: truncation, not rounding. The walk
@@ -133,10 +135,33 @@ TEST_F(EgridApi, FinishDownsamplesAndCrops) {
   EXPECT_EQ(g.resolution, 2.0);
 }
 
-TEST(EgridApiErrors, NullAndBadSizesDoNotCrash) {
-  carmen_mapper_initialize_evidence_grid(nullptr, 10, 10, 1, 0, 0.5, 0.55, 0.45, 0.95, 5, 10, 0);
+// CARMEN 0.7.4's prototypes exactly (DESIGN §2): a CARMEN program that keeps
+// these functions in pointers of CARMEN's types compiles against ours.
+static_assert(std::is_same<decltype(&carmen_mapper_initialize_evidence_grid),
+                           int (*)(evidence_grid *, int, int, double, double, double, double, double,
+                                   double, double, double, double)>::value,
+              "carmen_mapper_initialize_evidence_grid: CARMEN's prototype");
+static_assert(std::is_same<decltype(&carmen_mapper_update_evidence_grid_general),
+                           void (*)(evidence_grid *, double, double, double, int, float *, float *, double,
+                                    double)>::value,
+              "carmen_mapper_update_evidence_grid_general: CARMEN's prototype");
+static_assert(std::is_same<decltype(&carmen_mapper_update_evidence_grid),
+                           void (*)(evidence_grid *, double, double, double, int, float *, double, double)>::value,
+              "carmen_mapper_update_evidence_grid: CARMEN's prototype");
+#ifndef EGRID_H
+#error "egrid.h must define CARMEN's guard EGRID_H"
+#endif
+
+TEST(EgridApi, InitializeReturnsZero) {
   evidence_grid g;
-  carmen_mapper_initialize_evidence_grid(&g, -5, 10, 1, 0, 0.5, 0.55, 0.45, 0.95, 5, 10, 0);
+  EXPECT_EQ(carmen_mapper_initialize_evidence_grid(&g, 10, 10, 1, 0, 0.5, 0.55, 0.45, 0.95, 5, 10, 0), 0);
+  carmen_mapper_free_evidence_grid(&g);
+}
+
+TEST(EgridApiErrors, NullAndBadSizesDoNotCrash) {
+  EXPECT_EQ(carmen_mapper_initialize_evidence_grid(nullptr, 10, 10, 1, 0, 0.5, 0.55, 0.45, 0.95, 5, 10, 0), -1);
+  evidence_grid g;
+  EXPECT_EQ(carmen_mapper_initialize_evidence_grid(&g, -5, 10, 1, 0, 0.5, 0.55, 0.45, 0.95, 5, 10, 0), -1);
   EXPECT_EQ(g.prob, nullptr);
   float r = 1;
   carmen_mapper_update_evidence_grid(&g, 0, 0, 0, 1, &r, 0, 0);  // no-op

@@ -84,8 +84,8 @@ TEST_F(EgridSession, CpuThreadsKeepsCarmensBytesThroughClearAndGeneralUpdates) {
   std::vector<float> angles(181);
   for (size_t i = 0; i < angles.size(); ++i) angles[i] = static_cast<float>(-M_PI / 2 + i * M_PI / 180);
   random_scan(rng, &r, &x, &y, &th);
-  carmen_mapper_update_evidence_grid_general(&t.a, x, y, th, 181, r.data(), angles.data());
-  carmen_mapper_update_evidence_grid_general(&t.b, x, y, th, 181, r.data(), angles.data());
+  carmen_mapper_update_evidence_grid_general(&t.a, x, y, th, 181, r.data(), angles.data(), 0, 0);
+  carmen_mapper_update_evidence_grid_general(&t.b, x, y, th, 181, r.data(), angles.data(), 0, 0);
   t.expect_equal("general update");
   EXPECT_STREQ(vasco_egrid_grid_backend(&t.b), "cpu_double");  // the oracle from now on
   for (int i = 0; i < 5; ++i) both_update("update after a general one");

@@ -99,10 +99,10 @@ inline std::string digest(const FinishedMap &m) {
 inline FinishedMap run_egrid_c_api(const LogInput &in) {
   const MapperParams &p = in.params;
   evidence_grid g;
-  carmen_mapper_initialize_evidence_grid(&g, in.geo.size_x, in.geo.size_y, p.resolution,
+  const int init = carmen_mapper_initialize_evidence_grid(&g, in.geo.size_x, in.geo.size_y, p.resolution,
                                          in.geo.theta_offset, p.p_prior, p.p_occ, p.p_emp, 0.99,
                                          p.range_sure, p.range_max, p.wall_size);
-  if (g.prob == nullptr) throw std::runtime_error("egrid: the grid could not be allocated");
+  if (init != 0 || g.prob == nullptr) throw std::runtime_error("egrid: the grid could not be allocated");
   const ScanBatch &b = in.batch;
   for (size_t s = 0; s < b.num_scans(); ++s) {
     std::vector<float> ranges(b.ranges_of(s), b.ranges_of(s) + b.beams_in(s));

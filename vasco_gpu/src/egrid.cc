@@ -216,15 +216,15 @@ void update_on_session(evidence_grid *g, Session &s, double x, double y, double 
 
 extern "C" {
 
-void carmen_mapper_initialize_evidence_grid(evidence_grid *grid, int size_x, int size_y,
-                                            double resolution, double theta_offset,
-                                            double prior_occ, double occ_evidence,
-                                            double emp_evidence, double max_prob,
-                                            double max_sure_range, double max_range,
-                                            double wall_thickness) {
+int carmen_mapper_initialize_evidence_grid(evidence_grid *grid, int size_x, int size_y,
+                                           double resolution, double theta_offset,
+                                           double prior_occ, double occ_evidence,
+                                           double emp_evidence, double max_prob,
+                                           double max_sure_range, double max_range,
+                                           double wall_thickness) {
   if (grid == nullptr) {
     std::fprintf(stderr, "carmen_mapper_initialize_evidence_grid: grid is NULL\n");
-    return;
+    return -1;
   }
   std::memset(grid, 0, sizeof(*grid));
   grid->resolution = resolution;
@@ -242,13 +242,13 @@ void carmen_mapper_initialize_evidence_grid(evidence_grid *grid, int size_x, int
   if (size_x <= 0 || size_y <= 0 || !(resolution > 0)) {
     std::fprintf(stderr, "carmen_mapper_initialize_evidence_grid: bad size %d x %d or resolution %g\n",
                  size_x, size_y, resolution);
-    return;
+    return -1;
   }
   grid->prob = alloc_columns(size_x, size_y);
   if (grid->prob == nullptr) {
     std::fprintf(stderr, "carmen_mapper_initialize_evidence_grid: cannot allocate %d x %d cells\n",
                  size_x, size_y);
-    return;
+    return -1;
   }
   const size_t n = static_cast<size_t>(size_x) * size_y;
   for (size_t i = 0; i < n; ++i) grid->prob[0][i] = vasco::egrid::kUnknown;
@@ -274,6 +274,7 @@ void carmen_mapper_initialize_evidence_grid(evidence_grid *grid, int size_x, int
     std::lock_guard<std::mutex> lock(sessions_mutex);
     sessions()[grid] = std::move(s);
   }
+  return 0;
 }
 
 void carmen_mapper_update_evidence_grid(evidence_grid *grid, double laser_x, double laser_y,
@@ -298,7 +299,8 @@ void carmen_mapper_update_evidence_grid(evidence_grid *grid, double laser_x, dou
 void carmen_mapper_update_evidence_grid_general(evidence_grid *grid, double laser_x,
                                                 double laser_y, double laser_theta,
                                                 int num_readings, float *laser_range,
-                                                float *laser_angle) {
+                                                float *laser_angle, double /*angular_resolution*/,
+                                                double /*first_beam_angle*/) {
   if (laser_angle == nullptr) return;
   drop_session(grid);  // per-beam angles: the oracle, from now on (g->prob is current)
   update(grid, laser_x, laser_y, laser_theta, num_readings, laser_range,

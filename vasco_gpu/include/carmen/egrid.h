@@ -4,11 +4,11 @@
  * oracle, which reproduces CARMEN's arithmetic bit for bit.
  *
  * Differences from CARMEN, all on input CARMEN would crash on:
- *  - allocation failure prints a message and leaves `prob` NULL (every later
- *    call is then a no-op) instead of exiting;
- *  - NULL pointers and negative sizes are rejected with a message. */
-#ifndef CARMEN_EGRID_H
-#define CARMEN_EGRID_H
+ *  - allocation failure prints a message, returns -1 (as CARMEN does) and
+ *    leaves `prob` NULL, so every later call is a no-op;
+ *  - NULL pointers and negative sizes are rejected with a message (and -1). */
+#ifndef EGRID_H
+#define EGRID_H /* CARMEN's guard name: a program may test it */
 
 #ifdef __cplusplus
 extern "C" {
@@ -27,7 +27,8 @@ typedef struct {
   double start_x, start_y, start_theta;
 } evidence_grid;
 
-void carmen_mapper_initialize_evidence_grid(evidence_grid *grid, int size_x, int size_y,
+/* 0, or -1 when the grid cannot be allocated (or the arguments are bad). */
+int carmen_mapper_initialize_evidence_grid(evidence_grid *grid, int size_x, int size_y,
                                             double resolution, double theta_offset,
                                             double prior_occ, double occ_evidence,
                                             double emp_evidence, double max_prob,
@@ -40,11 +41,13 @@ void carmen_mapper_update_evidence_grid(evidence_grid *grid, double laser_x, dou
                                         double laser_theta, int num_readings, float *laser_range,
                                         double angular_resolution, double first_beam_angle);
 
-/* Beam i points at laser_theta + laser_angle[i]. */
+/* Beam i points at laser_theta + laser_angle[i]; angular_resolution and
+ * first_beam_angle are taken, and unused, as in CARMEN. */
 void carmen_mapper_update_evidence_grid_general(evidence_grid *grid, double laser_x,
                                                 double laser_y, double laser_theta,
                                                 int num_readings, float *laser_range,
-                                                float *laser_angle);
+                                                float *laser_angle, double angular_resolution,
+                                                double first_beam_angle);
 
 /* Every cell to the prior. */
 void carmen_mapper_clear_evidence_grid(evidence_grid *grid);
@@ -80,4 +83,4 @@ const char *vasco_egrid_grid_backend(const evidence_grid *grid);
 #ifdef __cplusplus
 }
 #endif
-#endif /* CARMEN_EGRID_H */
+#endif /* EGRID_H */
