@@ -152,7 +152,7 @@ static_assert(std::is_same<decltype(&carmen_mapper_update_evidence_grid),
 #error "egrid.h must define CARMEN's guard EGRID_H"
 #endif
 
-TEST(EgridApi, InitializeReturnsZero) {
+TEST(EgridApiPrototypes, InitializeReturnsZero) {
   evidence_grid g;
   EXPECT_EQ(carmen_mapper_initialize_evidence_grid(&g, 10, 10, 1, 0, 0.5, 0.55, 0.45, 0.95, 5, 10, 0), 0);
   carmen_mapper_free_evidence_grid(&g);
