@@ -8,7 +8,7 @@ CMAKE_FLAGS ?=
 GOLDEN_DIR ?= ../shared/golden
 GOLDEN_DATA ?= ../shared/data
 
-.PHONY: all configure test test-sanitize fuzz fuzz-smoke golden demo bench deps clean
+.PHONY: all configure test test-sanitize fuzz fuzz-smoke golden demo bench install deps clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -18,6 +18,12 @@ configure: deps
 
 test: all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow
+
+# Installs headers, libraries (also under CARMEN's names libegrid, libmap_io,
+# libreadlog), tools, the CMake package and vasco_gpu.pc into PREFIX.
+PREFIX ?= /usr/local
+install: all
+	cmake --install $(BUILD) --prefix $(PREFIX)
 
 # The CPU test suite under AddressSanitizer + UndefinedBehaviorSanitizer
 # (a separate build in build-asan).
