@@ -55,8 +55,8 @@ TEST(CudaBackend, WithoutAGpuCudaIsAClearError) {
   } catch (const std::runtime_error &e) {
     EXPECT_NE(std::string(e.what()).find("--backend cuda"), std::string::npos) << e.what();
   }
-  // auto falls back to the oracle.
-  EXPECT_EQ(make_backend("auto", BackendOptions{})->name(), "cpu_double");
+  // auto falls back to cpu_threads (the oracle's bytes, on every core).
+  EXPECT_EQ(make_backend("auto", BackendOptions{})->name(), "cpu_threads");
 }
 
 class CudaGolden : public ::testing::TestWithParam<const char *> {};

@@ -31,7 +31,8 @@ std::unique_ptr<Backend> make_backend(const std::string &name, const BackendOpti
     if (name == "cuda")
       throw std::runtime_error("--backend cuda: this build has no CUDA backend (configured without nvcc)");
 #endif
-    return make_cpu_double_backend();
+    // No GPU: cpu_threads, which gives cpu_double's bytes on every core.
+    return make_cpu_threads_backend(options.threads);
   }
   throw std::invalid_argument("unknown backend '" + name + "'");
 }

@@ -200,6 +200,17 @@ std::future<bool> start_cuda(const Options &opt, const vasco::BackendOptions &bo
   return ready;
 }
 
+// Why the GPU backend is not used, for the --backend auto note.
+std::string no_gpu_reason(const vasco::BackendOptions &bopt) {
+#if defined(VASCO_HAVE_CUDA)
+  std::string why;
+  return vasco::cuda_usable(bopt.cuda_device, &why) ? "GPU usable" : "no usable GPU (" + why + ")";
+#else
+  (void)bopt;
+  return "this build has no CUDA backend";
+#endif
+}
+
 // Parameters (command line > ini > the log's PARAM lines > defaults), the
 // scans and the grid, with a progress bar on a terminal.
 vasco::LogInput read_input(const Options &opt) {
@@ -302,6 +313,8 @@ int run(const Options &opt) {
   // A mapping session in the PROTOCOL frame, fed every scan at once.
   vasco::Mapper mapper(r.input.params, opt.backend, bopt);
   r.backend = mapper.backend_name();
+  if (opt.backend == "auto" && r.backend.rfind("cuda", 0) != 0 && !opt.quiet)
+    std::fprintf(stderr, "log2map: --backend auto: %s: using %s\n", no_gpu_reason(bopt).c_str(), r.backend.c_str());
   t = Clock::now();
   try {
     mapper.insert(r.input.batch);
@@ -352,7 +365,7 @@ int main(int argc, char **argv) {
   app.add_option("--robot", opt.robot, "robot section of the ini to use");
   app.add_option("--backend", opt.backend,
                  "cpu_double | cpu_threads | cpu_float | cuda | auto (default: auto = cuda if a GPU "
-                 "is usable, else cpu_double)")
+                 "is usable, else cpu_threads)")
       ->check(CLI::IsMember({"cpu_double", "cpu_threads", "cpu_float", "cuda", "auto"}));
   app.add_option("--threads", opt.threads, "threads of cpu_threads, 1 to 1024 (default: all cores)")
       ->check(CLI::Range(0, 1024));

@@ -68,7 +68,8 @@ class Backend {
 };
 
 // Backend names accepted by make_backend: cpu_double, cpu_threads, cpu_float,
-// cuda (if compiled in) and auto (cuda when a GPU is usable, else cpu_double).
+// cuda (if compiled in) and auto (cuda when a GPU is usable, else
+// cpu_threads: the oracle's bytes on every core).
 std::vector<std::string> compiled_backends();
 
 // Creates a backend; throws std::invalid_argument for an unknown name and
