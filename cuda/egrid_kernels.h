@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 namespace vasco {
 namespace cuda {
@@ -126,6 +127,10 @@ struct FloatModel {
 
 // Sets every cell to -0.0f, float mode's "never updated".
 void launch_float_clear(float *logodds, size_t num_cells, cudaStream_t stream);
+
+// Whether this build holds code the current device can run (machine code for
+// its architecture, or PTX the driver can compile for it); `why` otherwise.
+bool kernels_runnable_on_current_device(std::string *why);
 
 // Every cell to `value` (exact mode: a fresh grid is all kUnknown).
 void launch_fill(float *cells, size_t num_cells, float value, cudaStream_t stream);

@@ -148,6 +148,15 @@ unsigned fill_blocks(size_t n) { return static_cast<unsigned>(std::min<size_t>((
 
 }  // namespace
 
+bool kernels_runnable_on_current_device(std::string *why) {
+  cudaFuncAttributes attr;
+  const cudaError_t err = cudaFuncGetAttributes(&attr, fill_kernel);
+  if (err == cudaSuccess) return true;
+  (void)cudaGetLastError();  // clear it: the caller falls back to the CPU
+  if (why != nullptr) *why = cudaGetErrorString(err);
+  return false;
+}
+
 void launch_fill(float *cells, size_t num_cells, float value, cudaStream_t stream) {
   if (num_cells == 0) return;
   fill_kernel<<<fill_blocks(num_cells), 256, 0, stream>>>(cells, num_cells, value);

@@ -221,9 +221,11 @@ bool cuda_usable(int device, std::string *why) {
               cudaGetErrorString(err) + ")";
       return;
     }
-    if (prop.major < 9) {
-      s.why = std::string(prop.name) + " is compute capability " + std::to_string(prop.major) + "." +
-              std::to_string(prop.minor) + "; this build targets sm_90";
+    std::string image_why;
+    if (!cuda::kernels_runnable_on_current_device(&image_why)) {
+      s.why = std::string(prop.name) + " (compute capability " + std::to_string(prop.major) + "." +
+              std::to_string(prop.minor) + ") cannot run this build's kernels (" + image_why +
+              "): rebuild with its architecture in CMAKE_CUDA_ARCHITECTURES";
       return;
     }
     s.usable = true;
