@@ -86,18 +86,9 @@ std::string temp_map_path() {
   return std::string(tmp ? tmp : "/tmp") + "/vasco_bench_" + std::to_string(getpid()) + ".map.gz";
 }
 
-// One timed run of a backend alone (the paper's kernels, which only map whole
-// batches): map, finish, write.
-void run_once(vasco::Backend &backend, const vasco::ScanBatch &batch, const vasco::MapperParams &p,
-              const vasco::GridGeometry &geo, Phases *ph) {
-  const double t0 = now_s();
-  vasco::MapStats st;
-  std::vector<float> cells = backend.map(batch, p, geo, &st);
-  const double t1 = now_s();
-  const vasco::FinishedMap fin = vasco::finish_grid(cells.data(), geo.size_x, geo.size_y,
-                                                    geo.resolution, static_cast<int>(p.downsample),
-                                                    static_cast<int>(p.border));
-  const double t2 = now_s();
+// Writes a finished map as a .map.gz to a temporary file and removes it
+// (the write phase of a run).
+void write_and_discard(const vasco::FinishedMap &fin) {
   carmen::MapFile mf;
   carmen::GridMap g;
   g.size_x = fin.size_x;
@@ -108,16 +99,35 @@ void run_once(vasco::Backend &backend, const vasco::ScanBatch &batch, const vasc
   const std::string out = temp_map_path();
   carmen::write_map_file(out, mf);
   std::remove(out.c_str());
-  const double t3 = now_s();
+}
+
+// One run's phases, from its stats and the times t0 (start), t1 (mapped),
+// t2 (finished), t3 (written). map: CPU backends the wall time, GPU
+// backends the kernels (events).
+void record(Phases *ph, const vasco::MapStats &st, bool gpu, double t0, double t1, double t2, double t3) {
   ph->prep.push_back(st.prep_s);
   ph->upload.push_back(st.upload_s);
-  // CPU backends: the wall time of map(); GPU backends: the kernels (events).
-  ph->map.push_back(backend.name().rfind("cuda", 0) == 0 ? st.map_s : (t1 - t0));
+  ph->map.push_back(gpu ? st.map_s : (t1 - t0));
   ph->download.push_back(st.download_s);
   ph->finish.push_back(t2 - t1);
   ph->write.push_back(t3 - t2);
   ph->total.push_back(t3 - t0);
   ph->stats = st;
+}
+
+// One timed run of a backend alone (the paper's kernels, which only map whole
+// batches): map, finish, write.
+void run_once(vasco::Backend &backend, const vasco::ScanBatch &batch, const vasco::MapperParams &p,
+              const vasco::GridGeometry &geo, Phases *ph) {
+  const double t0 = now_s();
+  vasco::MapStats st;
+  std::vector<float> cells = backend.map(batch, p, geo, &st);
+  const double t1 = now_s();
+  const vasco::FinishedMap fin = vasco::finish_grid(cells.data(), geo.size_x, geo.size_y, geo.resolution,
+                                                    static_cast<int>(p.downsample), static_cast<int>(p.border));
+  const double t2 = now_s();
+  write_and_discard(fin);
+  record(ph, st, backend.name().rfind("cuda", 0) == 0, t0, t1, t2, now_s());
 }
 
 // One timed run through a mapping session, as log2map maps a log: a fresh
@@ -133,26 +143,8 @@ void run_session_once(const BackendSpec &spec, int threads, const vasco::ScanBat
   const double t1 = now_s();
   const vasco::FinishedMap fin = m.finish();
   const double t2 = now_s();
-  carmen::MapFile mf;
-  carmen::GridMap g;
-  g.size_x = fin.size_x;
-  g.size_y = fin.size_y;
-  g.resolution = fin.resolution;
-  g.cells = fin.cells;
-  mf.gridmap = std::move(g);
-  const std::string out = temp_map_path();
-  carmen::write_map_file(out, mf);
-  std::remove(out.c_str());
-  const double t3 = now_s();
-  ph->prep.push_back(st.prep_s);
-  ph->upload.push_back(st.upload_s);
-  // CPU backends: the wall time of the insert; GPU backends: the kernels (events).
-  ph->map.push_back(spec.gpu ? st.map_s : (t1 - t0));
-  ph->download.push_back(st.download_s);
-  ph->finish.push_back(t2 - t1);
-  ph->write.push_back(t3 - t2);
-  ph->total.push_back(t3 - t0);
-  ph->stats = st;
+  write_and_discard(fin);
+  record(ph, st, spec.gpu, t0, t1, t2, now_s());
 }
 
 void print_rule(int width) { std::printf("%s\n", std::string(width, '-').c_str()); }
