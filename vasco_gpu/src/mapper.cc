@@ -13,8 +13,8 @@ namespace vasco {
 namespace {
 
 // A renderer whose grid lives in host memory and whose backend applies
-// scans to it in place (every CPU backend; the CUDA backend through a round
-// trip of the grid until it has its own renderer).
+// scans to it in place: every CPU backend (CUDA sessions have their own
+// renderer, cuda_renderer.cc).
 class HostRenderer : public Renderer {
  public:
   explicit HostRenderer(std::unique_ptr<Backend> backend) : backend_(std::move(backend)) {}
