@@ -119,7 +119,7 @@ void compare_c_and_cpp(const std::string &path, long expect_lasers) {
       ret = carmen_string_to_robot_laser_message_orig(s, &robot.m);
       ASSERT_NE(ret, nullptr) << carmen_readlog_last_error();
       expect_same_laser(robot.m, cpp.laser);
-      EXPECT_EQ(robot.m.id, -1);
+      EXPECT_EQ(robot.m.id, 0);  // left as it was (CARMEN's old converter does not set it)
       EXPECT_EQ(std::atof(ret), cpp.laser.logger_timestamp);
       ++lasers;
     } else if (robotlaser) {
@@ -229,11 +229,26 @@ TEST(ReadlogConvert, NameOptionalIdAndReturnPointer) {
   EXPECT_EQ(r.m.config.start_angle, -kPi / 2.0);
   EXPECT_EQ(r.m.config.maximum_range, 80.0);
   EXPECT_EQ(r.m.config.laser_type, SICK_LMS);
-  EXPECT_EQ(r.m.tv, 0.0);
+  EXPECT_EQ(r.m.tv, 0.3);  // left as the ROBOTLASER1 above set it, as CARMEN's old converter does
   EXPECT_EQ(r.m.num_remissions, 0);
   EXPECT_EQ(std::atof(ret), 1.5);
   std::vector<char> d = buffer("4 1.0 2.0 3.0 4.0 0.1 0.2 0.3 1.1 1.2 1.3 50.0 hh 1.5");
+  // CARMEN's old converter leaves id, tv, rv, the safety distances and
+  // turn_axis as they were.
+  r.m.id = 7;
+  r.m.tv = 0.5;
+  r.m.rv = -0.25;
+  r.m.forward_safety_dist = 1.5;
+  r.m.side_safety_dist = 2.5;
+  r.m.turn_axis = 3.5;
   ASSERT_NE(carmen_string_to_robot_laser_message_orig(d.data(), &r.m), nullptr);
+  EXPECT_EQ(r.m.id, 7);
+  EXPECT_EQ(r.m.tv, 0.5);
+  EXPECT_EQ(r.m.rv, -0.25);
+  EXPECT_EQ(r.m.forward_safety_dist, 1.5);
+  EXPECT_EQ(r.m.side_safety_dist, 2.5);
+  EXPECT_EQ(r.m.turn_axis, 3.5);
+  EXPECT_EQ(r.m.laser_pose.y, 0.2);
 
   // RAWLASER and the old LASERn lines.
   LaserLaser l;

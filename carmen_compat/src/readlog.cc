@@ -115,7 +115,9 @@ bool fill_laser_laser(carmen_laser_laser_message *out, const carmen::LaserMessag
   return true;
 }
 
-bool fill_robot_laser(carmen_robot_laser_message *out, const carmen::LaserMessage &m, int id) {
+// `orig`: the old FLASER/RLASER converter, which leaves id, tv, rv, the
+// safety distances and turn_axis as they were, as CARMEN's does.
+bool fill_robot_laser(carmen_robot_laser_message *out, const carmen::LaserMessage &m, int id, bool orig = false) {
   const int n = static_cast<int>(m.range.size());
   const int r = static_cast<int>(m.remission.size());
   if (!resize_array(&out->range, out->num_readings, n) ||
@@ -124,7 +126,7 @@ bool fill_robot_laser(carmen_robot_laser_message *out, const carmen::LaserMessag
     set_error("out of memory");
     return false;
   }
-  out->id = id;
+  if (!orig) out->id = id;
   copy_config(out->config, m.config);
   out->num_readings = n;
   if (n) {
@@ -135,11 +137,13 @@ bool fill_robot_laser(carmen_robot_laser_message *out, const carmen::LaserMessag
   if (r) std::memcpy(out->remission, m.remission.data(), sizeof(float) * r);
   out->laser_pose = {m.laser_pose.x, m.laser_pose.y, m.laser_pose.theta};
   out->robot_pose = {m.robot_pose.x, m.robot_pose.y, m.robot_pose.theta};
-  out->tv = m.tv;
-  out->rv = m.rv;
-  out->forward_safety_dist = m.forward_safety_dist;
-  out->side_safety_dist = m.side_safety_dist;
-  out->turn_axis = m.turn_axis;
+  if (!orig) {
+    out->tv = m.tv;
+    out->rv = m.rv;
+    out->forward_safety_dist = m.forward_safety_dist;
+    out->side_safety_dist = m.side_safety_dist;
+    out->turn_axis = m.turn_axis;
+  }
   out->timestamp = m.timestamp;
   return true;
 }
@@ -239,7 +243,7 @@ char *carmen_string_to_robot_laser_message_orig(char *string, carmen_robot_laser
   if (!had && !skip_name(t, "RLASER", false, &id, &had)) return nullptr;
   const char *after = nullptr;
   if (!parse(carmen::MessageType::FLASER, t, &after)) return nullptr;
-  if (!fill_robot_laser(laser, g_scratch.laser, -1)) return nullptr;
+  if (!fill_robot_laser(laser, g_scratch.laser, -1, true)) return nullptr;
   return result(string, after);
 }
 

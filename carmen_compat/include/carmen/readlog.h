@@ -158,8 +158,9 @@ char *carmen_string_to_laser_laser_message(char *string, carmen_laser_laser_mess
 char *carmen_string_to_laser_laser_message_orig(char *string, carmen_laser_laser_message *laser);
 char *carmen_string_to_robot_laser_message(char *string, carmen_robot_laser_message *laser);
 /* FLASER / RLASER: laser_pose = the first pose triple, robot_pose = the odom
- * triple; the config is guessed from the beam count; id = -1; tv, rv, the
- * safety distances and turn_axis are set to 0; no remissions. */
+ * triple; the config is guessed from the beam count; id, tv, rv, the safety
+ * distances and turn_axis are left as they were (as CARMEN's converter leaves
+ * them); no remissions. */
 char *carmen_string_to_robot_laser_message_orig(char *string, carmen_robot_laser_message *laser);
 char *carmen_string_to_base_odometry_message(char *string, carmen_base_odometry_message *odometry);
 char *carmen_string_to_simulator_truepos_message(char *string,
