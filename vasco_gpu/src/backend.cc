@@ -37,4 +37,12 @@ std::unique_ptr<Backend> make_backend(const std::string &name, const BackendOpti
   throw std::invalid_argument("unknown backend '" + name + "'");
 }
 
+std::string resolve_backend_name(const std::string &name, BackendOptions *options) {
+  if (name == "cuda_exact" || name == "cuda_float") {
+    options->cuda_mode = name == "cuda_exact" ? CudaMode::Exact : CudaMode::Float;
+    return "cuda";
+  }
+  return name;
+}
+
 }  // namespace vasco

@@ -88,11 +88,7 @@ std::unique_ptr<Session> open_session(const evidence_grid *g, const std::string 
   if (backend == "cpu_double") return nullptr;
   try {
     vasco::BackendOptions opt;
-    std::string name = backend;
-    if (name == "cuda_exact") {
-      name = "cuda";
-      opt.cuda_mode = vasco::CudaMode::Exact;
-    }
+    const std::string name = vasco::resolve_backend_name(backend, &opt);
     vasco::GridGeometry frame;
     frame.size_x = g->size_x;
     frame.size_y = g->size_y;
@@ -320,7 +316,7 @@ void carmen_mapper_clear_evidence_grid(evidence_grid *grid) {
     const bool has_first = s->has_first;
     const vasco::Pose first = s->first;
     drop_session(grid);
-    std::unique_ptr<Session> fresh = open_session(grid, backend == "cuda_float" ? "cuda" : backend,
+    std::unique_ptr<Session> fresh = open_session(grid, backend,
                                                   has_first ? &first : nullptr);
     if (fresh) {
       fresh->cleared = true;

@@ -61,15 +61,6 @@ vasco::MapperParams to_params(const vasco_mapper_params &p) {
   return m;
 }
 
-// "cuda_exact" is "cuda" in exact mode; "cuda" alone is float mode.
-void backend_of(const char *name, std::string *backend, vasco::BackendOptions *opt) {
-  *backend = name != nullptr ? name : "cpu_double";
-  if (*backend == "cuda_exact") {
-    *backend = "cuda";
-    opt->cuda_mode = vasco::CudaMode::Exact;
-  }
-}
-
 vasco_status create(const vasco_mapper_params *params, const char *backend, const vasco::GridGeometry *frame,
                     vasco_mapper **out) {
   if (out == nullptr || params == nullptr) {
@@ -78,9 +69,8 @@ vasco_status create(const vasco_mapper_params *params, const char *backend, cons
   }
   *out = nullptr;
   return guarded(&create_error, [&] {
-    std::string name;
     vasco::BackendOptions opt;
-    backend_of(backend, &name, &opt);
+    const std::string name = vasco::resolve_backend_name(backend != nullptr ? backend : "cpu_double", &opt);
     auto h = std::make_unique<vasco_mapper>();
     const vasco::MapperParams p = to_params(*params);
     h->mapper = frame ? std::make_unique<vasco::Mapper>(p, *frame, name, opt)

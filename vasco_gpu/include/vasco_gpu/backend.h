@@ -76,6 +76,12 @@ std::vector<std::string> compiled_backends();
 // std::runtime_error for `cuda` without a usable GPU (the message says why).
 std::unique_ptr<Backend> make_backend(const std::string &name, const BackendOptions &options = {});
 
+// A backend name as the session APIs take it (C API, egrid.h): besides
+// make_backend's names, "cuda_exact" and "cuda_float" (what Backend::name()
+// reports) select the CUDA mode. Returns the make_backend name; sets
+// options->cuda_mode for the two aliases.
+std::string resolve_backend_name(const std::string &name, BackendOptions *options);
+
 std::unique_ptr<Backend> make_cpu_double_backend();
 std::unique_ptr<Backend> make_cpu_float_backend();
 
