@@ -47,7 +47,7 @@ double percentile(std::vector<double> v, double q) {
 
 struct Options {
   int runs = 20, cpu_runs = 3;
-  bool quick = false;
+  bool quick = false, gpu_only = false;
   std::string dataset;
 };
 
@@ -55,6 +55,9 @@ struct Row {
   std::string data, backend;
   size_t scans = 0;
   double rerender_ms = 0, insert_p50_ms = 0, insert_p99_ms = 0;
+  // Medians of the re-render's phases: host work before the upload (placing
+  // beams), the upload, the update kernels, and finish with its download.
+  double prep_ms = 0, upload_ms = 0, map_ms = 0, finish_ms = 0;
 };
 
 // The loop-closure correction: scans from the middle on rotated by 2 degrees
@@ -70,22 +73,31 @@ std::vector<Pose> corrected(const std::vector<Pose> &poses) {
   return out;
 }
 
-double rerender_ms(const vasco::LogInput &in, const std::string &backend, const vasco::BackendOptions &opt,
-                   int runs) {
+void rerender(const vasco::LogInput &in, const std::string &backend, const vasco::BackendOptions &opt, int runs,
+              Row *row) {
   Mapper m(in.params, backend, opt);
   m.insert(in.batch);
   const std::vector<Pose> original = m.poses(), moved = corrected(original);
   m.render(moved);  // warm-up
   m.finish();
-  std::vector<double> t;
+  std::vector<double> t, prep, upload, map, finish;
   for (int r = 0; r < runs; ++r) {
     const auto t0 = Clock::now();
     m.render(r % 2 ? moved : original);
+    const auto t1 = Clock::now();
     const vasco::FinishedMap f = m.finish();
     t.push_back(ms_since(t0));
+    finish.push_back(ms_since(t1));
+    prep.push_back(m.last_stats().prep_s * 1e3);
+    upload.push_back(m.last_stats().upload_s * 1e3);
+    map.push_back(m.last_stats().map_s * 1e3);
     if (f.cells.empty()) std::fprintf(stderr, "session_bench: an empty map\n");
   }
-  return percentile(t, 0.5);
+  row->rerender_ms = percentile(t, 0.5);
+  row->prep_ms = percentile(prep, 0.5);
+  row->upload_ms = percentile(upload, 0.5);
+  row->map_ms = percentile(map, 0.5);
+  row->finish_ms = percentile(finish, 0.5);
 }
 
 void insert_ms(const vasco::LogInput &in, const std::string &backend, const vasco::BackendOptions &opt,
@@ -145,9 +157,10 @@ int main(int argc, char **argv) {
     if (a == "--runs" && i + 1 < argc) opt.runs = std::atoi(argv[++i]);
     else if (a == "--cpu-runs" && i + 1 < argc) opt.cpu_runs = std::atoi(argv[++i]);
     else if (a == "--quick") opt.quick = true;
+    else if (a == "--gpu-only") opt.gpu_only = true;
     else if (a == "--dataset" && i + 1 < argc) opt.dataset = argv[++i];
     else {
-      std::fprintf(stderr, "usage: session_bench [--runs N] [--cpu-runs N] [--quick] [--dataset fr079|fr101]\n");
+      std::fprintf(stderr, "usage: session_bench [--runs N] [--cpu-runs N] [--quick] [--gpu-only] [--dataset fr079|fr101]\n");
       return 2;
     }
   }
@@ -170,11 +183,12 @@ int main(int argc, char **argv) {
     const vasco::LogInput in = vasco::load_log_input(lo);
     const double rebuild = rebuild_ms(in, opt.quick ? 1 : opt.cpu_runs);
     for (const Backend &b : backends(gpu)) {
+      if (opt.gpu_only && !b.gpu) continue;
       Row r;
       r.data = d.name;
       r.backend = b.label;
       r.scans = in.batch.num_scans();
-      r.rerender_ms = rerender_ms(in, b.name, b.opt, b.gpu ? opt.runs : (opt.quick ? 3 : opt.cpu_runs));
+      rerender(in, b.name, b.opt, b.gpu ? opt.runs : (opt.quick ? 3 : opt.cpu_runs), &r);
       insert_ms(in, b.name, b.opt, &r);
       rows.push_back(r);
       base.push_back(rebuild);
@@ -191,5 +205,10 @@ int main(int argc, char **argv) {
     std::printf("| %s | %s | %zu | %.3f | %.4f | %.4f | %.1f |\n", r.data.c_str(), r.backend.c_str(), r.scans,
                 r.rerender_ms, r.insert_p50_ms, r.insert_p99_ms, base[i] / r.rerender_ms);
   }
+  std::printf("\nRe-render phases (medians, ms): place = host work before the upload, map = update kernels\n\n");
+  std::printf("| data | backend | place | upload | map | finish + download |\n|---|---|---|---|---|---|\n");
+  for (const Row &r : rows)
+    std::printf("| %s | %s | %.3f | %.3f | %.3f | %.3f |\n", r.data.c_str(), r.backend.c_str(), r.prep_ms,
+                r.upload_ms, r.map_ms, r.finish_ms);
   return 0;
 }

@@ -75,17 +75,23 @@ void launch_exact_lines(const DeviceModel &m, const ExactBeam *beams, const Star
 void exact_scan(const uint32_t *counts, uint32_t *offsets, size_t num_beams, void *temp,
                 size_t temp_bytes, cudaStream_t stream);
 
-// Per beam: writes (tile, beam) pairs at its offset, in walk order.
+// Per beam: writes (tile, beam) pairs at its offset, in walk order, into
+// arrays of `capacity` pairs: a bound the host computed (exact_pair_bound), so
+// that no render waits for the real count. The slots after the real pairs
+// hold kNoTile. If the real count passed the capacity nothing is written and
+// *overflow is incremented.
+constexpr uint32_t kNoTile = 0xffffffffu;
 void launch_exact_pairs(const DeviceModel &m, const LineRec *lines, const uint32_t *offsets,
-                        size_t num_beams, uint32_t *pair_tile, uint32_t *pair_beam,
-                        cudaStream_t stream);
+                        size_t num_beams, size_t capacity, uint32_t *pair_tile, uint32_t *pair_beam,
+                        unsigned long long *overflow, cudaStream_t stream);
 
-// Stable sort of the pairs by tile: each tile's beams stay in (scan, beam) order.
+// Stable sort of the pairs by tile: each tile's beams stay in (scan, beam)
+// order. tile_bits must leave kNoTile's low bits above every real tile.
 void exact_sort(const uint32_t *tile_in, uint32_t *tile_out, const uint32_t *beam_in,
                 uint32_t *beam_out, size_t num_pairs, int tile_bits, void *temp,
                 size_t temp_bytes, cudaStream_t stream);
 
-// Each tile's slice [begin, end) of the sorted pairs.
+// Each tile's slice [begin, end) of the sorted pairs (kNoTile ignored).
 void launch_exact_tile_ranges(const uint32_t *sorted_tile, size_t num_pairs, uint32_t *tile_begin,
                               uint32_t *tile_end, size_t num_tiles, cudaStream_t stream);
 

@@ -87,9 +87,14 @@ __global__ void lines_kernel(DeviceModel m, const ExactBeam *beams, const StartC
 }
 
 __global__ void pairs_kernel(DeviceModel m, const LineRec *lines, const uint32_t *offsets, size_t n,
-                             uint32_t *pair_tile, uint32_t *pair_beam) {
+                             size_t capacity, uint32_t *pair_tile, uint32_t *pair_beam,
+                             unsigned long long *overflow) {
   const size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
+  if (offsets[n] > capacity) {  // the host's bound was wrong: write nothing, report
+    if (i == 0) atomicAdd(overflow, 1ull);
+    return;
+  }
   uint32_t o = offsets[i];
   for_each_tile(lines[i], m, [&](int t) {
     pair_tile[o] = static_cast<uint32_t>(t);
@@ -98,29 +103,105 @@ __global__ void pairs_kernel(DeviceModel m, const LineRec *lines, const uint32_t
   });
 }
 
-__global__ void tile_ranges_kernel(const uint32_t *key, size_t n, uint32_t *begin, uint32_t *end) {
+__global__ void tile_ranges_kernel(const uint32_t *key, size_t n, size_t num_tiles, uint32_t *begin,
+                                   uint32_t *end) {
   const size_t p = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
   if (p >= n) return;
   const uint32_t t = key[p];
+  if (t >= num_tiles) return;  // padding (kNoTile) sorts after every tile
   if (p == 0 || key[p - 1] != t) begin[t] = static_cast<uint32_t>(p);
   if (p == n - 1 || key[p + 1] != t) end[t] = static_cast<uint32_t>(p + 1);
 }
 
 constexpr int kTileThreads = kTile * kTile;
+static_assert(kTileThreads == 64, "a chunk's hit marks are one 64-bit word per cell");
 
+// Marks, in hit[cell of the tile], bit e for every cell of the tile that
+// beam e of the chunk visits. A closed-form line visits one cell per step and
+// its major coordinate is sx1 + inc*k, so only the (at most kTile) steps whose
+// major coordinate lies in the tile need looking at; this replaces kTile^2
+// membership tests per beam. The marked set is exactly
+// { c in tile : step_of_cell(L, c) >= 0 }.
+__device__ void mark_tile_cells(const LineRec &L, int e, int tx0, int ty0, unsigned long long *hit) {
+  const unsigned long long bit = 1ull << e;
+  if (L.flags & kDegenerate) {  // rare (see kClosedFormLimit): the oracle's walk
+    BresenhamLine line;
+    egrid::bresenham_init(line, L.x1, L.y1, L.x2, L.y2);
+    for (int k = 0; k <= L.k_max; ++k) {
+      int x, y;
+      egrid::bresenham_current(line, &x, &y);
+      const int u = x - tx0, v = y - ty0;
+      if (u >= 0 && u < kTile && v >= 0 && v < kTile) atomicOr(&hit[u * kTile + v], bit);
+      if (!egrid::bresenham_next(line)) break;
+    }
+    return;
+  }
+  const bool steep = L.flags & kSteep, backward = L.flags & kBackward, flipped = L.flags & kFlipped;
+  const int maj0 = steep ? ty0 : tx0, min0 = steep ? tx0 : ty0;
+  // Steps whose major coordinate is in [maj0, maj0 + kTile).
+  int k_lo = backward ? L.sx1 - (maj0 + kTile - 1) : maj0 - L.sx1;
+  int k_hi = k_lo + kTile - 1;
+  k_lo = max(k_lo, 0);
+  k_hi = min(k_hi, L.k_max);
+  for (int k = k_lo; k <= k_hi; ++k) {
+    // The walk's minor offset after k steps (egrid_math.h line_minor_offset);
+    // every operand is below 2^30 (kClosedFormLimit).
+    const int m = (L.two_b * k + L.bias) / L.two_a;
+    int mn = backward ? L.sy1 - m : L.sy1 + m;
+    if (flipped) mn = -mn;
+    const int maj = backward ? L.sx1 - k : L.sx1 + k;
+    const int du = maj - maj0, dv = mn - min0;
+    if (dv < 0 || dv >= kTile) continue;
+    const int u = steep ? dv : du, v = steep ? du : dv;
+    atomicOr(&hit[u * kTile + v], bit);
+  }
+}
+
+// One evidence update of the thread's cell by beam L (the oracle's
+// arithmetic; tables when built). Returns whether it updated.
+__device__ __forceinline__ bool update_cell(const DeviceModel &m, const LineRec &L, int cx, int cy,
+                                            const double *dist, const double *ff, const double *fo,
+                                            float *cell) {
+  const int T = m.table_size;
+  const int i = egrid::wrap_abs(egrid::wrap_sub(cx, L.x1));
+  const int j = egrid::wrap_abs(egrid::wrap_sub(cy, L.y1));
+  // i, j <= k <= table_size - 1: inside the table.
+  const double d = dist ? dist[i * T + j] : egrid::cell_distance(i, j, m.resolution);
+  // The oracle stops the beam at the first cell with d >= max; d never
+  // decreases along a walk, so that is: no update where d >= max.
+  if (!(d < m.max)) return false;
+  double f;
+  if (ff) {
+    f = d < static_cast<double>(L.range) ? ff[i * T + j] : fo[i * T + j];
+  } else {
+    const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
+    double p;
+    egrid::sensor_model(model, d, L.range, &p);
+    f = egrid::odds_factor(m.prior, p);
+  }
+  *cell = egrid::odds_apply(*cell, m.prior, f);
+  return true;
+}
+
+// One block per tile, one thread per cell. The tile's list is taken in
+// chunks of 64 beams: the chunk's beams mark the cells they visit (one
+// thread per beam), then every thread applies its marked beams lowest bit
+// first — the list's order, which is (scan, beam) order. A warp thus runs as
+// many update rounds as its busiest cell has hits, not as many as there are
+// beams touching any of its cells.
 __global__ void __launch_bounds__(kTileThreads)
     tiles_kernel(DeviceModel m, const LineRec *lines, const uint32_t *sorted_beam,
                  const uint32_t *order, const uint32_t *tile_begin, const uint32_t *tile_end,
                  const double *dist,
                  const double *ff, const double *fo, float *grid, unsigned long long *updates) {
   __shared__ LineRec sh[kTileThreads];
+  __shared__ unsigned long long hit[kTileThreads];
   const int tiles_y = (m.size_y + kTile - 1) / kTile;
   const int tile = static_cast<int>(order[blockIdx.x]);
-  const int cx = (tile / tiles_y) * kTile + threadIdx.x / kTile;
-  const int cy = (tile % tiles_y) * kTile + threadIdx.x % kTile;
+  const int tx0 = (tile / tiles_y) * kTile, ty0 = (tile % tiles_y) * kTile;
+  const int cx = tx0 + threadIdx.x / kTile;
+  const int cy = ty0 + threadIdx.x % kTile;
   const bool active = inside(cx, cy, m);
-  const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
-  const int T = m.table_size;
   // The grid holds the result of earlier scans (all unknown for a fresh map):
   // this launch's updates come after theirs, as in the oracle's order.
   float cell = active ? grid[static_cast<size_t>(cx) * m.size_y + cy] : egrid::kUnknown;
@@ -128,30 +209,15 @@ __global__ void __launch_bounds__(kTileThreads)
   const uint32_t begin = tile_begin[tile], end = tile_end[tile];
   for (uint32_t base = begin; base < end; base += kTileThreads) {
     const int n = static_cast<int>(min(static_cast<uint32_t>(kTileThreads), end - base));
+    hit[threadIdx.x] = 0;
     if (static_cast<int>(threadIdx.x) < n) sh[threadIdx.x] = lines[sorted_beam[base + threadIdx.x]];
     __syncthreads();
+    if (static_cast<int>(threadIdx.x) < n) mark_tile_cells(sh[threadIdx.x], threadIdx.x, tx0, ty0, hit);
+    __syncthreads();
     if (active) {
-      for (int e = 0; e < n; ++e) {
-        const LineRec &L = sh[e];
-        const int k = step_of_cell(L, cx, cy);
-        if (k < 0) continue;
-        const int i = egrid::wrap_abs(egrid::wrap_sub(cx, L.x1));
-        const int j = egrid::wrap_abs(egrid::wrap_sub(cy, L.y1));
-        // i, j <= k <= table_size - 1: inside the table.
-        const double d = dist ? dist[i * T + j] : egrid::cell_distance(i, j, m.resolution);
-        // The oracle stops the beam at the first cell with d >= max; d never
-        // decreases along a walk, so that is: no update where d >= max.
-        if (!(d < m.max)) continue;
-        double f;
-        if (ff) {
-          f = d < static_cast<double>(L.range) ? ff[i * T + j] : fo[i * T + j];
-        } else {
-          double p;
-          egrid::sensor_model(model, d, L.range, &p);
-          f = egrid::odds_factor(m.prior, p);
-        }
-        cell = egrid::odds_apply(cell, m.prior, f);
-        ++count;
+      for (unsigned long long h = hit[threadIdx.x]; h != 0; h &= h - 1) {
+        const int e = __ffsll(static_cast<long long>(h)) - 1;
+        count += update_cell(m, sh[e], cx, cy, dist, ff, fo, &cell) ? 1 : 0;
       }
     }
     __syncthreads();
@@ -216,11 +282,13 @@ void exact_scan(const uint32_t *counts, uint32_t *offsets, size_t num_beams, voi
 }
 
 void launch_exact_pairs(const DeviceModel &m, const LineRec *lines, const uint32_t *offsets,
-                        size_t num_beams, uint32_t *pair_tile, uint32_t *pair_beam,
-                        cudaStream_t stream) {
+                        size_t num_beams, size_t capacity, uint32_t *pair_tile, uint32_t *pair_beam,
+                        unsigned long long *overflow, cudaStream_t stream) {
+  // Slots past the real pairs keep kNoTile and sort last.
+  VG_CUDA_CHECK(cudaMemsetAsync(pair_tile, 0xff, capacity * sizeof(uint32_t), stream));
   if (num_beams == 0) return;
-  pairs_kernel<<<blocks_for(num_beams, 128), 128, 0, stream>>>(m, lines, offsets, num_beams,
-                                                                pair_tile, pair_beam);
+  pairs_kernel<<<blocks_for(num_beams, 128), 128, 0, stream>>>(m, lines, offsets, num_beams, capacity,
+                                                                pair_tile, pair_beam, overflow);
   VG_CUDA_CHECK_LAUNCH();
 }
 
@@ -237,7 +305,7 @@ void launch_exact_tile_ranges(const uint32_t *sorted_tile, size_t num_pairs, uin
   VG_CUDA_CHECK(cudaMemsetAsync(tile_begin, 0, num_tiles * sizeof(uint32_t), stream));
   VG_CUDA_CHECK(cudaMemsetAsync(tile_end, 0, num_tiles * sizeof(uint32_t), stream));
   if (num_pairs == 0) return;
-  tile_ranges_kernel<<<blocks_for(num_pairs, 256), 256, 0, stream>>>(sorted_tile, num_pairs,
+  tile_ranges_kernel<<<blocks_for(num_pairs, 256), 256, 0, stream>>>(sorted_tile, num_pairs, num_tiles,
                                                                      tile_begin, tile_end);
   VG_CUDA_CHECK_LAUNCH();
 }

@@ -24,51 +24,79 @@ std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeo
   return starts;
 }
 
-PlacedBeams place_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                        int threads, size_t first, size_t last) {
-  last = std::min(last, batch.num_scans());
-  first = std::min(first, last);
-  const size_t ns = last;
-  PlacedBeams out;
-  out.first_scan = first;
-  out.starts = place_scans(batch, geo, first, last);
+namespace {
 
-  std::vector<uint64_t> used_before(ns + 1, 0);
-  for (size_t s = first; s < ns; ++s) {
-    const float *r = batch.ranges_of(s);
-    uint64_t used = 0;
-    for (int b = 0; b < batch.beams_in(s); ++b) used += oracle::beam_used(r[b]) ? 1 : 0;
-    used_before[s + 1] = used_before[s] + used;
-  }
-  const uint64_t nb = used_before.back();
-  if (nb > std::numeric_limits<uint32_t>::max())
-    throw std::runtime_error("more than 2^32 used beams in one batch");
-  out.skipped = (batch.beam_offset[ns] - batch.beam_offset[first]) - nb;
-  out.beams.resize(nb);
+// Scans per work item: enough to amortise the shared counter, few enough to
+// balance a log whose scans differ in beam count.
+constexpr size_t kScansPerItem = 32;
 
-  std::atomic<size_t> next{first};
-  constexpr size_t kChunk = 32;
+// Runs fn(s) for every s in [s0, s1) on `threads` cores (<= 0: all), in
+// items of kScansPerItem scans; small runs stay on the calling thread.
+template <class Fn>
+void for_each_scan_parallel(size_t s0, size_t s1, int threads, Fn &&fn) {
+  std::atomic<size_t> next{s0};
   const int nt = threads > 0 ? threads : hardware_threads();
-  run_on_threads(ns - first < 256 ? 1 : nt, [&](int) {
+  run_on_threads(s1 - s0 < 8 * kScansPerItem ? 1 : nt, [&](int) {
     for (;;) {
-      const size_t s0 = next.fetch_add(kChunk);
-      if (s0 >= ns) break;
-      for (size_t s = s0; s < std::min(ns, s0 + kChunk); ++s) {
-        oracle::SteppedAngles angles{batch.first_angle[s], batch.angle_step[s]};
-        const float *r = batch.ranges_of(s);
-        uint64_t o = used_before[s];
-        double angle = 0;
-        for (int b = 0; b < batch.beams_in(s); ++b) {
-          angles(b, out.starts[s - first].theta, &angle);
-          if (!oracle::beam_used(r[b])) continue;
-          PlacedBeam &p = out.beams[o++];
-          oracle::beam_end(out.starts[s - first], angle, r[b], params.wall_size, geo.resolution, &p.x2, &p.y2);
-          p.scan = static_cast<uint32_t>(s - first);
-          p.range = r[b];
-        }
-      }
+      const size_t a = next.fetch_add(kScansPerItem);
+      if (a >= s1) break;
+      for (size_t s = a; s < std::min(s1, a + kScansPerItem); ++s) fn(s);
     }
   });
+}
+
+}  // namespace
+
+BeamLayout lay_out_beams(const ScanBatch &batch, const GridGeometry &geo, int threads, size_t first, size_t last) {
+  last = std::min(last, batch.num_scans());
+  first = std::min(first, last);
+  BeamLayout layout;
+  layout.first_scan = first;
+  layout.starts = place_scans(batch, geo, first, last);
+  const size_t n = last - first;
+  layout.used_before.assign(n + 1, 0);
+  for_each_scan_parallel(0, n, threads, [&](size_t i) {
+    const float *r = batch.ranges_of(first + i);
+    uint64_t used = 0;
+    for (int b = 0; b < batch.beams_in(first + i); ++b) used += oracle::beam_used(r[b]) ? 1 : 0;
+    layout.used_before[i + 1] = used;
+  });
+  for (size_t i = 0; i < n; ++i) layout.used_before[i + 1] += layout.used_before[i];
+  if (layout.used() > std::numeric_limits<uint32_t>::max())
+    throw std::runtime_error("more than 2^32 used beams in one batch");
+  layout.skipped = (batch.beam_offset[last] - batch.beam_offset[first]) - layout.used();
+  return layout;
+}
+
+void place_laid_out_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
+                          const BeamLayout &layout, size_t s0, size_t s1, int threads, PlacedBeam *out) {
+  for_each_scan_parallel(s0, s1, threads, [&](size_t i) {
+    const size_t s = layout.first_scan + i;
+    const oracle::ScanStart &start = layout.starts[i];
+    oracle::SteppedAngles angles{batch.first_angle[s], batch.angle_step[s]};
+    const float *r = batch.ranges_of(s);
+    PlacedBeam *o = out + layout.used_before[i];
+    double angle = 0;
+    for (int b = 0; b < batch.beams_in(s); ++b) {
+      angles(b, start.theta, &angle);  // every beam advances the angle, skipped ones too
+      if (!oracle::beam_used(r[b])) continue;
+      oracle::beam_end(start, angle, r[b], params.wall_size, geo.resolution, &o->x2, &o->y2);
+      o->scan = static_cast<uint32_t>(i);
+      o->range = r[b];
+      ++o;
+    }
+  });
+}
+
+PlacedBeams place_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
+                        int threads, size_t first, size_t last) {
+  BeamLayout layout = lay_out_beams(batch, geo, threads, first, last);
+  PlacedBeams out;
+  out.first_scan = layout.first_scan;
+  out.skipped = layout.skipped;
+  out.beams.resize(layout.used());
+  place_laid_out_beams(batch, geo, params, layout, 0, layout.starts.size(), threads, out.beams.data());
+  out.starts = std::move(layout.starts);
   return out;
 }
 

@@ -36,6 +36,25 @@ struct PlacedBeams {
 std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeometry &geo, size_t first = 0,
                                            size_t last = SIZE_MAX);
 
+// Where each placed scan's used beams go: the starts of scans [first, last)
+// and, per placed scan, the number of used beams before it. Counted on
+// `threads` cores (<= 0: all).
+struct BeamLayout {
+  size_t first_scan = 0;
+  std::vector<oracle::ScanStart> starts;  // per placed scan
+  std::vector<uint64_t> used_before;      // per placed scan, and the total last
+  uint64_t skipped = 0;
+  uint64_t used() const { return used_before.empty() ? 0 : used_before.back(); }
+};
+BeamLayout lay_out_beams(const ScanBatch &batch, const GridGeometry &geo, int threads, size_t first = 0,
+                         size_t last = SIZE_MAX);
+
+// Writes the used beams of placed scans [s0, s1) (indices into the layout)
+// to out[used_before[s0] .. used_before[s1]), on `threads` cores. `out` is
+// the caller's: a vector, or a GPU backend's pinned staging buffer.
+void place_laid_out_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
+                          const BeamLayout &layout, size_t s0, size_t s1, int threads, PlacedBeam *out);
+
 // The starts of scans [first, last) (all scans by default) and the end cells
 // of their used beams; threads <= 0: all cores. Throws std::runtime_error
 // past 2^32 used beams.

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 #include "cuda_check.h"
@@ -21,6 +22,7 @@
 #include "egrid_kernels.h"
 #include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/oracle.h"
+#include "vasco_gpu/parallel.h"
 
 namespace vasco {
 
@@ -33,6 +35,40 @@ namespace {
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 static_assert(sizeof(PlacedBeam) == sizeof(cuda::ExactBeam), "PlacedBeam is uploaded as cuda::ExactBeam");
+
+// Tiles a beam's walk can enter, at most: the walk is monotone in x and y and
+// moves at most one cell per step along each axis, so up to step k_max =
+// table_size - 1 it stays in a box of that half-width, and it enters a new
+// tile only by crossing a tile boundary. For a closed-form line the box is
+// also bounded by the end cell. Degenerate lines (egrid_math.h) get the box
+// bound alone, whatever their direction.
+uint64_t tile_bound_of_beam(const oracle::ScanStart &s, const PlacedBeam &b, int table_size) {
+  if (table_size <= 0) return 0;
+  const int64_t reach = table_size - 1, tile = cuda::kTile;
+  if (!egrid::is_closed_form_line(s.x1, s.y1, b.x2, b.y2)) return 2 * (static_cast<uint64_t>(reach) / tile + 1) + 1;
+  auto tiles_crossed = [&](int64_t from, int64_t to) {
+    const int64_t end = from + std::max(-reach, std::min(reach, to - from));
+    auto floor_div = [&](int64_t v) { return v >= 0 ? v / tile : -((-v + tile - 1) / tile); };
+    return static_cast<uint64_t>(std::llabs(floor_div(end) - floor_div(from)));
+  };
+  return 1 + tiles_crossed(s.x1, b.x2) + tiles_crossed(s.y1, b.y2);
+}
+
+// The sum of tile_bound_of_beam over a placed batch, on all cores.
+uint64_t exact_pair_bound(const PlacedBeam *beams, size_t n, const std::vector<oracle::ScanStart> &starts,
+                          int table_size) {
+  const int nt = n < (size_t(1) << 16) ? 1 : hardware_threads();
+  std::vector<uint64_t> part(static_cast<size_t>(nt), 0);
+  run_on_threads(nt, [&](int t) {
+    const size_t a = n * t / nt, b = n * (t + 1) / nt;
+    uint64_t sum = 0;
+    for (size_t i = a; i < b; ++i) sum += tile_bound_of_beam(starts[beams[i].scan], beams[i], table_size);
+    part[static_cast<size_t>(t)] = sum;
+  });
+  uint64_t total = 0;
+  for (uint64_t p : part) total += p;
+  return total;
+}
 
 }  // namespace
 
@@ -207,23 +243,37 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
   st->map_s += e_map.since(e_up) / 1e3;
 }
 
+// Exact mode, in three parts: place the beams on the host into pinned
+// staging; upload and list (tile, beam) pairs; apply them tile by tile. No
+// wait between the parts: the pair arrays are sized by a host bound.
 void CudaRenderer::apply_exact(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
   const auto t_prep = Clock::now();
-  const PlacedBeams placed = place_beams(scans, geo_, params_, 0, first, last);
-  const size_t nb = placed.beams.size(), ns = placed.starts.size();  // beams index the placed scans
-  st->beams_used += nb;
-  st->beams_skipped += placed.skipped;
-  VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // staging buffers are free
-  reserve(staging_beams_, std::max<size_t>(nb, 1));
-  std::memcpy(staging_beams_.get(), placed.beams.data(), nb * sizeof(cuda::ExactBeam));
-  reserve(staging_starts_, ns);
-  for (size_t s = 0; s < ns; ++s) staging_starts_[s] = {placed.starts[s].x1, placed.starts[s].y1};
+  const uint64_t pair_bound = place_exact_beams(scans, first, last, st);
   st->prep_s += seconds_since(t_prep);
-  if (nb == 0) return;
+  if (exact_beams_ == 0) return;
+  launch_exact_apply(pair_bound, st);
+}
 
-  const cuda::DeviceModel m = exact_model();
-  const size_t tiles = static_cast<size_t>((geo_.size_x + cuda::kTile - 1) / cuda::kTile) *
-                       ((geo_.size_y + cuda::kTile - 1) / cuda::kTile);
+// Places the beams of scans [first, last) with the oracle's code, on every
+// core, straight into the pinned staging buffer; returns the bound on their
+// (tile, beam) pairs.
+uint64_t CudaRenderer::place_exact_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
+  const BeamLayout layout = lay_out_beams(scans, geo_, 0, first, last);
+  exact_beams_ = layout.used();
+  exact_scans_ = layout.starts.size();
+  st->beams_used += exact_beams_;
+  st->beams_skipped += layout.skipped;
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // staging is free (every call ends idle)
+  reserve(staging_beams_, std::max<uint64_t>(exact_beams_, 1));
+  reserve(staging_starts_, std::max<size_t>(exact_scans_, 1));
+  PlacedBeam *beams = reinterpret_cast<PlacedBeam *>(staging_beams_.get());
+  place_laid_out_beams(scans, geo_, params_, layout, 0, exact_scans_, 0, beams);
+  for (size_t s = 0; s < exact_scans_; ++s) staging_starts_[s] = {layout.starts[s].x1, layout.starts[s].y1};
+  return exact_pair_bound(beams, exact_beams_, layout.starts, params_.table_size());
+}
+
+void CudaRenderer::reserve_exact_scratch(uint64_t pair_bound, size_t tiles) {
+  const size_t nb = exact_beams_, ns = exact_scans_;
   reserve(beams_, nb);
   reserve(starts_, ns);
   reserve(lines_, nb);
@@ -232,8 +282,20 @@ void CudaRenderer::apply_exact(const ScanBatch &scans, size_t first, size_t last
   for (auto *b : {&tile_begin_, &tile_end_, &order_, &order_keys_, &order_keys_out_, &order_ids_}) reserve(*b, tiles);
   reserve(scan_tmp_, std::max<size_t>(cuda::exact_scan_temp_bytes(nb), 1));
   reserve(order_tmp_, std::max<size_t>(cuda::exact_order_temp_bytes(tiles), 1));
-  reserve(updates_, 1);
+  reserve(updates_, 2);
+  const size_t pairs = std::max<size_t>(pair_bound, 1);
+  if (pairs > pair_tile_.size())
+    check_fits(4 * (pairs - pair_tile_.size()) * sizeof(uint32_t), "exact mode (tile lists)");
+  for (auto *b : {&pair_tile_, &pair_beam_, &sorted_tile_, &sorted_beam_}) reserve(*b, pairs);
+  reserve(sort_tmp_, std::max<size_t>(cuda::exact_sort_temp_bytes(pairs), 1));
+}
 
+void CudaRenderer::launch_exact_apply(uint64_t pair_bound, MapStats *st) {
+  const size_t nb = exact_beams_, ns = exact_scans_;
+  const cuda::DeviceModel m = exact_model();
+  const size_t tiles = static_cast<size_t>((geo_.size_x + cuda::kTile - 1) / cuda::kTile) *
+                       ((geo_.size_y + cuda::kTile - 1) / cuda::kTile);
+  reserve_exact_scratch(pair_bound, tiles);
   cuda::Event &e0 = *e_start_, &e_up = *e_uploaded_, &e_map = *e_mapped_;
   cudaStream_t s = stream_->get();
   e0.record(s);
@@ -242,38 +304,31 @@ void CudaRenderer::apply_exact(const ScanBatch &scans, size_t first, size_t last
   VG_CUDA_CHECK(cudaMemcpyAsync(starts_.get(), staging_starts_.get(), ns * sizeof(cuda::StartCell),
                                 cudaMemcpyHostToDevice, s));
   e_up.record(s);
-  VG_CUDA_CHECK(cudaMemsetAsync(updates_.get(), 0, sizeof(unsigned long long), s));
+  VG_CUDA_CHECK(cudaMemsetAsync(updates_.get(), 0, 2 * sizeof(unsigned long long), s));
   VG_CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, (nb + 1) * sizeof(uint32_t), s));
   cuda::launch_exact_lines(m, beams_.get(), starts_.get(), nb, lines_.get(), counts_.get(), s);
   cuda::exact_scan(counts_.get(), offsets_.get(), nb, scan_tmp_.get(), scan_tmp_.size(), s);
-  // The pair count sizes the lists: the one wait inside an exact apply.
-  reserve(staging_pairs_, 1);
-  VG_CUDA_CHECK(cudaMemcpyAsync(staging_pairs_.get(), offsets_.get() + nb, sizeof(uint32_t),
-                                cudaMemcpyDeviceToHost, s));
-  VG_CUDA_CHECK(cudaStreamSynchronize(s));
-  const size_t pairs = staging_pairs_[0];
-  const size_t sort_tmp = cuda::exact_sort_temp_bytes(pairs);
-  if (pairs > pair_tile_.size())
-    check_fits(4 * (pairs - pair_tile_.size()) * sizeof(uint32_t), "exact mode (tile lists)");
-  for (auto *b : {&pair_tile_, &pair_beam_, &sorted_tile_, &sorted_beam_}) reserve(*b, std::max<size_t>(pairs, 1));
-  reserve(sort_tmp_, std::max<size_t>(sort_tmp, 1));
-  cuda::launch_exact_pairs(m, lines_.get(), offsets_.get(), nb, pair_tile_.get(), pair_beam_.get(), s);
+  cuda::launch_exact_pairs(m, lines_.get(), offsets_.get(), nb, pair_bound, pair_tile_.get(), pair_beam_.get(),
+                           updates_.get() + 1, s);
+  // kNoTile's low tile_bits bits must not name a tile: 2^tile_bits > tiles.
   int tile_bits = 1;
-  while ((size_t(1) << tile_bits) < tiles) ++tile_bits;
-  if (pairs)
-    cuda::exact_sort(pair_tile_.get(), sorted_tile_.get(), pair_beam_.get(), sorted_beam_.get(), pairs, tile_bits,
-                     sort_tmp_.get(), sort_tmp_.size(), s);
-  cuda::launch_exact_tile_ranges(sorted_tile_.get(), pairs, tile_begin_.get(), tile_end_.get(), tiles, s);
+  while ((size_t(1) << tile_bits) <= tiles) ++tile_bits;
+  if (pair_bound)
+    cuda::exact_sort(pair_tile_.get(), sorted_tile_.get(), pair_beam_.get(), sorted_beam_.get(), pair_bound,
+                     tile_bits, sort_tmp_.get(), sort_tmp_.size(), s);
+  cuda::launch_exact_tile_ranges(sorted_tile_.get(), pair_bound, tile_begin_.get(), tile_end_.get(), tiles, s);
   cuda::exact_tile_order(tile_begin_.get(), tile_end_.get(), tiles, order_.get(), order_keys_.get(),
                          order_keys_out_.get(), order_ids_.get(), order_tmp_.get(), order_tmp_.size(), s);
   cuda::launch_exact_tiles(m, lines_.get(), sorted_beam_.get(), order_.get(), tile_begin_.get(), tile_end_.get(),
                            use_tables_ ? dist_.get() : nullptr, use_tables_ ? factor_free_.get() : nullptr,
                            use_tables_ ? factor_occ_.get() : nullptr, grid_.get(), updates_.get(), s);
   e_map.record(s);
-  reserve(staging_counters_, 1);
-  VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), updates_.get(), sizeof(unsigned long long),
+  reserve(staging_counters_, 2);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), updates_.get(), 2 * sizeof(unsigned long long),
                                 cudaMemcpyDeviceToHost, s));
-  VG_CUDA_CHECK(cudaStreamSynchronize(s));
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));  // the call's result is complete
+  if (staging_counters_[1] != 0)
+    throw std::logic_error("cuda exact mode: more (tile, beam) pairs than the host's bound (a bug)");
   st->cell_updates += staging_counters_[0];
   st->upload_s += e_up.since(e0) / 1e3;
   st->map_s += e_map.since(e_up) / 1e3;

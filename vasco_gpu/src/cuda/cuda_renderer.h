@@ -39,6 +39,9 @@ class CudaRenderer : public Renderer {
   void upload_ranges(const ScanBatch &scans, size_t last);
   void apply_float(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
   void apply_exact(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
+  uint64_t place_exact_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
+  void reserve_exact_scratch(uint64_t pair_bound, size_t tiles);
+  void launch_exact_apply(uint64_t pair_bound, MapStats *st);
 
   BackendOptions options_;
   std::unique_ptr<cuda::Stream> stream_;
@@ -55,6 +58,8 @@ class CudaRenderer : public Renderer {
   bool use_tables_ = false, tables_built_ = false;
   std::tuple<int, double, double, double, double, double, double> tables_key_;
   cuda::DeviceBuffer<double> dist_, factor_free_, factor_occ_;
+  uint64_t exact_beams_ = 0;  // placed by place_exact_beams, in staging_beams_
+  size_t exact_scans_ = 0;
   cuda::DeviceBuffer<cuda::ExactBeam> beams_;
   cuda::DeviceBuffer<cuda::StartCell> starts_;
   cuda::DeviceBuffer<cuda::LineRec> lines_;
