@@ -155,15 +155,16 @@ void set_param(vasco::MapperParams &p, const std::string &name, nb::handle value
                              .c_str());
   if (PyBool_Check(value.ptr()))
     throw nb::type_error(("Params: " + name + " must be a number, not a bool").c_str());
+  double v = 0;
+  if (!nb::try_cast<double>(value, v))
+    throw nb::type_error(("Params: " + name + " must be a number, not " +
+                          nb::cast<std::string>(nb::str(value.type().attr("__name__")))).c_str());
   if (k->d != nullptr) {
-    p.*(k->d) = nb::cast<double>(value);
-  } else if (PyFloat_Check(value.ptr())) {
-    const double v = nb::cast<double>(value);
+    p.*(k->d) = v;
+  } else {
     if (!(v == std::floor(v)) || std::fabs(v) > 1e15)
       throw nb::type_error(("Params: " + name + " must be a whole number").c_str());
     p.*(k->l) = static_cast<long>(v);
-  } else {
-    p.*(k->l) = nb::cast<long>(value);
   }
 }
 
@@ -288,12 +289,15 @@ vasco::ScanBatch make_scans(nb::handle poses_obj, nb::handle ranges_obj, nb::han
     throw std::invalid_argument("beam_counts: " + std::to_string(counts.shape(0)) + " counts for " +
                                 std::to_string(n) + " poses");
   auto per_scan = [&](nb::handle obj, const char *what) {
+    static nb::handle ndim = nb::object(nb::module_::import_("numpy").attr("ndim")).release();
+    std::vector<double> v;
+    if (nb::cast<int>(ndim(obj)) == 0) {
+      v.assign(n, nb::cast<double>(nb::module_::import_("builtins").attr("float")(obj)));
+      return v;
+    }
     nb::object a = contiguous(obj, "float64");
     auto arr = nb::cast<nb::ndarray<const double, nb::c_contig, nb::device::cpu>>(a);
-    std::vector<double> v;
-    if (arr.ndim() == 0) {
-      v.assign(n, arr.data()[0]);
-    } else if (arr.ndim() == 1 && arr.shape(0) == n) {
+    if (arr.ndim() == 1 && arr.shape(0) == n) {
       v.assign(arr.data(), arr.data() + n);
     } else {
       throw std::invalid_argument(std::string(what) + ": expected a number or one value per scan (" +
@@ -867,7 +871,14 @@ NB_MODULE(_core, m) {
         d["same_cells"] = c.same_cells();
         return d;
       }, "Every count as a dict.")
-      .def("__repr__", [](const vasco::GridComparison &c) { return c.agreement.table("B against A"); });
+      .def("__str__", [](const vasco::GridComparison &c) { return c.agreement.table("B against A"); })
+      .def("__repr__", [](const vasco::GridComparison &c) {
+        const vasco::Agreement &a = c.agreement;
+        return nb::str("Comparison(cells={}, class_agreement={:.6f}, status_differs={}, large_diffs={}, "
+                       "max_abs_diff={}, identical={}, outside={})")
+            .format(a.cells, a.class_agreement(), a.status_differs, a.large_diffs, a.max_abs_diff, a.identical,
+                    c.outside);
+      });
 
   m.def(
       "compare",

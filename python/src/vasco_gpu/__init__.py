@@ -38,7 +38,6 @@ from ._core import (
     Mapper,
     Params,
     Scans,
-    __version__,
     backends,
     compare,
     cuda_available,
@@ -47,6 +46,8 @@ from ._core import (
     write_map,
 )
 from . import _core
+
+__version__: str = _core.__version__
 
 __all__ = [
     "Comparison",
