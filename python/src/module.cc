@@ -463,7 +463,7 @@ NB_MODULE(_core, m) {
       "tenths of a second).");
 
   // ---- Params -------------------------------------------------------------
-  nb::class_<vasco::MapperParams>(m, "Params",
+  auto params_class = nb::class_<vasco::MapperParams>(m, "Params",
                                   "The mapper's parameters: carmen.ini's ``vasco_*`` keys without the prefix.\n\n"
                                   "``Params(p_occ=0.9, resolution=0.05)`` (the ``vasco_`` prefix is accepted\n"
                                   "too: ``Params(vasco_p_occ=0.9)``) starts from vasco's defaults and is\n"
@@ -508,9 +508,10 @@ NB_MODULE(_core, m) {
       .def("to_dict", &params_dict, "The parameters as a dict (keys without ``vasco_``).")
       .def("__repr__", &params_repr)
       .def("__eq__",
-           [](const vasco::MapperParams &a, const vasco::MapperParams &b) {
-             return params_dict(a).equal(params_dict(b));
-           })
+           [](const vasco::MapperParams &a, nb::handle b) -> nb::object {
+             if (!nb::isinstance<vasco::MapperParams>(b)) return nb::borrow(Py_NotImplemented);
+             return nb::bool_(params_dict(a).equal(params_dict(nb::cast<const vasco::MapperParams &>(b))));
+           }, nb::sig("def __eq__(self, other: object) -> bool"))
       .def("__copy__", [](const vasco::MapperParams &p) { return p; })
       .def("__deepcopy__", [](const vasco::MapperParams &p, nb::handle) { return p; }, "memo"_a)
       .def_rw("resolution", &vasco::MapperParams::resolution, "vasco_resolution: cell size in metres.")
@@ -527,6 +528,7 @@ NB_MODULE(_core, m) {
               "vasco_first_scan: first laser message used by load_log.")
       .def_rw("num_scans", &vasco::MapperParams::num_scans,
               "vasco_num_scans: laser messages used by load_log (-1: all).");
+  params_class.attr("__hash__") = nb::none();  // mutable, compared by value
 
   // ---- Frame --------------------------------------------------------------
   nb::class_<vasco::GridGeometry>(m, "Frame",
@@ -1011,8 +1013,14 @@ NB_MODULE(_core, m) {
             return owned(std::move(flat), {p.size(), 3});
           }, nb::rv_policy::reference,
           "The stored scans' poses, (n, 3) float64 (a new array).")
-      .def("__len__", [](PyMapper &pm) { return pm.mapper->num_scans(); })
-      .def_prop_ro("num_scans", [](PyMapper &pm) { return pm.mapper->num_scans(); })
+      .def("__len__", [](PyMapper &pm) {
+        std::lock_guard<std::mutex> lock(pm.mutex);
+        return pm.mapper->num_scans();
+      })
+      .def_prop_ro("num_scans", [](PyMapper &pm) {
+        std::lock_guard<std::mutex> lock(pm.mutex);
+        return pm.mapper->num_scans();
+      }, "Scans stored.")
       .def_prop_ro("frame", [](PyMapper &pm) {
         std::lock_guard<std::mutex> lock(pm.mutex);
         return pm.mapper->frame();
@@ -1024,9 +1032,13 @@ NB_MODULE(_core, m) {
         std::lock_guard<std::mutex> lock(pm.mutex);
         return stats_dict(pm.mapper->last_stats());
       }, "Counts and phase times of the last insert or render.")
-      .def_prop_ro("renders", [](PyMapper &pm) { return pm.mapper->renders(); },
+      .def_prop_ro("renders", [](PyMapper &pm) {
+        std::lock_guard<std::mutex> lock(pm.mutex);
+        return pm.mapper->renders();
+      },
                    "Full renders since construction (each render(), each growth, the first insert).")
       .def("__repr__", [](PyMapper &pm) {
+        std::lock_guard<std::mutex> lock(pm.mutex);
         return nb::str("Mapper(backend='{}', {} scans)").format(pm.mapper->backend_name(), pm.mapper->num_scans());
       });
 }

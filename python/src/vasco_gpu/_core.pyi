@@ -66,7 +66,7 @@ class Params:
 
     def __repr__(self) -> str: ...
 
-    def __eq__(self, arg: Params, /) -> bool: ...
+    def __eq__(self, other: object) -> bool: ...
 
     def __copy__(self) -> Params: ...
 
@@ -148,6 +148,8 @@ class Params:
 
     @num_scans.setter
     def num_scans(self, arg: int, /) -> None: ...
+
+    __hash__: None = None
 
 class Frame:
     """
@@ -576,7 +578,8 @@ class Mapper:
     def __len__(self) -> int: ...
 
     @property
-    def num_scans(self) -> int: ...
+    def num_scans(self) -> int:
+        """Scans stored."""
 
     @property
     def frame(self) -> Frame:
