@@ -15,7 +15,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstdio>
 #include <cstring>
+#include <functional>
 
 #include "cuda_check.h"
 #include "cuda_host_support.h"
@@ -304,24 +306,32 @@ void CudaRenderer::launch_exact_apply(uint64_t pair_bound, MapStats *st) {
   VG_CUDA_CHECK(cudaMemcpyAsync(starts_.get(), staging_starts_.get(), ns * sizeof(cuda::StartCell),
                                 cudaMemcpyHostToDevice, s));
   e_up.record(s);
+  cuda_host::StageTimer timer(s);
+  timer.mark("start");
   VG_CUDA_CHECK(cudaMemsetAsync(updates_.get(), 0, 2 * sizeof(unsigned long long), s));
   VG_CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, (nb + 1) * sizeof(uint32_t), s));
   cuda::launch_exact_lines(m, beams_.get(), starts_.get(), nb, lines_.get(), counts_.get(), s);
+  timer.mark("lines");
   cuda::exact_scan(counts_.get(), offsets_.get(), nb, scan_tmp_.get(), scan_tmp_.size(), s);
+  timer.mark("scan");
   cuda::launch_exact_pairs(m, lines_.get(), offsets_.get(), nb, pair_bound, pair_tile_.get(), pair_beam_.get(),
                            updates_.get() + 1, s);
+  timer.mark("pairs");
   // kNoTile's low tile_bits bits must not name a tile: 2^tile_bits > tiles.
   int tile_bits = 1;
   while ((size_t(1) << tile_bits) <= tiles) ++tile_bits;
   if (pair_bound)
     cuda::exact_sort(pair_tile_.get(), sorted_tile_.get(), pair_beam_.get(), sorted_beam_.get(), pair_bound,
                      tile_bits, sort_tmp_.get(), sort_tmp_.size(), s);
+  timer.mark("sort");
   cuda::launch_exact_tile_ranges(sorted_tile_.get(), pair_bound, tile_begin_.get(), tile_end_.get(), tiles, s);
   cuda::exact_tile_order(tile_begin_.get(), tile_end_.get(), tiles, order_.get(), order_keys_.get(),
                          order_keys_out_.get(), order_ids_.get(), order_tmp_.get(), order_tmp_.size(), s);
+  timer.mark("tile order");
   cuda::launch_exact_tiles(m, lines_.get(), sorted_beam_.get(), order_.get(), tile_begin_.get(), tile_end_.get(),
                            use_tables_ ? dist_.get() : nullptr, use_tables_ ? factor_free_.get() : nullptr,
                            use_tables_ ? factor_occ_.get() : nullptr, grid_.get(), updates_.get(), s);
+  timer.mark("tiles");
   e_map.record(s);
   reserve(staging_counters_, 2);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), updates_.get(), 2 * sizeof(unsigned long long),
@@ -329,9 +339,27 @@ void CudaRenderer::launch_exact_apply(uint64_t pair_bound, MapStats *st) {
   VG_CUDA_CHECK(cudaStreamSynchronize(s));  // the call's result is complete
   if (staging_counters_[1] != 0)
     throw std::logic_error("cuda exact mode: more (tile, beam) pairs than the host's bound (a bug)");
+  timer.report();
+  if (std::getenv("VASCO_CUDA_PROFILE")) report_tile_lists(pair_bound, tiles);
   st->cell_updates += staging_counters_[0];
   st->upload_s += e_up.since(e0) / 1e3;
   st->map_s += e_map.since(e_up) / 1e3;
+}
+
+// Profiling only (VASCO_CUDA_PROFILE): the pairs and the longest tile
+// lists, which bound the tile kernel (a tile's list runs in order).
+void CudaRenderer::report_tile_lists(uint64_t pair_bound, size_t tiles) {
+  std::vector<uint32_t> begin(tiles), end(tiles), order(std::min<size_t>(tiles, 4));
+  VG_CUDA_CHECK(cudaMemcpy(begin.data(), tile_begin_.get(), tiles * 4, cudaMemcpyDeviceToHost));
+  VG_CUDA_CHECK(cudaMemcpy(end.data(), tile_end_.get(), tiles * 4, cudaMemcpyDeviceToHost));
+  uint64_t pairs = 0;
+  std::vector<uint32_t> len(tiles);
+  for (size_t t = 0; t < tiles; ++t) pairs += len[t] = end[t] - begin[t];
+  std::sort(len.begin(), len.end(), std::greater<uint32_t>());
+  std::fprintf(stderr, "  [cuda] beams %llu, pairs %llu (bound %llu), tiles %zu, longest lists %u %u %u %u\n",
+               static_cast<unsigned long long>(exact_beams_), static_cast<unsigned long long>(pairs),
+               static_cast<unsigned long long>(pair_bound), tiles, len.size() > 0 ? len[0] : 0,
+               len.size() > 1 ? len[1] : 0, len.size() > 2 ? len[2] : 0, len.size() > 3 ? len[3] : 0);
 }
 
 FinishedMap CudaRenderer::finish(int downsample, int border) {

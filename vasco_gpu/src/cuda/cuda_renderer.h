@@ -42,6 +42,7 @@ class CudaRenderer : public Renderer {
   uint64_t place_exact_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
   void reserve_exact_scratch(uint64_t pair_bound, size_t tiles);
   void launch_exact_apply(uint64_t pair_bound, MapStats *st);
+  void report_tile_lists(uint64_t pair_bound, size_t tiles);
 
   BackendOptions options_;
   std::unique_ptr<cuda::Stream> stream_;
