@@ -5,6 +5,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
 from conftest import ROOT
 
 
@@ -25,3 +27,12 @@ def test_bench_render_script():
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     assert "median" in r.stdout
+
+
+def test_loop_closure_example_with_gtsam(tmp_path):
+    pytest.importorskip("gtsam", reason="GTSAM is optional (pip install gtsam)")
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "loop_closure.py"), "--scans", "600", "--gtsam",
+                        "--backend", "cpu_threads", "--runs", "1", "--out", str(tmp_path)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "corrected by GTSAM" in r.stdout
