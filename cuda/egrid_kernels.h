@@ -20,6 +20,9 @@ struct DeviceModel {
   double resolution, wall;
   int table_size;                     // (int)(max_range / resolution)
   int size_x, size_y;                 // grid size in cells
+  // prior, occ and emp strictly inside (0, 1): every odds factor is finite
+  // and positive, so a cell at exactly 0 or 1 never changes again.
+  bool saturation_holds;
 };
 
 // ---------------------------------------------------------------------------
@@ -61,10 +64,13 @@ constexpr int kTile = 8;
 size_t exact_scan_temp_bytes(size_t num_beams);
 size_t exact_sort_temp_bytes(size_t num_pairs);
 
-// Distance and odds-factor tables (table_size^2 doubles each), computed on
-// the device with the oracle's operations.
-void launch_exact_tables(const DeviceModel &m, double *dist, double *factor_free,
-                         double *factor_occ, cudaStream_t stream);
+// Exact mode's tables, computed on the device with the oracle's operations,
+// for table_size <= kMaxExactTable: distances and odds factors (free, occupied)
+// per (i, j), table_size^2 each, and per i the first j whose distance reaches
+// max_range (table_size entries).
+constexpr int kMaxExactTable = 2048;
+void launch_exact_tables(const DeviceModel &m, double *dist, double2 *factors, int *reach,
+                         cudaStream_t stream);
 
 // Per beam: builds its LineRec and counts the tiles its walk passes through.
 void launch_exact_lines(const DeviceModel &m, const ExactBeam *beams, const StartCell *starts,
@@ -105,13 +111,13 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
 
 // One block per tile (block i runs tile order[i]), one thread per cell:
 // applies every beam of the tile's list, in order, to the thread's own cell,
-// and writes the final grid (x-major floats, -1 unknown). Tables may be null
-// (distances on the fly).
+// and writes the final grid (x-major floats, -1 unknown). The tables are all
+// null above kMaxExactTable (distances on the fly).
 void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
                         const uint32_t *order, const uint32_t *tile_begin,
-                        const uint32_t *tile_end, const double *dist,
-                        const double *factor_free, const double *factor_occ, float *grid,
-                        unsigned long long *cell_updates, cudaStream_t stream);
+                        const uint32_t *tile_end, const double *dist, const double2 *factors,
+                        const int *reach, float *grid, unsigned long long *cell_updates,
+                        cudaStream_t stream);
 
 // ---------------------------------------------------------------------------
 // Float mode: single precision, all scans fused into one launch.

@@ -59,7 +59,7 @@ __device__ void for_each_tile(const LineRec &L, const DeviceModel &m, Visit visi
   }
 }
 
-__global__ void tables_kernel(DeviceModel m, double *dist, double *ff, double *fo) {
+__global__ void tables_kernel(DeviceModel m, double *dist, double2 *factors) {
   const int n = m.table_size * m.table_size;
   const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
   for (int idx = blockIdx.x * blockDim.x + threadIdx.x; idx < n; idx += gridDim.x * blockDim.x) {
@@ -68,9 +68,21 @@ __global__ void tables_kernel(DeviceModel m, double *dist, double *ff, double *f
     dist[idx] = d;
     double p;
     // A range of +inf makes every cell free, -inf every cell occupied.
-    ff[idx] = egrid::sensor_model(model, d, CUDART_INF, &p) ? egrid::odds_factor(m.prior, p) : 0.0;
-    fo[idx] = egrid::sensor_model(model, d, -CUDART_INF, &p) ? egrid::odds_factor(m.prior, p) : 0.0;
+    const double ff = egrid::sensor_model(model, d, CUDART_INF, &p) ? egrid::odds_factor(m.prior, p) : 0.0;
+    const double fo = egrid::sensor_model(model, d, -CUDART_INF, &p) ? egrid::odds_factor(m.prior, p) : 0.0;
+    factors[idx] = make_double2(ff, fo);
   }
+}
+
+// reach[i] = the first j with distance(i, j) >= max_range (table_size if
+// none). For tables of at most 2^11 entries per axis i*i + j*j cannot wrap, so
+// the distance grows with j and "an update at (i, j)" is exactly j < reach[i].
+__global__ void reach_kernel(DeviceModel m, const double *dist, int *reach) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= m.table_size) return;
+  int j = 0;
+  while (j < m.table_size && dist[i * m.table_size + j] < m.max) ++j;
+  reach[i] = j;
 }
 
 __global__ void lines_kernel(DeviceModel m, const ExactBeam *beams, const StartCell *starts,
@@ -157,30 +169,81 @@ __device__ void mark_tile_cells(const LineRec &L, int e, int tx0, int ty0, unsig
   }
 }
 
-// One evidence update of the thread's cell by beam L (the oracle's
-// arithmetic; tables when built). Returns whether it updated.
-__device__ __forceinline__ bool update_cell(const DeviceModel &m, const LineRec &L, int cx, int cy,
-                                            const double *dist, const double *ff, const double *fo,
-                                            float *cell) {
-  const int T = m.table_size;
+// A cell at exactly 0 or 1 keeps its value under every update whose odds
+// factor is finite and positive (t = f*0 = 0 gives 0; f*1/0 = inf gives 1),
+// which every factor is when prior, occ and emp lie strictly inside (0, 1)
+// (the host sets m.saturation_holds then). Cells next to a robot that stood
+// still saturate early and then take most of their tile's updates: skipping
+// the arithmetic there shortens the longest chains of dependent updates.
+__device__ __forceinline__ bool saturated(const DeviceModel &m, float cell) {
+  return m.saturation_holds && (__float_as_uint(cell) == 0u || cell == 1.0f);
+}
+
+// The updates beam L makes to (cx, cy) with the tables built: whether there
+// is one (distance below max_range) and its odds factor. Independent of the
+// cell's value, so a batch of them is loaded before the dependent chain.
+__device__ __forceinline__ bool tabled_factor(const DeviceModel &m, const LineRec &L, int cx, int cy,
+                                              const int *reach, const double *dist, const double2 *factors,
+                                              bool need_factor, double *f) {
   const int i = egrid::wrap_abs(egrid::wrap_sub(cx, L.x1));
   const int j = egrid::wrap_abs(egrid::wrap_sub(cy, L.y1));
-  // i, j <= k <= table_size - 1: inside the table.
-  const double d = dist ? dist[i * T + j] : egrid::cell_distance(i, j, m.resolution);
-  // The oracle stops the beam at the first cell with d >= max; d never
-  // decreases along a walk, so that is: no update where d >= max.
-  if (!(d < m.max)) return false;
-  double f;
-  if (ff) {
-    f = d < static_cast<double>(L.range) ? ff[i * T + j] : fo[i * T + j];
-  } else {
-    const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
-    double p;
-    egrid::sensor_model(model, d, L.range, &p);
-    f = egrid::odds_factor(m.prior, p);
+  // i, j <= k <= table_size - 1: inside the tables.
+  if (j >= reach[i]) return false;  // the oracle stops the beam here: no update
+  if (need_factor) {
+    const size_t idx = static_cast<size_t>(i) * m.table_size + j;
+    const double d = dist[idx];
+    const double2 fs = factors[idx];
+    *f = d < static_cast<double>(L.range) ? fs.x : fs.y;
   }
-  *cell = egrid::odds_apply(*cell, m.prior, f);
   return true;
+}
+
+// The same without tables (table_size above 2^11): everything on the fly.
+__device__ __forceinline__ bool computed_factor(const DeviceModel &m, const LineRec &L, int cx, int cy,
+                                                double *f) {
+  const int i = egrid::wrap_abs(egrid::wrap_sub(cx, L.x1));
+  const int j = egrid::wrap_abs(egrid::wrap_sub(cy, L.y1));
+  const double d = egrid::cell_distance(i, j, m.resolution);
+  // d never decreases along a walk, so the oracle's stop at the first
+  // d >= max is: no update where d >= max.
+  if (!(d < m.max)) return false;
+  const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
+  double p;
+  egrid::sensor_model(model, d, L.range, &p);
+  *f = egrid::odds_factor(m.prior, p);
+  return true;
+}
+
+// Applies the beams marked in `h` to the thread's cell, lowest bit first (the
+// list's order). Factors are fetched kBatch at a time ahead of the chain of
+// dependent odds updates, so their loads overlap. Returns the updates made.
+__device__ __forceinline__ unsigned drain_hits(const DeviceModel &m, const LineRec *sh, unsigned long long h,
+                                               int cx, int cy, const int *reach, const double *dist,
+                                               const double2 *factors, float *cell) {
+  constexpr int kBatch = 4;
+  unsigned count = 0;
+  while (h != 0) {
+    double f[kBatch];
+    bool update[kBatch];
+    const bool need = !saturated(m, *cell);
+#pragma unroll
+    for (int u = 0; u < kBatch; ++u) {
+      update[u] = false;
+      f[u] = 0;
+      if (h == 0) continue;
+      const int e = __ffsll(static_cast<long long>(h)) - 1;
+      h &= h - 1;
+      update[u] = reach ? tabled_factor(m, sh[e], cx, cy, reach, dist, factors, need, &f[u])
+                        : computed_factor(m, sh[e], cx, cy, &f[u]);
+    }
+#pragma unroll
+    for (int u = 0; u < kBatch; ++u) {
+      if (!update[u]) continue;
+      ++count;
+      if (!saturated(m, *cell)) *cell = egrid::odds_apply(*cell, m.prior, f[u]);
+    }
+  }
+  return count;
 }
 
 // One block per tile, one thread per cell. The tile's list is taken in
@@ -192,10 +255,16 @@ __device__ __forceinline__ bool update_cell(const DeviceModel &m, const LineRec 
 __global__ void __launch_bounds__(kTileThreads)
     tiles_kernel(DeviceModel m, const LineRec *lines, const uint32_t *sorted_beam,
                  const uint32_t *order, const uint32_t *tile_begin, const uint32_t *tile_end,
-                 const double *dist,
-                 const double *ff, const double *fo, float *grid, unsigned long long *updates) {
+                 const double *dist, const double2 *factors, const int *reach_global, float *grid,
+                 unsigned long long *updates) {
   __shared__ LineRec sh[kTileThreads];
   __shared__ unsigned long long hit[kTileThreads];
+  extern __shared__ int reach_shared[];  // the reach table, when tables are used
+  const int *reach = nullptr;
+  if (reach_global) {
+    for (int i = threadIdx.x; i < m.table_size; i += kTileThreads) reach_shared[i] = reach_global[i];
+    reach = reach_shared;
+  }
   const int tiles_y = (m.size_y + kTile - 1) / kTile;
   const int tile = static_cast<int>(order[blockIdx.x]);
   const int tx0 = (tile / tiles_y) * kTile, ty0 = (tile % tiles_y) * kTile;
@@ -214,12 +283,7 @@ __global__ void __launch_bounds__(kTileThreads)
     __syncthreads();
     if (static_cast<int>(threadIdx.x) < n) mark_tile_cells(sh[threadIdx.x], threadIdx.x, tx0, ty0, hit);
     __syncthreads();
-    if (active) {
-      for (unsigned long long h = hit[threadIdx.x]; h != 0; h &= h - 1) {
-        const int e = __ffsll(static_cast<long long>(h)) - 1;
-        count += update_cell(m, sh[e], cx, cy, dist, ff, fo, &cell) ? 1 : 0;
-      }
-    }
+    if (active) count += drain_hits(m, sh, hit[threadIdx.x], cx, cy, reach, dist, factors, &cell);
     __syncthreads();
   }
   if (active) grid[static_cast<size_t>(cx) * m.size_y + cy] = cell;
@@ -258,11 +322,13 @@ size_t exact_sort_temp_bytes(size_t num_pairs) {
   return bytes;
 }
 
-void launch_exact_tables(const DeviceModel &m, double *dist, double *ff, double *fo,
+void launch_exact_tables(const DeviceModel &m, double *dist, double2 *factors, int *reach,
                          cudaStream_t stream) {
   const size_t n = static_cast<size_t>(m.table_size) * m.table_size;
   if (n == 0) return;
-  tables_kernel<<<min(blocks_for(n, 256), 4096u), 256, 0, stream>>>(m, dist, ff, fo);
+  tables_kernel<<<min(blocks_for(n, 256), 4096u), 256, 0, stream>>>(m, dist, factors);
+  VG_CUDA_CHECK_LAUNCH();
+  reach_kernel<<<blocks_for(static_cast<size_t>(m.table_size), 128), 128, 0, stream>>>(m, dist, reach);
   VG_CUDA_CHECK_LAUNCH();
 }
 
@@ -333,14 +399,14 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
 
 void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
                         const uint32_t *order, const uint32_t *tile_begin,
-                        const uint32_t *tile_end, const double *dist,
-                        const double *ff, const double *fo, float *grid,
-                        unsigned long long *updates, cudaStream_t stream) {
+                        const uint32_t *tile_end, const double *dist, const double2 *factors,
+                        const int *reach, float *grid, unsigned long long *updates, cudaStream_t stream) {
   const size_t tiles = static_cast<size_t>((m.size_x + kTile - 1) / kTile) *
                        ((m.size_y + kTile - 1) / kTile);
   if (tiles == 0) return;
-  tiles_kernel<<<static_cast<unsigned>(tiles), kTileThreads, 0, stream>>>(
-      m, lines, sorted_beam, order, tile_begin, tile_end, dist, ff, fo, grid, updates);
+  const size_t shared = reach ? static_cast<size_t>(m.table_size) * sizeof(int) : 0;
+  tiles_kernel<<<static_cast<unsigned>(tiles), kTileThreads, shared, stream>>>(
+      m, lines, sorted_beam, order, tile_begin, tile_end, dist, factors, reach, grid, updates);
   VG_CUDA_CHECK_LAUNCH();
 }
 

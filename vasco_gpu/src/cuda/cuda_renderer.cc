@@ -113,6 +113,8 @@ cuda::DeviceModel CudaRenderer::exact_model() const {
   m.table_size = params_.table_size();
   m.size_x = geo_.size_x;
   m.size_y = geo_.size_y;
+  auto inside_unit = [](double v) { return v > 0.0 && v < 1.0; };
+  m.saturation_holds = inside_unit(m.prior) && inside_unit(m.occ) && inside_unit(m.emp);
   return m;
 }
 
@@ -130,14 +132,14 @@ cuda::GridEncoding CudaRenderer::encoding() const {
 void CudaRenderer::build_tables() {
   const int T = params_.table_size();
   const size_t t2 = static_cast<size_t>(std::max(T, 0)) * static_cast<size_t>(std::max(T, 0));
-  use_tables_ = t2 > 0 && t2 <= (size_t(1) << 22);
+  use_tables_ = T > 0 && T <= cuda::kMaxExactTable;
   const auto key = std::make_tuple(T, params_.resolution, params_.p_prior, params_.p_occ, params_.p_emp,
                                    params_.range_sure, params_.range_max);
   if (!use_tables_ || (tables_built_ && key == tables_key_)) return;
   reserve(dist_, t2);
-  reserve(factor_free_, t2);
-  reserve(factor_occ_, t2);
-  cuda::launch_exact_tables(exact_model(), dist_.get(), factor_free_.get(), factor_occ_.get(), stream_->get());
+  reserve(factors_, t2);
+  reserve(reach_, static_cast<size_t>(T));
+  cuda::launch_exact_tables(exact_model(), dist_.get(), factors_.get(), reach_.get(), stream_->get());
   tables_key_ = key;
   tables_built_ = true;
 }
@@ -329,8 +331,8 @@ void CudaRenderer::launch_exact_apply(uint64_t pair_bound, MapStats *st) {
                          order_keys_out_.get(), order_ids_.get(), order_tmp_.get(), order_tmp_.size(), s);
   timer.mark("tile order");
   cuda::launch_exact_tiles(m, lines_.get(), sorted_beam_.get(), order_.get(), tile_begin_.get(), tile_end_.get(),
-                           use_tables_ ? dist_.get() : nullptr, use_tables_ ? factor_free_.get() : nullptr,
-                           use_tables_ ? factor_occ_.get() : nullptr, grid_.get(), updates_.get(), s);
+                           use_tables_ ? dist_.get() : nullptr, use_tables_ ? factors_.get() : nullptr,
+                           use_tables_ ? reach_.get() : nullptr, grid_.get(), updates_.get(), s);
   timer.mark("tiles");
   e_map.record(s);
   reserve(staging_counters_, 2);
