@@ -20,9 +20,6 @@ struct DeviceModel {
   double resolution, wall;
   int table_size;                     // (int)(max_range / resolution)
   int size_x, size_y;                 // grid size in cells
-  // prior, occ and emp strictly inside (0, 1): every odds factor is finite
-  // and positive, so a cell at exactly 0 or 1 never changes again.
-  bool saturation_holds;
 };
 
 // ---------------------------------------------------------------------------

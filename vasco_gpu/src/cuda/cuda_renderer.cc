@@ -113,8 +113,6 @@ cuda::DeviceModel CudaRenderer::exact_model() const {
   m.table_size = params_.table_size();
   m.size_x = geo_.size_x;
   m.size_y = geo_.size_y;
-  auto inside_unit = [](double v) { return v > 0.0 && v < 1.0; };
-  m.saturation_holds = inside_unit(m.prior) && inside_unit(m.occ) && inside_unit(m.emp);
   return m;
 }
 
