@@ -76,13 +76,17 @@ TEST_P(MapIo, WriteAllThenReadEveryChunk) {
   EXPECT_EQ(map.map[2][1], 0.125f * 5);
   EXPECT_EQ(map.complete_map[2 * 2 + 1], 0.125f * 5);  // x-major
   EXPECT_EQ(map.map[1], map.complete_map + 2);
+  EXPECT_STREQ(map.config.map_name, file.c_str());  // CARMEN's reader sets the file name
   std::free(map.map);
   std::free(map.complete_map);
+  std::free(map.config.map_name);
 
   carmen_map_config_t config;
   ASSERT_EQ(carmen_map_read_gridmap_config(file.c_str(), &config), 0);
   EXPECT_EQ(config.x_size, 3);
   EXPECT_EQ(config.y_size, 2);
+  EXPECT_STREQ(config.map_name, file.c_str());
+  std::free(config.map_name);
 
   time_t when = 0;
   char user[11], origin[81], desc[81];
@@ -181,8 +185,10 @@ TEST_P(MapIo, NamedChunks) {
   ASSERT_EQ(carmen_map_read_named_gridmap_chunk(file.c_str(), "second", &map), 0);
   EXPECT_EQ(map.config.x_size, 2);
   EXPECT_EQ(map.map[1][0], 1.0f);
+  EXPECT_STREQ(map.config.map_name, "second");  // the named reader sets the chunk name, as CARMEN's
   std::free(map.map);
   std::free(map.complete_map);
+  std::free(map.config.map_name);
   // No unnamed gridmap: the unnamed reader fails, with a message naming the file.
   testing::internal::CaptureStderr();
   EXPECT_EQ(carmen_map_read_gridmap_chunk(file.c_str(), &map), -1);
@@ -198,12 +204,14 @@ TEST_P(MapIo, NamedChunks) {
   carmen_FILE *in = carmen_fopen(file.c_str(), "r");
   ASSERT_NE(in, nullptr);
   ASSERT_EQ(carmen_map_advance_to_named_chunk(in, CARMEN_MAP_GRIDMAP_CHUNK, "second"), 0);
-  // Positioned after the type byte: the id (17) + first chunk (5 + 36) + 1.
-  EXPECT_EQ(carmen_ftell(in), 17 + 41 + 1);
+  // Positioned at the type byte, as CARMEN leaves it: the id (17) + the
+  // first chunk (5 + 36).
+  EXPECT_EQ(carmen_ftell(in), 17 + 41);
+  EXPECT_EQ(carmen_fgetc(in), CARMEN_MAP_GRIDMAP_CHUNK | CARMEN_MAP_NAMED_CHUNK_FLAG);
   carmen_fclose(in);
 }
 
-TEST_P(MapIo, AdvanceToChunkStopsAfterTheTypeByte) {
+TEST_P(MapIo, AdvanceToChunkStopsAtTheTypeByte) {
   // A gzip or plain copy of freiburg.map.
   const std::string file = path("fr");
   if (std::string(GetParam()).size() > 4) {
@@ -214,6 +222,7 @@ TEST_P(MapIo, AdvanceToChunkStopsAfterTheTypeByte) {
   carmen_FILE *fp = carmen_fopen(file.c_str(), "r");
   ASSERT_NE(fp, nullptr);
   ASSERT_EQ(carmen_map_advance_to_chunk(fp, CARMEN_MAP_GRIDMAP_CHUNK), 0);
+  EXPECT_EQ(carmen_fgetc(fp), CARMEN_MAP_GRIDMAP_CHUNK);  // CARMEN's readers take the type next
   unsigned char buf[4 + 10 + 8];
   ASSERT_EQ(carmen_fread(buf, 1, sizeof buf, fp), sizeof buf);
   const std::string s(reinterpret_cast<char *>(buf), sizeof buf);
@@ -222,7 +231,7 @@ TEST_P(MapIo, AdvanceToChunkStopsAfterTheTypeByte) {
   EXPECT_EQ(maptest::read_i32(s, 14), 300);
   EXPECT_EQ(maptest::read_i32(s, 18), 300);
   ASSERT_EQ(carmen_map_advance_to_chunk(fp, CARMEN_MAP_CREATOR_CHUNK), 0);  // rescans from the start
-  EXPECT_EQ(carmen_ftell(fp), 18);
+  EXPECT_EQ(carmen_ftell(fp), 17);  // freiburg.map has no comments: the creator follows the id
   EXPECT_EQ(carmen_map_advance_to_chunk(fp, CARMEN_MAP_PLACES_CHUNK), -1);
   carmen_fclose(fp);
 }
@@ -242,7 +251,8 @@ TEST(MapIoFreiburg, ReadersAndUtilities) {
   EXPECT_EQ(config.x_size, 300);
   EXPECT_EQ(config.y_size, 300);
   EXPECT_EQ(config.resolution, double(0.1f));
-  EXPECT_EQ(config.map_name, nullptr);
+  EXPECT_STREQ(config.map_name, file.c_str());
+  std::free(config.map_name);
   time_t when = 0;
   char user[11];
   ASSERT_EQ(carmen_map_read_creator_chunk(file.c_str(), &when, user, nullptr, nullptr), 0);

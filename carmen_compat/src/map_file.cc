@@ -809,7 +809,7 @@ std::string places_payload(const PlaceList &places) {
       throw std::invalid_argument("place \"" + p.name + "\" has unknown type " + std::to_string(p.type));
     }
     put_i32(s, p.type);
-    put_field(s, p.name, 20, '\0');
+    put_field(s, p.name, 20, ' ');  // space-padded, as CARMEN's write_fixed_string
     put_f32(s, static_cast<float>(p.x));
     put_f32(s, static_cast<float>(p.y));
     if (p.type != kNamedPosition) put_f32(s, static_cast<float>(p.theta));
@@ -1135,6 +1135,31 @@ std::vector<std::string> standard_map_comments(int size_x, int size_y, double re
       " Description   : " + description,
       rule,
   };
+}
+
+std::string encode_raw_chunk(int type, const std::string &payload, const std::string &name) {
+  return chunk_bytes(type, !name.empty(), name, payload);
+}
+
+std::string read_chunk_body(const std::string &path, const ChunkInfo &chunk) {
+  if (chunk.size < 10) throw FileError(path, "chunk at offset " + std::to_string(chunk.offset) + " is too short");
+  Input in(path);
+  const uint64_t start = static_cast<uint64_t>(chunk.offset) + 5;  // type byte and size field
+  if (in.skip(start) != start) throw FileError(path, "ends before the chunk at " + std::to_string(chunk.offset));
+  // Read in pieces: the size was checked by the listing, but a gzip stream
+  // can still end early.
+  std::string body;
+  const size_t want = static_cast<size_t>(chunk.size);
+  while (body.size() < want) {
+    const size_t k = std::min(want - body.size(), kReadPiece);
+    const size_t old = body.size();
+    body.resize(old + k);
+    if (in.read(&body[old], k) != k) {
+      const std::string why = in.stream_error();
+      throw FileError(path, why.empty() ? "ends inside the chunk at offset " + std::to_string(chunk.offset) : why);
+    }
+  }
+  return body;
 }
 
 }  // namespace carmen

@@ -12,6 +12,7 @@
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_file.h"
+#include "map_io_support.h"
 
 static_assert(CARMEN_MAP_GRIDMAP_CHUNK == carmen::kGridmapChunk, "chunk code");
 static_assert(CARMEN_MAP_OFFLIMITS_CHUNK == carmen::kOfflimitsChunk, "chunk code");
@@ -28,24 +29,8 @@ static_assert(CARMEN_LOCALIZATION_INIT_TYPE == carmen::kLocalizationInit, "place
 
 namespace {
 
-void report(const char *func, const std::string &msg) { std::fprintf(stderr, "%s: %s\n", func, msg.c_str()); }
-
-// Runs `body`; any exception becomes a message on stderr and -1.
-template <typename F>
-int guarded(const char *func, const char *filename, F &&body) {
-  try {
-    return body();
-  } catch (const carmen::FileError &e) {
-    report(func, e.what());
-  } catch (const std::bad_alloc &) {
-    report(func, std::string(filename ? filename : "map") + ": out of memory");
-  } catch (const std::exception &e) {
-    report(func, std::string(filename ? filename + std::string(": ") : std::string()) + e.what());
-  } catch (...) {
-    report(func, "unexpected error");
-  }
-  return -1;
-}
+using carmen::map_io_detail::guarded;
+using carmen::map_io_detail::report;
 
 carmen::MapFile read_file(const char *filename) {
   if (filename == nullptr) throw std::invalid_argument("no file name given");
@@ -54,6 +39,11 @@ carmen::MapFile read_file(const char *filename) {
 
 [[noreturn]] void missing(const char *filename, const char *what) {
   throw carmen::FileError(filename, std::string("has no ") + what + " chunk");
+}
+
+[[noreturn]] void missing_named(const char *filename, const char *what, const char *name) {
+  throw carmen::FileError(filename, std::string("has no ") + what + " chunk named \"" +
+                                        carmen::printable(name ? name : "") + "\"");
 }
 
 template <typename T>
@@ -145,21 +135,42 @@ carmen::LaserScanList scans_from(const carmen_laser_scan_t *scans, int n) {
   return out;
 }
 
-void fill_map(const carmen::GridMap &g, carmen_map_p map) {
+// A malloc()ed copy of `text`, as CARMEN's readers make for map_name.
+char *malloc_copy(const char *text) {
+  const size_t n = std::strlen(text) + 1;
+  auto *copy = static_cast<char *>(std::malloc(n));
+  if (copy == nullptr) throw std::bad_alloc();
+  std::memcpy(copy, text, n);
+  return copy;
+}
+
+void fill_config(const carmen::GridMap &g, const char *map_name, carmen_map_config_p config) {
+  char *name = malloc_copy(map_name);
+  config->x_size = g.size_x;
+  config->y_size = g.size_y;
+  config->resolution = g.resolution;
+  config->map_name = name;
+}
+
+// map_name: what CARMEN's reader puts there (the file or the chunk name).
+void fill_map(const carmen::GridMap &g, const char *map_name, carmen_map_p map) {
   const size_t n = g.cells.size();
   auto *cells = static_cast<float *>(std::malloc(sizeof(float) * n));
   auto **rows = static_cast<float **>(std::malloc(sizeof(float *) * size_t(g.size_x)));
-  if (cells == nullptr || rows == nullptr) {
+  char *name = static_cast<char *>(std::malloc(std::strlen(map_name) + 1));
+  if (cells == nullptr || rows == nullptr || name == nullptr) {
     std::free(cells);
     std::free(rows);
+    std::free(name);
     throw std::bad_alloc();
   }
+  std::strcpy(name, map_name);
   std::memcpy(cells, g.cells.data(), sizeof(float) * n);
   for (int x = 0; x < g.size_x; ++x) rows[x] = cells + size_t(x) * size_t(g.size_y);
   map->config.x_size = g.size_x;
   map->config.y_size = g.size_y;
   map->config.resolution = g.resolution;
-  map->config.map_name = nullptr;
+  map->config.map_name = name;
   map->complete_map = cells;
   map->map = rows;
 }
@@ -268,11 +279,12 @@ int advance(carmen_FILE *fp, int specific_chunk, const char *chunk_name) {
     const int type = carmen_fgetc(fp);
     if (type == EOF) return -1;
     const long after_type = carmen_ftell(fp);
+    const long at_type = after_type - 1;
     int32_t size;
     if (!read_i32(fp, &size) || size < 10) return -1;
     long skip = size;
     if ((type & ~CARMEN_MAP_NAMED_CHUNK_FLAG) == specific_chunk) {
-      if (chunk_name == nullptr) return carmen_fseek(fp, after_type, SEEK_SET) == 0 ? 0 : -1;
+      if (chunk_name == nullptr) return carmen_fseek(fp, at_type, SEEK_SET) == 0 ? 0 : -1;
       if (type & CARMEN_MAP_NAMED_CHUNK_FLAG) {
         char desc[10];
         if (carmen_fread(desc, 1, 10, fp) != 10) return -1;
@@ -285,7 +297,7 @@ int advance(carmen_FILE *fp, int specific_chunk, const char *chunk_name) {
           name.push_back(static_cast<char>(c));
           if (name.size() > 4096) return -1;
         }
-        if (name == chunk_name) return carmen_fseek(fp, after_type, SEEK_SET) == 0 ? 0 : -1;
+        if (name == chunk_name) return carmen_fseek(fp, at_type, SEEK_SET) == 0 ? 0 : -1;
       }
     }
     if (carmen_fseek(fp, skip, SEEK_CUR) != 0) return -1;
@@ -349,8 +361,8 @@ int carmen_map_write_comment_chunk(carmen_FILE *fp, int size_x, int size_y, doub
 
 int carmen_map_write_id(carmen_FILE *fp) { return write_bytes(fp, carmen::encode_map_id(), __func__); }
 
-int carmen_map_write_creator_chunk(carmen_FILE *fp, const char *origin, const char *description) {
-  const char *const fn = __func__;
+static int write_creator(const char *fn, carmen_FILE *fp, const char *name, const char *origin,
+                         const char *description) {
   return guarded(fn, nullptr, [&] {
     carmen::CreatorInfo c;
     const char *user = std::getenv("USER");
@@ -359,8 +371,19 @@ int carmen_map_write_creator_chunk(carmen_FILE *fp, const char *origin, const ch
     c.description = description ? description : "";
     c.time = static_cast<int64_t>(std::time(nullptr));
     c.time_bytes = static_cast<int>(sizeof(time_t));
-    return write_bytes(fp, carmen::encode_creator_chunk(c), fn);
+    return write_bytes(fp, carmen::encode_creator_chunk(c, name ? name : ""), fn);
   });
+}
+int carmen_map_write_creator_chunk(carmen_FILE *fp, const char *origin, const char *description) {
+  return write_creator(__func__, fp, nullptr, origin, description);
+}
+int carmen_map_write_named_creator_chunk(carmen_FILE *fp, const char *name, const char *origin,
+                                         const char *description) {
+  if (name == nullptr || *name == '\0') {
+    report(__func__, "a named chunk needs a non-empty name");
+    return -1;
+  }
+  return write_creator(__func__, fp, name, origin, description);
 }
 
 int carmen_map_write_named_gridmap_chunk(carmen_FILE *fp, const char *name, float **prob, int size_x,
@@ -435,7 +458,7 @@ static int read_gridmap(const char *fn, const char *filename, const char *chunk_
     const carmen::GridMap *g =
         chunk_name ? find_named<carmen::GridMap>(m, chunk_name) : (m.gridmap ? &*m.gridmap : nullptr);
     if (g == nullptr) missing(filename, "GRIDMAP");
-    fill_map(*g, map);
+    fill_map(*g, chunk_name ? chunk_name : filename, map);
     return 0;
   });
 }
@@ -446,17 +469,34 @@ int carmen_map_read_gridmap_chunk(const char *filename, carmen_map_p map) {
   return read_gridmap(__func__, filename, nullptr, map);
 }
 
-int carmen_map_read_gridmap_config(const char *filename, carmen_map_config_p config) {
-  return guarded(__func__, filename, [&] {
+static int read_gridmap_config(const char *fn, const char *filename, const char *chunk_name,
+                               carmen_map_config_p config) {
+  return guarded(fn, filename, [&] {
     if (config == nullptr) throw std::invalid_argument("no config given (NULL)");
     const carmen::MapFile m = read_file(filename);
-    if (!m.gridmap) missing(filename, "GRIDMAP");
-    config->x_size = m.gridmap->size_x;
-    config->y_size = m.gridmap->size_y;
-    config->resolution = m.gridmap->resolution;
-    config->map_name = nullptr;
+    const carmen::GridMap *g =
+        chunk_name ? find_named<carmen::GridMap>(m, chunk_name) : (m.gridmap ? &*m.gridmap : nullptr);
+    if (g == nullptr && chunk_name) missing_named(filename, "GRIDMAP", chunk_name);
+    if (g == nullptr) missing(filename, "GRIDMAP");
+    fill_config(*g, chunk_name ? chunk_name : filename, config);
     return 0;
   });
+}
+int carmen_map_read_gridmap_config(const char *filename, carmen_map_config_p config) {
+  return read_gridmap_config(__func__, filename, nullptr, config);
+}
+int carmen_map_read_named_gridmap_config(const char *filename, const char *chunk_name,
+                                         carmen_map_config_p config) {
+  if (chunk_name == nullptr) return read_gridmap_config(__func__, filename, "", config);
+  return read_gridmap_config(__func__, filename, chunk_name, config);
+}
+
+static void copy_creator(const carmen::CreatorInfo &c, time_t *creation_time, char *username, char *origin,
+                         char *description) {
+  if (creation_time != nullptr) *creation_time = static_cast<time_t>(c.time);
+  copy_text(username, 11, c.user);
+  copy_text(origin, 81, c.origin);
+  copy_text(description, 81, c.description);
 }
 
 int carmen_map_read_creator_chunk(const char *filename, time_t *creation_time, char *username, char *origin,
@@ -465,10 +505,20 @@ int carmen_map_read_creator_chunk(const char *filename, time_t *creation_time, c
     const carmen::MapFile m = read_file(filename);
     if (!m.creator) missing(filename, "CREATOR");
     if (m.old_style_creator) std::fprintf(stderr, "%s: old-style map (creator chunk code 0)\n", filename);
-    if (creation_time != nullptr) *creation_time = static_cast<time_t>(m.creator->time);
-    copy_text(username, 11, m.creator->user);
-    copy_text(origin, 81, m.creator->origin);
-    copy_text(description, 81, m.creator->description);
+    copy_creator(*m.creator, creation_time, username, origin, description);
+    return 0;
+  });
+}
+
+// Old-style (code 0) creators have no name, so only a named CREATOR chunk
+// answers here.
+int carmen_map_read_named_creator_chunk(const char *filename, const char *chunk_name, time_t *creation_time,
+                                        char *username, char *origin, char *description) {
+  return guarded(__func__, filename, [&] {
+    const carmen::MapFile m = read_file(filename);
+    const carmen::CreatorInfo *c = find_named<carmen::CreatorInfo>(m, chunk_name);
+    if (c == nullptr) missing_named(filename, "CREATOR", chunk_name);
+    copy_creator(*c, creation_time, username, origin, description);
     return 0;
   });
 }

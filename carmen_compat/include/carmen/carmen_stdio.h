@@ -3,8 +3,12 @@
  * A name ending in ".gz" is read and written through zlib; anything else is a
  * plain FILE. The content is never sniffed (as in CARMEN). The functions keep
  * CARMEN's names and signatures so existing code links unchanged. */
-#ifndef CARMEN_CARMEN_STDIO_H
-#define CARMEN_CARMEN_STDIO_H
+/* DGC_MY_STDIO_H is CARMEN's guard for its carmen_stdio.h: whichever of the
+ * two a program includes first is the one it gets (carmen_FILE is a typedef
+ * of an anonymous struct, which C cannot define twice). The layouts agree;
+ * CARMEN declares comp_fp as gzFile * and carmen_fprintf as returning void. */
+#ifndef DGC_MY_STDIO_H
+#define DGC_MY_STDIO_H
 
 #include <stdio.h>
 #include <zlib.h>
@@ -49,4 +53,4 @@ int carmen_fflush(carmen_FILE *fp);
 #ifdef __cplusplus
 }
 #endif
-#endif /* CARMEN_CARMEN_STDIO_H */
+#endif /* DGC_MY_STDIO_H */

@@ -1,5 +1,5 @@
-/* map_io.h — CARMEN 0.7.4's map file API (maptools/map_io.h and the structs
- * of maptools/map.h), with CARMEN's names and signatures.
+/* map_io.h — CARMEN 0.7.4's map file API (maptools/map_io.h; the structs are
+ * in carmen/map.h), with CARMEN's names, signatures and macro values.
  *
  * Differences from CARMEN, all on the safe side:
  *  - String arguments are `const char *` (CARMEN: `char *`); C callers are
@@ -11,13 +11,22 @@
  *  - Files are always read and written little-endian (CARMEN: host order).
  *  - The comment block ends its Description line with a newline (CARMEN 0.7.4
  *    forgets it) and keeps lines short enough for CARMEN's own reader.
+ *  - Where CARMEN's behaviour is undefined or a crash (a named chunk in
+ *    vstrip's table, an unknown HMAP link type, PPM bytes out of range),
+ *    the function below says what it does instead.
  * Functions return 0 on success and -1 on error unless said otherwise. */
+/* The search for CARMEN's own headers comes before our include guard (see
+ * carmen_compat/carmen_shared_types.h). CARMEN_MAP_IO_H is CARMEN's guard:
+ * whichever map_io.h a program includes first is the one it gets. */
+#include <carmen_compat/carmen_shared_types.h>
+
 #ifndef CARMEN_MAP_IO_H
 #define CARMEN_MAP_IO_H
 
 #include <time.h>
 
-#include "carmen/carmen_stdio.h"
+#include <carmen/carmen_stdio.h>
+#include <carmen/map.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -27,6 +36,7 @@ extern "C" {
 #define CARMEN_MAP_LABEL "CARMENMAPFILE"
 #define CARMEN_MAP_VERSION "v020"
 
+#define CARMEN_MAP_NO_CHUNK 0
 #define CARMEN_MAP_CREATOR_OLD_CHUNK 0 /* pre-0.7 creator code (not a CARMEN name) */
 #define CARMEN_MAP_GRIDMAP_CHUNK 1
 #define CARMEN_MAP_OFFLIMITS_CHUNK 2
@@ -36,71 +46,8 @@ extern "C" {
 #define CARMEN_MAP_LASERSCANS_CHUNK 16
 #define CARMEN_MAP_CREATOR_CHUNK 32
 #define CARMEN_MAP_GLOBAL_OFFSET_CHUNK 64
-#define CARMEN_MAP_NAMED_CHUNK_FLAG 0x80
-
-/* ---- Structs (CARMEN's maptools/map.h) ---------------------------------- */
-typedef struct {
-  int x_size;
-  int y_size;
-  double resolution; /* metres per cell */
-  char *map_name;    /* the readers here set it to NULL */
-} carmen_map_config_t, *carmen_map_config_p;
-
-/* map[x][y] == complete_map[x * y_size + y] (x-major). Both arrays come from
- * malloc(): release with free(map->map) and free(map->complete_map). */
-typedef struct {
-  carmen_map_config_t config;
-  float *complete_map;
-  float **map;
-} carmen_map_t, *carmen_map_p;
-
-/* Place types. A position stores x y, a pose x y theta, a localization init
- * x y theta x_std y_std theta_std. */
-#define CARMEN_NAMED_POSITION_TYPE 0
-#define CARMEN_NAMED_POSE_TYPE 1
-#define CARMEN_LOCALIZATION_INIT_TYPE 2
-
-typedef struct {
-  int type;
-  int size;      /* not stored in map files; the readers set it to 0 */
-  char name[22]; /* 20 characters are stored in the file */
-  double x, y, theta;
-  double x_std, y_std, theta_std;
-} carmen_place_t, *carmen_place_p;
-
-/* places from malloc(): release with free(list.places). */
-typedef struct {
-  carmen_place_p places;
-  int num_places;
-} carmen_map_placelist_t, *carmen_map_placelist_p;
-
-typedef enum {
-  CARMEN_OFFLIMITS_POINT_ID,
-  CARMEN_OFFLIMITS_LINE_ID,
-  CARMEN_OFFLIMITS_RECT_ID
-} carmen_offlimits_type_t;
-
-/* A point uses x1 y1; a line and a rectangle use x1 y1 x2 y2 (cells). */
-typedef struct {
-  int type; /* carmen_offlimits_type_t */
-  int x1, y1, x2, y2;
-} carmen_offlimits_t, *carmen_offlimits_p;
-
-typedef struct {
-  carmen_offlimits_p offlimits;
-  int list_length;
-} carmen_offlimits_list_t, *carmen_offlimits_list_p;
-
-/* range from malloc() (one per scan), the scan array too. */
-typedef struct {
-  double x, y, theta;
-  int num_readings;
-  float *range;
-} carmen_laser_scan_t, *carmen_laser_scan_p;
-
-typedef struct {
-  double x, y, theta;
-} carmen_global_offset_t, *carmen_global_offset_p;
+#define CARMEN_MAP_NAMED_CHUNK_FLAG (1 << 7)
+#define CARMEN_MAP_CHUNK_IS_NAMED(type) ((type) & CARMEN_MAP_NAMED_CHUNK_FLAG)
 
 /* ---- Writers ------------------------------------------------------------ */
 /* Comments, id, creator and grid map, then places, off-limits and laser
@@ -115,12 +62,19 @@ int carmen_map_write_comment_chunk(carmen_FILE *fp, int size_x, int size_y, doub
 int carmen_map_write_id(carmen_FILE *fp);
 /* User from $USER, time now, time_t written with sizeof(time_t) bytes. */
 int carmen_map_write_creator_chunk(carmen_FILE *fp, const char *origin, const char *description);
+int carmen_map_write_named_creator_chunk(carmen_FILE *fp, const char *name, const char *origin,
+                                         const char *description);
 int carmen_map_write_gridmap_chunk(carmen_FILE *fp, float **prob, int size_x, int size_y, double resolution);
 int carmen_map_write_places_chunk(carmen_FILE *fp, carmen_place_p places, int num_places);
 int carmen_map_write_offlimits_chunk(carmen_FILE *fp, carmen_offlimits_p offlimits_list,
                                      int num_offlimits_items);
 int carmen_map_write_laserscans_chunk(carmen_FILE *fp, carmen_laser_scan_p scan_list, int num_scans);
 int carmen_map_write_global_offset_chunk(carmen_FILE *fp, carmen_global_offset_t *global_offset);
+
+/* A hierarchical map (HMAP, never named in CARMEN). Every link must be a
+ * door or an elevator, its keys valid zone indices, and zone names shorter
+ * than 128 characters (CARMEN's reader stops there). */
+int carmen_map_write_hmap_chunk(carmen_FILE *fp, carmen_hmap_p hmap);
 
 int carmen_map_write_named_gridmap_chunk(carmen_FILE *fp, const char *name, float **prob, int size_x,
                                          int size_y, double resolution);
@@ -136,24 +90,40 @@ int carmen_map_write_named_global_offset_chunk(carmen_FILE *fp, const char *name
 /* ---- Readers (take a file name; ".gz" names are gunzipped) --------------- */
 /* The unnamed readers use the first unnamed chunk of their type; the named
  * ones the first chunk of the type with that name. (CARMEN's unnamed readers
- * stop at the first chunk of the type, named or not, and misread a named
- * one.) carmen_map_read_gridmap_chunk allocates map->complete_map and
- * map->map and sets map->config. */
+ * take the first chunk of the type, named or not.)
+ * carmen_map_read_gridmap_chunk allocates map->complete_map and map->map and
+ * sets map->config. The gridmap readers set config.map_name to a malloc()ed
+ * copy of the file name (the named ones: of chunk_name), as CARMEN's do; the
+ * caller owns it and free()s it. */
 int carmen_map_read_gridmap_chunk(const char *filename, carmen_map_p map);
 int carmen_map_read_gridmap_config(const char *filename, carmen_map_config_p config);
 /* Buffers: username >= 11 bytes, origin and description >= 81 bytes; any
  * argument may be NULL. Falls back to an old-style (code 0) creator. */
 int carmen_map_read_creator_chunk(const char *filename, time_t *creation_time, char *username, char *origin,
                                   char *description);
+int carmen_map_read_named_creator_chunk(const char *filename, const char *chunk_name, time_t *creation_time,
+                                        char *username, char *origin, char *description);
 int carmen_map_read_places_chunk(const char *filename, carmen_map_placelist_p places);
 /* Points first, then lines, then rectangles; *offlimits_list is NULL when
  * the chunk is empty. */
 int carmen_map_read_offlimits_chunk(const char *filename, carmen_offlimits_p *offlimits_list,
                                     int *list_length);
+/* Reads the off-limits chunk and marks its cells in map (already read, same
+ * size) by adding 2.0, as CARMEN does: points, lines (CARMEN's Bresenham,
+ * both ends) and rectangles (x1..x2 by y1..y2, inclusive); cells outside the
+ * map are left out. -1 as in CARMEN when there is no off-limits chunk, when
+ * it is empty, or when map has no cells. */
+int carmen_map_read_offlimits_chunk_into_map(const char *filename, carmen_map_p map);
 int carmen_map_read_laserscans_chunk(const char *filename, carmen_laser_scan_p *scan_list, int *num_scans);
+/* Fills *hmap from the first unnamed HMAP chunk; every array comes from
+ * malloc(): free each zone name, zone_names, each link's keys and points,
+ * and links. hmap is left untouched on error. */
+int carmen_map_read_hmap_chunk(const char *filename, carmen_hmap_p hmap);
 int carmen_map_read_global_offset_chunk(const char *filename, carmen_global_offset_p global_offset);
 
 int carmen_map_read_named_gridmap_chunk(const char *filename, const char *chunk_name, carmen_map_p map);
+int carmen_map_read_named_gridmap_config(const char *filename, const char *chunk_name,
+                                         carmen_map_config_p config);
 int carmen_map_read_named_places_chunk(const char *filename, const char *chunk_name,
                                        carmen_map_placelist_p places);
 int carmen_map_read_named_offlimits_chunk(const char *filename, const char *chunk_name,
@@ -172,12 +142,36 @@ int carmen_map_file(const char *filename);
 int carmen_map_chunk_exists(const char *filename, int specific_chunk);
 int carmen_map_named_chunk_exists(const char *filename, int specific_chunk, const char *chunk_name);
 /* Rewinds, skips the comments and id, and stops at the first chunk whose type
- * (named flag masked off) is specific_chunk: fp is left just after the type
- * byte, so the int32 size comes next. -1 when there is none. */
+ * (named flag masked off) is specific_chunk: fp is left at its type byte, as
+ * CARMEN leaves it (its readers carmen_fgetc() the type next). -1 when there
+ * is none. */
 int carmen_map_advance_to_chunk(carmen_FILE *fp, int specific_chunk);
-/* The same for a named chunk with this name; fp is left just after the type
- * byte too. */
+/* The same for a named chunk with this name; fp is left at its type byte
+ * too. */
 int carmen_map_advance_to_named_chunk(carmen_FILE *fp, int specific_chunk, const char *chunk_name);
+
+/* Copies the comment lines and the map id from fp_in (from where it is: a
+ * freshly opened map) to fp_out. -1 when the id does not follow the
+ * comments. Lines of any length are copied whole. */
+int carmen_map_copy_comments(carmen_FILE *fp_in, carmen_FILE *fp_out);
+/* Copies a map from fp_in to fp_out without the chunks of the num_chunks
+ * types given (ints, 0..127) after num_chunks; a named chunk goes with its
+ * type (CARMEN reads past its table there). -1 for a type out of range or a
+ * truncated chunk. */
+int carmen_map_vstrip(carmen_FILE *fp_in, carmen_FILE *fp_out, int num_chunks, ...);
+/* carmen_map_vstrip() of one chunk type. */
+int carmen_map_strip(carmen_FILE *fp_in, carmen_FILE *fp_out, int chunk);
+/* Appends to out_file (an existing map; it may be in_file) a copy of the
+ * first chunk of chunk_type in in_file, named chunk_name. -1 when in_file has
+ * no such chunk, when that chunk is already named, or when out_file already
+ * has a chunk of that type with that name. */
+int carmen_map_name_chunk(const char *in_file, const char *out_file, int chunk_type, const char *chunk_name);
+/* Writes map as a binary PPM (P6, x_size by y_size, the top row is the
+ * largest y): unknown (-1) blue, a probability p grey 255 - 255 * p, an
+ * off-limits cell (2 + p) red-tinted (255, 255 - 255 * p, same); bytes are
+ * truncated as CARMEN's conversion to char does. Values that are none of
+ * these (damage) are clamped to 0..255 where CARMEN's are undefined. */
+int carmen_map_write_to_ppm(carmen_map_p map, const char *output_filename);
 
 #ifdef __cplusplus
 }

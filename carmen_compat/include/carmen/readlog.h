@@ -21,100 +21,21 @@
  *     the next message (or to the end), so a loop of
  *     carmen_logfile_read_next_line() until carmen_logfile_eof() never spins.
  */
+/* The message structs are CARMEN's, from carmen_compat/carmen_shared_types.h
+ * (or from CARMEN's own headers when a program uses them: see there); that
+ * search comes before our include guard, which is CARMEN's (CARMEN_READLOG_H). */
+#include <carmen_compat/carmen_shared_types.h>
+
 #ifndef CARMEN_READLOG_H
 #define CARMEN_READLOG_H
 
 #include <sys/types.h>
 
-#include "carmen/carmen_stdio.h"
+#include <carmen/carmen_stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-#ifndef CARMEN_POINT_T_DEFINED
-#define CARMEN_POINT_T_DEFINED
-typedef struct {
-  double x;
-  double y;
-  double theta;
-} carmen_point_t, *carmen_point_p;
-#endif
-
-#ifndef CARMEN_LASER_LASER_CONFIG_T_DEFINED
-#define CARMEN_LASER_LASER_CONFIG_T_DEFINED
-typedef enum {
-  SICK_LMS = 0,
-  SICK_PLS = 1,
-  HOKUYO_URG = 2,
-  SIMULATED_LASER = 3,
-  SICK_S300 = 4,
-  UMKNOWN_PROXIMITY_SENSOR = 99
-} carmen_laser_laser_type_t;
-
-typedef enum {
-  REMISSION_NONE = 0,
-  REMISSION_DIRECT = 1,
-  REMISSION_NORMALIZED = 2
-} carmen_laser_remission_type_t;
-
-typedef struct {
-  carmen_laser_laser_type_t laser_type;
-  double start_angle;        /* angle of the first beam (rad) */
-  double fov;                /* field of view (rad) */
-  double angular_resolution; /* angle between two beams (rad) */
-  double maximum_range;      /* m */
-  double accuracy;           /* m */
-  carmen_laser_remission_type_t remission_mode;
-} carmen_laser_laser_config_t;
-#endif
-
-/* RAWLASERn */
-typedef struct {
-  int id;
-  carmen_laser_laser_config_t config;
-  int num_readings;
-  float *range;
-  int num_remissions;
-  float *remission;
-  double timestamp;
-  char *host;
-} carmen_laser_laser_message;
-
-/* ROBOTLASERn, and the old FLASER / RLASER */
-typedef struct {
-  int id;
-  carmen_laser_laser_config_t config;
-  int num_readings;
-  float *range;
-  char *tooclose;
-  int num_remissions;
-  float *remission;
-  carmen_point_t laser_pose;
-  carmen_point_t robot_pose;
-  double tv, rv;
-  double forward_safety_dist, side_safety_dist;
-  double turn_axis;
-  double timestamp;
-  char *host;
-} carmen_robot_laser_message;
-
-/* ODOM */
-typedef struct {
-  double x, y, theta;
-  double tv, rv;
-  double acceleration;
-  double timestamp;
-  char *host;
-} carmen_base_odometry_message;
-
-/* TRUEPOS */
-typedef struct {
-  carmen_point_t truepose;
-  carmen_point_t odometrypose;
-  double timestamp;
-  char *host;
-} carmen_simulator_truepos_message;
 
 /* Byte offsets of the messages of a log: offset[i] is where message i
  * starts, offset[num_messages] the uncompressed length. As in CARMEN, every

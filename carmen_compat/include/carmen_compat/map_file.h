@@ -231,6 +231,13 @@ std::string encode_places_chunk(const PlaceList &places, const std::string &name
 std::string encode_offlimits_chunk(const OffLimits &offlimits, const std::string &name = {});
 std::string encode_laserscans_chunk(const LaserScanList &scans, const std::string &name = {});
 std::string encode_chunk(const ChunkPayload &payload, const std::string &name = {});
+// A whole chunk of `type` around a payload already encoded by the caller
+// (for kinds MapFile does not hold, such as HMAP).
+std::string encode_raw_chunk(int type, const std::string &payload, const std::string &name = {});
+
+// The bytes after the size field of a chunk found by list_map_chunks():
+// description, name and NUL (named chunks), payload. Throws FileError.
+std::string read_chunk_body(const std::string &path, const ChunkInfo &chunk);
 
 }  // namespace carmen
 

@@ -1,0 +1,291 @@
+// CARMEN's map_io utilities that work on whole files or on a map in memory:
+// copy_comments, strip / vstrip, name_chunk, write_to_ppm and
+// read_offlimits_chunk_into_map.
+#include <algorithm>
+#include <cerrno>
+#include <cstdarg>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "carmen/map_io.h"
+#include "carmen_compat/error.h"
+#include "carmen_compat/map_file.h"
+#include "map_io_support.h"
+
+using carmen::map_io_detail::guarded;
+using carmen::map_io_detail::put_bytes;
+
+namespace {
+
+constexpr size_t kCopyPiece = size_t{1} << 16;
+
+std::string map_id() { return std::string(CARMEN_MAP_LABEL) + CARMEN_MAP_VERSION; }
+
+// Copies the '#' lines and the id; throws if the id is not there.
+void copy_comments(carmen_FILE *in, carmen_FILE *out) {
+  if (in == nullptr || out == nullptr) throw std::invalid_argument("no file given (NULL carmen_FILE)");
+  std::string text;
+  int c;
+  while ((c = carmen_fgetc(in)) == '#') {
+    text.push_back('#');
+    while ((c = carmen_fgetc(in)) != EOF && c != '\n') text.push_back(static_cast<char>(c));
+    if (c == EOF) throw std::runtime_error("input ends inside its comment lines");
+    text.push_back('\n');
+  }
+  const std::string id = map_id();
+  char rest[16];
+  if (c == EOF || static_cast<char>(c) != id[0] || carmen_fread(rest, 1, 16, in) != 16 ||
+      std::memcmp(rest, id.data() + 1, 16) != 0) {
+    throw std::runtime_error("input is not a CARMEN map: no " + id + " after the comments");
+  }
+  put_bytes(out, text + id);
+}
+
+// Copies (out != NULL) or discards n bytes of in; throws if they are not there.
+void pass_bytes(carmen_FILE *in, carmen_FILE *out, int64_t n) {
+  std::vector<char> buf(kCopyPiece);
+  while (n > 0) {
+    const size_t k = static_cast<size_t>(std::min<int64_t>(n, int64_t(buf.size())));
+    if (carmen_fread(buf.data(), 1, k, in) != k) throw std::runtime_error("input ends inside a chunk");
+    if (out != nullptr) put_bytes(out, std::string(buf.data(), k));
+    n -= int64_t(k);
+  }
+}
+
+int32_t read_le_i32(const unsigned char *b) {
+  const uint32_t u = uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+  int32_t v;
+  std::memcpy(&v, &u, 4);
+  return v;
+}
+
+// The chunks after the id: each one copied unless its type (named flag
+// masked off) is in strip.
+void copy_chunks(carmen_FILE *in, carmen_FILE *out, const bool strip[128]) {
+  int type;
+  while ((type = carmen_fgetc(in)) != EOF) {
+    unsigned char size_bytes[4];
+    if (carmen_fread(size_bytes, 1, 4, in) != 4) throw std::runtime_error("input ends inside a chunk header");
+    const int32_t size = read_le_i32(size_bytes);
+    if (size < 10) throw std::runtime_error("damaged chunk: size " + std::to_string(size) + " (at least 10)");
+    const bool keep = !strip[type & ~CARMEN_MAP_NAMED_CHUNK_FLAG];
+    if (keep) put_bytes(out, std::string(1, static_cast<char>(type)) + std::string(reinterpret_cast<char *>(size_bytes), 4));
+    pass_bytes(in, keep ? out : nullptr, size);
+  }
+}
+
+// ---- Off-limits ------------------------------------------------------------
+// CARMEN's Bresenham walk (global.c), both ends included; DESIGN §2.1.
+template <typename F>
+void bresenham(int x1, int y1, int x2, int y2, F &&visit) {
+  const bool steep = std::abs(double(y2 - y1) / double(x2 - x1)) > 1;  // 0/0 is NaN: not steep
+  int a1 = steep ? y1 : x1, b1 = steep ? x1 : y1, a2 = steep ? y2 : x2, b2 = steep ? x2 : y2;
+  const bool flipped = (long long)(x2 - x1) * (long long)(y2 - y1) < 0;
+  if (flipped) {
+    b1 = -b1;
+    b2 = -b2;
+  }
+  const int inc = a2 > a1 ? 1 : -1;
+  const long long dx = a2 - a1, dy = b2 - b1;
+  const long long incr_e = 2 * dy * inc, incr_ne = 2 * (dy - dx) * inc;
+  long long d = (2 * dy - dx) * inc;
+  int a = a1, b = b1;
+  while (true) {
+    const int minor = flipped ? -b : b;
+    if (steep) visit(minor, a); else visit(a, minor);
+    if (a == a2) break;
+    a += inc;
+    if (d < 0 || (inc < 0 && d <= 0)) {
+      d += incr_e;
+    } else {
+      d += incr_ne;
+      b += inc;
+    }
+  }
+}
+
+void mark(carmen_map_p map, int x, int y) {
+  if (x >= 0 && y >= 0 && x < map->config.x_size && y < map->config.y_size) map->map[x][y] += 2.0;
+}
+
+void apply_offlimits(const carmen_offlimits_t *list, int n, carmen_map_p map) {
+  for (int i = 0; i < n; ++i) {
+    const carmen_offlimits_t &o = list[i];
+    if (o.type == CARMEN_OFFLIMITS_POINT_ID) {
+      mark(map, o.x1, o.y1);
+    } else if (o.type == CARMEN_OFFLIMITS_LINE_ID) {
+      bresenham(o.x1, o.y1, o.x2, o.y2, [&](int x, int y) { mark(map, x, y); });
+    } else if (o.type == CARMEN_OFFLIMITS_RECT_ID) {
+      for (int x = o.x1; x <= o.x2; ++x) {
+        for (int y = o.y1; y <= o.y2; ++y) mark(map, x, y);
+      }
+    }
+  }
+}
+
+// ---- PPM ---------------------------------------------------------------------
+// 0..255 from CARMEN's expression; its conversion to char truncates, and is
+// undefined outside the range, where we clamp (NaN gives 0).
+unsigned char to_byte(double t) {
+  if (!(t >= 0)) return 0;
+  if (t >= 255) return 255;
+  return static_cast<unsigned char>(static_cast<int>(t));
+}
+
+void ppm_pixel(float v, std::string &out) {
+  if (v == -1) {
+    out += {'\0', '\0', '\xff'};
+  } else if (v >= 2.0) {
+    const auto c = static_cast<char>(to_byte(255 - 255 * (double(v) - 2.0)));
+    out += {'\xff', c, c};
+  } else {
+    const auto c = static_cast<char>(to_byte(255.0f - 255.0f * v));  // float arithmetic, as CARMEN's
+    out += {c, c, c};
+  }
+}
+
+std::string ppm_bytes(const carmen_map_t &map) {
+  const int sx = map.config.x_size, sy = map.config.y_size;
+  std::string out = "P6\n" + std::to_string(sx) + " " + std::to_string(sy) + "\n255\n";
+  out.reserve(out.size() + size_t(sx) * size_t(sy) * 3);
+  for (int y = sy - 1; y >= 0; --y) {
+    for (int x = 0; x < sx; ++x) ppm_pixel(map.map[x][y], out);
+  }
+  return out;
+}
+
+void check_map(const carmen_map_t *map) {
+  if (map == nullptr || map->map == nullptr) throw std::invalid_argument("no map given (NULL)");
+  if (map->config.x_size <= 0 || map->config.y_size <= 0) {
+    throw std::invalid_argument("invalid map size " + std::to_string(map->config.x_size) + " x " +
+                                std::to_string(map->config.y_size));
+  }
+  for (int x = 0; x < map->config.x_size; ++x) {
+    if (map->map[x] == nullptr) throw std::invalid_argument("row " + std::to_string(x) + " of the map is NULL");
+  }
+}
+
+void write_file(const char *filename, const std::string &bytes) {
+  std::FILE *f = std::fopen(filename, "wb");
+  if (f == nullptr) throw carmen::FileError(filename, std::string("cannot create: ") + std::strerror(errno));
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  if (std::fclose(f) != 0 || !ok) throw carmen::FileError(filename, "write failed (disk full?)");
+}
+
+// ---- Naming a chunk ----------------------------------------------------------
+const carmen::ChunkInfo &first_chunk(const std::vector<carmen::ChunkInfo> &chunks, const char *file, int type) {
+  for (const carmen::ChunkInfo &c : chunks) {
+    if (c.base_type() == type) return c;
+  }
+  throw carmen::FileError(file, "has no " + carmen::chunk_type_name(type) + " chunk");
+}
+
+void check_name_free(const char *out_file, int type, const char *name) {
+  for (const carmen::ChunkInfo &c : carmen::list_map_chunks(out_file)) {
+    if (c.named() && c.base_type() == type && c.name == name) {
+      throw carmen::FileError(out_file, "already has a " + carmen::chunk_type_name(type) + " chunk named \"" +
+                                            carmen::printable(name) + "\"");
+    }
+  }
+}
+
+// The chunk as a named one: the description is kept as it was.
+std::string named_copy(int type, const std::string &body, const char *name) {
+  std::string bytes = carmen::encode_raw_chunk(type, body.substr(10), name);
+  bytes.replace(5, 10, body, 0, 10);
+  return bytes;
+}
+
+void append(const char *out_file, const std::string &bytes) {
+  carmen_FILE *out = carmen_fopen(out_file, "a");
+  if (out == nullptr) throw carmen::FileError(out_file, std::string("cannot append: ") + std::strerror(errno));
+  const bool ok = carmen_fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size();
+  if (carmen_fclose(out) != 0 || !ok) throw carmen::FileError(out_file, "write failed (disk full?)");
+}
+
+}  // namespace
+
+extern "C" {
+
+int carmen_map_copy_comments(carmen_FILE *fp_in, carmen_FILE *fp_out) {
+  return guarded(__func__, nullptr, [&] {
+    copy_comments(fp_in, fp_out);
+    return 0;
+  });
+}
+
+int carmen_map_vstrip(carmen_FILE *fp_in, carmen_FILE *fp_out, int num_chunks, ...) {
+  bool strip[128] = {};
+  va_list ap;
+  va_start(ap, num_chunks);
+  bool bad = num_chunks < 0;
+  int bad_value = num_chunks;
+  for (int i = 0; i < num_chunks && !bad; ++i) {
+    const int type = va_arg(ap, int);
+    bad = type < 0 || type >= 128;
+    bad_value = type;
+    if (!bad) strip[type] = true;
+  }
+  va_end(ap);
+  return guarded(__func__, nullptr, [&] {
+    if (bad) throw std::invalid_argument("invalid chunk type or count " + std::to_string(bad_value));
+    copy_comments(fp_in, fp_out);
+    copy_chunks(fp_in, fp_out, strip);
+    return 0;
+  });
+}
+
+int carmen_map_strip(carmen_FILE *fp_in, carmen_FILE *fp_out, int chunk) {
+  return carmen_map_vstrip(fp_in, fp_out, 1, chunk);
+}
+
+int carmen_map_name_chunk(const char *in_file, const char *out_file, int chunk_type, const char *chunk_name) {
+  return guarded(__func__, in_file, [&] {
+    if (in_file == nullptr || out_file == nullptr) throw std::invalid_argument("no file name given");
+    if (chunk_name == nullptr || *chunk_name == '\0') throw std::invalid_argument("no chunk name given");
+    const int type = chunk_type & ~CARMEN_MAP_NAMED_CHUNK_FLAG;
+    const std::vector<carmen::ChunkInfo> chunks = carmen::list_map_chunks(in_file);
+    const carmen::ChunkInfo &c = first_chunk(chunks, in_file, type);
+    if (c.named()) {
+      throw carmen::FileError(in_file, "its first " + carmen::chunk_type_name(type) + " chunk is already named");
+    }
+    const std::string body = carmen::read_chunk_body(in_file, c);
+    check_name_free(out_file, type, chunk_name);
+    append(out_file, named_copy(type, body, chunk_name));
+    return 0;
+  });
+}
+
+int carmen_map_write_to_ppm(carmen_map_p map, const char *output_filename) {
+  return guarded(__func__, output_filename, [&] {
+    if (output_filename == nullptr) throw std::invalid_argument("no file name given");
+    check_map(map);
+    write_file(output_filename, ppm_bytes(*map));
+    return 0;
+  });
+}
+
+int carmen_map_read_offlimits_chunk_into_map(const char *filename, carmen_map_p map) {
+  if (map == nullptr || map->complete_map == nullptr) {
+    std::fprintf(stderr, "%s: %s: no map to mark (NULL)\n", __func__, filename ? filename : "(null)");
+    return -1;
+  }
+  carmen_offlimits_p list = nullptr;
+  int n = 0;
+  if (carmen_map_read_offlimits_chunk(filename, &list, &n) < 0) return -1;
+  const int rc = guarded(__func__, filename, [&] {
+    if (n == 0) throw carmen::FileError(filename, "the OFFLIMITS chunk is empty");  // -1, as in CARMEN
+    check_map(map);
+    apply_offlimits(list, n, map);
+    return 0;
+  });
+  std::free(list);
+  return rc;
+}
+
+}  // extern "C"

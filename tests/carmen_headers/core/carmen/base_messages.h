@@ -1,0 +1,29 @@
+/* Stand-in for CARMEN's base_messages.h (see ../../README.md). */
+#ifndef CARMEN_BASE_MESSAGES_H
+#define CARMEN_BASE_MESSAGES_H
+#define CARMEN_STANDIN_BASE_MESSAGES 1
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+  double x, y, theta;
+  double tv, rv;
+  double acceleration;
+  double timestamp;
+  char *host;
+} carmen_base_odometry_message;
+
+#define CARMEN_BASE_ODOMETRY_NAME "carmen_base_odometry"
+
+typedef struct {
+  double tv, rv;
+  double timestamp;
+  char *host;
+} carmen_base_velocity_message;
+
+#ifdef __cplusplus
+}
+#endif
+#endif
