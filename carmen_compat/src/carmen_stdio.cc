@@ -17,9 +17,21 @@ bool ends_with_gz(const char *name) {
 
 }  // namespace
 
+// CARMEN keeps these functions in its libglobal, which a CARMEN program links
+// anyway. Ours are weak definitions: where the program also links CARMEN's
+// libglobal, its (strong) definitions win, statically or at run time, with
+// no duplicate-symbol error, and every caller, our readers and writers
+// included, uses them (same carmen_FILE layout, same semantics). Without
+// libglobal, ours serve. carmen_ferror is ours alone, so it stays strong.
+#if defined(__GNUC__)
+#define CARMEN_STDIO_WEAK __attribute__((weak))
+#else
+#define CARMEN_STDIO_WEAK
+#endif
+
 extern "C" {
 
-carmen_FILE *carmen_fopen(const char *filename, const char *mode) {
+CARMEN_STDIO_WEAK carmen_FILE *carmen_fopen(const char *filename, const char *mode) {
   if (filename == nullptr || mode == nullptr) {
     errno = EINVAL;
     return nullptr;
@@ -48,7 +60,7 @@ carmen_FILE *carmen_fopen(const char *filename, const char *mode) {
   return f;
 }
 
-int carmen_fclose(carmen_FILE *fp) {
+CARMEN_STDIO_WEAK int carmen_fclose(carmen_FILE *fp) {
   if (fp == nullptr) return EOF;
   int rc = 0;
   if (fp->compressed) {
@@ -60,31 +72,31 @@ int carmen_fclose(carmen_FILE *fp) {
   return rc;
 }
 
-int carmen_fgetc(carmen_FILE *fp) {
+CARMEN_STDIO_WEAK int carmen_fgetc(carmen_FILE *fp) {
   return fp->compressed ? gzgetc(fp->comp_fp) : std::fgetc(fp->fp);
 }
 
-int carmen_fputc(int c, carmen_FILE *fp) {
+CARMEN_STDIO_WEAK int carmen_fputc(int c, carmen_FILE *fp) {
   return fp->compressed ? gzputc(fp->comp_fp, c) : std::fputc(c, fp->fp);
 }
 
-char *carmen_fgets(char *s, int size, carmen_FILE *fp) {
+CARMEN_STDIO_WEAK char *carmen_fgets(char *s, int size, carmen_FILE *fp) {
   return fp->compressed ? gzgets(fp->comp_fp, s, size) : std::fgets(s, size, fp->fp);
 }
 
-size_t carmen_fread(void *ptr, size_t size, size_t nmemb, carmen_FILE *fp) {
+CARMEN_STDIO_WEAK size_t carmen_fread(void *ptr, size_t size, size_t nmemb, carmen_FILE *fp) {
   if (!fp->compressed) return std::fread(ptr, size, nmemb, fp->fp);
   if (size == 0 || nmemb == 0) return 0;
   return gzfread(ptr, size, nmemb, fp->comp_fp);
 }
 
-size_t carmen_fwrite(const void *ptr, size_t size, size_t nmemb, carmen_FILE *fp) {
+CARMEN_STDIO_WEAK size_t carmen_fwrite(const void *ptr, size_t size, size_t nmemb, carmen_FILE *fp) {
   if (!fp->compressed) return std::fwrite(ptr, size, nmemb, fp->fp);
   if (size == 0 || nmemb == 0) return 0;
   return gzfwrite(ptr, size, nmemb, fp->comp_fp);
 }
 
-int carmen_fprintf(carmen_FILE *fp, const char *fmt, ...) {
+CARMEN_STDIO_WEAK int carmen_fprintf(carmen_FILE *fp, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   va_list ap2;
@@ -102,7 +114,7 @@ int carmen_fprintf(carmen_FILE *fp, const char *fmt, ...) {
   return written == static_cast<size_t>(n) ? n : -1;
 }
 
-int carmen_feof(carmen_FILE *fp) {
+CARMEN_STDIO_WEAK int carmen_feof(carmen_FILE *fp) {
   return fp->compressed ? gzeof(fp->comp_fp) : std::feof(fp->fp);
 }
 
@@ -113,7 +125,7 @@ int carmen_ferror(carmen_FILE *fp) {
   return err != Z_OK && err != Z_STREAM_END ? 1 : 0;
 }
 
-int carmen_fseek(carmen_FILE *fp, long offset, int whence) {
+CARMEN_STDIO_WEAK int carmen_fseek(carmen_FILE *fp, long offset, int whence) {
   if (!fp->compressed) return std::fseek(fp->fp, offset, whence);
   if (whence == SEEK_END) {
     errno = EINVAL;
@@ -122,11 +134,11 @@ int carmen_fseek(carmen_FILE *fp, long offset, int whence) {
   return gzseek(fp->comp_fp, offset, whence) < 0 ? -1 : 0;
 }
 
-long carmen_ftell(carmen_FILE *fp) {
+CARMEN_STDIO_WEAK long carmen_ftell(carmen_FILE *fp) {
   return fp->compressed ? static_cast<long>(gztell(fp->comp_fp)) : std::ftell(fp->fp);
 }
 
-int carmen_fflush(carmen_FILE *fp) {
+CARMEN_STDIO_WEAK int carmen_fflush(carmen_FILE *fp) {
   return fp->compressed ? (gzflush(fp->comp_fp, Z_SYNC_FLUSH) == Z_OK ? 0 : EOF)
                         : std::fflush(fp->fp);
 }
