@@ -20,6 +20,10 @@ struct DeviceModel {
   double resolution, wall;
   int table_size;                     // (int)(max_range / resolution)
   int size_x, size_y;                 // grid size in cells
+  // Within max_sure_range the evidence is occ or emp itself: cells with
+  // i*i + j*j < n_sure take one of these two factors, no table needed.
+  int n_sure;
+  double factor_free_near, factor_occ_near;
 };
 
 // ---------------------------------------------------------------------------
@@ -49,6 +53,7 @@ struct LineRec {
   int flags;        // kSteep | kFlipped | kBackward | kDegenerate
   float range;
   int x2, y2;       // end cell (for the sequential fall-back of degenerate lines)
+  int free_below;   // a cell is free (distance < range) iff i*i + j*j < free_below (tables only)
 };
 constexpr int kSteep = 1, kFlipped = 2, kBackward = 4, kDegenerate = 8;
 // Exact mode works on kTile x kTile cell tiles, a block of kTile^2 threads
@@ -62,12 +67,11 @@ size_t exact_scan_temp_bytes(size_t num_beams);
 size_t exact_sort_temp_bytes(size_t num_pairs);
 
 // Exact mode's tables, computed on the device with the oracle's operations,
-// for table_size <= kMaxExactTable: distances and odds factors (free, occupied)
-// per (i, j), table_size^2 each, and per i the first j whose distance reaches
+// for table_size <= kMaxExactTable: the odds factors (free, occupied) per
+// (i, j), table_size^2 of them, and per i the first j whose distance reaches
 // max_range (table_size entries).
 constexpr int kMaxExactTable = 2048;
-void launch_exact_tables(const DeviceModel &m, double *dist, double2 *factors, int *reach,
-                         cudaStream_t stream);
+void launch_exact_tables(const DeviceModel &m, double2 *factors, int *reach, cudaStream_t stream);
 
 // Per beam: builds its LineRec and counts the tiles its walk passes through.
 void launch_exact_lines(const DeviceModel &m, const ExactBeam *beams, const StartCell *starts,
@@ -112,9 +116,8 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
 // null above kMaxExactTable (distances on the fly).
 void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
                         const uint32_t *order, const uint32_t *tile_begin,
-                        const uint32_t *tile_end, const double *dist, const double2 *factors,
-                        const int *reach, float *grid, unsigned long long *cell_updates,
-                        cudaStream_t stream);
+                        const uint32_t *tile_end, const double2 *factors, const int *reach,
+                        float *grid, unsigned long long *cell_updates, cudaStream_t stream);
 
 // ---------------------------------------------------------------------------
 // Float mode: single precision, all scans fused into one launch.

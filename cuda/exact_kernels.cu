@@ -35,37 +35,70 @@ __device__ __forceinline__ int tile_of(int cx, int cy, int tiles_y) {
   return (cx / kTile) * tiles_y + cy / kTile;
 }
 
-// Walks the steps that can update a cell (k <= k_max) with the oracle's
-// walker, calling visit(tile) once per tile entered. A straight line's cells
-// are monotone in x and in y, so a tile, once left, is never re-entered.
+// Calls visit(tile) once per tile whose cells inside the grid the walk visits
+// at a step that can update a cell (k <= k_max). A straight line's cells are
+// monotone in x and in y, so a tile, once left, is never re-entered.
+//
+// Closed-form lines go a tile column at a time: along the major axis the k of
+// a column of tiles is an interval, and over it the minor coordinate moves
+// monotonically by at most one cell a step, so the walk visits exactly the
+// tiles between the minor coordinates at the interval's ends (both clipped
+// to the grid). About 2 * table_size / kTile iterations instead of table_size.
 template <class Visit>
 __device__ void for_each_tile(const LineRec &L, const DeviceModel &m, Visit visit) {
   if (L.k_max < 0) return;
   const int tiles_y = (m.size_y + kTile - 1) / kTile;
-  BresenhamLine line;
-  egrid::bresenham_init(line, L.x1, L.y1, L.x2, L.y2);
-  int prev = -1;
-  for (int k = 0; k <= L.k_max; ++k) {
-    int cx, cy;
-    egrid::bresenham_current(line, &cx, &cy);
-    if (inside(cx, cy, m)) {
-      const int t = tile_of(cx, cy, tiles_y);
-      if (t != prev) {
-        visit(t);
-        prev = t;
+  if (L.flags & kDegenerate) {  // the oracle's walker, step by step
+    BresenhamLine line;
+    egrid::bresenham_init(line, L.x1, L.y1, L.x2, L.y2);
+    int prev = -1;
+    for (int k = 0; k <= L.k_max; ++k) {
+      int cx, cy;
+      egrid::bresenham_current(line, &cx, &cy);
+      if (inside(cx, cy, m)) {
+        const int t = tile_of(cx, cy, tiles_y);
+        if (t != prev) {
+          visit(t);
+          prev = t;
+        }
+      }
+      if (!egrid::bresenham_next(line)) break;
+    }
+    return;
+  }
+  const bool steep = L.flags & kSteep, backward = L.flags & kBackward, flipped = L.flags & kFlipped;
+  const int size_maj = steep ? m.size_y : m.size_x, size_min = steep ? m.size_x : m.size_y;
+  // Steps whose major coordinate (sx1 +- k) is inside the grid.
+  const int k_lo = backward ? max(0, L.sx1 - (size_maj - 1)) : max(0, -L.sx1);
+  const int k_hi = backward ? min(L.k_max, L.sx1) : min(L.k_max, size_maj - 1 - L.sx1);
+  auto minor_at = [&](int k) {  // grid minor coordinate at step k (egrid_math.h line_cell)
+    const int off = (L.two_b * k + L.bias) / L.two_a;
+    const int mn = backward ? L.sy1 - off : L.sy1 + off;
+    return flipped ? -mn : mn;
+  };
+  for (int k = k_lo; k <= k_hi;) {
+    const int maj = backward ? L.sx1 - k : L.sx1 + k;
+    const int tmaj = maj / kTile;
+    const int k_end = min(k_hi, backward ? maj - tmaj * kTile + k : tmaj * kTile + kTile - 1 - maj + k);
+    const int a = minor_at(k), b = minor_at(k_end);
+    if (max(a, b) >= 0 && min(a, b) < size_min) {
+      const int t_from = min(max(a, 0), size_min - 1) / kTile, t_to = min(max(b, 0), size_min - 1) / kTile;
+      const int step = t_to >= t_from ? 1 : -1;
+      for (int t = t_from;; t += step) {
+        visit(steep ? t * tiles_y + tmaj : tmaj * tiles_y + t);
+        if (t == t_to) break;
       }
     }
-    if (!egrid::bresenham_next(line)) break;
+    k = k_end + 1;
   }
 }
 
-__global__ void tables_kernel(DeviceModel m, double *dist, double2 *factors) {
+__global__ void tables_kernel(DeviceModel m, double2 *factors) {
   const int n = m.table_size * m.table_size;
   const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
   for (int idx = blockIdx.x * blockDim.x + threadIdx.x; idx < n; idx += gridDim.x * blockDim.x) {
     const int i = idx / m.table_size, j = idx % m.table_size;
     const double d = egrid::cell_distance(i, j, m.resolution);
-    dist[idx] = d;
     double p;
     // A range of +inf makes every cell free, -inf every cell occupied.
     const double ff = egrid::sensor_model(model, d, CUDART_INF, &p) ? egrid::odds_factor(m.prior, p) : 0.0;
@@ -77,11 +110,11 @@ __global__ void tables_kernel(DeviceModel m, double *dist, double2 *factors) {
 // reach[i] = the first j with distance(i, j) >= max_range (table_size if
 // none). For tables of at most 2^11 entries per axis i*i + j*j cannot wrap, so
 // the distance grows with j and "an update at (i, j)" is exactly j < reach[i].
-__global__ void reach_kernel(DeviceModel m, const double *dist, int *reach) {
+__global__ void reach_kernel(DeviceModel m, int *reach) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= m.table_size) return;
   int j = 0;
-  while (j < m.table_size && dist[i * m.table_size + j] < m.max) ++j;
+  while (j < m.table_size && egrid::cell_distance(i, j, m.resolution) < m.max) ++j;
   reach[i] = j;
 }
 
@@ -91,7 +124,11 @@ __global__ void lines_kernel(DeviceModel m, const ExactBeam *beams, const StartC
   if (i >= n) return;
   const ExactBeam b = beams[i];
   const StartCell s = starts[b.scan];
-  const LineRec L = make_line(s.x1, s.y1, b.x2, b.y2, b.range, m.table_size);
+  LineRec L = make_line(s.x1, s.y1, b.x2, b.y2, b.range, m.table_size);
+  if (m.table_size <= kMaxExactTable) {
+    const int64_t n_max = 2 * static_cast<int64_t>(m.table_size) * m.table_size;
+    L.free_below = static_cast<int>(egrid::first_square_not_below(b.range, m.resolution, n_max));
+  }
   lines[i] = L;
   uint32_t c = 0;
   for_each_tile(L, m, [&](int) { ++c; });
@@ -199,16 +236,21 @@ struct FixedPoints {
 // is one (distance below max_range) and its odds factor. Independent of the
 // cell's value, so a batch of them is loaded before the dependent chain.
 __device__ __forceinline__ bool tabled_factor(const DeviceModel &m, const LineRec &L, int cx, int cy,
-                                              const int *reach, const double *dist, const double2 *factors,
-                                              double *f) {
+                                              const int *reach, const double2 *factors, double *f) {
   const int i = egrid::wrap_abs(egrid::wrap_sub(cx, L.x1));
   const int j = egrid::wrap_abs(egrid::wrap_sub(cy, L.y1));
   // i, j <= k <= table_size - 1: inside the tables.
   if (j >= reach[i]) return false;  // the oracle stops the beam here: no update
-  const size_t idx = static_cast<size_t>(i) * m.table_size + j;
-  const double d = dist[idx];
-  const double2 fs = factors[idx];
-  *f = d < static_cast<double>(L.range) ? fs.x : fs.y;
+  // distance < range, and distance < max_sure_range, through i*i + j*j
+  // (egrid_math.h first_square_not_below): no distance load.
+  const int n = i * i + j * j;
+  const bool free = n < L.free_below;
+  if (n < m.n_sure) {
+    *f = free ? m.factor_free_near : m.factor_occ_near;
+  } else {
+    const double2 fs = factors[static_cast<size_t>(i) * m.table_size + j];
+    *f = free ? fs.x : fs.y;
+  }
   return true;
 }
 
@@ -233,8 +275,8 @@ __device__ __forceinline__ bool computed_factor(const DeviceModel &m, const Line
 // dependent odds updates, so their loads overlap; updates known to change
 // nothing are skipped. Returns the updates made (skipped ones included).
 __device__ __forceinline__ unsigned drain_hits(const DeviceModel &m, const LineRec *sh, unsigned long long h,
-                                               int cx, int cy, const int *reach, const double *dist,
-                                               const double2 *factors, FixedPoints *fixed, float *cell) {
+                                               int cx, int cy, const int *reach, const double2 *factors,
+                                               FixedPoints *fixed, float *cell) {
   constexpr int kBatch = 4;
   unsigned count = 0;
   while (h != 0) {
@@ -247,7 +289,7 @@ __device__ __forceinline__ unsigned drain_hits(const DeviceModel &m, const LineR
       if (h == 0) continue;
       const int e = __ffsll(static_cast<long long>(h)) - 1;
       h &= h - 1;
-      update[u] = reach ? tabled_factor(m, sh[e], cx, cy, reach, dist, factors, &f[u])
+      update[u] = reach ? tabled_factor(m, sh[e], cx, cy, reach, factors, &f[u])
                         : computed_factor(m, sh[e], cx, cy, &f[u]);
     }
 #pragma unroll
@@ -272,8 +314,7 @@ __device__ __forceinline__ unsigned drain_hits(const DeviceModel &m, const LineR
 __global__ void __launch_bounds__(kTileThreads)
     tiles_kernel(DeviceModel m, const LineRec *lines, const uint32_t *sorted_beam,
                  const uint32_t *order, const uint32_t *tile_begin, const uint32_t *tile_end,
-                 const double *dist, const double2 *factors, const int *reach_global, float *grid,
-                 unsigned long long *updates) {
+                 const double2 *factors, const int *reach_global, float *grid, unsigned long long *updates) {
   __shared__ LineRec sh[kTileThreads];
   __shared__ unsigned long long hit[kTileThreads];
   extern __shared__ int reach_shared[];  // the reach table, when tables are used
@@ -301,7 +342,7 @@ __global__ void __launch_bounds__(kTileThreads)
     __syncthreads();
     if (static_cast<int>(threadIdx.x) < n) mark_tile_cells(sh[threadIdx.x], threadIdx.x, tx0, ty0, hit);
     __syncthreads();
-    if (active) count += drain_hits(m, sh, hit[threadIdx.x], cx, cy, reach, dist, factors, &fixed, &cell);
+    if (active) count += drain_hits(m, sh, hit[threadIdx.x], cx, cy, reach, factors, &fixed, &cell);
     __syncthreads();
   }
   if (active) grid[static_cast<size_t>(cx) * m.size_y + cy] = cell;
@@ -340,13 +381,12 @@ size_t exact_sort_temp_bytes(size_t num_pairs) {
   return bytes;
 }
 
-void launch_exact_tables(const DeviceModel &m, double *dist, double2 *factors, int *reach,
-                         cudaStream_t stream) {
+void launch_exact_tables(const DeviceModel &m, double2 *factors, int *reach, cudaStream_t stream) {
   const size_t n = static_cast<size_t>(m.table_size) * m.table_size;
   if (n == 0) return;
-  tables_kernel<<<min(blocks_for(n, 256), 4096u), 256, 0, stream>>>(m, dist, factors);
+  tables_kernel<<<min(blocks_for(n, 256), 4096u), 256, 0, stream>>>(m, factors);
   VG_CUDA_CHECK_LAUNCH();
-  reach_kernel<<<blocks_for(static_cast<size_t>(m.table_size), 128), 128, 0, stream>>>(m, dist, reach);
+  reach_kernel<<<blocks_for(static_cast<size_t>(m.table_size), 128), 128, 0, stream>>>(m, reach);
   VG_CUDA_CHECK_LAUNCH();
 }
 
@@ -417,14 +457,14 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
 
 void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
                         const uint32_t *order, const uint32_t *tile_begin,
-                        const uint32_t *tile_end, const double *dist, const double2 *factors,
-                        const int *reach, float *grid, unsigned long long *updates, cudaStream_t stream) {
+                        const uint32_t *tile_end, const double2 *factors, const int *reach, float *grid,
+                        unsigned long long *updates, cudaStream_t stream) {
   const size_t tiles = static_cast<size_t>((m.size_x + kTile - 1) / kTile) *
                        ((m.size_y + kTile - 1) / kTile);
   if (tiles == 0) return;
   const size_t shared = reach ? static_cast<size_t>(m.table_size) * sizeof(int) : 0;
   tiles_kernel<<<static_cast<unsigned>(tiles), kTileThreads, shared, stream>>>(
-      m, lines, sorted_beam, order, tile_begin, tile_end, dist, factors, reach, grid, updates);
+      m, lines, sorted_beam, order, tile_begin, tile_end, factors, reach, grid, updates);
   VG_CUDA_CHECK_LAUNCH();
 }
 

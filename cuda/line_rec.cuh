@@ -24,6 +24,7 @@ __device__ __forceinline__ LineRec make_line(int x1, int y1, int x2, int y2, flo
   L.x2 = x2;
   L.y2 = y2;
   L.range = range;
+  L.free_below = 0;
   L.flags = 0;
   const bool closed = egrid::is_closed_form_line(x1, y1, x2, y2);
   egrid::LineParams p{};

@@ -226,6 +226,26 @@ TEST(SensorModel, CellDistanceIsTheTableValue) {
   EXPECT_EQ(cell_distance(1, 1, 0.1), std::sqrt(2.0) * 0.1);
 }
 
+// The CUDA exact mode decides "distance < range" and "distance < sure" from
+// i*i + j*j against first_square_not_below; checked here against the
+// distance itself, cell by cell, for ranges that fall on, just below and
+// just above table distances, and for ranges no cell reaches.
+TEST(SensorModel, FirstSquareNotBelowSplitsTheTableLikeTheDistance) {
+  const int T = 400;
+  const double res = 0.025;
+  const int64_t n_max = 2 * int64_t(T) * T;
+  const double limits[] = {0.0,  -INFINITY, 5.0, 0.025, cell_distance(3, 4, res), std::nextafter(5.0, 0.0),
+                           std::nextafter(cell_distance(7, 9, res), 1e9), 9.99, 10.0, 60.0, INFINITY};
+  for (double limit : limits) {
+    const int64_t cut = first_square_not_below(limit, res, n_max);
+    for (int i = 0; i < T; i += 7)
+      for (int j = 0; j < T; ++j)
+        ASSERT_EQ(cell_distance(i, j, res) < limit, i * i + j * j < cut) << "limit " << limit << " at " << i << "," << j;
+  }
+  EXPECT_EQ(first_square_not_below(NAN, res, n_max), 0);  // d < NaN never holds
+  EXPECT_EQ(first_square_not_below(INFINITY, res, n_max), n_max + 1);
+}
+
 }  // namespace
 }  // namespace egrid
 }  // namespace vasco

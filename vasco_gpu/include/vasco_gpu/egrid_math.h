@@ -269,6 +269,24 @@ VG_HD double cell_distance(int i, int j, double resolution) {
   return sqrt(static_cast<double>(wrap_add(wrap_mul(i, i), wrap_mul(j, j)))) * resolution;
 }
 
+// The distance of a cell depends on i and j only through n = i*i + j*j, and
+// grows with n (sqrt and the product are monotone). So "distance < limit"
+// is exactly "n < first_square_not_below(limit, ...)": the smallest n in
+// [0, n_max] whose distance is not below `limit`, or n_max + 1. Valid where
+// i*i + j*j does not wrap (tables of at most 2^15 entries per axis).
+VG_HD int64_t first_square_not_below(double limit, double resolution, int64_t n_max) {
+  int64_t lo = 0, hi = n_max + 1;
+  while (lo < hi) {
+    const int64_t mid = lo + (hi - lo) / 2;
+    if (!(sqrt(static_cast<double>(mid)) * resolution < limit)) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
 // One odds update of a stored cell, exactly as egrid.c evaluates it:
 // new = 1 - 1 / (1 + ((1-prior)/prior) * p / (1-p) * old / (1-old)), every step
 // in double except `1 - old`, which in CARMEN's C is int minus float: a float

@@ -113,6 +113,12 @@ cuda::DeviceModel CudaRenderer::exact_model() const {
   m.table_size = params_.table_size();
   m.size_x = geo_.size_x;
   m.size_y = geo_.size_y;
+  const int64_t n_max = 2 * static_cast<int64_t>(std::max(m.table_size, 0)) * std::max(m.table_size, 0);
+  m.n_sure = m.table_size <= cuda::kMaxExactTable
+                 ? static_cast<int>(egrid::first_square_not_below(m.sure, m.resolution, n_max))
+                 : 0;
+  m.factor_free_near = egrid::odds_factor(m.prior, m.emp);  // sensor_model's p below max_sure_range
+  m.factor_occ_near = egrid::odds_factor(m.prior, m.occ);
   return m;
 }
 
@@ -134,10 +140,9 @@ void CudaRenderer::build_tables() {
   const auto key = std::make_tuple(T, params_.resolution, params_.p_prior, params_.p_occ, params_.p_emp,
                                    params_.range_sure, params_.range_max);
   if (!use_tables_ || (tables_built_ && key == tables_key_)) return;
-  reserve(dist_, t2);
   reserve(factors_, t2);
   reserve(reach_, static_cast<size_t>(T));
-  cuda::launch_exact_tables(exact_model(), dist_.get(), factors_.get(), reach_.get(), stream_->get());
+  cuda::launch_exact_tables(exact_model(), factors_.get(), reach_.get(), stream_->get());
   tables_key_ = key;
   tables_built_ = true;
 }
@@ -329,8 +334,8 @@ void CudaRenderer::launch_exact_apply(uint64_t pair_bound, MapStats *st) {
                          order_keys_out_.get(), order_ids_.get(), order_tmp_.get(), order_tmp_.size(), s);
   timer.mark("tile order");
   cuda::launch_exact_tiles(m, lines_.get(), sorted_beam_.get(), order_.get(), tile_begin_.get(), tile_end_.get(),
-                           use_tables_ ? dist_.get() : nullptr, use_tables_ ? factors_.get() : nullptr,
-                           use_tables_ ? reach_.get() : nullptr, grid_.get(), updates_.get(), s);
+                           use_tables_ ? factors_.get() : nullptr, use_tables_ ? reach_.get() : nullptr,
+                           grid_.get(), updates_.get(), s);
   timer.mark("tiles");
   e_map.record(s);
   reserve(staging_counters_, 2);

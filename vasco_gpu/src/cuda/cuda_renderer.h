@@ -58,7 +58,6 @@ class CudaRenderer : public Renderer {
   // Exact mode: tables, beams and the tile lists' scratch.
   bool use_tables_ = false, tables_built_ = false;
   std::tuple<int, double, double, double, double, double, double> tables_key_;
-  cuda::DeviceBuffer<double> dist_;
   cuda::DeviceBuffer<double2> factors_;  // (free, occupied) odds factors
   cuda::DeviceBuffer<int> reach_;
   uint64_t exact_beams_ = 0;  // placed by place_exact_beams, in staging_beams_
