@@ -165,44 +165,54 @@ __global__ void tile_ranges_kernel(const uint32_t *key, size_t n, size_t num_til
 constexpr int kTileThreads = kTile * kTile;
 static_assert(kTileThreads == 64, "a chunk's hit marks are one 64-bit word per cell");
 
-// Marks, in hit[cell of the tile], bit e for every cell of the tile that
-// beam e of the chunk visits. A closed-form line visits one cell per step and
-// its major coordinate is sx1 + inc*k, so only the (at most kTile) steps whose
-// major coordinate lies in the tile need looking at; this replaces kTile^2
-// membership tests per beam. The marked set is exactly
+// Marks, for every cell of the tile, which beams of the chunk visit it: beam
+// e = 32 * w + lane sets bit `lane` of hit[2 * cell + w]. Each thread takes
+// one beam. A closed-form line visits one cell per step and its major
+// coordinate is sx1 + inc*k, so only the (at most kTile) steps whose major
+// coordinate lies in the tile need looking at; the marked set is exactly
 // { c in tile : step_of_cell(L, c) >= 0 }.
-__device__ void mark_tile_cells(const LineRec &L, int e, int tx0, int ty0, unsigned long long *hit) {
-  const unsigned long long bit = 1ull << e;
-  if (L.flags & kDegenerate) {  // rare (see kClosedFormLimit): the oracle's walk
+//
+// The warp goes through those steps together and merges the lanes that mark
+// the same cell (__match_any_sync) into one plain write by one lane: in the
+// tiles where the robot stood still every beam starts in the same cell, and
+// per-lane atomics on that one word would serialise the whole warp.
+__device__ void mark_chunk(const LineRec *sh, int n, int tx0, int ty0, unsigned *hit) {
+  const int lane = threadIdx.x & 31, w = threadIdx.x >> 5, e = threadIdx.x;
+  const bool mine = e < n;
+  const LineRec &L = sh[mine ? e : 0];
+  const bool closed = mine && !(L.flags & kDegenerate);
+  const bool steep = L.flags & kSteep, backward = L.flags & kBackward, flipped = L.flags & kFlipped;
+  const int maj0 = steep ? ty0 : tx0, min0 = steep ? tx0 : ty0;
+  // Steps whose major coordinate is in [maj0, maj0 + kTile).
+  int k_lo = backward ? L.sx1 - (maj0 + kTile - 1) : maj0 - L.sx1;
+  const int k_hi = min(k_lo + kTile - 1, L.k_max);
+  k_lo = max(k_lo, 0);
+  for (int step = 0; step < kTile; ++step) {
+    const int k = k_lo + step;
+    int cell = -1;
+    if (closed && k <= k_hi) {
+      // The walk's minor offset after k steps (egrid_math.h
+      // line_minor_offset); every operand is below 2^30 (kClosedFormLimit).
+      const int m = (L.two_b * k + L.bias) / L.two_a;
+      int mn = backward ? L.sy1 - m : L.sy1 + m;
+      if (flipped) mn = -mn;
+      const int du = (backward ? L.sx1 - k : L.sx1 + k) - maj0, dv = mn - min0;
+      if (dv >= 0 && dv < kTile) cell = steep ? dv * kTile + du : du * kTile + dv;
+    }
+    const unsigned peers = __match_any_sync(0xffffffffu, cell);
+    if (cell >= 0 && lane == __ffs(peers) - 1) hit[2 * cell + w] |= peers;
+    __syncwarp();
+  }
+  if (mine && !closed) {  // rare (see kClosedFormLimit): the oracle's walk
     BresenhamLine line;
     egrid::bresenham_init(line, L.x1, L.y1, L.x2, L.y2);
     for (int k = 0; k <= L.k_max; ++k) {
       int x, y;
       egrid::bresenham_current(line, &x, &y);
       const int u = x - tx0, v = y - ty0;
-      if (u >= 0 && u < kTile && v >= 0 && v < kTile) atomicOr(&hit[u * kTile + v], bit);
+      if (u >= 0 && u < kTile && v >= 0 && v < kTile) atomicOr(&hit[2 * (u * kTile + v) + w], 1u << lane);
       if (!egrid::bresenham_next(line)) break;
     }
-    return;
-  }
-  const bool steep = L.flags & kSteep, backward = L.flags & kBackward, flipped = L.flags & kFlipped;
-  const int maj0 = steep ? ty0 : tx0, min0 = steep ? tx0 : ty0;
-  // Steps whose major coordinate is in [maj0, maj0 + kTile).
-  int k_lo = backward ? L.sx1 - (maj0 + kTile - 1) : maj0 - L.sx1;
-  int k_hi = k_lo + kTile - 1;
-  k_lo = max(k_lo, 0);
-  k_hi = min(k_hi, L.k_max);
-  for (int k = k_lo; k <= k_hi; ++k) {
-    // The walk's minor offset after k steps (egrid_math.h line_minor_offset);
-    // every operand is below 2^30 (kClosedFormLimit).
-    const int m = (L.two_b * k + L.bias) / L.two_a;
-    int mn = backward ? L.sy1 - m : L.sy1 + m;
-    if (flipped) mn = -mn;
-    const int maj = backward ? L.sx1 - k : L.sx1 + k;
-    const int du = maj - maj0, dv = mn - min0;
-    if (dv < 0 || dv >= kTile) continue;
-    const int u = steep ? dv : du, v = steep ? du : dv;
-    atomicOr(&hit[u * kTile + v], bit);
   }
 }
 
@@ -316,7 +326,7 @@ __global__ void __launch_bounds__(kTileThreads)
                  const uint32_t *order, const uint32_t *tile_begin, const uint32_t *tile_end,
                  const double2 *factors, const int *reach_global, float *grid, unsigned long long *updates) {
   __shared__ LineRec sh[kTileThreads];
-  __shared__ unsigned long long hit[kTileThreads];
+  __shared__ unsigned hit[2 * kTileThreads];  // per cell: beams 0-31, beams 32-63
   extern __shared__ int reach_shared[];  // the reach table, when tables are used
   const int *reach = nullptr;
   if (reach_global) {
@@ -337,12 +347,14 @@ __global__ void __launch_bounds__(kTileThreads)
   const uint32_t begin = tile_begin[tile], end = tile_end[tile];
   for (uint32_t base = begin; base < end; base += kTileThreads) {
     const int n = static_cast<int>(min(static_cast<uint32_t>(kTileThreads), end - base));
-    hit[threadIdx.x] = 0;
+    hit[2 * threadIdx.x] = hit[2 * threadIdx.x + 1] = 0;
     if (static_cast<int>(threadIdx.x) < n) sh[threadIdx.x] = lines[sorted_beam[base + threadIdx.x]];
     __syncthreads();
-    if (static_cast<int>(threadIdx.x) < n) mark_tile_cells(sh[threadIdx.x], threadIdx.x, tx0, ty0, hit);
+    mark_chunk(sh, n, tx0, ty0, hit);
     __syncthreads();
-    if (active) count += drain_hits(m, sh, hit[threadIdx.x], cx, cy, reach, factors, &fixed, &cell);
+    const unsigned long long mine =
+        (static_cast<unsigned long long>(hit[2 * threadIdx.x + 1]) << 32) | hit[2 * threadIdx.x];
+    if (active) count += drain_hits(m, sh, mine, cx, cy, reach, factors, &fixed, &cell);
     __syncthreads();
   }
   if (active) grid[static_cast<size_t>(cx) * m.size_y + cy] = cell;
