@@ -26,6 +26,10 @@ namespace egrid {
 // Beams whose float range is not below this are skipped entirely
 // (egrid.c's LASER_RANGE_LIMIT): they clear nothing.
 constexpr double kLaserRangeLimit = 50.0;
+// Whether a beam is used at all: float range promoted to double, below 50 m.
+// (NaN and +inf are not; -inf and negative ranges are, as in CARMEN.)
+VG_HD bool is_beam_used(float range) { return static_cast<double>(range) < kLaserRangeLimit; }
+
 // Distance used for cells beyond the distance table (egrid.c uses 1e6).
 constexpr double kFarDistance = 1e6;
 // Cell value meaning "unknown".

@@ -49,9 +49,8 @@ inline ScanStart scan_start(GridFrame &frame, double x, double y, double theta) 
   return s;
 }
 
-// Whether a beam is used at all: float range promoted to double, below 50 m.
-// (NaN and +inf are not; -inf and negative ranges are, as in CARMEN.)
-inline bool beam_used(float range) { return static_cast<double>(range) < egrid::kLaserRangeLimit; }
+// Whether a beam is used at all (egrid_math.h).
+inline bool beam_used(float range) { return egrid::is_beam_used(range); }
 
 // The beam's end cell (DESIGN §2 step 5): (int) truncation, not floor.
 inline void beam_end(const ScanStart &s, double angle, float range, double wall,
