@@ -139,13 +139,13 @@ TEST_P(MapIoHmap, DamagedChunksAreRefusedOnReading) {
   Sample s;
   const std::string good = s.payload();
   const std::string cases[] = {
-      good.substr(0, good.size() - 4),                        // cut short
-      good + "x",                                             // bytes left over
-      i32(1) + "no terminator",                               // zone name without NUL
-      i32(-1) + i32(0),                                       // negative zone count
+      good.substr(0, good.size() - 4),                            // cut short
+      good + "x",                                                 // bytes left over
+      i32(1) + "no terminator",                                   // zone name without NUL
+      i32(-1) + i32(0),                                           // negative zone count
       i32(1) + std::string("a\0", 2) + i32(1) + i32(9) + i32(0),  // unknown link type
       i32(1) + std::string("a\0", 2) + i32(1) + i32(2) + i32(1) + i32(5) + f32(0) + f32(0) + f32(0),  // key 5
-      i32(0) + i32(1000000),                                  // more links than bytes
+      i32(0) + i32(1000000),  // more links than bytes
   };
   carmen_hmap_t back;
   std::memset(&back, 0, sizeof back);

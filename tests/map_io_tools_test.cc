@@ -60,7 +60,8 @@ TEST(MapIoMacros, AreCarmensValues) {
   EXPECT_NE(CARMEN_MAP_CHUNK_IS_NAMED(0x81), 0);
   EXPECT_EQ(CARMEN_MAP_CHUNK_IS_NAMED(0x01), 0);
   EXPECT_EQ(CARMEN_MAP_CHUNK_IS_NAMED(CARMEN_MAP_GLOBAL_OFFSET_CHUNK), 0);
-#if !defined(CARMEN_OFFLIMITS_POINT_ID) || !defined(CARMEN_OFFLIMITS_LINE_ID) || !defined(CARMEN_OFFLIMITS_RECT_ID)
+#if !defined(CARMEN_OFFLIMITS_POINT_ID) || !defined(CARMEN_OFFLIMITS_LINE_ID) || \
+    !defined(CARMEN_OFFLIMITS_RECT_ID)
   ADD_FAILURE() << "CARMEN_OFFLIMITS_*_ID must be macros, as in CARMEN's map.h";
 #endif
   EXPECT_EQ(CARMEN_OFFLIMITS_POINT_ID, 0);
@@ -112,8 +113,9 @@ TEST_P(MapIoTools, NamedCreatorChunk) {
 
 TEST_P(MapIoTools, NamedGridmapConfigNamesTheChunk) {
   const std::string file = path("config");
-  write_map(file, kId + chunk(1, "GRIDMAP", grid_payload(1, 1, 0.5f, {0.5f}), "small", true) +
-                      chunk(1, "GRIDMAP", grid_payload(3, 2, 0.25f, std::vector<float>(6, 0.0f)), "big", true));
+  write_map(file,
+            kId + chunk(1, "GRIDMAP", grid_payload(1, 1, 0.5f, {0.5f}), "small", true) +
+                chunk(1, "GRIDMAP", grid_payload(3, 2, 0.25f, std::vector<float>(6, 0.0f)), "big", true));
   carmen_map_config_t config;
   ASSERT_EQ(carmen_map_read_named_gridmap_config(file.c_str(), "big", &config), 0);
   EXPECT_EQ(config.x_size, 3);
@@ -187,17 +189,20 @@ TEST_P(MapIoTools, CopyCommentsCopiesCommentsAndId) {
 TEST_P(MapIoTools, StripRemovesEveryChunkOfTheType) {
   const Pieces p;
   write_map(path("in"), p.all());
-  EXPECT_EQ(run_on(path("in"), path("out"),
-                   [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_strip(i, o, CARMEN_MAP_PLACES_CHUNK); }),
-            0);
+  EXPECT_EQ(
+      run_on(path("in"), path("out"),
+             [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_strip(i, o, CARMEN_MAP_PLACES_CHUNK); }),
+      0);
   EXPECT_EQ(content(path("out")), p.comments + kId + p.grid + p.offset);
   EXPECT_EQ(run_on(path("in"), path("out"),
                    [](carmen_FILE *i, carmen_FILE *o) {
-                     return carmen_map_vstrip(i, o, 2, CARMEN_MAP_GRIDMAP_CHUNK, CARMEN_MAP_GLOBAL_OFFSET_CHUNK);
+                     return carmen_map_vstrip(i, o, 2, CARMEN_MAP_GRIDMAP_CHUNK,
+                                              CARMEN_MAP_GLOBAL_OFFSET_CHUNK);
                    }),
             0);
   EXPECT_EQ(content(path("out")), p.comments + kId + p.places + p.named_places);
-  EXPECT_EQ(run_on(path("in"), path("out"), [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_vstrip(i, o, 0); }),
+  EXPECT_EQ(run_on(path("in"), path("out"),
+                   [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_vstrip(i, o, 0); }),
             0);
   EXPECT_EQ(content(path("out")), p.all());
 }
@@ -206,13 +211,16 @@ TEST_P(MapIoTools, StripRefusesBadTypesAndTruncatedInput) {
   const Pieces p;
   write_map(path("in"), p.all());
   testing::internal::CaptureStderr();
-  EXPECT_EQ(run_on(path("in"), path("out"), [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_strip(i, o, 200); }),
+  EXPECT_EQ(run_on(path("in"), path("out"),
+                   [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_strip(i, o, 200); }),
             -1);
-  EXPECT_EQ(run_on(path("in"), path("out"), [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_vstrip(i, o, -1); }),
+  EXPECT_EQ(run_on(path("in"), path("out"),
+                   [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_vstrip(i, o, -1); }),
             -1);
   const std::string all = p.all();
   write_map(path("cut"), all.substr(0, all.size() - 3));
-  EXPECT_EQ(run_on(path("cut"), path("out"), [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_strip(i, o, 4); }),
+  EXPECT_EQ(run_on(path("cut"), path("out"),
+                   [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_strip(i, o, 4); }),
             -1);
   EXPECT_EQ(carmen_map_strip(nullptr, nullptr, 4), -1);
   const std::string err = testing::internal::GetCapturedStderr();
@@ -238,7 +246,8 @@ TEST_P(MapIoTools, NameChunkAppendsANamedCopy) {
   // missing type or output file is refused.
   EXPECT_EQ(carmen_map_name_chunk(file.c_str(), file.c_str(), CARMEN_MAP_GRIDMAP_CHUNK, "copy"), -1);
   write_map(path("named_first"), kId + p.named_places);
-  EXPECT_EQ(carmen_map_name_chunk(path("named_first").c_str(), file.c_str(), CARMEN_MAP_PLACES_CHUNK, "x"), -1);
+  EXPECT_EQ(carmen_map_name_chunk(path("named_first").c_str(), file.c_str(), CARMEN_MAP_PLACES_CHUNK, "x"),
+            -1);
   EXPECT_EQ(carmen_map_name_chunk(file.c_str(), file.c_str(), CARMEN_MAP_HMAP_CHUNK, "x"), -1);
   EXPECT_EQ(carmen_map_name_chunk(file.c_str(), path("absent").c_str(), CARMEN_MAP_GRIDMAP_CHUNK, "x"), -1);
   EXPECT_EQ(carmen_map_name_chunk(file.c_str(), file.c_str(), CARMEN_MAP_GRIDMAP_CHUNK, ""), -1);
@@ -266,12 +275,13 @@ TEST_P(MapIoTools, OfflimitsIntoMapAddsTwoToEveryMarkedCell) {
   cells[0] = -1.0f;  // cell (0, 0): -1 + 2 = 1, as CARMEN computes it
   // Points (0,0) and (10,10) (outside), the line (1,1)-(4,3), the rectangle
   // (3,0)-(4,1).
-  const std::string payload = i32(2) + i32(0) + i32(0) + i32(10) + i32(10) + i32(1) + i32(1) + i32(1) + i32(4) +
-                              i32(3) + i32(1) + i32(3) + i32(0) + i32(4) + i32(1);
+  const std::string payload = i32(2) + i32(0) + i32(0) + i32(10) + i32(10) + i32(1) + i32(1) + i32(1) +
+                              i32(4) + i32(3) + i32(1) + i32(3) + i32(0) + i32(4) + i32(1);
   carmen_map_t map = read_with_offlimits(file, 6, 5, cells, payload);
   ASSERT_EQ(carmen_map_read_offlimits_chunk_into_map(file.c_str(), &map), 0);
   // CARMEN's Bresenham from (1,1) to (4,3), worked by hand: (1,1) (2,2) (3,2) (4,3).
-  const std::vector<std::pair<int, int>> marked = {{1, 1}, {2, 2}, {3, 2}, {4, 3}, {3, 0}, {3, 1}, {4, 0}, {4, 1}};
+  const std::vector<std::pair<int, int>> marked = {{1, 1}, {2, 2}, {3, 2}, {4, 3},
+                                                   {3, 0}, {3, 1}, {4, 0}, {4, 1}};
   for (int x = 0; x < 6; ++x) {
     for (int y = 0; y < 5; ++y) {
       const bool hit = std::find(marked.begin(), marked.end(), std::make_pair(x, y)) != marked.end();
@@ -310,9 +320,10 @@ TEST_P(MapIoTools, OfflimitsIntoMapFailsAsCarmenDoes) {
   free_map(map);
 }
 
-INSTANTIATE_TEST_SUITE_P(PlainAndGzip, MapIoTools, ::testing::Values(".map", ".map.gz"), [](const auto &info) {
-  return std::string(info.param).size() > 4 ? "gzip" : "plain";
-});
+INSTANTIATE_TEST_SUITE_P(PlainAndGzip, MapIoTools, ::testing::Values(".map", ".map.gz"),
+                         [](const auto &info) {
+                           return std::string(info.param).size() > 4 ? "gzip" : "plain";
+                         });
 
 // ---- PPM ---------------------------------------------------------------------
 struct Ppm {
@@ -352,7 +363,8 @@ TEST(MapIoPpm, ColoursAndOrientationAreCarmens) {
   EXPECT_EQ(p.maxval, 255);
   // Top row is y = 1: 0.5 -> 255 - 127.5 = 127; 0.25 -> 191.25 = 191;
   // 2.5 (off-limits 0.5) -> (255, 127, 127). Then y = 0: -1 blue; 0 white; 1 black.
-  const unsigned char want[] = {127, 127, 127, 191, 191, 191, 255, 127, 127, 0, 0, 255, 255, 255, 255, 0, 0, 0};
+  const unsigned char want[] = {127, 127, 127, 191, 191, 191, 255, 127, 127,
+                                0,   0,   255, 255, 255, 255, 0,   0,   0};
   ASSERT_EQ(p.pixels.size(), sizeof want);
   for (size_t i = 0; i < sizeof want; ++i) EXPECT_EQ(uint8_t(p.pixels[i]), want[i]) << "byte " << i;
 }

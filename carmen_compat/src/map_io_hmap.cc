@@ -40,7 +40,8 @@ void put_f32(std::string &s, float v) {
 
 // ---- Writing -----------------------------------------------------------------
 void put_zone_names(std::string &s, const carmen_hmap_t &h) {
-  if (h.num_zones < 0 || (h.num_zones > 0 && h.zone_names == nullptr)) throw std::invalid_argument("invalid zone list");
+  if (h.num_zones < 0 || (h.num_zones > 0 && h.zone_names == nullptr))
+    throw std::invalid_argument("invalid zone list");
   put_i32(s, h.num_zones);
   for (int i = 0; i < h.num_zones; ++i) {
     const char *name = h.zone_names[i];
@@ -62,7 +63,8 @@ void put_link(std::string &s, const carmen_hmap_link_t &l, int num_zones, int in
   put_i32(s, l.type);
   put_i32(s, l.degree);
   for (int j = 0; j < l.degree; ++j) {
-    if (l.keys[j] < 0 || l.keys[j] >= num_zones) throw std::invalid_argument(which + " has a key out of range");
+    if (l.keys[j] < 0 || l.keys[j] >= num_zones)
+      throw std::invalid_argument(which + " has a key out of range");
     put_i32(s, l.keys[j]);
   }
   for (int k = 0; k < n * l.degree; ++k) {
@@ -76,7 +78,8 @@ std::string hmap_payload(const carmen_hmap_t *h) {
   if (h == nullptr) throw std::invalid_argument("no hmap given (NULL)");
   std::string s;
   put_zone_names(s, *h);
-  if (h->num_links < 0 || (h->num_links > 0 && h->links == nullptr)) throw std::invalid_argument("invalid link list");
+  if (h->num_links < 0 || (h->num_links > 0 && h->links == nullptr))
+    throw std::invalid_argument("invalid link list");
   put_i32(s, h->num_links);
   for (int i = 0; i < h->num_links; ++i) put_link(s, h->links[i], h->num_zones, i);
   return s;
@@ -113,7 +116,8 @@ class Cursor {
   // A count of items of at least min_bytes each that the payload can hold.
   int32_t count(const char *what, size_t min_bytes) {
     const int32_t n = i32();
-    if (n < 0 || uint64_t(n) * min_bytes > left()) fail(std::string("invalid ") + what + " count " + std::to_string(n));
+    if (n < 0 || uint64_t(n) * min_bytes > left())
+      fail(std::string("invalid ") + what + " count " + std::to_string(n));
     return n;
   }
   size_t left() const { return b_.size() - pos_; }

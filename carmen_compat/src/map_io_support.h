@@ -44,7 +44,8 @@ inline void need_name(const char *filename) {
 // Writes all of `bytes` or throws.
 inline void put_bytes(carmen_FILE *fp, const std::string &bytes) {
   if (fp == nullptr) throw std::invalid_argument("no file given (NULL carmen_FILE)");
-  if (carmen_fwrite(bytes.data(), 1, bytes.size(), fp) != bytes.size()) throw std::runtime_error("write failed");
+  if (carmen_fwrite(bytes.data(), 1, bytes.size(), fp) != bytes.size())
+    throw std::runtime_error("write failed");
 }
 
 }  // namespace carmen::map_io_detail

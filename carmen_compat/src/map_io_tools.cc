@@ -74,7 +74,9 @@ void copy_chunks(carmen_FILE *in, carmen_FILE *out, const bool strip[128]) {
     const int32_t size = read_le_i32(size_bytes);
     if (size < 10) throw std::runtime_error("damaged chunk: size " + std::to_string(size) + " (at least 10)");
     const bool keep = !strip[type & ~CARMEN_MAP_NAMED_CHUNK_FLAG];
-    if (keep) put_bytes(out, std::string(1, static_cast<char>(type)) + std::string(reinterpret_cast<char *>(size_bytes), 4));
+    if (keep)
+      put_bytes(out, std::string(1, static_cast<char>(type)) +
+                         std::string(reinterpret_cast<char *>(size_bytes), 4));
     pass_bytes(in, keep ? out : nullptr, size);
   }
 }
@@ -97,7 +99,10 @@ void bresenham(int x1, int y1, int x2, int y2, F &&visit) {
   int a = a1, b = b1;
   while (true) {
     const int minor = flipped ? -b : b;
-    if (steep) visit(minor, a); else visit(a, minor);
+    if (steep)
+      visit(minor, a);
+    else
+      visit(a, minor);
     if (a == a2) break;
     a += inc;
     if (d < 0 || (inc < 0 && d <= 0)) {
@@ -166,7 +171,8 @@ void check_map(const carmen_map_t *map) {
                                 std::to_string(map->config.y_size));
   }
   for (int x = 0; x < map->config.x_size; ++x) {
-    if (map->map[x] == nullptr) throw std::invalid_argument("row " + std::to_string(x) + " of the map is NULL");
+    if (map->map[x] == nullptr)
+      throw std::invalid_argument("row " + std::to_string(x) + " of the map is NULL");
   }
 }
 
@@ -178,7 +184,8 @@ void write_file(const char *filename, const std::string &bytes) {
 }
 
 // ---- Naming a chunk ----------------------------------------------------------
-const carmen::ChunkInfo &first_chunk(const std::vector<carmen::ChunkInfo> &chunks, const char *file, int type) {
+const carmen::ChunkInfo &first_chunk(const std::vector<carmen::ChunkInfo> &chunks, const char *file,
+                                     int type) {
   for (const carmen::ChunkInfo &c : chunks) {
     if (c.base_type() == type) return c;
   }
@@ -203,7 +210,8 @@ std::string named_copy(int type, const std::string &body, const char *name) {
 
 void append(const char *out_file, const std::string &bytes) {
   carmen_FILE *out = carmen_fopen(out_file, "a");
-  if (out == nullptr) throw carmen::FileError(out_file, std::string("cannot append: ") + std::strerror(errno));
+  if (out == nullptr)
+    throw carmen::FileError(out_file, std::string("cannot append: ") + std::strerror(errno));
   const bool ok = carmen_fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size();
   if (carmen_fclose(out) != 0 || !ok) throw carmen::FileError(out_file, "write failed (disk full?)");
 }
@@ -252,7 +260,8 @@ int carmen_map_name_chunk(const char *in_file, const char *out_file, int chunk_t
     const std::vector<carmen::ChunkInfo> chunks = carmen::list_map_chunks(in_file);
     const carmen::ChunkInfo &c = first_chunk(chunks, in_file, type);
     if (c.named()) {
-      throw carmen::FileError(in_file, "its first " + carmen::chunk_type_name(type) + " chunk is already named");
+      throw carmen::FileError(in_file,
+                              "its first " + carmen::chunk_type_name(type) + " chunk is already named");
     }
     const std::string body = carmen::read_chunk_body(in_file, c);
     check_name_free(out_file, type, chunk_name);

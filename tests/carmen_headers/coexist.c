@@ -4,6 +4,9 @@
  * build must compile (no type defined twice), see CARMEN's layouts
  * (layout_check.h), and work at run time.
  *   coexist FREIBURG_MAP */
+/* A user's program: it does not opt out of the search for CARMEN's carmen.h
+ * as every target of this tree does. */
+#undef VASCO_CARMEN_STANDALONE
 #ifdef OURS_FIRST
 #include <carmen/egrid.h>
 #include <carmen/readlog.h>
