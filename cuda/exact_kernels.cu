@@ -123,13 +123,6 @@ __global__ void lines_kernel(DeviceModel m, const ExactBeam *beams, const StartC
   const size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   const ExactBeam b = beams[i];
-  if (!egrid::is_beam_used(b.range)) {  // uploaded in place, not walked
-    LineRec L{};
-    L.k_max = -1;
-    lines[i] = L;
-    counts[i] = 0;
-    return;
-  }
   const StartCell s = starts[b.scan];
   LineRec L = make_line(s.x1, s.y1, b.x2, b.y2, b.range, m.table_size);
   if (m.table_size <= kMaxExactTable) {

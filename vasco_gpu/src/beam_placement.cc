@@ -1,6 +1,5 @@
 #include "vasco_gpu/beam_placement.h"
 
-#include <algorithm>
 #include <atomic>
 #include <limits>
 #include <stdexcept>
@@ -70,32 +69,26 @@ BeamLayout lay_out_beams(const ScanBatch &batch, const GridGeometry &geo, int th
 }
 
 uint64_t place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                          const oracle::ScanStart &start, size_t s, uint32_t scan_index, bool keep_skipped,
-                          PlacedBeam *out) {
+                          const oracle::ScanStart &start, size_t s, uint32_t scan_index, PlacedBeam *out) {
   oracle::SteppedAngles angles{batch.first_angle[s], batch.angle_step[s]};
   const float *r = batch.ranges_of(s);
   PlacedBeam *o = out;
   double angle = 0;
   for (int b = 0; b < batch.beams_in(s); ++b) {
     angles(b, start.theta, &angle);  // every beam advances the angle, skipped ones too
-    const bool used = oracle::beam_used(r[b]);
-    if (!used && !keep_skipped) continue;
-    o->x2 = o->y2 = 0;
-    if (used) oracle::beam_end(start, angle, r[b], params.wall_size, geo.resolution, &o->x2, &o->y2);
+    if (!oracle::beam_used(r[b])) continue;
+    oracle::beam_end(start, angle, r[b], params.wall_size, geo.resolution, &o->x2, &o->y2);
     o->scan = scan_index;
     o->range = r[b];
     ++o;
   }
-  return keep_skipped ? static_cast<uint64_t>(std::count_if(out, o, [](const PlacedBeam &p) {
-    return oracle::beam_used(p.range);
-  }))
-                      : static_cast<uint64_t>(o - out);
+  return static_cast<uint64_t>(o - out);
 }
 
 void place_laid_out_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
                           const BeamLayout &layout, size_t s0, size_t s1, int threads, PlacedBeam *out) {
   for_each_scan_parallel(s0, s1, threads, [&](size_t i) {
-    place_scan_beams(batch, geo, params, layout.starts[i], layout.first_scan + i, static_cast<uint32_t>(i), false,
+    place_scan_beams(batch, geo, params, layout.starts[i], layout.first_scan + i, static_cast<uint32_t>(i),
                      out + layout.used_before[i]);
   });
 }

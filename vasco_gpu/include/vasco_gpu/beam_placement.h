@@ -55,13 +55,10 @@ BeamLayout lay_out_beams(const ScanBatch &batch, const GridGeometry &geo, int th
 void place_laid_out_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
                           const BeamLayout &layout, size_t s0, size_t s1, int threads, PlacedBeam *out);
 
-// The end cells of scan s's beams, written from out[0] on: its used beams
-// only, or with keep_skipped every beam (a skipped one keeps its range, which
-// says it is not used, and end cell 0, 0). `scan_index` goes into each
-// beam's `scan`. Returns the number of used beams.
+// The end cells of scan s's used beams, written from out[0] on, with
+// `scan_index` in each beam's `scan`. Returns the number written.
 uint64_t place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                          const oracle::ScanStart &start, size_t s, uint32_t scan_index, bool keep_skipped,
-                          PlacedBeam *out);
+                          const oracle::ScanStart &start, size_t s, uint32_t scan_index, PlacedBeam *out);
 
 // The starts of scans [first, last) (all scans by default) and the end cells
 // of their used beams; threads <= 0: all cores. Throws std::runtime_error

@@ -12,8 +12,6 @@
 #include "cuda_renderer.h"
 
 #include <algorithm>
-#include <atomic>
-#include <thread>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -56,6 +54,22 @@ uint64_t tile_bound_of_beam(const oracle::ScanStart &s, const PlacedBeam &b, int
     return static_cast<uint64_t>(std::llabs(floor_div(end) - floor_div(from)));
   };
   return 1 + tiles_crossed(s.x1, b.x2) + tiles_crossed(s.y1, b.y2);
+}
+
+// The sum of tile_bound_of_beam over a placed batch, on all cores.
+uint64_t exact_pair_bound(const PlacedBeam *beams, size_t n, const std::vector<oracle::ScanStart> &starts,
+                          int table_size) {
+  const int nt = n < (size_t(1) << 16) ? 1 : hardware_threads();
+  std::vector<uint64_t> part(static_cast<size_t>(nt), 0);
+  run_on_threads(nt, [&](int t) {
+    const size_t a = n * t / nt, b = n * (t + 1) / nt;
+    uint64_t sum = 0;
+    for (size_t i = a; i < b; ++i) sum += tile_bound_of_beam(starts[beams[i].scan], beams[i], table_size);
+    part[static_cast<size_t>(t)] = sum;
+  });
+  uint64_t total = 0;
+  for (uint64_t p : part) total += p;
+  return total;
 }
 
 }  // namespace
@@ -237,96 +251,38 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
 }
 
 // Exact mode, in three parts: place the beams on the host into pinned
-// staging, uploading each piece as soon as it is placed; list (tile, beam)
-// pairs; apply them tile by tile. No wait between the parts: the pair arrays
-// are sized by a host bound.
+// staging; upload and list (tile, beam) pairs; apply them tile by tile. No
+// wait between the parts: the pair arrays are sized by a host bound.
 void CudaRenderer::apply_exact(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
   const auto t_prep = Clock::now();
-  const uint64_t pair_bound = place_and_upload_exact_beams(scans, first, last, st);
+  const uint64_t pair_bound = place_exact_beams(scans, first, last, st);
   st->prep_s += seconds_since(t_prep);
-  if (pair_bound == 0) {
-    VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // the call ends with the stream idle
-    return;
-  }
+  if (exact_beams_ == 0) return;
   launch_exact_apply(pair_bound, st);
 }
 
-// Every beam of scans [first, last) (skipped ones too, in place: the lines
-// kernel leaves them out, and no counting pass is needed), placed with the
-// oracle's code on every core straight into pinned staging. The calling
-// thread uploads each of kPieces pieces as soon as its scans are placed, so
-// the upload overlaps the placing, and places scans itself while it waits.
-// Returns the bound on the (tile, beam) pairs.
-uint64_t CudaRenderer::place_and_upload_exact_beams(const ScanBatch &scans, size_t first, size_t last,
-                                                    MapStats *st) {
-  const std::vector<oracle::ScanStart> starts = place_scans(scans, geo_, first, last);
-  const size_t ns = starts.size();
-  const uint64_t base = scans.beam_offset[first], nb = scans.beam_offset[last] - base;
-  if (nb > UINT32_MAX) throw std::runtime_error("cuda exact mode: more than 2^32 beams in one launch");
-  exact_beams_ = nb;
-  exact_scans_ = ns;
-  cudaStream_t s = stream_->get();
-  VG_CUDA_CHECK(cudaStreamSynchronize(s));  // staging is free (every call ends idle)
-  reserve(staging_beams_, std::max<uint64_t>(nb, 1));
-  reserve(staging_starts_, std::max<size_t>(ns, 1));
-  reserve(beams_, std::max<uint64_t>(nb, 1));
-  reserve(starts_, std::max<size_t>(ns, 1));
-  for (size_t i = 0; i < ns; ++i) staging_starts_[i] = {starts[i].x1, starts[i].y1};
-  e_start_->record(s);
-  VG_CUDA_CHECK(cudaMemcpyAsync(starts_.get(), staging_starts_.get(), ns * sizeof(cuda::StartCell),
-                                cudaMemcpyHostToDevice, s));
-  PlacedBeam *out = reinterpret_cast<PlacedBeam *>(staging_beams_.get());
-  const int T = params_.table_size();
-  constexpr size_t kScansPerItem = 32, kPieces = 8;
-  const size_t items = (ns + kScansPerItem - 1) / kScansPerItem;
-  const size_t per_piece = std::max<size_t>(1, (items + kPieces - 1) / kPieces);
-  const size_t pieces = (items + per_piece - 1) / per_piece;
-  std::unique_ptr<std::atomic<size_t>[]> done(new std::atomic<size_t>[std::max<size_t>(pieces, 1)]);
-  for (size_t p = 0; p < pieces; ++p) done[p].store(0);
-  std::atomic<size_t> next{0};
-  const int nt = items < 8 ? 1 : hardware_threads();
-  std::vector<uint64_t> used(static_cast<size_t>(nt), 0), bound(static_cast<size_t>(nt), 0);
-  // Places one item of scans (never throws: the uploader waits for it).
-  auto place_item = [&](int t, size_t item) {
-    for (size_t i = item * kScansPerItem; i < std::min(ns, (item + 1) * kScansPerItem); ++i) {
-      PlacedBeam *o = out + (scans.beam_offset[first + i] - base);
-      used[t] += place_scan_beams(scans, geo_, params_, starts[i], first + i, static_cast<uint32_t>(i), true, o);
-      for (int b = 0; b < scans.beams_in(first + i); ++b)
-        if (oracle::beam_used(o[b].range)) bound[t] += tile_bound_of_beam(starts[i], o[b], T);
-    }
-    done[item / per_piece].fetch_add(1, std::memory_order_release);
-  };
-  run_on_threads(nt, [&](int t) {
-    if (t != 0) {
-      for (size_t i; (i = next.fetch_add(1)) < items;) place_item(t, i);
-      return;
-    }
-    for (size_t p = 0; p < pieces; ++p) {
-      const size_t in_piece = std::min(items, (p + 1) * per_piece) - p * per_piece;
-      while (done[p].load(std::memory_order_acquire) < in_piece) {
-        const size_t i = next.fetch_add(1);
-        if (i < items) place_item(0, i);
-        else std::this_thread::yield();
-      }
-      const uint64_t b0 = scans.beam_offset[first + std::min(ns, p * per_piece * kScansPerItem)] - base;
-      const uint64_t b1 = scans.beam_offset[first + std::min(ns, (p + 1) * per_piece * kScansPerItem)] - base;
-      VG_CUDA_CHECK(cudaMemcpyAsync(beams_.get() + b0, staging_beams_.get() + b0, (b1 - b0) * sizeof(cuda::ExactBeam),
-                                    cudaMemcpyHostToDevice, s));
-    }
-  });
-  e_uploaded_->record(s);
-  uint64_t n_used = 0, pair_bound = 0;
-  for (int t = 0; t < nt; ++t) {
-    n_used += used[static_cast<size_t>(t)];
-    pair_bound += bound[static_cast<size_t>(t)];
-  }
-  st->beams_used += n_used;
-  st->beams_skipped += nb - n_used;
-  return pair_bound;
+// Places the beams of scans [first, last) with the oracle's code, on every
+// core, straight into the pinned staging buffer; returns the bound on their
+// (tile, beam) pairs.
+uint64_t CudaRenderer::place_exact_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
+  const BeamLayout layout = lay_out_beams(scans, geo_, 0, first, last);
+  exact_beams_ = layout.used();
+  exact_scans_ = layout.starts.size();
+  st->beams_used += exact_beams_;
+  st->beams_skipped += layout.skipped;
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // staging is free (every call ends idle)
+  reserve(staging_beams_, std::max<uint64_t>(exact_beams_, 1));
+  reserve(staging_starts_, std::max<size_t>(exact_scans_, 1));
+  PlacedBeam *beams = reinterpret_cast<PlacedBeam *>(staging_beams_.get());
+  place_laid_out_beams(scans, geo_, params_, layout, 0, exact_scans_, 0, beams);
+  for (size_t s = 0; s < exact_scans_; ++s) staging_starts_[s] = {layout.starts[s].x1, layout.starts[s].y1};
+  return exact_pair_bound(beams, exact_beams_, layout.starts, params_.table_size());
 }
 
 void CudaRenderer::reserve_exact_scratch(uint64_t pair_bound, size_t tiles) {
-  const size_t nb = exact_beams_;
+  const size_t nb = exact_beams_, ns = exact_scans_;
+  reserve(beams_, nb);
+  reserve(starts_, ns);
   reserve(lines_, nb);
   reserve(counts_, nb + 1);
   reserve(offsets_, nb + 1);
@@ -342,13 +298,19 @@ void CudaRenderer::reserve_exact_scratch(uint64_t pair_bound, size_t tiles) {
 }
 
 void CudaRenderer::launch_exact_apply(uint64_t pair_bound, MapStats *st) {
-  const size_t nb = exact_beams_;
+  const size_t nb = exact_beams_, ns = exact_scans_;
   const cuda::DeviceModel m = exact_model();
   const size_t tiles = static_cast<size_t>((geo_.size_x + cuda::kTile - 1) / cuda::kTile) *
                        ((geo_.size_y + cuda::kTile - 1) / cuda::kTile);
   reserve_exact_scratch(pair_bound, tiles);
   cuda::Event &e0 = *e_start_, &e_up = *e_uploaded_, &e_map = *e_mapped_;
   cudaStream_t s = stream_->get();
+  e0.record(s);
+  VG_CUDA_CHECK(cudaMemcpyAsync(beams_.get(), staging_beams_.get(), nb * sizeof(cuda::ExactBeam),
+                                cudaMemcpyHostToDevice, s));
+  VG_CUDA_CHECK(cudaMemcpyAsync(starts_.get(), staging_starts_.get(), ns * sizeof(cuda::StartCell),
+                                cudaMemcpyHostToDevice, s));
+  e_up.record(s);
   cuda_host::StageTimer timer(s);
   timer.mark("start");
   VG_CUDA_CHECK(cudaMemsetAsync(updates_.get(), 0, 2 * sizeof(unsigned long long), s));

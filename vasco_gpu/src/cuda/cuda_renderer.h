@@ -39,7 +39,7 @@ class CudaRenderer : public Renderer {
   void upload_ranges(const ScanBatch &scans, size_t last);
   void apply_float(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
   void apply_exact(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
-  uint64_t place_and_upload_exact_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
+  uint64_t place_exact_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
   void reserve_exact_scratch(uint64_t pair_bound, size_t tiles);
   void launch_exact_apply(uint64_t pair_bound, MapStats *st);
   void report_tile_lists(uint64_t pair_bound, size_t tiles);
@@ -60,7 +60,7 @@ class CudaRenderer : public Renderer {
   std::tuple<int, double, double, double, double, double, double> tables_key_;
   cuda::DeviceBuffer<double2> factors_;  // (free, occupied) odds factors
   cuda::DeviceBuffer<int> reach_;
-  uint64_t exact_beams_ = 0;  // placed by place_and_upload_exact_beams (skipped ones too)
+  uint64_t exact_beams_ = 0;  // placed by place_exact_beams, in staging_beams_
   size_t exact_scans_ = 0;
   cuda::DeviceBuffer<cuda::ExactBeam> beams_;
   cuda::DeviceBuffer<cuda::StartCell> starts_;
