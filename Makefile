@@ -19,8 +19,9 @@ configure: deps
 test: all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow
 
-# Installs headers, libraries (also under CARMEN's names libegrid, libmap_io,
-# libreadlog), tools, the CMake package and vasco_gpu.pc into PREFIX.
+# Installs headers, static and shared libraries (also under CARMEN's names libegrid,
+# libmap_io, libreadlog), tools, the CMake package, vasco_gpu.pc (shared) and
+# vasco_gpu-static.pc into PREFIX.
 PREFIX ?= /usr/local
 install: all
 	cmake --install $(BUILD) --prefix $(PREFIX)

@@ -38,6 +38,7 @@
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"
 #if defined(VASCO_HAVE_CUDA)
+#include "paper_backend.h"
 #include "vasco_gpu/cuda_backend.h"
 #endif
 
@@ -288,16 +289,16 @@ int main(int argc, char **argv) {
       }
 #if defined(VASCO_HAVE_CUDA)
       if (gpu && ablation) {
-        const std::pair<const char *, vasco::CudaKernel> variants[] = {
-            {"paper: launch per scan, beam data in shared, params in constant", vasco::CudaKernel::PaperPerScan},
-            {"  - without shared memory (each thread places the beam)", vasco::CudaKernel::PaperPerScanNoShared},
-            {"  - without constant memory (params from global)", vasco::CudaKernel::PaperPerScanNoConst},
-            {"  + all scans fused into one launch", vasco::CudaKernel::PaperFused},
-            {"ours: warp per beam, block per scan, one launch", vasco::CudaKernel::Ours}};
+        using vasco::cuda::PaperVariant;
+        const std::pair<const char *, int> variants[] = {
+            {"paper: launch per scan, beam data in shared, params in constant", int(PaperVariant::PerScan)},
+            {"  - without shared memory (each thread places the beam)", int(PaperVariant::PerScanNoShared)},
+            {"  - without constant memory (params from global)", int(PaperVariant::PerScanNoConst)},
+            {"  + all scans fused into one launch", int(PaperVariant::Fused)},
+            {"ours: warp per beam, block per scan, one launch", -1}};
         for (const auto &v : variants) {
-          vasco::BackendOptions o;
-          o.cuda_kernel = v.second;
-          auto backend = vasco::make_backend("cuda", o);
+          auto backend = v.second < 0 ? vasco::make_backend("cuda", vasco::BackendOptions{})
+                                      : vasco::make_paper_backend(static_cast<PaperVariant>(v.second));
           Phases ph, warm;
           run_once(*backend, batch, ps.params, geo, &warm);
           for (int r = 0; r < runs; ++r) run_once(*backend, batch, ps.params, geo, &ph);

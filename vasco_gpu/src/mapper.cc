@@ -64,7 +64,7 @@ void check_window(const GridWindow &w, const GridGeometry &geo) {
 std::unique_ptr<Renderer> make_renderer(const std::string &backend, const BackendOptions &options) {
 #if defined(VASCO_HAVE_CUDA)
   std::string why;
-  if ((backend == "cuda" || backend == "auto") && options.cuda_kernel == CudaKernel::Ours &&
+  if ((backend == "cuda" || backend == "auto") &&
       cuda_usable(options.cuda_device, &why))
     return make_cuda_renderer(options);
 #endif

@@ -28,10 +28,6 @@ struct MapStats {
 
 enum class CudaMode { Float, Exact };
 
-// Float-mode kernels: ours, or the paper's kernel and its ablation variants
-// (benchmark baselines; see cuda/paper_kernels.cu).
-enum class CudaKernel { Ours, PaperPerScan, PaperPerScanNoShared, PaperPerScanNoConst, PaperFused };
-
 // The host-memory budget of a mapping session by default: 2 GiB, which a
 // laptop has to spare (a 580 m square at 2.5 cm cells); a grid of 10^9 cells
 // (two scans 400 m apart) does not fit it and is refused before anything is
@@ -40,7 +36,6 @@ constexpr uint64_t kDefaultMaxMemoryBytes = uint64_t(2) << 30;
 
 struct BackendOptions {
   CudaMode cuda_mode = CudaMode::Float;
-  CudaKernel cuda_kernel = CudaKernel::Ours;
   int threads = 0;   // cpu_threads: 0 = all cores
   int cuda_device = 0;
   uint64_t max_memory_bytes = kDefaultMaxMemoryBytes;  // host memory a Mapper may use (0: no limit)

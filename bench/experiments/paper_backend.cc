@@ -1,0 +1,134 @@
+// The paper's kernel and its ablation variants as a one-shot backend (see
+// paper_backend.h).
+#include "paper_backend.h"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+#include <vector>
+
+#include "cuda_check.h"
+#include "cuda_host_support.h"
+#include "egrid_kernels.h"
+#include "vasco_gpu/beam_placement.h"
+#include "vasco_gpu/cuda_backend.h"
+
+namespace vasco {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using cuda::DeviceBuffer;
+using cuda::Event;
+using cuda::PinnedBuffer;
+using cuda::Stream;
+using cuda_host::check_fits;
+using cuda_host::StageTimer;
+
+double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+class PaperBackend : public Backend {
+ public:
+  PaperBackend(cuda::PaperVariant v, int device) : variant_(v), device_(device) {
+    VG_CUDA_CHECK(cudaSetDevice(device));
+  }
+  std::string name() const override { return cuda::paper_variant_name(variant_); }
+
+  std::vector<float> map(const ScanBatch &batch, const MapperParams &params, const GridGeometry &geo,
+                         MapStats *stats) override {
+    VG_CUDA_CHECK(cudaSetDevice(device_));
+    check_fits(2 * geo.num_cells() * sizeof(float), "the evidence grid");
+    std::vector<float> grid(geo.num_cells());
+    MapStats st;
+    map_paper(batch, params, geo, grid.data(), &st);
+    st.scans = batch.num_scans();
+    if (stats != nullptr) *stats = st;
+    return grid;
+  }
+
+  void apply(const ScanBatch &, size_t, size_t, const MapperParams &, const GridGeometry &, float *,
+             MapStats *) override {
+    throw std::logic_error("the paper's kernels map whole batches only");
+  }
+
+ private:
+  // Uploads the batch once, runs every scan with the variant's kernels,
+  // downloads the grid once (the paper's working cycle).
+  void map_paper(const ScanBatch &batch, const MapperParams &params, const GridGeometry &geo,
+                 float *host_grid, MapStats *st) {
+    const auto t_prep = Clock::now();
+    const std::vector<oracle::ScanStart> starts = place_scans(batch, geo);
+    const size_t nscans = batch.num_scans();
+    PinnedBuffer<cuda::FloatScan> h_scans(std::max<size_t>(nscans, 1));
+    for (size_t s = 0; s < nscans; ++s) {
+      cuda::FloatScan f;
+      f.lx = static_cast<float>(starts[s].lx);
+      f.ly = static_cast<float>(starts[s].ly);
+      f.theta = static_cast<float>(starts[s].theta);
+      f.x1 = starts[s].x1;
+      f.y1 = starts[s].y1;
+      f.first = static_cast<float>(batch.first_angle[s]);
+      f.step = static_cast<float>(batch.angle_step[s]);
+      f.beam_begin = static_cast<uint32_t>(batch.beam_offset[s]);
+      f.beam_count = batch.beams_in(s);
+      h_scans[s] = f;
+    }
+    const cuda::FloatModel m = float_model_of(params, geo);
+    st->prep_s = seconds(t_prep);
+
+    const size_t cells = geo.num_cells(), nbeams = batch.num_beams();
+    if (nbeams > UINT32_MAX) throw std::runtime_error("the paper's kernels: more than 2^32 beams");
+    check_fits(cells * (sizeof(float) + 1) + nbeams * sizeof(float) + nscans * sizeof(cuda::FloatScan),
+               "float mode (grid and beams)");
+    Stream stream;
+    Event e0, e_up, e_map, e_down;
+    DeviceBuffer<cuda::FloatScan> d_scans(nscans);
+    DeviceBuffer<float> d_ranges(nbeams), d_grid(cells);
+    DeviceBuffer<uint8_t> d_touched(cells);
+    DeviceBuffer<unsigned long long> d_counters(3);
+    DeviceBuffer<cuda::FloatModel> d_model(1);
+
+    e0.record(stream.get());
+    if (nscans)
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_scans.get(), h_scans.get(), nscans * sizeof(cuda::FloatScan),
+                                    cudaMemcpyHostToDevice, stream.get()));
+    if (nbeams)
+      VG_CUDA_CHECK(cudaMemcpyAsync(d_ranges.get(), batch.range.data(), nbeams * sizeof(float),
+                                    cudaMemcpyHostToDevice, stream.get()));
+    e_up.record(stream.get());
+    StageTimer timer(stream.get());
+    timer.mark("start");
+    VG_CUDA_CHECK(cudaMemsetAsync(d_grid.get(), 0, cells * sizeof(float), stream.get()));
+    VG_CUDA_CHECK(cudaMemsetAsync(d_touched.get(), 0, cells, stream.get()));
+    timer.mark("clear");
+    VG_CUDA_CHECK(cudaMemsetAsync(d_counters.get(), 0, 3 * sizeof(unsigned long long), stream.get()));
+    const cuda::PaperVariant v = variant_;
+    VG_CUDA_CHECK(cudaMemcpyAsync(d_model.get(), &m, sizeof m, cudaMemcpyHostToDevice, stream.get()));
+    cuda::run_paper_variant(v, m, d_model.get(), h_scans.get(), d_scans.get(), static_cast<int>(nscans),
+                            d_ranges.get(), d_grid.get(), d_touched.get(), stream.get());
+    timer.mark("map");
+    cuda::launch_float_finalize(m, d_grid.get(), d_touched.get(), cells, stream.get());
+    timer.mark("finalize");
+    e_map.record(stream.get());
+    VG_CUDA_CHECK(cudaMemcpyAsync(host_grid, d_grid.get(), cells * sizeof(float),
+                                  cudaMemcpyDeviceToHost, stream.get()));
+    e_down.record(stream.get());
+    stream.synchronize();
+    timer.report();
+    st->upload_s = e_up.since(e0) / 1e3;
+    st->map_s = e_map.since(e_up) / 1e3;
+    st->download_s = e_down.since(e_map) / 1e3;
+  }
+
+  cuda::PaperVariant variant_;
+  int device_;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> make_paper_backend(cuda::PaperVariant variant, int cuda_device) {
+  std::string why;
+  if (!cuda_usable(cuda_device, &why)) throw std::runtime_error("no usable GPU: " + why);
+  return std::make_unique<PaperBackend>(variant, cuda_device);
+}
+
+}  // namespace vasco
