@@ -98,11 +98,8 @@ __global__ void tables_kernel(DeviceModel m, double2 *factors) {
   const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
   for (int idx = blockIdx.x * blockDim.x + threadIdx.x; idx < n; idx += gridDim.x * blockDim.x) {
     const int i = idx / m.table_size, j = idx % m.table_size;
-    const double d = egrid::cell_distance(i, j, m.resolution);
-    double p;
-    // A range of +inf makes every cell free, -inf every cell occupied.
-    const double ff = egrid::sensor_model(model, d, CUDART_INF, &p) ? egrid::odds_factor(m.prior, p) : 0.0;
-    const double fo = egrid::sensor_model(model, d, -CUDART_INF, &p) ? egrid::odds_factor(m.prior, p) : 0.0;
+    double ff, fo;
+    egrid::odds_factors_at(model, egrid::cell_distance(i, j, m.resolution), &ff, &fo);
     factors[idx] = make_double2(ff, fo);
   }
 }

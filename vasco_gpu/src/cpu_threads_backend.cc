@@ -466,14 +466,7 @@ class CpuThreadsBackend : public Backend {
         for (int j = 0; j < T; ++j) {
           Entry &e = table_[static_cast<size_t>(i) * T + j];
           e.d = egrid::cell_distance(i, j, params.resolution);
-          double p;
-          e.stop = egrid::sensor_model(model, e.d, std::numeric_limits<double>::infinity(), &p) ? 0 : 1;
-          e.f_free = e.stop ? 0.0 : egrid::odds_factor(model.prior, p);
-          e.f_occ = 0.0;
-          if (!e.stop) {
-            egrid::sensor_model(model, e.d, -std::numeric_limits<double>::infinity(), &p);
-            e.f_occ = egrid::odds_factor(model.prior, p);
-          }
+          e.stop = egrid::odds_factors_at(model, e.d, &e.f_free, &e.f_occ) ? 0 : 1;
         }
       }
     });

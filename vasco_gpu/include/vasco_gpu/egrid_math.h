@@ -254,6 +254,10 @@ struct ModelParams {
   double sure, max;         // max_sure_range, max_range
 };
 
+// Whether a beam stops at a cell at distance d (sensor_model refuses it):
+// it depends on d alone, not on the range.
+VG_HD bool stops_beam(const ModelParams &m, double d) { return !(d < m.sure) && !(d < m.max); }
+
 // The evidence p for a cell at distance d of a beam of range r; returns false
 // when the beam stops here (d >= max_range).
 VG_HD bool sensor_model(const ModelParams &m, double d, double r, double *p) {
@@ -267,6 +271,15 @@ VG_HD bool sensor_model(const ModelParams &m, double d, double r, double *p) {
   }
   return true;
 }
+
+// The odds factors of an update at distance d, the one source of every
+// backend's factor tables: for a cell the beam passes (free, d < range) and
+// for the cell it ends in (occupied), odds_factor(prior, p) with p =
+// sensor_model(d, +inf) resp. sensor_model(d, -inf). sensor_model uses the
+// range only through d < range, so odds_apply(cell, prior, factor) is
+// odds_update(cell, prior, sensor_model(d, range)) bit for bit. Returns false
+// (zeros) where d >= max_range: the beam stops there.
+VG_HD bool odds_factors_at(const ModelParams &m, double d, double *f_free, double *f_occ);
 
 // Distance between two cells i and j cells apart, as the distance table holds it.
 VG_HD double cell_distance(int i, int j, double resolution) {
@@ -318,6 +331,18 @@ VG_HD float odds_apply(float cell, double prior, double factor) {
 
 VG_HD float odds_update(float cell, double prior, double p) {
   return odds_apply(cell, prior, odds_factor(prior, p));
+}
+
+VG_HD bool odds_factors_at(const ModelParams &m, double d, double *f_free, double *f_occ) {
+  double p;
+  if (!sensor_model(m, d, HUGE_VAL, &p)) {
+    *f_free = *f_occ = 0.0;
+    return false;
+  }
+  *f_free = odds_factor(m.prior, p);
+  sensor_model(m, d, -HUGE_VAL, &p);
+  *f_occ = odds_factor(m.prior, p);
+  return true;
 }
 
 // The float port (the paper's CPU version): the same update in single precision.
