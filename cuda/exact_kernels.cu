@@ -12,7 +12,6 @@
 //      same cell and no update can be lost.
 // Every double operation is the oracle's (egrid_math.h, built with
 // --fmad=false), so the values match bit for bit.
-#include <math_constants.h>
 
 #include <cub/cub.cuh>
 
