@@ -6,6 +6,12 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
 #include <cerrno>
 #include <cfloat>
 #include <charconv>
@@ -802,6 +808,194 @@ constexpr std::size_t kMaxLineCap = std::size_t(1) << 30;  // largest max_line_l
 
 }  // namespace
 
+// Inflates a gzip file (several members and zero padding between them
+// allowed, as gzip -t accepts) into the caller's buffer. Errors are not
+// thrown: they end the stream with a message, delivered after the good bytes.
+class GzipInflater {
+ public:
+  explicit GzipInflater(std::FILE *fp) : fp_(fp), in_(kInChunk) {
+    if (inflateInit2(&zs_, 15 + 16) != Z_OK) throw std::bad_alloc();
+  }
+  ~GzipInflater() { inflateEnd(&zs_); }
+  GzipInflater(const GzipInflater &) = delete;
+  GzipInflater &operator=(const GzipInflater &) = delete;
+
+  // Fills dst with up to cap bytes; fewer only at the end of the stream, when
+  // `eof` or `error` is set.
+  std::size_t read(char *dst, std::size_t cap, bool *eof, std::string *error) {
+    zs_.next_out = reinterpret_cast<Bytef *>(dst);
+    zs_.avail_out = static_cast<uInt>(cap);
+    while (zs_.avail_out > 0 && !step(cap, eof, error)) {
+    }
+    const std::size_t n = cap - zs_.avail_out;
+    produced_ += n;
+    return n;
+  }
+  uint64_t compressed_read() const { return comp_read_.load(std::memory_order_relaxed); }
+
+ private:
+  // One inflate step; true when the stream ended (eof or error set).
+  bool step(std::size_t cap, bool *eof, std::string *error) {
+    if (zs_.avail_in == 0 && !in_eof_) {
+      const std::size_t n = std::fread(in_.data(), 1, in_.size(), fp_);
+      comp_read_.fetch_add(n, std::memory_order_relaxed);
+      if (n == 0) {
+        if (std::ferror(fp_)) {
+          *error = std::string("read error: ") + std::strerror(errno);
+          return true;
+        }
+        in_eof_ = true;
+      }
+      zs_.next_in = in_.data();
+      zs_.avail_in = static_cast<uInt>(n);
+    }
+    if (after_member_) {
+      // Zero bytes after a member are padding (tape and block devices add
+      // them; gzip -t accepts them): skipped.
+      while (zs_.avail_in > 0 && *zs_.next_in == 0) {
+        ++zs_.next_in;
+        --zs_.avail_in;
+      }
+      if (zs_.avail_in == 0 && !in_eof_) return false;
+      if (zs_.avail_in == 0 && in_eof_) {
+        *eof = true;
+        return true;
+      }
+    }
+    const int ret = inflate(&zs_, Z_NO_FLUSH);
+    if (ret == Z_STREAM_END) {
+      after_member_ = true;  // another gzip member may follow (as gzip -c a b > c makes)
+      inflateReset(&zs_);
+      return false;
+    }
+    if (ret == Z_OK) {
+      after_member_ = false;
+      return false;
+    }
+    const uint64_t at = produced_ + (cap - zs_.avail_out);
+    if (ret == Z_BUF_ERROR && zs_.avail_in == 0 && in_eof_) {
+      *error = "truncated gzip stream: the compressed data ends after " + std::to_string(at) +
+               " uncompressed bytes, before the end of the stream";
+    } else if (ret == Z_DATA_ERROR && after_member_ && zs_.total_out == 0) {
+      *error = "corrupt gzip file: data after the end of the gzip stream is not gzip data";
+    } else if (ret == Z_MEM_ERROR) {
+      *error = "out of memory while inflating";
+    } else if (ret == Z_BUF_ERROR) {
+      return false;  // no progress possible yet: more input will come
+    } else {
+      *error = std::string("corrupt gzip stream after ") + std::to_string(at) +
+               " uncompressed bytes: " + (zs_.msg ? zs_.msg : "invalid data");
+    }
+    return true;
+  }
+
+  std::FILE *fp_;
+  std::vector<unsigned char> in_;
+  z_stream zs_{};
+  bool in_eof_ = false, after_member_ = false;
+  uint64_t produced_ = 0;
+  std::atomic<uint64_t> comp_read_{0};
+};
+
+// Runs a GzipInflater on its own thread, kQueuedBlocks blocks ahead of the
+// parser: inflating (zlib's share of a .gz parse is about half) overlaps
+// parsing. Blocks come out in order; the end (eof or error) after the last.
+class BackgroundInflater {
+ public:
+  explicit BackgroundInflater(std::FILE *fp) : inflater_(fp), thread_([this] { produce(); }) {}
+  ~BackgroundInflater() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      stop_ = true;
+    }
+    space_.notify_all();
+    thread_.join();
+  }
+
+  // Copies up to cap bytes of the stream into dst; 0 at the end, with `eof`
+  // or `error` set.
+  std::size_t read(char *dst, std::size_t cap, bool *eof, std::string *error) {
+    std::unique_lock<std::mutex> lock(m_);
+    data_.wait(lock, [&] { return !ready_.empty() || finished_; });
+    if (ready_.empty()) {
+      *eof = eof_;
+      *error = error_;
+      return 0;
+    }
+    Block &b = ready_.front();
+    const std::size_t n = std::min(cap, b.bytes.size() - b.pos);
+    std::memcpy(dst, b.bytes.data() + b.pos, n);
+    b.pos += n;
+    if (b.pos == b.bytes.size()) {
+      spare_.push_back(std::move(b.bytes));
+      ready_.pop_front();
+      lock.unlock();
+      space_.notify_one();
+    }
+    return n;
+  }
+  uint64_t compressed_read() const { return inflater_.compressed_read(); }
+
+ private:
+  struct Block {
+    std::vector<char> bytes;
+    std::size_t pos = 0;
+  };
+  static constexpr std::size_t kQueuedBlocks = 4;
+
+  void produce() {
+    try {
+      produce_blocks();
+    } catch (const std::exception &e) {  // bad_alloc: end the stream with it
+      {
+        std::lock_guard<std::mutex> lock(m_);
+        finished_ = true;
+        error_ = std::string("while inflating: ") + e.what();
+      }
+      data_.notify_one();
+    }
+  }
+
+  void produce_blocks() {
+    for (;;) {
+      std::vector<char> bytes;
+      {
+        std::unique_lock<std::mutex> lock(m_);
+        space_.wait(lock, [&] { return stop_ || ready_.size() < kQueuedBlocks; });
+        if (stop_) return;
+        if (!spare_.empty()) {
+          bytes = std::move(spare_.back());
+          spare_.pop_back();
+        }
+      }
+      bytes.resize(kReadChunk);
+      bool eof = false;
+      std::string error;
+      bytes.resize(inflater_.read(bytes.data(), bytes.size(), &eof, &error));
+      {
+        std::lock_guard<std::mutex> lock(m_);
+        if (!bytes.empty()) ready_.push_back(Block{std::move(bytes), 0});
+        if (eof || !error.empty()) {
+          finished_ = true;
+          eof_ = eof;
+          error_ = error;
+        }
+      }
+      data_.notify_one();
+      if (eof || !error.empty()) return;
+    }
+  }
+
+  GzipInflater inflater_;
+  std::mutex m_;
+  std::condition_variable data_, space_;
+  std::deque<Block> ready_;
+  std::vector<std::vector<char>> spare_;
+  bool stop_ = false, finished_ = false, eof_ = false;
+  std::string error_;
+  std::thread thread_;  // last: starts once everything above exists
+};
+
 struct LogReader::Impl {
   std::string path;
   LogReaderOptions opt;
@@ -809,16 +1003,10 @@ struct LogReader::Impl {
 
   std::FILE *fp = nullptr;
   uint64_t size = 0;
-  uint64_t comp_read = 0;
+  uint64_t comp_read = 0;   // plain files; a .gz's count is its inflater's
   bool gzip_magic = false;  // the file starts with 1f 8b
-
-  // Inflate state (gz == true).
   bool gz = false;
-  bool zs_init = false;
-  z_stream zs{};
-  std::vector<unsigned char> zin;
-  bool in_eof = false;
-  bool after_member = false;
+  std::unique_ptr<BackgroundInflater> inflater;  // gz == true
 
   // Text buffer: [pos, lim) not yet consumed; buf[0] is stream offset base.
   std::vector<char> buf;
@@ -834,7 +1022,7 @@ struct LogReader::Impl {
   LineError err;
 
   ~Impl() {
-    if (zs_init) inflateEnd(&zs);
+    inflater.reset();  // its thread reads fp
     if (fp) std::fclose(fp);
   }
 
@@ -859,9 +1047,11 @@ struct LogReader::Impl {
     // As zlib's gzread: a .gz name with non-gzip content is read as it is.
     gz = ends_with(path, ".gz") && gzip_magic;
     if (gz) {
-      zin.resize(kInChunk);
-      if (inflateInit2(&zs, 15 + 16) != Z_OK) fail(0, "cannot initialise zlib");
-      zs_init = true;
+      try {
+        inflater = std::make_unique<BackgroundInflater>(fp);
+      } catch (const std::exception &e) {
+        fail(0, std::string("cannot start inflating: ") + e.what());
+      }
     }
     opt.max_line_length = std::min(std::max(opt.max_line_length, std::size_t(16)), kMaxLineCap);
     buf.resize(opt.max_line_length + kReadChunk + 1);
@@ -878,62 +1068,19 @@ struct LogReader::Impl {
   }
 
   std::size_t read_gz(char *dst, std::size_t cap) {
-    zs.next_out = reinterpret_cast<Bytef *>(dst);
-    zs.avail_out = static_cast<uInt>(cap);
-    while (zs.avail_out > 0) {
-      if (zs.avail_in == 0 && !in_eof) {
-        const std::size_t n = std::fread(zin.data(), 1, zin.size(), fp);
-        comp_read += n;
-        if (n == 0) {
-          if (std::ferror(fp)) {
-            src_error = std::string("read error: ") + std::strerror(errno);
-            break;
-          }
-          in_eof = true;
-        }
-        zs.next_in = zin.data();
-        zs.avail_in = static_cast<uInt>(n);
-      }
-      if (after_member) {
-        // Zero bytes after a member are padding (tape and block devices add
-        // them; gzip -t accepts them): skipped.
-        while (zs.avail_in > 0 && *zs.next_in == 0) {
-          ++zs.next_in;
-          --zs.avail_in;
-        }
-        if (zs.avail_in == 0 && !in_eof) continue;
-      }
-      if (after_member && zs.avail_in == 0 && in_eof) {
-        src_eof = true;
+    std::size_t n = 0;
+    while (n < cap) {
+      bool eof = false;
+      std::string error;
+      const std::size_t got = inflater->read(dst + n, cap - n, &eof, &error);
+      n += got;
+      if (got == 0) {
+        if (!error.empty()) src_error = error;
+        else src_eof = true;
         break;
       }
-      const int ret = inflate(&zs, Z_NO_FLUSH);
-      if (ret == Z_STREAM_END) {
-        after_member = true;  // another gzip member may follow (as gzip -c a b > c makes)
-        inflateReset(&zs);
-        continue;
-      }
-      if (ret == Z_OK) {
-        after_member = false;
-        continue;
-      }
-      const uint64_t at = base + lim + (cap - zs.avail_out);
-      if (ret == Z_BUF_ERROR && zs.avail_in == 0 && in_eof) {
-        src_error = "truncated gzip stream: the compressed data ends after " + std::to_string(at) +
-                    " uncompressed bytes, before the end of the stream";
-      } else if (ret == Z_DATA_ERROR && after_member && zs.total_out == 0) {
-        src_error = "corrupt gzip file: data after the end of the gzip stream is not gzip data";
-      } else if (ret == Z_MEM_ERROR) {
-        src_error = "out of memory while inflating";
-      } else if (ret == Z_BUF_ERROR) {
-        continue;  // no progress possible yet: more input will come
-      } else {
-        src_error = std::string("corrupt gzip stream after ") + std::to_string(at) +
-                    " uncompressed bytes: " + (zs.msg ? zs.msg : "invalid data");
-      }
-      break;
     }
-    return cap - zs.avail_out;
+    return n;
   }
 
   // Appends more text to the buffer (compacting it first).
@@ -1113,7 +1260,9 @@ bool LogReader::next(LogMessage &msg) { return impl_->next(msg); }
 const LogStats &LogReader::stats() const { return impl_->stats; }
 const std::string &LogReader::path() const { return impl_->path; }
 const LogReaderOptions &LogReader::options() const { return impl_->opt; }
-uint64_t LogReader::compressed_bytes_read() const { return impl_->comp_read; }
+uint64_t LogReader::compressed_bytes_read() const {
+  return impl_->inflater ? impl_->inflater->compressed_read() : impl_->comp_read;
+}
 uint64_t LogReader::file_size() const { return impl_->size; }
 bool LogReader::compressed() const { return impl_->gz; }
 
