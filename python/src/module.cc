@@ -427,19 +427,24 @@ NB_MODULE(_core, m) {
   m.doc() = "vasco_gpu's C++ engine (see the package vasco_gpu for the documentation).";
 
   // carmen::FileError -> vasco_gpu.FileError(text, file, line, message).
-  // A reference kept for the life of the process (no destructor at exit).
-  static PyObject *file_error = nb::object(nb::module_::import_("vasco_gpu._errors").attr("FileError")).release().ptr();
+  // The class travels as the translator's payload, one per initialisation of
+  // the module (a re-import gets its own translator and class, never a stale
+  // one); the reference is kept for the life of the process (no destructor at
+  // exit). Other exceptions leave the translator as they came, for nanobind's
+  // own translator (std::invalid_argument -> ValueError, ...).
+  PyObject *file_error = nb::object(nb::module_::import_("vasco_gpu._errors").attr("FileError")).release().ptr();
   nb::register_exception_translator(
-      [](const std::exception_ptr &p, void *) {
+      [](const std::exception_ptr &p, void *payload) {
         try {
           std::rethrow_exception(p);
         } catch (const carmen::FileError &e) {
+          nb::handle cls(static_cast<PyObject *>(payload));
           nb::object line = e.line() > 0 ? nb::object(nb::int_(e.line())) : nb::none();
-          nb::object exc = nb::handle(file_error)(carmen::printable(e.what()), e.file(), line, e.message());
-          PyErr_SetObject(file_error, exc.ptr());
+          nb::object exc = cls(carmen::printable(e.what()), e.file(), line, e.message());
+          PyErr_SetObject(cls.ptr(), exc.ptr());
         }
       },
-      nullptr);
+      file_error);
 
   m.attr("__version__") = vasco::version();
 #if defined(VASCO_HAVE_CUDA)

@@ -4,9 +4,13 @@ files, compare, threads."""
 from __future__ import annotations
 
 import gzip
+import os
 import pickle
+import subprocess
+import sys
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,6 +32,54 @@ def edge_map(edge):
     m = vg.Mapper(edge.params, backend="cpu_double")
     m.insert(edge.scans)
     return m.finish()
+
+
+# ---- errors in a fresh interpreter (first, so that a crash is reported, not fatal) ----
+
+# Every way a C++ error becomes a Python exception, each as the first exception
+# of a fresh interpreter (the first one to pass through the exception
+# translators and the unwinder), followed by the others. In a subprocess: a
+# crash there fails this test and names the path, instead of ending the run.
+_ERROR_PATHS = [
+    # (id, exception, call)
+    ("kwargs_init_value_error", "ValueError", "vg.Params(**{'p_occ': 1.5})"),  # std::invalid_argument
+    ("kwargs_init_type_error", "TypeError", "vg.Params(**{'p_ocupied': 0.6})"),  # nb::type_error
+    ("file_error", "FileError", "vg.load_log(MISSING)"),  # carmen::FileError, the module's translator
+    ("gil_released_value_error", "ValueError", "vg.Mapper(BAD)"),  # thrown while the GIL is released
+]
+_ERROR_SCRIPT = """
+import builtins
+import sys
+
+import vasco_gpu as vg
+
+MISSING = sys.argv[1]
+BAD = vg.Params()
+BAD.p_occ = 3.0
+for name, exc, call in PATHS:
+    want = vg.FileError if exc == "FileError" else getattr(builtins, exc)
+    try:
+        eval(call)
+    except want as e:
+        if exc == "FileError":
+            assert e.file == MISSING and e.line is None, (e.file, e.line)
+        print(name, flush=True)
+    else:
+        raise AssertionError(call + " did not raise " + exc)
+"""
+
+
+@pytest.mark.parametrize("first", range(len(_ERROR_PATHS)), ids=[p[0] for p in _ERROR_PATHS])
+def test_errors_in_a_fresh_interpreter(tmp_path, first):
+    paths = [_ERROR_PATHS[first]] + [p for i, p in enumerate(_ERROR_PATHS) if i != first]
+    env = dict(os.environ, PYTHONFAULTHANDLER="1")
+    # The vasco_gpu these tests import, whether installed or from a build tree.
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(vg.__file__).resolve().parents[1])] +
+                                        ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
+    r = subprocess.run([sys.executable, "-c", f"PATHS = {paths!r}\n" + _ERROR_SCRIPT, str(tmp_path / "no.log")],
+                       capture_output=True, text=True, timeout=120, env=env)
+    assert r.returncode == 0, f"exit status {r.returncode}, first {paths[0][2]}\n{r.stdout}\n{r.stderr}"
+    assert r.stdout.split() == [p[0] for p in paths]
 
 
 # ---- Params -----------------------------------------------------------------
