@@ -423,7 +423,10 @@ bool cuda_available(std::string *why) {
 
 }  // namespace
 
-NB_MODULE(_core, m) {
+namespace {
+
+// The error translator, the version and the module-level functions.
+void bind_module(nb::module_ &m) {
   m.doc() = "vasco_gpu's C++ engine (see the package vasco_gpu for the documentation).";
 
   // carmen::FileError -> vasco_gpu.FileError(text, file, line, message).
@@ -466,8 +469,9 @@ NB_MODULE(_core, m) {
       "Whether the CUDA backend can run here (built with CUDA and a usable GPU), and why not.\n\n"
       "Returns ``(True, '')`` or ``(False, reason)``. The first call starts the CUDA context (a few\n"
       "tenths of a second).");
+}
 
-  // ---- Params -------------------------------------------------------------
+void bind_params(nb::module_ &m) {
   auto params_class = nb::class_<vasco::MapperParams>(m, "Params",
                                   "The mapper's parameters: carmen.ini's ``vasco_*`` keys without the prefix.\n\n"
                                   "``Params(p_occ=0.9, resolution=0.05)`` (the ``vasco_`` prefix is accepted\n"
@@ -534,8 +538,9 @@ NB_MODULE(_core, m) {
       .def_rw("num_scans", &vasco::MapperParams::num_scans,
               "vasco_num_scans: laser messages used by load_log (-1: all).");
   params_class.attr("__hash__") = nb::none();  // mutable, compared by value
+}
 
-  // ---- Frame --------------------------------------------------------------
+void bind_frame(nb::module_ &m) {
   nb::class_<vasco::GridGeometry>(m, "Frame",
                                   "Where a full-resolution evidence grid lies: size in cells, resolution,\n"
                                   "the first scan's heading (theta_offset) and laser position (x0, y0); the\n"
@@ -565,8 +570,9 @@ NB_MODULE(_core, m) {
         return nb::str("Frame(size_x={}, size_y={}, resolution={}, theta_offset={}, x0={}, y0={})")
             .format(g.size_x, g.size_y, g.resolution, g.theta_offset, g.x0, g.y0);
       });
+}
 
-  // ---- Scans --------------------------------------------------------------
+void bind_scans(nb::module_ &m) {
   nb::class_<vasco::ScanBatch>(
       m, "Scans",
       "Laser scans, stored as CARMEN reads them: a pose (x, y, theta of the laser, float64) and beam\n"
@@ -647,8 +653,9 @@ NB_MODULE(_core, m) {
       .def("__repr__", [](const vasco::ScanBatch &b) {
         return nb::str("Scans({} scans, {} beams)").format(b.num_scans(), b.num_beams());
       });
+}
 
-  // ---- Log ----------------------------------------------------------------
+void bind_log(nb::module_ &m) {
   nb::class_<vasco::LogInput>(m, "Log",
                               "A CARMEN log read by load_log: the selected scans, the effective parameters\n"
                               "(keywords > ini > the log's PARAM lines > defaults), the PROTOCOL frame and\n"
@@ -706,8 +713,9 @@ NB_MODULE(_core, m) {
       "PARAM lines). Strict by default: a bad line raises FileError with ``.file`` and ``.line``;\n"
       "``lenient=True`` skips bad lines and counts them in ``Log.stats['bad_lines']``. The GIL is\n"
       "released while the log is read.");
+}
 
-  // ---- Map ----------------------------------------------------------------
+void bind_map(nb::module_ &m) {
   nb::class_<Map>(m, "Map",
                   "A finished occupancy map (or one read from a file).\n\n"
                   "``cells`` is a writable 2-D float32 NumPy view of the map's memory, shape (size_x,\n"
@@ -813,8 +821,9 @@ NB_MODULE(_core, m) {
       "chunk when the map has an origin), ``.pgm`` (ROS map_server image plus a ``.yaml`` beside it;\n"
       "``mode`` trinary, scale or raw) or ``.png`` (grey: white free, black occupied, mid grey\n"
       "unknown). Atomic: a failure leaves no file behind. Raises FileError naming the file.");
+}
 
-  // ---- compare ------------------------------------------------------------
+void bind_compare(nb::module_ &m) {
   nb::class_<vasco::GridComparison>(
       m, "Comparison",
       "DESIGN section 4's agreement table of map B against map A (the reference), over their overlap.")
@@ -903,8 +912,9 @@ NB_MODULE(_core, m) {
       "known/unknown differences, |dp| > 0.1, max |dp|, bit-identical cells). Maps whose origins\n"
       "are a whole number of cells apart are aligned by them (``align=False``: cell (0, 0) on cell\n"
       "(0, 0)). ``top``: how many of the largest differences to keep in ``.largest``.");
+}
 
-  // ---- Mapper -------------------------------------------------------------
+void bind_mapper(nb::module_ &m) {
   nb::class_<PyMapper>(
       m, "Mapper",
       "A mapping session (DESIGN section 7): scans stored once (on the GPU for ``cuda``), poses\n"
@@ -1046,4 +1056,17 @@ NB_MODULE(_core, m) {
         std::lock_guard<std::mutex> lock(pm.mutex);
         return nb::str("Mapper(backend='{}', {} scans)").format(pm.mapper->backend_name(), pm.mapper->num_scans());
       });
+}
+
+}  // namespace
+
+NB_MODULE(_core, m) {
+  bind_module(m);
+  bind_params(m);
+  bind_frame(m);
+  bind_scans(m);
+  bind_log(m);
+  bind_map(m);
+  bind_compare(m);
+  bind_mapper(m);
 }
