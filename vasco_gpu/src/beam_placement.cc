@@ -68,8 +68,12 @@ BeamLayout lay_out_beams(const ScanBatch &batch, const GridGeometry &geo, int th
   return layout;
 }
 
-uint64_t place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                          const oracle::ScanStart &start, size_t s, uint32_t scan_index, PlacedBeam *out) {
+namespace {
+
+// The end cells of scan s's used beams, written from out[0] on, with
+// `scan_index` in each beam's `scan`.
+void place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
+                      const oracle::ScanStart &start, size_t s, uint32_t scan_index, PlacedBeam *out) {
   oracle::SteppedAngles angles{batch.first_angle[s], batch.angle_step[s]};
   const float *r = batch.ranges_of(s);
   PlacedBeam *o = out;
@@ -82,12 +86,13 @@ uint64_t place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const
     o->range = r[b];
     ++o;
   }
-  return static_cast<uint64_t>(o - out);
 }
 
+}  // namespace
+
 void place_laid_out_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                          const BeamLayout &layout, size_t s0, size_t s1, int threads, PlacedBeam *out) {
-  for_each_scan_parallel(s0, s1, threads, [&](size_t i) {
+                          const BeamLayout &layout, int threads, PlacedBeam *out) {
+  for_each_scan_parallel(0, layout.starts.size(), threads, [&](size_t i) {
     place_scan_beams(batch, geo, params, layout.starts[i], layout.first_scan + i, static_cast<uint32_t>(i),
                      out + layout.used_before[i]);
   });
@@ -100,7 +105,7 @@ PlacedBeams place_beams(const ScanBatch &batch, const GridGeometry &geo, const M
   out.first_scan = layout.first_scan;
   out.skipped = layout.skipped;
   out.beams.resize(layout.used());
-  place_laid_out_beams(batch, geo, params, layout, 0, layout.starts.size(), threads, out.beams.data());
+  place_laid_out_beams(batch, geo, params, layout, threads, out.beams.data());
   out.starts = std::move(layout.starts);
   return out;
 }

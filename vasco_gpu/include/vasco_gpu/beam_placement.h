@@ -49,16 +49,11 @@ struct BeamLayout {
 BeamLayout lay_out_beams(const ScanBatch &batch, const GridGeometry &geo, int threads, size_t first = 0,
                          size_t last = SIZE_MAX);
 
-// Writes the used beams of placed scans [s0, s1) (indices into the layout)
-// to out[used_before[s0] .. used_before[s1]), on `threads` cores. `out` is
-// the caller's: a vector, or a GPU backend's pinned staging buffer.
+// Writes the used beams of every laid-out scan to out[0 .. layout.used()),
+// on `threads` cores. `out` is the caller's: a vector, or a GPU backend's
+// pinned staging buffer.
 void place_laid_out_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                          const BeamLayout &layout, size_t s0, size_t s1, int threads, PlacedBeam *out);
-
-// The end cells of scan s's used beams, written from out[0] on, with
-// `scan_index` in each beam's `scan`. Returns the number written.
-uint64_t place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                          const oracle::ScanStart &start, size_t s, uint32_t scan_index, PlacedBeam *out);
+                          const BeamLayout &layout, int threads, PlacedBeam *out);
 
 // The starts of scans [first, last) (all scans by default) and the end cells
 // of their used beams; threads <= 0: all cores. Throws std::runtime_error

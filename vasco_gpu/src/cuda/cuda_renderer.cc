@@ -274,7 +274,7 @@ uint64_t CudaRenderer::place_exact_beams(const ScanBatch &scans, size_t first, s
   reserve(staging_beams_, std::max<uint64_t>(exact_beams_, 1));
   reserve(staging_starts_, std::max<size_t>(exact_scans_, 1));
   PlacedBeam *beams = reinterpret_cast<PlacedBeam *>(staging_beams_.get());
-  place_laid_out_beams(scans, geo_, params_, layout, 0, exact_scans_, 0, beams);
+  place_laid_out_beams(scans, geo_, params_, layout, 0, beams);
   for (size_t s = 0; s < exact_scans_; ++s) staging_starts_[s] = {layout.starts[s].x1, layout.starts[s].y1};
   return exact_pair_bound(beams, exact_beams_, layout.starts, params_.table_size());
 }
