@@ -35,6 +35,7 @@
 #include "vasco_gpu/cpu_threads_backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/mapper.hpp"
+#include "vasco_gpu/parallel.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"
 #if defined(VASCO_HAVE_CUDA)
@@ -203,7 +204,7 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
-  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (threads <= 0) threads = vasco::hardware_threads();
 
   const std::string src = VASCO_SOURCE_DIR;
   const std::vector<Dataset> datasets = {{"fr079", src + "/logs/fr079-complete.gfs.log.gz"},

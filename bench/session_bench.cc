@@ -26,6 +26,7 @@
 
 #include "vasco_gpu/log_input.h"
 #include "vasco_gpu/mapper.hpp"
+#include "vasco_gpu/parallel.h"
 #if defined(VASCO_HAVE_CUDA)
 #include "vasco_gpu/cuda_backend.h"
 #endif
@@ -136,7 +137,7 @@ struct Backend {
 
 std::vector<Backend> backends(bool gpu) {
   std::vector<Backend> b = {{"cpu_double", "cpu_double", {}, false},
-                            {"cpu_threads (" + std::to_string(std::thread::hardware_concurrency()) + ")",
+                            {"cpu_threads (" + std::to_string(vasco::hardware_threads()) + ")",
                              "cpu_threads", {}, false},
                             {"cpu_float", "cpu_float", {}, false}};
   if (gpu) {

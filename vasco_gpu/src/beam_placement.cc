@@ -1,6 +1,7 @@
 #include "vasco_gpu/beam_placement.h"
 
 #include <atomic>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -70,22 +71,92 @@ BeamLayout lay_out_beams(const ScanBatch &batch, const GridGeometry &geo, int th
 
 namespace {
 
+// A beam's end cell is (int)(l + w·cos(angle)/resolution) per axis, with the
+// cos and sin of glibc (oracle::beam_end). Calling both for every beam is
+// most of the placement's time, so this class derives them from the scan's
+// first angle a0 and a per-step table: angle = a0 + d, d = b·step + r, where
+// r (the accumulated angle's rounding, |r| < 1e-9 is required) is applied to
+// first order:
+//   cos(d) = cos(b·step) - sin(b·step)·r,  sin(d) = sin(b·step) + cos(b·step)·r
+//   cos(angle) = cos(a0)cos(d) - sin(a0)sin(d),  sin likewise.
+// Every term is within an ulp or two of the true value and the dropped r²/2
+// is below 1e-18, so the result is within 1e-14 of glibc's (taken as 1e-12
+// below: a 100x margin). A truncation changes only at an integer, so where
+// the approximate coordinate v lies farther than its error bound from every
+// integer, (int)v is the oracle's; elsewhere (a few beams in 10^7), and for
+// non-finite or huge values, the oracle's own beam_end decides.
+class BeamEnds {
+ public:
+  // Prepares the table for scans of n beams `step` apart.
+  void prepare(double step, int n) {
+    if (step == step_ && n <= static_cast<int>(cos_.size())) return;
+    step_ = step;
+    cos_.resize(static_cast<size_t>(n));
+    sin_.resize(static_cast<size_t>(n));
+    for (int b = 0; b < n; ++b) {
+      cos_[static_cast<size_t>(b)] = std::cos(b * step);
+      sin_[static_cast<size_t>(b)] = std::sin(b * step);
+    }
+  }
+
+  // Beam b's end cell; `a0` is the scan's first angle, `angle` beam b's.
+  void end_cell(const oracle::ScanStart &s, double a0, double ca0, double sa0, int b, double angle, float range,
+                double wall, double resolution, int *x2, int *y2) const {
+    const double r = (angle - a0) - b * step_;
+    if (std::fabs(r) < 1e-9) {
+      const double cb = cos_[static_cast<size_t>(b)], sb = sin_[static_cast<size_t>(b)];
+      const double cd = cb - sb * r, sd = sb + cb * r;
+      const double k = (static_cast<double>(range) + wall) / resolution;
+      const double vx = s.lx + k * (ca0 * cd - sa0 * sd);
+      const double vy = s.ly + k * (sa0 * cd + ca0 * sd);
+      const double tol = 1e-11 * (1 + std::fabs(s.lx) + std::fabs(s.ly) + std::fabs(k));
+      if (far_from_integers(vx, tol) && far_from_integers(vy, tol)) {
+        *x2 = static_cast<int>(vx);
+        *y2 = static_cast<int>(vy);
+        return;
+      }
+    }
+    oracle::beam_end(s, angle, range, wall, resolution, x2, y2);
+  }
+
+ private:
+  // Whether v lies farther than tol from every integer; false for NaN and
+  // past +-2^30 (left to the oracle's checks).
+  static bool far_from_integers(double v, double tol) {
+    if (!(std::fabs(v) < 1073741824.0)) return false;
+    const double f = std::fabs(v - static_cast<double>(static_cast<int>(v)));  // in [0, 1)
+    return f > tol && f < 1 - tol;
+  }
+
+  double step_ = std::nan("");
+  std::vector<double> cos_, sin_;
+};
+
 // The end cells of scan s's used beams, written from out[0] on, with
-// `scan_index` in each beam's `scan`.
-void place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                      const oracle::ScanStart &start, size_t s, uint32_t scan_index, PlacedBeam *out) {
+// `scan_index` in each beam's `scan`; returns how many were written.
+size_t place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
+                        const oracle::ScanStart &start, size_t s, uint32_t scan_index, BeamEnds &ends,
+                        PlacedBeam *out) {
   oracle::SteppedAngles angles{batch.first_angle[s], batch.angle_step[s]};
   const float *r = batch.ranges_of(s);
+  const int n = batch.beams_in(s);
+  ends.prepare(batch.angle_step[s], n);
   PlacedBeam *o = out;
-  double angle = 0;
-  for (int b = 0; b < batch.beams_in(s); ++b) {
+  double angle = 0, a0 = 0, ca0 = 1, sa0 = 0;
+  for (int b = 0; b < n; ++b) {
     angles(b, start.theta, &angle);  // every beam advances the angle, skipped ones too
+    if (b == 0) {
+      a0 = angle;
+      ca0 = std::cos(a0);
+      sa0 = std::sin(a0);
+    }
     if (!oracle::beam_used(r[b])) continue;
-    oracle::beam_end(start, angle, r[b], params.wall_size, geo.resolution, &o->x2, &o->y2);
+    ends.end_cell(start, a0, ca0, sa0, b, angle, r[b], params.wall_size, geo.resolution, &o->x2, &o->y2);
     o->scan = scan_index;
     o->range = r[b];
     ++o;
   }
+  return static_cast<size_t>(o - out);
 }
 
 }  // namespace
@@ -93,7 +164,8 @@ void place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const Map
 void place_laid_out_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
                           const BeamLayout &layout, int threads, PlacedBeam *out) {
   for_each_scan_parallel(0, layout.starts.size(), threads, [&](size_t i) {
-    place_scan_beams(batch, geo, params, layout.starts[i], layout.first_scan + i, static_cast<uint32_t>(i),
+    thread_local BeamEnds ends;
+    place_scan_beams(batch, geo, params, layout.starts[i], layout.first_scan + i, static_cast<uint32_t>(i), ends,
                      out + layout.used_before[i]);
   });
 }

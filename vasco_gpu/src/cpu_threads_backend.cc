@@ -392,7 +392,7 @@ void run_stripes(const Context &ctx, const Beam *beams, const std::vector<oracle
 class CpuThreadsBackend : public Backend {
  public:
   explicit CpuThreadsBackend(int threads)
-      : threads_(threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))) {}
+      : threads_(threads > 0 ? threads : hardware_threads()) {}
 
   std::string name() const override { return "cpu_threads"; }
 

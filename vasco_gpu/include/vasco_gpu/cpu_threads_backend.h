@@ -12,7 +12,7 @@
 
 namespace vasco {
 
-// threads <= 0: std::thread::hardware_concurrency(). name() is "cpu_threads".
+// threads <= 0: hardware_threads() (parallel.h: the cores this process may use). name() is "cpu_threads".
 std::unique_ptr<Backend> make_cpu_threads_backend(int threads);
 
 // How the last map() call of a cpu_threads backend split its work: the grid

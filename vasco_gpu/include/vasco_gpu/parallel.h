@@ -2,47 +2,23 @@
 #ifndef VASCO_GPU_PARALLEL_H
 #define VASCO_GPU_PARALLEL_H
 
-#include <algorithm>
-#include <exception>
-#include <mutex>
-#include <thread>
-#include <vector>
+#include <functional>
 
 namespace vasco {
 
-// All cores (at least 1).
-inline int hardware_threads() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+// The cores this process may run on (at least 1): its CPU affinity mask and,
+// under a cgroup v2 CPU quota (cpu.max), the quota rounded up.
+// std::thread::hardware_concurrency() counts every core of the host, which
+// in a container that was given 16 of 200 cores starts 200 threads per pass.
+int hardware_threads();
 
-// Runs fn(t) for t in [0, n), fn(0) on the calling thread; rethrows the first
-// exception.
-template <class Fn>
-inline void run_on_threads(int n, Fn &&fn) {
-  if (n <= 1) {
-    fn(0);
-    return;
-  }
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto body = [&](int t) {
-    try {
-      fn(t);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (!error) error = std::current_exception();
-    }
-  };
-  std::vector<std::thread> pool;
-  pool.reserve(static_cast<size_t>(n - 1));
-  try {
-    for (int t = 1; t < n; ++t) pool.emplace_back(body, t);
-  } catch (...) {
-    for (auto &th : pool) th.join();
-    throw;
-  }
-  body(0);
-  for (auto &th : pool) th.join();
-  if (error) std::rethrow_exception(error);
-}
+// Runs fn(t) once for each t in [0, n), on up to n threads, fn(0) on the
+// calling thread (the others may run there too: fn must not wait for another
+// index); returns when all have returned and rethrows the first exception. The helpers come from a process-wide pool, started on
+// first use and kept (a render places beams in several passes, and starting
+// 15 threads per pass costs about as much as the pass); a call made while the
+// pool is busy (nested or from another thread) starts its own threads.
+void run_on_threads(int n, const std::function<void(int)> &fn);
 
 }  // namespace vasco
 
