@@ -35,7 +35,7 @@ std::vector<float> plain_loop(const vasco::ScanBatch &b, const vasco::MapperPara
   frame.size_y = geo.size_y;
   frame.resolution = geo.resolution;
   frame.theta_offset = geo.theta_offset;
-  const vasco::egrid::ModelParams model{p.p_prior, p.p_occ, p.p_emp, p.range_sure, p.range_max};
+  const vasco::egrid::SensorModel<double> model = p.sensor_model();
   const int t = p.table_size();
   std::vector<double> table(static_cast<size_t>(t) * t);
   std::vector<const double *> rows(t);

@@ -11,33 +11,34 @@
 #include <cstdint>
 #include <string>
 
+#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/placed_beam.h"
+
 namespace vasco {
 namespace cuda {
 
-// Model parameters as the oracle uses them (double).
-struct DeviceModel {
-  double prior, occ, emp, sure, max;  // prior_occ, occ/emp evidence, sure/max range
-  double resolution, wall;
-  int table_size;                     // (int)(max_range / resolution)
-  int size_x, size_y;                 // grid size in cells
-  // Within max_sure_range the evidence is occ or emp itself: cells with
-  // i*i + j*j < n_sure take one of these two factors, no table needed.
+// The sensor model and the grid as the kernels read them, in their mode's
+// precision: double in exact mode (the oracle's values), float in float mode.
+template <class Real>
+struct KernelModel {
+  egrid::SensorModel<Real> sensor;
+  Real resolution, wall;
+  int table_size;      // (int)(max_range / resolution)
+  int size_x, size_y;  // grid size in cells
+  // Exact mode: within max_sure_range the evidence is occ or emp itself, so
+  // cells with i*i + j*j < n_sure take one of these two factors, no table.
   int n_sure;
   double factor_free_near, factor_occ_near;
+  // Float mode: log(prior / (1 - prior)).
+  Real logodds_prior;
 };
 
 // ---------------------------------------------------------------------------
 // Exact mode: bit-identical to cpu_double.
 // ---------------------------------------------------------------------------
 
-// One used beam, as the host's oracle code placed it (skipped beams are not
-// uploaded; the order is the oracle's (scan, beam) order).
-struct ExactBeam {
-  int x2, y2;     // end cell (oracle::beam_end, host libm)
-  int scan;       // index of the scan (its start cell is in the scan table)
-  float range;    // the float range
-};
-
+// A scan's start cell; beams (vasco::PlacedBeam, only the used ones) name
+// their scan's by index.
 struct StartCell {
   int x1, y1;
 };
@@ -71,10 +72,10 @@ size_t exact_sort_temp_bytes(size_t num_pairs);
 // (i, j), table_size^2 of them, and per i the first j whose distance reaches
 // max_range (table_size entries).
 constexpr int kMaxExactTable = 2048;
-void launch_exact_tables(const DeviceModel &m, double2 *factors, int *reach, cudaStream_t stream);
+void launch_exact_tables(const KernelModel<double> &m, double2 *factors, int *reach, cudaStream_t stream);
 
 // Per beam: builds its LineRec and counts the tiles its walk passes through.
-void launch_exact_lines(const DeviceModel &m, const ExactBeam *beams, const StartCell *starts,
+void launch_exact_lines(const KernelModel<double> &m, const PlacedBeam *beams, const StartCell *starts,
                         size_t num_beams, LineRec *lines, uint32_t *tile_counts,
                         cudaStream_t stream);
 
@@ -88,7 +89,7 @@ void exact_scan(const uint32_t *counts, uint32_t *offsets, size_t num_beams, voi
 // hold kNoTile. If the real count passed the capacity nothing is written and
 // *overflow is incremented.
 constexpr uint32_t kNoTile = 0xffffffffu;
-void launch_exact_pairs(const DeviceModel &m, const LineRec *lines, const uint32_t *offsets,
+void launch_exact_pairs(const KernelModel<double> &m, const LineRec *lines, const uint32_t *offsets,
                         size_t num_beams, size_t capacity, uint32_t *pair_tile, uint32_t *pair_beam,
                         unsigned long long *overflow, cudaStream_t stream);
 
@@ -114,7 +115,7 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
 // applies every beam of the tile's list, in order, to the thread's own cell,
 // and writes the final grid (x-major floats, -1 unknown). The tables are all
 // null above kMaxExactTable (distances on the fly).
-void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
+void launch_exact_tiles(const KernelModel<double> &m, const LineRec *lines, const uint32_t *sorted_beam,
                         const uint32_t *order, const uint32_t *tile_begin,
                         const uint32_t *tile_end, const double2 *factors, const int *reach,
                         float *grid, unsigned long long *cell_updates, cudaStream_t stream);
@@ -131,12 +132,6 @@ struct FloatScan {
   int beam_count;
 };
 
-struct FloatModel {
-  float prior, occ, emp, sure, max, resolution, wall;
-  float logodds_prior;  // log(prior / (1 - prior))
-  int table_size, size_x, size_y;
-};
-
 // Sets every cell to -0.0f, float mode's "never updated".
 void launch_float_clear(float *logodds, size_t num_cells, cudaStream_t stream);
 
@@ -149,18 +144,18 @@ void launch_fill(float *cells, size_t num_cells, float value, cudaStream_t strea
 
 // Probabilities (-1 unknown) to float mode's log-odds sums, in place: the
 // inverse of launch_float_finalize, for continuing a grid mapped earlier.
-void launch_float_from_prob(const FloatModel &m, float *grid, size_t num_cells, cudaStream_t stream);
+void launch_float_from_prob(const KernelModel<float> &m, float *grid, size_t num_cells, cudaStream_t stream);
 
 // Adds every beam's log-odds evidence to `logodds` (atomics: no update is
 // lost). counters: beams used, beams skipped, cell updates.
-void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans,
+void launch_float_map(const KernelModel<float> &m, const FloatScan *scans, int num_scans,
                       const float *ranges, float *logodds, unsigned long long *counters,
                       cudaStream_t stream);
 
 // logodds -> probability, in place; cells never updated become -1. Those are
 // the cells still -0.0f, or, when `touched` is given (the paper's kernels),
 // the cells whose flag is 0.
-void launch_float_finalize(const FloatModel &m, float *grid_logodds, const uint8_t *touched,
+void launch_float_finalize(const KernelModel<float> &m, float *grid_logodds, const uint8_t *touched,
                            size_t num_cells, cudaStream_t stream);
 
 // ---------------------------------------------------------------------------

@@ -24,9 +24,7 @@ namespace vasco {
 namespace cuda {
 namespace {
 
-using egrid::BresenhamLine;
-
-__device__ __forceinline__ bool inside(int cx, int cy, const DeviceModel &m) {
+__device__ __forceinline__ bool inside(int cx, int cy, const KernelModel<double> &m) {
   return cx >= 0 && cx < m.size_x && cy >= 0 && cy < m.size_y;
 }
 
@@ -44,16 +42,12 @@ __device__ __forceinline__ int tile_of(int cx, int cy, int tiles_y) {
 // tiles between the minor coordinates at the interval's ends (both clipped
 // to the grid). About 2 * table_size / kTile iterations instead of table_size.
 template <class Visit>
-__device__ void for_each_tile(const LineRec &L, const DeviceModel &m, Visit visit) {
+__device__ void for_each_tile(const LineRec &L, const KernelModel<double> &m, Visit visit) {
   if (L.k_max < 0) return;
   const int tiles_y = (m.size_y + kTile - 1) / kTile;
   if (L.flags & kDegenerate) {  // the oracle's walker, step by step
-    BresenhamLine line;
-    egrid::bresenham_init(line, L.x1, L.y1, L.x2, L.y2);
     int prev = -1;
-    for (int k = 0; k <= L.k_max; ++k) {
-      int cx, cy;
-      egrid::bresenham_current(line, &cx, &cy);
+    egrid::walk_line(L.x1, L.y1, L.x2, L.y2, L.k_max + 1, [&](int cx, int cy, int) {
       if (inside(cx, cy, m)) {
         const int t = tile_of(cx, cy, tiles_y);
         if (t != prev) {
@@ -61,8 +55,8 @@ __device__ void for_each_tile(const LineRec &L, const DeviceModel &m, Visit visi
           prev = t;
         }
       }
-      if (!egrid::bresenham_next(line)) break;
-    }
+      return true;
+    });
     return;
   }
   const bool steep = L.flags & kSteep, backward = L.flags & kBackward, flipped = L.flags & kFlipped;
@@ -92,33 +86,32 @@ __device__ void for_each_tile(const LineRec &L, const DeviceModel &m, Visit visi
   }
 }
 
-__global__ void tables_kernel(DeviceModel m, double2 *factors) {
+__global__ void tables_kernel(KernelModel<double> m, double2 *factors) {
   const int n = m.table_size * m.table_size;
-  const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
-  for (int idx = blockIdx.x * blockDim.x + threadIdx.x; idx < n; idx += gridDim.x * blockDim.x) {
+    for (int idx = blockIdx.x * blockDim.x + threadIdx.x; idx < n; idx += gridDim.x * blockDim.x) {
     const int i = idx / m.table_size, j = idx % m.table_size;
     double ff, fo;
-    egrid::odds_factors_at(model, egrid::cell_distance(i, j, m.resolution), &ff, &fo);
+    egrid::odds_factors_at(m.sensor, egrid::cell_distance(i, j, m.resolution), &ff, &fo);
     factors[idx] = make_double2(ff, fo);
   }
 }
 
-// reach[i] = the first j with distance(i, j) >= max_range (table_size if
-// none). For tables of at most 2^11 entries per axis i*i + j*j cannot wrap, so
+// reach[i] = the first j where the beam stops (distance(i, j) >= max_range;
+// table_size if none). For tables of at most 2^11 entries per axis i*i + j*j cannot wrap, so
 // the distance grows with j and "an update at (i, j)" is exactly j < reach[i].
-__global__ void reach_kernel(DeviceModel m, int *reach) {
+__global__ void reach_kernel(KernelModel<double> m, int *reach) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= m.table_size) return;
   int j = 0;
-  while (j < m.table_size && egrid::cell_distance(i, j, m.resolution) < m.max) ++j;
+  while (j < m.table_size && !egrid::stops_beam(m.sensor, egrid::cell_distance(i, j, m.resolution))) ++j;
   reach[i] = j;
 }
 
-__global__ void lines_kernel(DeviceModel m, const ExactBeam *beams, const StartCell *starts,
+__global__ void lines_kernel(KernelModel<double> m, const PlacedBeam *beams, const StartCell *starts,
                              size_t n, LineRec *lines, uint32_t *counts) {
   const size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
-  const ExactBeam b = beams[i];
+  const PlacedBeam b = beams[i];
   const StartCell s = starts[b.scan];
   LineRec L = make_line(s.x1, s.y1, b.x2, b.y2, b.range, m.table_size);
   if (m.table_size <= kMaxExactTable) {
@@ -131,7 +124,7 @@ __global__ void lines_kernel(DeviceModel m, const ExactBeam *beams, const StartC
   counts[i] = c;
 }
 
-__global__ void pairs_kernel(DeviceModel m, const LineRec *lines, const uint32_t *offsets, size_t n,
+__global__ void pairs_kernel(KernelModel<double> m, const LineRec *lines, const uint32_t *offsets, size_t n,
                              size_t capacity, uint32_t *pair_tile, uint32_t *pair_beam,
                              unsigned long long *overflow) {
   const size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
@@ -200,15 +193,11 @@ __device__ void mark_chunk(const LineRec *sh, int n, int tx0, int ty0, unsigned 
     __syncwarp();
   }
   if (mine && !closed) {  // rare (see kClosedFormLimit): the oracle's walk
-    BresenhamLine line;
-    egrid::bresenham_init(line, L.x1, L.y1, L.x2, L.y2);
-    for (int k = 0; k <= L.k_max; ++k) {
-      int x, y;
-      egrid::bresenham_current(line, &x, &y);
+    egrid::walk_line(L.x1, L.y1, L.x2, L.y2, L.k_max + 1, [&](int x, int y, int) {
       const int u = x - tx0, v = y - ty0;
       if (u >= 0 && u < kTile && v >= 0 && v < kTile) atomicOr(&hit[2 * (u * kTile + v) + w], 1u << lane);
-      if (!egrid::bresenham_next(line)) break;
-    }
+      return true;
+    });
   }
 }
 
@@ -241,7 +230,7 @@ struct FixedPoints {
 // The updates beam L makes to (cx, cy) with the tables built: whether there
 // is one (distance below max_range) and its odds factor. Independent of the
 // cell's value, so a batch of them is loaded before the dependent chain.
-__device__ __forceinline__ bool tabled_factor(const DeviceModel &m, const LineRec &L, int cx, int cy,
+__device__ __forceinline__ bool tabled_factor(const KernelModel<double> &m, const LineRec &L, int cx, int cy,
                                               const int *reach, const double2 *factors, double *f) {
   const int i = egrid::wrap_abs(egrid::wrap_sub(cx, L.x1));
   const int j = egrid::wrap_abs(egrid::wrap_sub(cy, L.y1));
@@ -261,18 +250,16 @@ __device__ __forceinline__ bool tabled_factor(const DeviceModel &m, const LineRe
 }
 
 // The same without tables (table_size above 2^11): everything on the fly.
-__device__ __forceinline__ bool computed_factor(const DeviceModel &m, const LineRec &L, int cx, int cy,
+__device__ __forceinline__ bool computed_factor(const KernelModel<double> &m, const LineRec &L, int cx, int cy,
                                                 double *f) {
   const int i = egrid::wrap_abs(egrid::wrap_sub(cx, L.x1));
   const int j = egrid::wrap_abs(egrid::wrap_sub(cy, L.y1));
   const double d = egrid::cell_distance(i, j, m.resolution);
-  // d never decreases along a walk, so the oracle's stop at the first
-  // d >= max is: no update where d >= max.
-  if (!(d < m.max)) return false;
-  const egrid::ModelParams model{m.prior, m.occ, m.emp, m.sure, m.max};
+  // d never decreases along a walk, so the oracle's stop at the first cell
+  // the model refuses is: no update where it refuses one.
   double p;
-  egrid::sensor_model(model, d, L.range, &p);
-  *f = egrid::odds_factor(m.prior, p);
+  if (!egrid::sensor_model(m.sensor, d, L.range, &p)) return false;
+  *f = egrid::odds_factor(m.sensor.prior, p);
   return true;
 }
 
@@ -280,7 +267,7 @@ __device__ __forceinline__ bool computed_factor(const DeviceModel &m, const Line
 // list's order). Factors are fetched kBatch at a time ahead of the chain of
 // dependent odds updates, so their loads overlap; updates known to change
 // nothing are skipped. Returns the updates made (skipped ones included).
-__device__ __forceinline__ unsigned drain_hits(const DeviceModel &m, const LineRec *sh, unsigned long long h,
+__device__ __forceinline__ unsigned drain_hits(const KernelModel<double> &m, const LineRec *sh, unsigned long long h,
                                                int cx, int cy, const int *reach, const double2 *factors,
                                                FixedPoints *fixed, float *cell) {
   constexpr int kBatch = 4;
@@ -303,7 +290,7 @@ __device__ __forceinline__ unsigned drain_hits(const DeviceModel &m, const LineR
       if (!update[u]) continue;
       ++count;
       if (fixed->holds(*cell, f[u])) continue;
-      const float next = egrid::odds_apply(*cell, m.prior, f[u]);
+      const float next = egrid::odds_apply(*cell, m.sensor.prior, f[u]);
       if (__float_as_uint(next) == __float_as_uint(*cell)) fixed->learn(next, f[u]);
       *cell = next;
     }
@@ -318,7 +305,7 @@ __device__ __forceinline__ unsigned drain_hits(const DeviceModel &m, const LineR
 // many update rounds as its busiest cell has hits, not as many as there are
 // beams touching any of its cells.
 __global__ void __launch_bounds__(kTileThreads)
-    tiles_kernel(DeviceModel m, const LineRec *lines, const uint32_t *sorted_beam,
+    tiles_kernel(KernelModel<double> m, const LineRec *lines, const uint32_t *sorted_beam,
                  const uint32_t *order, const uint32_t *tile_begin, const uint32_t *tile_end,
                  const double2 *factors, const int *reach_global, float *grid, unsigned long long *updates) {
   __shared__ LineRec sh[kTileThreads];
@@ -389,7 +376,7 @@ size_t exact_sort_temp_bytes(size_t num_pairs) {
   return bytes;
 }
 
-void launch_exact_tables(const DeviceModel &m, double2 *factors, int *reach, cudaStream_t stream) {
+void launch_exact_tables(const KernelModel<double> &m, double2 *factors, int *reach, cudaStream_t stream) {
   const size_t n = static_cast<size_t>(m.table_size) * m.table_size;
   if (n == 0) return;
   tables_kernel<<<min(blocks_for(n, 256), 4096u), 256, 0, stream>>>(m, factors);
@@ -398,7 +385,7 @@ void launch_exact_tables(const DeviceModel &m, double2 *factors, int *reach, cud
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_exact_lines(const DeviceModel &m, const ExactBeam *beams, const StartCell *starts,
+void launch_exact_lines(const KernelModel<double> &m, const PlacedBeam *beams, const StartCell *starts,
                         size_t num_beams, LineRec *lines, uint32_t *counts, cudaStream_t stream) {
   if (num_beams == 0) return;
   lines_kernel<<<blocks_for(num_beams, 128), 128, 0, stream>>>(m, beams, starts, num_beams, lines,
@@ -413,7 +400,7 @@ void exact_scan(const uint32_t *counts, uint32_t *offsets, size_t num_beams, voi
                                               static_cast<int64_t>(num_beams + 1), stream));
 }
 
-void launch_exact_pairs(const DeviceModel &m, const LineRec *lines, const uint32_t *offsets,
+void launch_exact_pairs(const KernelModel<double> &m, const LineRec *lines, const uint32_t *offsets,
                         size_t num_beams, size_t capacity, uint32_t *pair_tile, uint32_t *pair_beam,
                         unsigned long long *overflow, cudaStream_t stream) {
   // Slots past the real pairs keep kNoTile and sort last.
@@ -463,7 +450,7 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
                                                           stream));
 }
 
-void launch_exact_tiles(const DeviceModel &m, const LineRec *lines, const uint32_t *sorted_beam,
+void launch_exact_tiles(const KernelModel<double> &m, const LineRec *lines, const uint32_t *sorted_beam,
                         const uint32_t *order, const uint32_t *tile_begin,
                         const uint32_t *tile_end, const double2 *factors, const int *reach, float *grid,
                         unsigned long long *updates, cudaStream_t stream) {

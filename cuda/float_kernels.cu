@@ -32,16 +32,15 @@ constexpr int kWarpsPerBlock = 8;
 // every x, +0.0 included; so after the sum, "-0.0" means "never updated" —
 // no separate touched array and none of its stores (prob_of_logodds).
 
-__device__ __forceinline__ void add_evidence(const FloatModel &m, int cx, int cy, int x1, int y1,
+__device__ __forceinline__ void add_evidence(const KernelModel<float> &m, int cx, int cy, int x1, int y1,
                                              float r, float *logodds, unsigned *count, bool *stop) {
   if (cx < 0 || cx >= m.size_x || cy < 0 || cy >= m.size_y) return;
   const int i = abs(cx - x1), j = abs(cy - y1);
   const float d = (i >= m.table_size || j >= m.table_size)
                       ? 1e6f
                       : sqrtf(static_cast<float>(i * i + j * j)) * m.resolution;
-  const egrid::ModelParamsF mf{m.prior, m.occ, m.emp, m.sure, m.max};
-  float p;
-  if (!egrid::sensor_model_f(mf, d, r, &p)) {
+    float p;
+  if (!egrid::sensor_model(m.sensor, d, r, &p)) {
     *stop = true;
     return;
   }
@@ -51,7 +50,7 @@ __device__ __forceinline__ void add_evidence(const FloatModel &m, int cx, int cy
 }
 
 __global__ void __launch_bounds__(kWarpsPerBlock * 32)
-    float_map_kernel(FloatModel m, const FloatScan *scans, int num_scans, int parts, const float *ranges,
+    float_map_kernel(KernelModel<float> m, const FloatScan *scans, int num_scans, int parts, const float *ranges,
                      float *logodds, unsigned long long *counters) {
   const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
   unsigned used = 0, skipped = 0, updates = 0;
@@ -74,15 +73,11 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
       if (!egrid::is_closed_form_line(sc.x1, sc.y1, x2, y2)) {
         // Degenerate line (a range of -inf): one lane walks it sequentially.
         if (lane == 0) {
-          egrid::BresenhamLine line;
-          egrid::bresenham_init(line, sc.x1, sc.y1, x2, y2);
           bool stop = false;
-          for (int k = 0; k < m.table_size && !stop; ++k) {
-            int cx, cy;
-            egrid::bresenham_current(line, &cx, &cy);
+          egrid::walk_line(sc.x1, sc.y1, x2, y2, m.table_size, [&](int cx, int cy, int) {
             add_evidence(m, cx, cy, sc.x1, sc.y1, r, logodds, &updates, &stop);
-            if (!egrid::bresenham_next(line)) break;
-          }
+            return !stop;
+          });
         }
         continue;
       }
@@ -125,7 +120,7 @@ __global__ void fill_kernel(float *grid, size_t n, float value) {
     grid[c] = value;
 }
 
-__global__ void finalize_kernel(FloatModel m, float *grid, const uint8_t *touched, size_t n) {
+__global__ void finalize_kernel(KernelModel<float> m, float *grid, const uint8_t *touched, size_t n) {
   for (size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x; c < n;
        c += static_cast<size_t>(gridDim.x) * blockDim.x) {
     if (touched && !touched[c])
@@ -135,7 +130,7 @@ __global__ void finalize_kernel(FloatModel m, float *grid, const uint8_t *touche
   }
 }
 
-__global__ void from_prob_kernel(FloatModel m, float *grid, size_t n) {
+__global__ void from_prob_kernel(KernelModel<float> m, float *grid, size_t n) {
   for (size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x; c < n;
        c += static_cast<size_t>(gridDim.x) * blockDim.x) {
     const float p = grid[c];
@@ -163,7 +158,7 @@ void launch_fill(float *cells, size_t num_cells, float value, cudaStream_t strea
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_float_from_prob(const FloatModel &m, float *grid, size_t num_cells, cudaStream_t stream) {
+void launch_float_from_prob(const KernelModel<float> &m, float *grid, size_t num_cells, cudaStream_t stream) {
   if (num_cells == 0) return;
   from_prob_kernel<<<fill_blocks(num_cells), 256, 0, stream>>>(m, grid, num_cells);
   VG_CUDA_CHECK_LAUNCH();
@@ -176,7 +171,7 @@ void launch_float_clear(float *logodds, size_t num_cells, cudaStream_t stream) {
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans,
+void launch_float_map(const KernelModel<float> &m, const FloatScan *scans, int num_scans,
                       const float *ranges, float *logodds, unsigned long long *counters,
                       cudaStream_t stream) {
   if (num_scans <= 0) return;
@@ -188,7 +183,7 @@ void launch_float_map(const FloatModel &m, const FloatScan *scans, int num_scans
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_float_finalize(const FloatModel &m, float *grid, const uint8_t *touched,
+void launch_float_finalize(const KernelModel<float> &m, float *grid, const uint8_t *touched,
                            size_t num_cells, cudaStream_t stream) {
   if (num_cells == 0) return;
   const unsigned blocks = static_cast<unsigned>(std::min<size_t>((num_cells + 255) / 256, 65536));

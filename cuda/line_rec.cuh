@@ -52,15 +52,12 @@ __device__ __forceinline__ LineRec make_line(int x1, int y1, int x2, int y2, flo
 __device__ __forceinline__ int step_of_cell(const LineRec &L, int cx, int cy) {
   if (L.flags & kDegenerate) {
     // Sequential walk, exactly the oracle's (rare: see kClosedFormLimit).
-    egrid::BresenhamLine line;
-    egrid::bresenham_init(line, L.x1, L.y1, L.x2, L.y2);
-    for (int k = 0; k <= L.k_max; ++k) {
-      int x, y;
-      egrid::bresenham_current(line, &x, &y);
-      if (x == cx && y == cy) return k;
-      if (!egrid::bresenham_next(line)) break;
-    }
-    return -1;
+    int step = -1;
+    egrid::walk_line(L.x1, L.y1, L.x2, L.y2, L.k_max + 1, [&](int x, int y, int k) {
+      if (x == cx && y == cy) step = k;
+      return step < 0;
+    });
+    return step;
   }
   const bool steep = L.flags & kSteep, backward = L.flags & kBackward;
   const int maj = steep ? cy : cx;

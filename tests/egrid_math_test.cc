@@ -207,7 +207,7 @@ TEST(OddsUpdate, SaturatesAtOneAndStays) {
 }
 
 TEST(SensorModel, FreeAndOccupiedBands) {
-  const ModelParams m{0.5, 0.55, 0.45, 5.0, 10.0};
+  const SensorModel<double> m{0.5, 0.55, 0.45, 5.0, 10.0};
   double p;
   ASSERT_TRUE(sensor_model(m, 1.0, 3.0, &p));
   EXPECT_EQ(p, 0.45);  // d < r, d < sure

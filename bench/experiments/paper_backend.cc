@@ -72,7 +72,7 @@ class PaperBackend : public Backend {
       f.beam_count = batch.beams_in(s);
       h_scans[s] = f;
     }
-    const cuda::FloatModel m = float_model_of(params, geo);
+    const cuda::KernelModel<float> m = kernel_model_of<float>(params, geo);
     st->prep_s = seconds(t_prep);
 
     const size_t cells = geo.num_cells(), nbeams = batch.num_beams();
@@ -85,7 +85,7 @@ class PaperBackend : public Backend {
     DeviceBuffer<float> d_ranges(nbeams), d_grid(cells);
     DeviceBuffer<uint8_t> d_touched(cells);
     DeviceBuffer<unsigned long long> d_counters(3);
-    DeviceBuffer<cuda::FloatModel> d_model(1);
+    DeviceBuffer<cuda::KernelModel<float>> d_model(1);
 
     e0.record(stream.get());
     if (nscans)

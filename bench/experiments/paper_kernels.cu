@@ -22,7 +22,7 @@ namespace vasco {
 namespace cuda {
 namespace {
 
-__constant__ FloatModel c_model;
+__constant__ KernelModel<float> c_model;
 
 struct BeamShared {
   int x1, y1, k_end;
@@ -31,7 +31,7 @@ struct BeamShared {
   bool used, closed;
 };
 
-__device__ __forceinline__ void place_beam(const FloatModel &m, const FloatScan &sc, int b,
+__device__ __forceinline__ void place_beam(const KernelModel<float> &m, const FloatScan &sc, int b,
                                            const float *ranges, BeamShared *out) {
   const float r = ranges[sc.beam_begin + b];
   out->used = r < 50.0f;
@@ -49,16 +49,15 @@ __device__ __forceinline__ void place_beam(const FloatModel &m, const FloatScan 
   out->k_end = min(out->p.major_len, m.table_size - 1);
 }
 
-__device__ __forceinline__ void update_cell(const FloatModel &m, const BeamShared &B, int k,
+__device__ __forceinline__ void update_cell(const KernelModel<float> &m, const BeamShared &B, int k,
                                             float *logodds, uint8_t *touched) {
   int cx, cy;
   egrid::line_cell(B.p, k, &cx, &cy);
   if (cx < 0 || cx >= m.size_x || cy < 0 || cy >= m.size_y) return;
   const int i = abs(cx - B.x1), j = abs(cy - B.y1);
   const float d = sqrtf(static_cast<float>(i * i + j * j)) * m.resolution;
-  const egrid::ModelParamsF mf{m.prior, m.occ, m.emp, m.sure, m.max};
-  float p;
-  if (!egrid::sensor_model_f(mf, d, B.r, &p)) return;
+    float p;
+  if (!egrid::sensor_model(m.sensor, d, B.r, &p)) return;
   const size_t c = static_cast<size_t>(cx) * m.size_y + cy;
   atomicAdd(logodds + c, __logf(p / (1.0f - p)) - m.logodds_prior);
   touched[c] = 1;
@@ -66,9 +65,9 @@ __device__ __forceinline__ void update_cell(const FloatModel &m, const BeamShare
 
 // Block per beam of one scan (scan_base + blockIdx.y selects the scan when fused).
 template <bool kShared, bool kConst>
-__global__ void paper_kernel(const FloatModel *g_model, const FloatScan *scans, int scan_base,
+__global__ void paper_kernel(const KernelModel<float> *g_model, const FloatScan *scans, int scan_base,
                              const float *ranges, float *logodds, uint8_t *touched) {
-  const FloatModel &m = kConst ? c_model : *g_model;
+  const KernelModel<float> &m = kConst ? c_model : *g_model;
   const FloatScan &sc = scans[scan_base + blockIdx.y];
   const int b = blockIdx.x;
   if (b >= sc.beam_count) return;
@@ -99,7 +98,7 @@ const char *paper_variant_name(PaperVariant v) {
   return "?";
 }
 
-void run_paper_variant(PaperVariant v, const FloatModel &m, const FloatModel *d_model,
+void run_paper_variant(PaperVariant v, const KernelModel<float> &m, const KernelModel<float> *d_model,
                        const FloatScan *h_scans, const FloatScan *d_scans, int num_scans,
                        const float *d_ranges, float *d_logodds, uint8_t *d_touched,
                        cudaStream_t stream) {

@@ -16,7 +16,7 @@ const char *paper_variant_name(PaperVariant v);
 // Accumulates every scan into d_logodds / d_touched like launch_float_map.
 // h_scans is the host copy of d_scans (per-scan launches need the counts);
 // d_model is a device copy of m (for the variant without constant memory).
-void run_paper_variant(PaperVariant v, const FloatModel &m, const FloatModel *d_model,
+void run_paper_variant(PaperVariant v, const KernelModel<float> &m, const KernelModel<float> *d_model,
                        const FloatScan *h_scans, const FloatScan *d_scans, int num_scans,
                        const float *d_ranges, float *d_logodds, uint8_t *d_touched,
                        cudaStream_t stream);

@@ -43,8 +43,7 @@ class CpuDoubleBackend : public Backend {
     frame.theta_offset = geo.theta_offset;
     // CARMEN's first update call records the start pose: that is scan 0's.
     if (first > 0 && batch.num_scans() > 0) oracle::scan_start(frame, batch.x[0], batch.y[0], batch.theta[0]);
-    const egrid::ModelParams model{params.p_prior, params.p_occ, params.p_emp, params.range_sure,
-                                   params.range_max};
+    const egrid::SensorModel<double> model = params.sensor_model();
     if (table_.size() != params.table_size() || table_resolution_ != params.resolution) {
       table_ = DistanceTable(params.table_size(), params.resolution);
       table_resolution_ = params.resolution;

@@ -21,11 +21,7 @@ class CpuFloatBackend : public Backend {
     const int sx = geo.size_x, sy = geo.size_y;
     const float res = static_cast<float>(params.resolution);
     const float wall = static_cast<float>(params.wall_size);
-    const egrid::ModelParamsF model{static_cast<float>(params.p_prior),
-                                    static_cast<float>(params.p_occ),
-                                    static_cast<float>(params.p_emp),
-                                    static_cast<float>(params.range_sure),
-                                    static_cast<float>(params.range_max)};
+    const egrid::SensorModel<float> model = params.sensor_model<float>();
     const int table_size = params.table_size();
     // A float distance table, as the paper's port has, unless it would be huge
     // (then the same sqrtf on the fly).
@@ -74,7 +70,7 @@ class CpuFloatBackend : public Backend {
                           : tabulated ? table[static_cast<size_t>(i) * table_size + j]
                                       : std::sqrt(static_cast<float>(i * i + j * j)) * res;
           float p;
-          if (!egrid::sensor_model_f(model, d, r, &p)) return false;
+          if (!egrid::sensor_model(model, d, r, &p)) return false;
           float &cell = cells[static_cast<size_t>(cx) * sy + cy];
           cell = egrid::odds_update_f(cell, model.prior, p);
           ++st.cell_updates;

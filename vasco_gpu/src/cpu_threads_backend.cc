@@ -115,7 +115,7 @@ struct Context {
   int size_x, size_y;
   int table_size;
   double resolution;
-  egrid::ModelParams model;
+  egrid::SensorModel<double> model;
   const Entry *table;      // null: computed on the fly
 };
 
@@ -435,8 +435,7 @@ class CpuThreadsBackend : public Backend {
 
     // 4. The stripes.
     const auto t_stripes = Clock::now();
-    const egrid::ModelParams model{params.p_prior, params.p_occ, params.p_emp, params.range_sure,
-                                   params.range_max};
+    const egrid::SensorModel<double> model = params.sensor_model();
     const Context ctx{cells, size_x, size_y, T, geo.resolution, model, table_.empty() ? nullptr : table_.data()};
     run_stripes(ctx, beams.get(), starts, stripes, bins, nt, &load);
     load.stripes_s = seconds_since(t_stripes);
@@ -457,8 +456,7 @@ class CpuThreadsBackend : public Backend {
     table_key_ = key;
     table_built_ = true;
     if (static_cast<int64_t>(T) * T > kMaxTableEntries || T <= 0) return;
-    const egrid::ModelParams model{params.p_prior, params.p_occ, params.p_emp, params.range_sure,
-                                   params.range_max};
+    const egrid::SensorModel<double> model = params.sensor_model();
     table_.resize(static_cast<size_t>(T) * static_cast<size_t>(T));
     run_on_threads(std::min(nt, T), [&](int t) {
       const int per = (T + nt - 1) / nt;

@@ -160,7 +160,7 @@ void store_frame(evidence_grid *g, const vasco::oracle::GridFrame &f) {
   g->start_theta = f.start_theta;
 }
 
-vasco::egrid::ModelParams model_of(const evidence_grid *g) {
+vasco::egrid::SensorModel<double> model_of(const evidence_grid *g) {
   return {g->prior_occ, g->occ_evidence, g->emp_evidence, g->max_sure_range, g->max_range};
 }
 

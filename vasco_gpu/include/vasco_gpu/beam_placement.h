@@ -13,16 +13,10 @@
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/oracle.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/placed_beam.h"
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco {
-
-// A used beam (range < 50 m): 16 bytes, the layout the CUDA exact mode uploads.
-struct PlacedBeam {
-  int x2, y2;      // end cell (oracle::beam_end)
-  uint32_t scan;   // its scan, counted from the first placed one: starts[scan]
-  float range;
-};
 
 struct PlacedBeams {
   size_t first_scan = 0;                  // starts[i] is scan first_scan + i

@@ -129,24 +129,32 @@ VG_HD bool bresenham_next(BresenhamLine &l) {
   return true;
 }
 
-// The sequential walk of one beam over the cells it can update, written once
-// for every backend that walks beams step by step: steps k < table_size (no
-// later cell is ever updated: see oracle::trace_beam), cells inside the grid
-// only, with i = |cx - x1| and j = |cy - y1| as CARMEN's int arithmetic gives
-// them. visit(cx, cy, i, j) returns false to stop the beam there.
+// CARMEN's sequential walk from (x1, y1) towards (x2, y2), written once for
+// every walker: the cells of steps k = 0 .. steps - 1 in order, inside the
+// grid or not; visit(cx, cy, k) returns false to stop there.
+template <class Visit>
+VG_HD void walk_line(int x1, int y1, int x2, int y2, int steps, Visit &&visit) {
+  BresenhamLine line;
+  bresenham_init(line, x1, y1, x2, y2);
+  for (int k = 0; k < steps; ++k) {
+    int cx, cy;
+    bresenham_current(line, &cx, &cy);
+    if (!visit(cx, cy, k)) return;
+    if (!bresenham_next(line)) return;
+  }
+}
+
+// The walk of one beam over the cells it can update: steps k < table_size
+// (no later cell is ever updated: see oracle::trace_beam), cells inside the
+// grid only, with i = |cx - x1| and j = |cy - y1| as CARMEN's int arithmetic
+// gives them. visit(cx, cy, i, j) returns false to stop the beam there.
 template <class Visit>
 VG_HD void walk_beam_cells(int x1, int y1, int x2, int y2, int table_size, int size_x, int size_y,
                            Visit &&visit) {
-  BresenhamLine line;
-  bresenham_init(line, x1, y1, x2, y2);
-  for (int k = 0; k < table_size; ++k) {
-    int cx, cy;
-    bresenham_current(line, &cx, &cy);
-    if (cx >= 0 && cx < size_x && cy >= 0 && cy < size_y) {
-      if (!visit(cx, cy, wrap_abs(wrap_sub(cx, x1)), wrap_abs(wrap_sub(cy, y1)))) return;
-    }
-    if (!bresenham_next(line)) return;
-  }
+  walk_line(x1, y1, x2, y2, table_size, [&](int cx, int cy, int) {
+    if (cx < 0 || cx >= size_x || cy < 0 || cy >= size_y) return true;
+    return static_cast<bool>(visit(cx, cy, wrap_abs(wrap_sub(cx, x1)), wrap_abs(wrap_sub(cy, y1))));
+  });
 }
 
 // ---------------------------------------------------------------------------
@@ -249,19 +257,34 @@ VG_HD int line_step_of_cell(const LineParams &p, int cx, int cy) {
 // ---------------------------------------------------------------------------
 // The sensor model and the odds update (DESIGN §2 step 6).
 // ---------------------------------------------------------------------------
-struct ModelParams {
-  double prior, occ, emp;   // prior_occ, occ_evidence, emp_evidence
-  double sure, max;         // max_sure_range, max_range
+// The type itself, in a parameter that should convert rather than deduce.
+template <class T>
+struct Exactly {
+  using type = T;
+};
+
+// The sensor model's parameters in the precision of the update that reads
+// them: double for CARMEN's update, float for the float port.
+template <class Real>
+struct SensorModel {
+  Real prior, occ, emp;  // prior_occ, occ_evidence, emp_evidence
+  Real sure, max;        // max_sure_range, max_range
 };
 
 // Whether a beam stops at a cell at distance d (sensor_model refuses it):
 // it depends on d alone, not on the range.
-VG_HD bool stops_beam(const ModelParams &m, double d) { return !(d < m.sure) && !(d < m.max); }
+template <class Real>
+VG_HD bool stops_beam(const SensorModel<Real> &m, typename Exactly<Real>::type d) {
+  return !(d < m.sure) && !(d < m.max);
+}
 
 // The evidence p for a cell at distance d of a beam of range r; returns false
-// when the beam stops here (d >= max_range).
-VG_HD bool sensor_model(const ModelParams &m, double d, double r, double *p) {
-  const double ev = d < r ? m.emp : m.occ;
+// when the beam stops here (d >= max_range). The same expression in either
+// precision, chosen by the model (a float range is promoted exactly).
+template <class Real>
+VG_HD bool sensor_model(const SensorModel<Real> &m, typename Exactly<Real>::type d,
+                        typename Exactly<Real>::type r, Real *p) {
+  const Real ev = d < r ? m.emp : m.occ;
   if (d < m.sure) {
     *p = ev;
   } else if (d < m.max) {
@@ -279,7 +302,7 @@ VG_HD bool sensor_model(const ModelParams &m, double d, double r, double *p) {
 // range only through d < range, so odds_apply(cell, prior, factor) is
 // odds_update(cell, prior, sensor_model(d, range)) bit for bit. Returns false
 // (zeros) where d >= max_range: the beam stops there.
-VG_HD bool odds_factors_at(const ModelParams &m, double d, double *f_free, double *f_occ);
+VG_HD bool odds_factors_at(const SensorModel<double> &m, double d, double *f_free, double *f_occ);
 
 // Distance between two cells i and j cells apart, as the distance table holds it.
 VG_HD double cell_distance(int i, int j, double resolution) {
@@ -333,7 +356,7 @@ VG_HD float odds_update(float cell, double prior, double p) {
   return odds_apply(cell, prior, odds_factor(prior, p));
 }
 
-VG_HD bool odds_factors_at(const ModelParams &m, double d, double *f_free, double *f_occ) {
+VG_HD bool odds_factors_at(const SensorModel<double> &m, double d, double *f_free, double *f_occ) {
   double p;
   if (!sensor_model(m, d, HUGE_VAL, &p)) {
     *f_free = *f_occ = 0.0;
@@ -345,23 +368,7 @@ VG_HD bool odds_factors_at(const ModelParams &m, double d, double *f_free, doubl
   return true;
 }
 
-// The float port (the paper's CPU version): the same update in single precision.
-struct ModelParamsF {
-  float prior, occ, emp, sure, max;
-};
-
-VG_HD bool sensor_model_f(const ModelParamsF &m, float d, float r, float *p) {
-  const float ev = d < r ? m.emp : m.occ;
-  if (d < m.sure) {
-    *p = ev;
-  } else if (d < m.max) {
-    *p = ev + (d - m.sure) / m.max * (m.prior - ev);
-  } else {
-    return false;
-  }
-  return true;
-}
-
+// The float port (the paper's CPU version): the odds update in single precision.
 VG_HD float odds_update_f(float cell, float prior, float p) {
   if (cell == kUnknown) cell = prior;
   float t = (1.0f - prior) / prior;

@@ -99,7 +99,7 @@ inline double table_distance(int i, int j, int table_size, const double *const *
 }
 
 inline long trace_beam(float *cells, int size_x, int size_y, int x1, int y1, int x2, int y2,
-                       double range, const egrid::ModelParams &model, double resolution,
+                       double range, const egrid::SensorModel<double> &model, double resolution,
                        int table_size, const double *const *distance_table) {
   long updates = 0;
   egrid::walk_beam_cells(x1, y1, x2, y2, table_size, size_x, size_y, [&](int cx, int cy, int i, int j) {
@@ -137,7 +137,7 @@ struct ScanUpdateCounts {
 // places the pose, then traces every used beam in order. angle_of(i, theta,
 // &angle) yields beam i's angle. `table` may be null (distances on the fly).
 template <class AngleOf>
-inline ScanUpdateCounts update_scan(float *cells, GridFrame &frame, const egrid::ModelParams &model,
+inline ScanUpdateCounts update_scan(float *cells, GridFrame &frame, const egrid::SensorModel<double> &model,
                                     double wall, int table_size, const double *const *table,
                                     double x, double y, double theta, int n, const float *range,
                                     AngleOf &&angle_of) {

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "vasco_gpu/egrid_math.h"
+
 namespace carmen {
 class ParamFile;
 }
@@ -36,6 +38,13 @@ struct MapperParams {
   // 0 <= range_sure <= range_max, downsample >= 1, border >= 0, ...); throws
   // std::invalid_argument naming the key.
   void validate() const;
+
+  // The sensor model's parameters, in the precision of the update.
+  template <class Real = double>
+  egrid::SensorModel<Real> sensor_model() const {
+    return {static_cast<Real>(p_prior), static_cast<Real>(p_occ), static_cast<Real>(p_emp),
+            static_cast<Real>(range_sure), static_cast<Real>(range_max)};
+  }
 
   // Number of distance-table entries per axis: (int)(range_max / resolution).
   int table_size() const;

@@ -47,13 +47,6 @@ double seconds(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-static_assert(sizeof(PlacedBeam) == sizeof(cuda::ExactBeam) &&
-                  offsetof(PlacedBeam, x2) == offsetof(cuda::ExactBeam, x2) &&
-                  offsetof(PlacedBeam, y2) == offsetof(cuda::ExactBeam, y2) &&
-                  offsetof(PlacedBeam, scan) == offsetof(cuda::ExactBeam, scan) &&
-                  offsetof(PlacedBeam, range) == offsetof(cuda::ExactBeam, range),
-              "PlacedBeam is uploaded as cuda::ExactBeam");
-
 class CudaBackend : public Backend {
  public:
   explicit CudaBackend(const BackendOptions &o) : options_(o) {

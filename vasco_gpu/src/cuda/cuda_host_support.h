@@ -79,20 +79,24 @@ void reserve(cuda::PinnedBuffer<T> &b, size_t n) {
 
 }  // namespace cuda_host
 
-// Float mode's parameters for a grid (the kernels' single-precision copy).
-inline cuda::FloatModel float_model_of(const MapperParams &p, const GridGeometry &geo) {
-  cuda::FloatModel m;
-  m.prior = static_cast<float>(p.p_prior);
-  m.occ = static_cast<float>(p.p_occ);
-  m.emp = static_cast<float>(p.p_emp);
-  m.sure = static_cast<float>(p.range_sure);
-  m.max = static_cast<float>(p.range_max);
-  m.resolution = static_cast<float>(p.resolution);
-  m.wall = static_cast<float>(p.wall_size);
-  m.logodds_prior = static_cast<float>(std::log(p.p_prior / (1 - p.p_prior)));
+// The kernels' model for a grid in their mode's precision (double: exact
+// mode, float: float mode), with both modes' derived constants.
+template <class Real>
+cuda::KernelModel<Real> kernel_model_of(const MapperParams &p, const GridGeometry &geo) {
+  cuda::KernelModel<Real> m{};
+  m.sensor = p.sensor_model<Real>();
+  m.resolution = static_cast<Real>(p.resolution);
+  m.wall = static_cast<Real>(p.wall_size);
   m.table_size = p.table_size();
   m.size_x = geo.size_x;
   m.size_y = geo.size_y;
+  const int64_t t = std::max(m.table_size, 0);
+  m.n_sure = m.table_size <= cuda::kMaxExactTable
+                 ? static_cast<int>(egrid::first_square_not_below(p.range_sure, p.resolution, 2 * t * t))
+                 : 0;
+  m.factor_free_near = egrid::odds_factor(p.p_prior, p.p_emp);  // sensor_model's p below max_sure_range
+  m.factor_occ_near = egrid::odds_factor(p.p_prior, p.p_occ);
+  m.logodds_prior = static_cast<Real>(std::log(p.p_prior / (1 - p.p_prior)));
   return m;
 }
 

@@ -36,7 +36,6 @@ namespace {
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-static_assert(sizeof(PlacedBeam) == sizeof(cuda::ExactBeam), "PlacedBeam is uploaded as cuda::ExactBeam");
 
 // Tiles a beam's walk can enter, at most: the walk is monotone in x and y and
 // moves at most one cell per step along each axis, so up to step k_max =
@@ -101,33 +100,11 @@ void CudaRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
   }
 }
 
-cuda::DeviceModel CudaRenderer::exact_model() const {
-  cuda::DeviceModel m;
-  m.prior = params_.p_prior;
-  m.occ = params_.p_occ;
-  m.emp = params_.p_emp;
-  m.sure = params_.range_sure;
-  m.max = params_.range_max;
-  m.resolution = params_.resolution;
-  m.wall = params_.wall_size;
-  m.table_size = params_.table_size();
-  m.size_x = geo_.size_x;
-  m.size_y = geo_.size_y;
-  const int64_t n_max = 2 * static_cast<int64_t>(std::max(m.table_size, 0)) * std::max(m.table_size, 0);
-  m.n_sure = m.table_size <= cuda::kMaxExactTable
-                 ? static_cast<int>(egrid::first_square_not_below(m.sure, m.resolution, n_max))
-                 : 0;
-  m.factor_free_near = egrid::odds_factor(m.prior, m.emp);  // sensor_model's p below max_sure_range
-  m.factor_occ_near = egrid::odds_factor(m.prior, m.occ);
-  return m;
-}
-
-cuda::FloatModel CudaRenderer::float_model() const { return float_model_of(params_, geo_); }
 
 cuda::GridEncoding CudaRenderer::encoding() const {
   cuda::GridEncoding e;
   e.logodds = !exact();
-  e.logodds_prior = float_model().logodds_prior;
+  e.logodds_prior = kernel_model_of<float>(params_, geo_).logodds_prior;
   return e;
 }
 
@@ -142,7 +119,7 @@ void CudaRenderer::build_tables() {
   if (!use_tables_ || (tables_built_ && key == tables_key_)) return;
   reserve(factors_, t2);
   reserve(reach_, static_cast<size_t>(T));
-  cuda::launch_exact_tables(exact_model(), factors_.get(), reach_.get(), stream_->get());
+  cuda::launch_exact_tables(kernel_model_of<double>(params_, geo_), factors_.get(), reach_.get(), stream_->get());
   tables_key_ = key;
   tables_built_ = true;
 }
@@ -236,7 +213,7 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
                                 cudaMemcpyHostToDevice, stream_->get()));
   VG_CUDA_CHECK(cudaMemsetAsync(counters_.get(), 0, 3 * sizeof(unsigned long long), stream_->get()));
   e_up.record(stream_->get());
-  cuda::launch_float_map(float_model(), scan_records_.get(), static_cast<int>(n), ranges_.get(), grid_.get(),
+  cuda::launch_float_map(kernel_model_of<float>(params_, geo_), scan_records_.get(), static_cast<int>(n), ranges_.get(), grid_.get(),
                          counters_.get(), stream_->get());
   e_map.record(stream_->get());
   reserve(staging_counters_, 3);
@@ -273,7 +250,7 @@ uint64_t CudaRenderer::place_exact_beams(const ScanBatch &scans, size_t first, s
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_->get()));  // staging is free (every call ends idle)
   reserve(staging_beams_, std::max<uint64_t>(exact_beams_, 1));
   reserve(staging_starts_, std::max<size_t>(exact_scans_, 1));
-  PlacedBeam *beams = reinterpret_cast<PlacedBeam *>(staging_beams_.get());
+  PlacedBeam *beams = staging_beams_.get();
   place_laid_out_beams(scans, geo_, params_, layout, 0, beams);
   for (size_t s = 0; s < exact_scans_; ++s) staging_starts_[s] = {layout.starts[s].x1, layout.starts[s].y1};
   return exact_pair_bound(beams, exact_beams_, layout.starts, params_.table_size());
@@ -299,14 +276,14 @@ void CudaRenderer::reserve_exact_scratch(uint64_t pair_bound, size_t tiles) {
 
 void CudaRenderer::launch_exact_apply(uint64_t pair_bound, MapStats *st) {
   const size_t nb = exact_beams_, ns = exact_scans_;
-  const cuda::DeviceModel m = exact_model();
+  const cuda::KernelModel<double> m = kernel_model_of<double>(params_, geo_);
   const size_t tiles = static_cast<size_t>((geo_.size_x + cuda::kTile - 1) / cuda::kTile) *
                        ((geo_.size_y + cuda::kTile - 1) / cuda::kTile);
   reserve_exact_scratch(pair_bound, tiles);
   cuda::Event &e0 = *e_start_, &e_up = *e_uploaded_, &e_map = *e_mapped_;
   cudaStream_t s = stream_->get();
   e0.record(s);
-  VG_CUDA_CHECK(cudaMemcpyAsync(beams_.get(), staging_beams_.get(), nb * sizeof(cuda::ExactBeam),
+  VG_CUDA_CHECK(cudaMemcpyAsync(beams_.get(), staging_beams_.get(), nb * sizeof(PlacedBeam),
                                 cudaMemcpyHostToDevice, s));
   VG_CUDA_CHECK(cudaMemcpyAsync(starts_.get(), staging_starts_.get(), ns * sizeof(cuda::StartCell),
                                 cudaMemcpyHostToDevice, s));
@@ -419,7 +396,7 @@ std::vector<float> CudaRenderer::read(const GridWindow &w) {
 void CudaRenderer::upload_grid(const float *probabilities) {
   const size_t cells = geo_.num_cells();
   VG_CUDA_CHECK(cudaMemcpy(grid_.get(), probabilities, cells * sizeof(float), cudaMemcpyHostToDevice));
-  if (!exact()) cuda::launch_float_from_prob(float_model(), grid_.get(), cells, stream_->get());
+  if (!exact()) cuda::launch_float_from_prob(kernel_model_of<float>(params_, geo_), grid_.get(), cells, stream_->get());
 }
 
 void CudaRenderer::forget_scans() { stored_beams_ = 0; }

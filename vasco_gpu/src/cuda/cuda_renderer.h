@@ -31,8 +31,6 @@ class CudaRenderer : public Renderer {
 
  private:
   bool exact() const { return options_.cuda_mode == CudaMode::Exact; }
-  cuda::DeviceModel exact_model() const;
-  cuda::FloatModel float_model() const;
   cuda::GridEncoding encoding() const;
   void build_tables();
   uint64_t exact_beams_per_launch() const;
@@ -62,7 +60,7 @@ class CudaRenderer : public Renderer {
   cuda::DeviceBuffer<int> reach_;
   uint64_t exact_beams_ = 0;  // placed by place_exact_beams, in staging_beams_
   size_t exact_scans_ = 0;
-  cuda::DeviceBuffer<cuda::ExactBeam> beams_;
+  cuda::DeviceBuffer<PlacedBeam> beams_;
   cuda::DeviceBuffer<cuda::StartCell> starts_;
   cuda::DeviceBuffer<cuda::LineRec> lines_;
   cuda::DeviceBuffer<uint32_t> counts_, offsets_, tile_begin_, tile_end_, order_, order_keys_, order_keys_out_,
@@ -75,7 +73,7 @@ class CudaRenderer : public Renderer {
   // Pinned staging, both ways.
   cuda::PinnedBuffer<float> staging_ranges_, staging_out_;
   cuda::PinnedBuffer<cuda::FloatScan> staging_scans_;
-  cuda::PinnedBuffer<cuda::ExactBeam> staging_beams_;
+  cuda::PinnedBuffer<PlacedBeam> staging_beams_;
   cuda::PinnedBuffer<cuda::StartCell> staging_starts_;
   cuda::PinnedBuffer<unsigned long long> staging_counters_;
   cuda::PinnedBuffer<uint32_t> staging_pairs_;
