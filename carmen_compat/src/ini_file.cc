@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <locale.h>
+#include <optional>
 #include <stdlib.h>
 #include <unordered_set>
 #include <utility>
@@ -172,6 +173,127 @@ struct Line {
   std::string text;  // the section name (trimmed, without brackets), or the whole line
 };
 
+// One raw line made ready for parsing: '\r' and comment removed, trimmed; NUL bytes and
+// over-long lines are errors at FILE:NUMBER.
+std::string clean_line(std::string raw, const std::string &file, long number) {
+  if (!raw.empty() && raw.back() == '\r') raw.pop_back();
+  if (raw.find('\0') != std::string::npos)
+    throw FileError(file, number, "NUL byte: not a text parameter file");
+  if (raw.size() > ParamFile::kMaxLineLength)
+    throw FileError(file, number,
+                    "line longer than " + std::to_string(ParamFile::kMaxLineLength) +
+                        " characters (" + std::to_string(raw.size()) + ")");
+  const std::size_t hash = raw.find('#');
+  if (hash != std::string::npos) raw.erase(hash);
+  return trim(raw);
+}
+
+// A "[name]" header (`line` starts with '['): the name, checked; text after the ']' is a warning.
+Line section_header(const std::string &line, const std::string &file, long number,
+                    std::vector<ParamWarning> &warnings) {
+  const std::size_t close = line.find(']');
+  if (close == std::string::npos)
+    throw FileError(file, number, "section header without ']': " + line);
+  std::string section = trim(line.substr(1, close - 1));
+  if (section.empty()) throw FileError(file, number, "empty section name");
+  if (close + 1 < line.size())
+    warnings.push_back({file, number,
+                        "text after section header [" + section + "] ignored: " +
+                            trim(line.substr(close + 1))});
+  return {number, true, section};
+}
+
+// Pass 1: split into lines (the last one kept even without a newline, unlike CARMEN 0.7.4, which
+// loses it), check lengths, strip comments, trim, and find the section headers.
+std::vector<Line> split_lines(const std::string &text, const std::string &file,
+                              std::vector<ParamWarning> &warnings) {
+  std::vector<Line> lines;
+  long number = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    ++number;
+    std::size_t nl = text.find('\n', pos);
+    if (nl == std::string::npos) nl = text.size();
+    std::string line = clean_line(text.substr(pos, nl - pos), file, number);
+    pos = nl + 1;
+    if (line.empty()) continue;
+    if (line[0] == '[')
+      lines.push_back(section_header(line, file, number, warnings));
+    else
+      lines.push_back({number, false, line});
+  }
+  return lines;
+}
+
+// Robots: every section other than [*] and [expert...], each once, first spelling (a set of
+// lower-cased names: linear in the number of sections).
+std::vector<std::string> robot_sections(const std::vector<Line> &lines) {
+  std::vector<std::string> robots;
+  std::unordered_set<std::string> seen;
+  for (const Line &l : lines) {
+    if (!l.is_section || classify(l.text) != SectionKind::kRobot) continue;
+    if (seen.insert(lower(l.text)).second) robots.push_back(l.text);
+  }
+  return robots;
+}
+
+// The robot section to use as spelled in the file: the named one, else the only one, else ""
+// when there are none; a missing or ambiguous robot is an error.
+std::string select_robot(const std::vector<std::string> &robots, const std::string &robot,
+                         const std::string &file) {
+  if (!robot.empty()) {
+    const auto it = std::find_if(robots.begin(), robots.end(),
+                                 [&](const std::string &r) { return iequals(r, robot); });
+    if (it == robots.end())
+      throw FileError(file, "no section [" + robot + "] for robot '" + robot + "' (" +
+                                (robots.empty() ? std::string("the file has no robot sections")
+                                                : "robots: " + join(robots)) +
+                                ")");
+    return *it;
+  }
+  if (robots.size() > 1)
+    throw FileError(file, "several robots (" + join(robots) + "): the robot to use must be named");
+  return robots.empty() ? std::string() : robots.front();
+}
+
+// Enters section `l` (pass 2): its kind, and in `applies` whether its definitions are used.
+SectionKind enter_section(const Line &l, const std::string &file, const std::string &selected_robot,
+                          bool &applies, std::vector<ParamWarning> &warnings) {
+  const SectionKind kind = classify(l.text);
+  applies = kind == SectionKind::kAll || kind == SectionKind::kExpert ||
+            (kind == SectionKind::kRobot && iequals(l.text, selected_robot));
+  if (kind == SectionKind::kOtherExpert)
+    warnings.push_back({file, l.number,
+                        "section [" + l.text +
+                            "] is neither [expert] nor a robot; its lines are ignored"});
+  return kind;
+}
+
+// A "module_variable value" line of an applying section; nullopt (with a warning) when the name
+// is not module_variable, an error when it is too long.
+std::optional<ParamValue> definition(const Line &l, const std::string &file,
+                                     std::vector<ParamWarning> &warnings) {
+  std::size_t name_end = 0;
+  while (name_end < l.text.size() && !is_blank(l.text[name_end])) ++name_end;
+  const std::string name = l.text.substr(0, name_end);
+  if (name.size() > ParamFile::kMaxNameLength)
+    throw FileError(file, l.number,
+                    "parameter name longer than " + std::to_string(ParamFile::kMaxNameLength) +
+                        " characters");
+  std::size_t value_begin = name_end;
+  while (value_begin < l.text.size() && is_blank(l.text[value_begin])) ++value_begin;
+  if (module_split(name) == std::string::npos) {
+    warnings.push_back({file, l.number, "'" + name + "' is not module_variable; ignored"});
+    return std::nullopt;
+  }
+  ParamValue pv;
+  pv.name = name;
+  pv.value = l.text.substr(value_begin);
+  pv.file = file;
+  pv.line = l.number;
+  return pv;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -222,81 +344,16 @@ ParamFile ParamFile::parse(const std::string &text, const std::string &name_for_
   ParamFile pf;
   pf.source_ = name_for_errors;
   const std::string &file = name_for_errors;
-
-  // Pass 1: split into lines (the last one kept even without a newline,
-  // unlike CARMEN 0.7.4, which loses it), check lengths, strip comments,
-  // trim, and find the section headers.
-  std::vector<Line> lines;
-  long number = 0;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    ++number;
-    std::size_t nl = text.find('\n', pos);
-    if (nl == std::string::npos) nl = text.size();
-    std::string raw = text.substr(pos, nl - pos);
-    pos = nl + 1;
-    if (!raw.empty() && raw.back() == '\r') raw.pop_back();
-    if (raw.find('\0') != std::string::npos)
-      throw FileError(file, number, "NUL byte: not a text parameter file");
-    if (raw.size() > kMaxLineLength)
-      throw FileError(file, number,
-                      "line longer than " + std::to_string(kMaxLineLength) + " characters (" +
-                          std::to_string(raw.size()) + ")");
-    const std::size_t hash = raw.find('#');
-    if (hash != std::string::npos) raw.erase(hash);
-    std::string line = trim(raw);
-    if (line.empty()) continue;
-    if (line[0] == '[') {
-      const std::size_t close = line.find(']');
-      if (close == std::string::npos)
-        throw FileError(file, number, "section header without ']': " + line);
-      std::string section = trim(line.substr(1, close - 1));
-      if (section.empty()) throw FileError(file, number, "empty section name");
-      if (close + 1 < line.size())
-        pf.warnings_.push_back({file, number,
-                                "text after section header [" + section + "] ignored: " +
-                                    trim(line.substr(close + 1))});
-      lines.push_back({number, true, section});
-    } else {
-      lines.push_back({number, false, line});
-    }
-  }
-
-  // Robots: every section other than [*] and [expert...], each once (a set
-  // of lower-cased names: linear in the number of sections).
-  std::unordered_set<std::string> seen;
-  for (const Line &l : lines) {
-    if (!l.is_section || classify(l.text) != SectionKind::kRobot) continue;
-    if (seen.insert(lower(l.text)).second) pf.robots_.push_back(l.text);
-  }
-  if (!robot.empty()) {
-    const auto it = std::find_if(pf.robots_.begin(), pf.robots_.end(),
-                                 [&](const std::string &r) { return iequals(r, robot); });
-    if (it == pf.robots_.end())
-      throw FileError(file, "no section [" + robot + "] for robot '" + robot + "' (" +
-                                (pf.robots_.empty() ? std::string("the file has no robot sections")
-                                                    : "robots: " + join(pf.robots_)) +
-                                ")");
-    pf.selected_robot_ = *it;
-  } else if (pf.robots_.size() == 1) {
-    pf.selected_robot_ = pf.robots_.front();
-  } else if (pf.robots_.size() > 1) {
-    throw FileError(file, "several robots (" + join(pf.robots_) +
-                              "): the robot to use must be named");
-  }
+  const std::vector<Line> lines = split_lines(text, file, pf.warnings_);
+  pf.robots_ = robot_sections(lines);
+  pf.selected_robot_ = select_robot(pf.robots_, robot, file);
 
   // Pass 2: the definitions of the sections that apply.
   SectionKind kind = SectionKind::kNone;
   bool applies = false;
   for (const Line &l : lines) {
     if (l.is_section) {
-      kind = classify(l.text);
-      applies = kind == SectionKind::kAll || kind == SectionKind::kExpert ||
-                (kind == SectionKind::kRobot && iequals(l.text, pf.selected_robot_));
-      if (kind == SectionKind::kOtherExpert)
-        pf.warnings_.push_back({file, l.number,
-                                "section [" + l.text +
-                                    "] is neither [expert] nor a robot; its lines are ignored"});
+      kind = enter_section(l, file, pf.selected_robot_, applies, pf.warnings_);
       continue;
     }
     if (kind == SectionKind::kNone) {
@@ -304,27 +361,10 @@ ParamFile ParamFile::parse(const std::string &text, const std::string &name_for_
       continue;
     }
     if (!applies) continue;
-    std::size_t name_end = 0;
-    while (name_end < l.text.size() && !is_blank(l.text[name_end])) ++name_end;
-    const std::string name = l.text.substr(0, name_end);
-    if (name.size() > kMaxNameLength)
-      throw FileError(file, l.number,
-                      "parameter name longer than " + std::to_string(kMaxNameLength) +
-                          " characters");
-    std::size_t value_begin = name_end;
-    while (value_begin < l.text.size() && is_blank(l.text[value_begin])) ++value_begin;
-    if (module_split(name) == std::string::npos) {
-      pf.warnings_.push_back({file, l.number,
-                              "'" + name + "' is not module_variable; ignored"});
-      continue;
-    }
-    ParamValue pv;
-    pv.name = name;
-    pv.value = l.text.substr(value_begin);
-    pv.file = file;
-    pv.line = l.number;
-    pv.expert = kind == SectionKind::kExpert;
-    pf.put(pf.ini_, std::move(pv));
+    std::optional<ParamValue> pv = definition(l, file, pf.warnings_);
+    if (!pv) continue;
+    pv->expert = kind == SectionKind::kExpert;
+    pf.put(pf.ini_, std::move(*pv));
   }
   return pf;
 }

@@ -422,134 +422,165 @@ std::string fields_str(std::size_t n) {
   return std::to_string(n) + (n == 1 ? " field" : " fields");
 }
 
-void diagnose(MessageType type, const char *begin, const char *end, const FieldParser &f,
-              const Counts &c, LineError *err, const char *name_override = nullptr) {
-  if (!err) return;
-  const std::string name = name_override ? name_override : message_type_name(type);
-  auto set = [&](BadLine k, std::string m) {
-    err->kind = k;
-    err->message = std::move(m);
-  };
+// Records the verdict on a failed line.
+void set_error(LineError *err, BadLine kind, std::string message) {
+  err->kind = kind;
+  err->message = std::move(message);
+}
 
-  // 1. A count that is negative, absurd or not an integer.
+// Step 1: a count that is negative, absurd or not an integer; true when it recorded a verdict.
+bool diagnose_count(const std::string &name, const FieldParser &f, LineError *err) {
   if (f.failure == FieldParser::NEGATIVE_COUNT || f.failure == FieldParser::HUGE_COUNT) {
-    set(BadLine::BAD_COUNT,
-        name + " " + f.what + " " + std::to_string(f.count_value_) +
-            (f.failure == FieldParser::NEGATIVE_COUNT
-                 ? " is negative"
-                 : " exceeds the limit of " + std::to_string(kMaxCount)));
-    return;
+    set_error(err, BadLine::BAD_COUNT,
+              name + " " + f.what + " " + std::to_string(f.count_value_) +
+                  (f.failure == FieldParser::NEGATIVE_COUNT
+                       ? " is negative"
+                       : " exceeds the limit of " + std::to_string(kMaxCount)));
+    return true;
   }
   const bool count_field = f.what && std::strcmp(f.what, "num_readings") == 0;
   if (f.failure == FieldParser::NOT_NUMBER && count_field) {
-    set(BadLine::NOT_A_NUMBER, name + " num_readings (field " + std::to_string(f.failed_field) +
-                                   "): " + quote_token(f.failed_token) + " is not an integer");
-    return;
+    set_error(err, BadLine::NOT_A_NUMBER,
+              name + " num_readings (field " + std::to_string(f.failed_field) +
+                  "): " + quote_token(f.failed_token) + " is not an integer");
+    return true;
   }
+  return false;
+}
 
-  // 2. Structure: the number of fields the counts call for.
-  const std::vector<std::string_view> t = split_fields(begin, end);
+// Compares the line's field count with the `expected` one; records why they differ and returns
+// false when they do.
+bool check_field_total(std::size_t expected, const std::string &what_needs,
+                       const std::vector<std::string_view> &t, const Counts &c, LineError *err) {
   const std::size_t T = t.size();
-  auto structure = [&](std::size_t expected, const std::string &what_needs) -> bool {
-    if (T == expected) return true;
-    if (T < expected && (c.beams < 0 || looks_cut(t))) {
-      set(BadLine::TRUNCATED, "truncated line: " + what_needs + " needs " + fields_str(expected) +
-                                  " after the name, the line has " + std::to_string(T));
-    } else if (c.beams >= 0) {
-      set(BadLine::FIELD_COUNT, "num_readings " + std::to_string(c.beams) +
-                                    " disagrees with the fields present: " + what_needs +
-                                    " needs " + fields_str(expected) +
-                                    " after the name, the line has " + std::to_string(T));
-    } else {
-      set(BadLine::FIELD_COUNT, "extra fields: " + what_needs + " has " + fields_str(expected) +
-                                    " after the name, the line has " + std::to_string(T));
+  if (T == expected) return true;
+  if (T < expected && (c.beams < 0 || looks_cut(t))) {
+    set_error(err, BadLine::TRUNCATED,
+              "truncated line: " + what_needs + " needs " + fields_str(expected) +
+                  " after the name, the line has " + std::to_string(T));
+  } else if (c.beams >= 0) {
+    set_error(err, BadLine::FIELD_COUNT,
+              "num_readings " + std::to_string(c.beams) +
+                  " disagrees with the fields present: " + what_needs + " needs " +
+                  fields_str(expected) + " after the name, the line has " + std::to_string(T));
+  } else {
+    set_error(err, BadLine::FIELD_COUNT,
+              "extra fields: " + what_needs + " has " + fields_str(expected) +
+                  " after the name, the line has " + std::to_string(T));
+  }
+  return false;
+}
+
+// Which beam and remission counts would fit a RAWLASERn / ROBOTLASERn line (a hint for the
+// message; "" when none does).
+std::string beam_count_fit(const std::vector<std::string_view> &t, std::size_t tail) {
+  const std::size_t T = t.size();
+  for (std::size_t k = 0; 9 + k + tail <= T; ++k) {
+    long long rr;
+    const std::string_view tok = t[8 + k];
+    if (token_to_long(tok.data(), tok.data() + tok.size(), rr) && rr >= 0 &&
+        9 + k + static_cast<std::size_t>(rr) + tail == T) {
+      return " (the fields fit " + std::to_string(k) + " beams and " + std::to_string(rr) +
+             " remissions)";
     }
-    return false;
-  };
+  }
+  return std::string();
+}
+
+// Step 2 for RAWLASERn / ROBOTLASERn, whose remission count sits after the beams; true when it
+// recorded a verdict.
+bool diagnose_raw_structure(MessageType type, const std::string &name,
+                            const std::vector<std::string_view> &t, const Counts &c,
+                            LineError *err) {
+  if (c.beams < 0) return false;
+  const std::size_t T = t.size();
+  const std::size_t tail = (type == MessageType::ROBOTLASER1 ||
+                            type == MessageType::ROBOTLASER2) ? 14 : 3;
+  const std::size_t rpos = 8 + static_cast<std::size_t>(c.beams);
+  long long r = 0;
+  const bool have_r = rpos < T && token_to_long(t[rpos].data(), t[rpos].data() + t[rpos].size(), r) &&
+                      r >= 0 && r <= kMaxCount;
+  const std::size_t expected = rpos + 1 + static_cast<std::size_t>(have_r ? r : 0) + tail;
+  if (have_r && T == expected) return false;
+  if (T < expected && looks_cut(t)) {
+    set_error(err, BadLine::TRUNCATED,
+              "truncated line: " + name + " with " + std::to_string(c.beams) +
+                  " beams needs at least " + fields_str(expected) +
+                  " after the name, the line has " + std::to_string(T));
+    return true;
+  }
+  set_error(err, BadLine::FIELD_COUNT,
+            "num_readings " + std::to_string(c.beams) +
+                " disagrees with the fields present: the line has " + std::to_string(T) +
+                " fields after the name" + beam_count_fit(t, tail));
+  return true;
+}
+
+// Step 2: the number of fields the counts call for; true when it recorded a verdict. `poses`:
+// FLASER/RLASER lines carry poses (old LASERn lines have none).
+bool diagnose_structure(MessageType type, const std::string &name, bool poses,
+                        const std::vector<std::string_view> &t, const Counts &c, LineError *err) {
   switch (type) {
     case MessageType::ODOM:
     case MessageType::TRUEPOS:
-      if (!structure(9, name)) return;
-      break;
+      return !check_field_total(9, name, t, c, err);
     case MessageType::PARAM:
-      if (T < 2) {
-        set(BadLine::TRUNCATED, "truncated line: PARAM needs a name and a value");
-        return;
-      }
-      break;
+      if (t.size() >= 2) return false;
+      set_error(err, BadLine::TRUNCATED, "truncated line: PARAM needs a name and a value");
+      return true;
     case MessageType::SYNC:
-      if (T < 1) {
-        set(BadLine::TRUNCATED, "truncated line: SYNC needs a tag");
-        return;
-      }
-      break;
+      if (t.size() >= 1) return false;
+      set_error(err, BadLine::TRUNCATED, "truncated line: SYNC needs a tag");
+      return true;
     case MessageType::FLASER:
     case MessageType::RLASER: {
-      const bool poses = name_override == nullptr;  // old LASERn lines have none
       const std::size_t fixed = poses ? 10 : 4;
-      if (c.beams >= 0 &&
-          !structure(fixed + static_cast<std::size_t>(c.beams),
-                     name + " with " + std::to_string(c.beams) + " beams"))
-        return;
-      break;
+      return c.beams >= 0 &&
+             !check_field_total(fixed + static_cast<std::size_t>(c.beams),
+                                name + " with " + std::to_string(c.beams) + " beams", t, c, err);
     }
-    default: {  // RAWLASERn / ROBOTLASERn
-      if (c.beams < 0) break;
-      const std::size_t tail = (type == MessageType::ROBOTLASER1 ||
-                                type == MessageType::ROBOTLASER2) ? 14 : 3;
-      const std::size_t rpos = 8 + static_cast<std::size_t>(c.beams);
-      long long r = 0;
-      const bool have_r = rpos < T && token_to_long(t[rpos].data(), t[rpos].data() + t[rpos].size(), r) &&
-                          r >= 0 && r <= kMaxCount;
-      const std::size_t expected = rpos + 1 + static_cast<std::size_t>(have_r ? r : 0) + tail;
-      if (have_r && T == expected) break;
-      if (T < expected && looks_cut(t)) {
-        set(BadLine::TRUNCATED, "truncated line: " + name + " with " + std::to_string(c.beams) +
-                                    " beams needs at least " + fields_str(expected) +
-                                    " after the name, the line has " + std::to_string(T));
-        return;
-      }
-      // Which beam count would fit the line?
-      std::string fit;
-      for (std::size_t k = 0; 9 + k + tail <= T; ++k) {
-        long long rr;
-        const std::string_view tok = t[8 + k];
-        if (token_to_long(tok.data(), tok.data() + tok.size(), rr) && rr >= 0 &&
-            9 + k + static_cast<std::size_t>(rr) + tail == T) {
-          fit = " (the fields fit " + std::to_string(k) + " beams and " + std::to_string(rr) +
-                " remissions)";
-          break;
-        }
-      }
-      set(BadLine::FIELD_COUNT, "num_readings " + std::to_string(c.beams) +
-                                    " disagrees with the fields present: the line has " +
-                                    std::to_string(T) + " fields after the name" + fit);
-      return;
-    }
+    default:  // RAWLASERn / ROBOTLASERn
+      return diagnose_raw_structure(type, name, t, c, err);
   }
+}
 
-  // 3. The field itself.
+// Step 3: the field that tripped the sequential parse.
+void diagnose_field(const std::string &name, const FieldParser &f, LineError *err) {
   std::string field = std::string(f.what ? f.what : "field");
   if (f.index >= 0) field += "[" + std::to_string(f.index) + "]";
   field += " (field " + std::to_string(f.failed_field) + ")";
   switch (f.failure) {
     case FieldParser::NOT_NUMBER:
-      set(BadLine::NOT_A_NUMBER, name + " " + field + ": " + quote_token(f.failed_token) +
-                                     " is not a number");
+      set_error(err, BadLine::NOT_A_NUMBER,
+                name + " " + field + ": " + quote_token(f.failed_token) + " is not a number");
       return;
     case FieldParser::NOT_FINITE:
-      set(BadLine::NON_FINITE, name + " " + field + ": " + quote_token(f.failed_token) +
-                                   " is not finite");
+      set_error(err, BadLine::NON_FINITE,
+                name + " " + field + ": " + quote_token(f.failed_token) + " is not finite");
       return;
     case FieldParser::EXTRA:
-      set(BadLine::FIELD_COUNT, name + ": extra fields after the logger timestamp, starting with " +
-                                    quote_token(f.failed_token));
+      set_error(err, BadLine::FIELD_COUNT,
+                name + ": extra fields after the logger timestamp, starting with " +
+                    quote_token(f.failed_token));
       return;
     case FieldParser::MISSING:
     default:
-      set(BadLine::TRUNCATED, "truncated line: " + name + " ends before its " + field);
+      set_error(err, BadLine::TRUNCATED, "truncated line: " + name + " ends before its " + field);
       return;
   }
+}
+
+// Explains why `f` failed on the line [begin, end): a bad count first, then the field total,
+// then the field itself.
+void diagnose(MessageType type, const char *begin, const char *end, const FieldParser &f,
+              const Counts &c, LineError *err, const char *name_override = nullptr) {
+  if (!err) return;
+  const std::string name = name_override ? name_override : message_type_name(type);
+  if (diagnose_count(name, f, err)) return;
+  const std::vector<std::string_view> t = split_fields(begin, end);
+  const bool poses = name_override == nullptr;  // old LASERn lines have none
+  if (diagnose_structure(type, name, poses, t, c, err)) return;
+  diagnose_field(name, f, err);
 }
 
 }  // namespace
