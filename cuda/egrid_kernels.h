@@ -132,8 +132,25 @@ struct FloatScan {
   int beam_count;
 };
 
-// Sets every cell to -0.0f, float mode's "never updated".
-void launch_float_clear(float *logodds, size_t num_cells, cudaStream_t stream);
+// Float mode accumulates each cell's log-odds evidence in a 64-bit integer,
+// with integer atomics: integer addition is associative, so the sum, and
+// the map, are the same bytes on every run and every GPU of the same build
+// (float atomics added in a different order each run). An update of log-odds
+// increment x adds (q << kFixedCountBits) + 1, q = round(x * 2^kFixedFracBits):
+//  - the low bits count the updates, so 0 means "never updated"; the count
+//    carries into the sum only after 2^16 updates of one cell, adding 2^-24
+//    log-odds per carry, and a cell reads as never updated only if such a
+//    count also lands on an exactly opposite sum;
+//  - the sum holds +-2^23 log-odds in steps of 2^-24: a step is 6e-8, below
+//    the float rounding of x itself (|x| ~ 0.2 has a float ulp of 1.5e-8 and
+//    __logf's error is larger), and the host refuses a render whose beams
+//    could push any cell past +-2^22 (kFixedLimit: cells get one update per
+//    beam at most).
+constexpr int kFixedCountBits = 16, kFixedFracBits = 24;
+constexpr double kFixedLimit = 4194304.0;  // 2^22 log-odds
+
+// Sets every cell to 0, float mode's "never updated".
+void launch_float_clear(unsigned long long *sums, size_t num_cells, cudaStream_t stream);
 
 // Whether this build holds code the current device can run (machine code for
 // its architecture, or PTX the driver can compile for it); `why` otherwise.
@@ -142,19 +159,21 @@ bool kernels_runnable_on_current_device(std::string *why);
 // Every cell to `value` (exact mode: a fresh grid is all kUnknown).
 void launch_fill(float *cells, size_t num_cells, float value, cudaStream_t stream);
 
-// Probabilities (-1 unknown) to float mode's log-odds sums, in place: the
-// inverse of launch_float_finalize, for continuing a grid mapped earlier.
-void launch_float_from_prob(const KernelModel<float> &m, float *grid, size_t num_cells, cudaStream_t stream);
+// Probabilities (-1 unknown) to float mode's fixed-point sums, for
+// continuing a grid mapped earlier (0 and 1 saturate at +-2^20 log-odds).
+void launch_float_from_prob(const KernelModel<float> &m, const float *probs, unsigned long long *sums,
+                            size_t num_cells, cudaStream_t stream);
 
-// Adds every beam's log-odds evidence to `logodds` (atomics: no update is
-// lost). counters: beams used, beams skipped, cell updates.
+// Adds every beam's log-odds evidence to `sums` (integer atomics: no update
+// is lost, none depends on the order). counters: beams used, beams skipped,
+// cell updates.
 void launch_float_map(const KernelModel<float> &m, const FloatScan *scans, int num_scans,
-                      const float *ranges, float *logodds, unsigned long long *counters,
+                      const float *ranges, unsigned long long *sums, unsigned long long *counters,
                       cudaStream_t stream);
 
-// logodds -> probability, in place; cells never updated become -1. Those are
-// the cells still -0.0f, or, when `touched` is given (the paper's kernels),
-// the cells whose flag is 0.
+// Float log-odds sums (the paper's kernels, bench/experiments) ->
+// probability, in place; cells never updated become -1: those still -0.0f,
+// or, when `touched` is given, those whose flag is 0.
 void launch_float_finalize(const KernelModel<float> &m, float *grid_logodds, const uint8_t *touched,
                            size_t num_cells, cudaStream_t stream);
 
@@ -164,33 +183,43 @@ void launch_float_finalize(const KernelModel<float> &m, float *grid_logodds, con
 // finished map then crosses the bus.
 // ---------------------------------------------------------------------------
 
-// How the grid's cells are stored: probabilities (exact mode) or float
-// mode's log-odds sums (-0.0f: untouched), converted as launch_float_finalize does.
-struct GridEncoding {
-  bool logodds = false;
+// The grid's cells: probabilities (exact mode) or, when `sums` is set, float
+// mode's fixed-point sums, read as prob_of_fixed does.
+struct GridCells {
+  const float *probs = nullptr;
+  const unsigned long long *sums = nullptr;
   float logodds_prior = 0;
 };
 
 // blocks[bx * ny + by] for nx = size_x / ds, ny = size_y / ds, and bbox =
 // {min_x, max_x, min_y, max_y} widened by every known block (initialised by
 // the caller to CARMEN's start values).
-void launch_finish_blocks(const float *grid, int size_x, int size_y, int ds, GridEncoding enc,
-                          float *blocks, int *bbox, cudaStream_t stream);
+void launch_finish_blocks(GridCells grid, int size_x, int size_y, int ds, float *blocks, int *bbox,
+                          cudaStream_t stream);
 
 // out[x * out_y + y] = blocks[(x + min_x) * ny + (y + min_y)].
 void launch_crop(const float *blocks, int ny, int min_x, int min_y, int out_x, int out_y, float *out,
                  cudaStream_t stream);
 
 // A window of the grid as probabilities: out[x * height + y].
-void launch_read_window(const float *grid, int size_y, GridEncoding enc, int x0, int y0, int width, int height,
-                        float *out, cudaStream_t stream);
+void launch_read_window(GridCells grid, int size_y, int x0, int y0, int width, int height, float *out,
+                        cudaStream_t stream);
 
-// Probabilities from float mode's log-odds sum (the one expression finalize,
-// finish and read use, so they agree bit for bit).
+// Probabilities from a float log-odds sum and from float mode's fixed-point
+// sum (the expressions finalize, finish and read use, so they agree bit for
+// bit).
 #if defined(__CUDACC__)
 __device__ __forceinline__ float prob_of_logodds(float logodds_prior, float sum) {
   if (__float_as_uint(sum) == 0x80000000u) return -1.0f;  // untouched
   // p = 1 - 1/(1 + odds), odds = exp(L): saturates to exactly 1 or 0.
+  const float odds = expf(logodds_prior + sum);
+  return 1.0f - 1.0f / (1.0f + odds);
+}
+
+__device__ __forceinline__ float prob_of_fixed(float logodds_prior, unsigned long long v) {
+  if (v == 0) return -1.0f;  // never updated
+  const long long units = static_cast<long long>(v) >> kFixedCountBits;
+  const float sum = static_cast<float>(units) * (1.0f / static_cast<float>(1 << kFixedFracBits));
   const float odds = expf(logodds_prior + sum);
   return 1.0f - 1.0f / (1.0f + odds);
 }

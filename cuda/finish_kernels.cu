@@ -11,12 +11,12 @@ namespace vasco {
 namespace cuda {
 namespace {
 
-__device__ __forceinline__ float cell_prob(const float *grid, size_t c, GridEncoding enc) {
-  return enc.logodds ? prob_of_logodds(enc.logodds_prior, grid[c]) : grid[c];
+__device__ __forceinline__ float cell_prob(const GridCells &grid, size_t c) {
+  return grid.sums ? prob_of_fixed(grid.logodds_prior, grid.sums[c]) : grid.probs[c];
 }
 
-__global__ void finish_blocks_kernel(const float *grid, int size_y, int ds, int nx, int ny, GridEncoding enc,
-                                     float *blocks, int *bbox) {
+__global__ void finish_blocks_kernel(GridCells grid, int size_y, int ds, int nx, int ny, float *blocks,
+                                     int *bbox) {
   const size_t b = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
   if (b >= static_cast<size_t>(nx) * ny) return;
   const int bx = static_cast<int>(b / ny), by = static_cast<int>(b % ny);
@@ -24,7 +24,7 @@ __global__ void finish_blocks_kernel(const float *grid, int size_y, int ds, int 
   int count = 0;
   for (int i = bx * ds; i < (bx + 1) * ds; ++i) {
     for (int j = by * ds; j < (by + 1) * ds; ++j) {
-      const float v = cell_prob(grid, static_cast<size_t>(i) * size_y + j, enc);
+      const float v = cell_prob(grid, static_cast<size_t>(i) * size_y + j);
       if (v != -1.0f) {
         sum += v;
         ++count;
@@ -49,24 +49,23 @@ __global__ void crop_kernel(const float *blocks, int ny, int min_x, int min_y, i
   out[c] = blocks[static_cast<size_t>(x + min_x) * ny + (y + min_y)];
 }
 
-__global__ void window_kernel(const float *grid, int size_y, GridEncoding enc, int x0, int y0, int width,
-                              int height, float *out) {
+__global__ void window_kernel(GridCells grid, int size_y, int x0, int y0, int width, int height, float *out) {
   const size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
   if (c >= static_cast<size_t>(width) * height) return;
   const int x = static_cast<int>(c / height), y = static_cast<int>(c % height);
-  out[c] = cell_prob(grid, static_cast<size_t>(x0 + x) * size_y + (y0 + y), enc);
+  out[c] = cell_prob(grid, static_cast<size_t>(x0 + x) * size_y + (y0 + y));
 }
 
 unsigned blocks_of(size_t n) { return static_cast<unsigned>((n + 255) / 256); }
 
 }  // namespace
 
-void launch_finish_blocks(const float *grid, int size_x, int size_y, int ds, GridEncoding enc, float *blocks,
-                          int *bbox, cudaStream_t stream) {
+void launch_finish_blocks(GridCells grid, int size_x, int size_y, int ds, float *blocks, int *bbox,
+                          cudaStream_t stream) {
   const int nx = size_x / ds, ny = size_y / ds;
   const size_t n = static_cast<size_t>(nx) * ny;
   if (n == 0) return;
-  finish_blocks_kernel<<<blocks_of(n), 256, 0, stream>>>(grid, size_y, ds, nx, ny, enc, blocks, bbox);
+  finish_blocks_kernel<<<blocks_of(n), 256, 0, stream>>>(grid, size_y, ds, nx, ny, blocks, bbox);
   VG_CUDA_CHECK_LAUNCH();
 }
 
@@ -78,11 +77,11 @@ void launch_crop(const float *blocks, int ny, int min_x, int min_y, int out_x, i
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_read_window(const float *grid, int size_y, GridEncoding enc, int x0, int y0, int width, int height,
-                        float *out, cudaStream_t stream) {
+void launch_read_window(GridCells grid, int size_y, int x0, int y0, int width, int height, float *out,
+                        cudaStream_t stream) {
   const size_t n = static_cast<size_t>(width) * height;
   if (n == 0) return;
-  window_kernel<<<blocks_of(n), 256, 0, stream>>>(grid, size_y, enc, x0, y0, width, height, out);
+  window_kernel<<<blocks_of(n), 256, 0, stream>>>(grid, size_y, x0, y0, width, height, out);
   VG_CUDA_CHECK_LAUNCH();
 }
 

@@ -6,11 +6,15 @@
 // ((1-prior)/prior) * p/(1-p); in log-odds that is a sum,
 //     L = logit(prior) + sum over updates of (logit(p) - logit(prior)),
 // and a sum does not depend on the order of its terms. So all beams of all
-// scans can be applied at once, with atomic adds (no update is lost).
+// scans can be applied at once, with atomic adds (no update is lost). Only
+// an exact sum is order-free: float atomics rounded after every add, so the
+// order the adds happened to take showed in the map and no two runs agreed.
+// The sums are therefore 64-bit fixed point added with integer atomics
+// (egrid_kernels.h kFixedFracBits): the same bytes on every run.
 //
-// What this changes against the oracle: (1) single precision and a
-// different association of the same product, so values differ in the last
-// bits; (2) saturation — the oracle stores a float after every update, and
+// What this changes against the oracle: (1) single precision, increments
+// rounded to 2^-24 log-odds, and a different association of the same
+// product, so values differ in the last bits; (2) saturation — the oracle stores a float after every update, and
 // once a cell rounds to exactly 1.0 (or 0.0) its odds are infinite (zero) and
 // it stays there for good, while the log-odds sum keeps counting: a cell that
 // the oracle pinned at 1.0 can come back below 1 here if enough free updates
@@ -27,13 +31,12 @@ namespace {
 
 constexpr int kWarpsPerBlock = 8;
 
-// Untouched cells hold -0.0f. A term of the sum is never -0.0 (logf of a
-// positive ratio minus logit(prior) is +0.0 at worst), and -0.0 + x == x for
-// every x, +0.0 included; so after the sum, "-0.0" means "never updated" —
-// no separate touched array and none of its stores (prob_of_logodds).
+// The sums are fixed point (egrid_kernels.h kFixedCountBits): 0 means
+// "never updated", and every update adds its count bit, so no separate
+// touched array and none of its stores.
 
 __device__ __forceinline__ void add_evidence(const KernelModel<float> &m, int cx, int cy, int x1, int y1,
-                                             float r, float *logodds, unsigned *count, bool *stop) {
+                                             float r, unsigned long long *sums, unsigned *count, bool *stop) {
   if (cx < 0 || cx >= m.size_x || cy < 0 || cy >= m.size_y) return;
   const int i = abs(cx - x1), j = abs(cy - y1);
   const float d = (i >= m.table_size || j >= m.table_size)
@@ -45,13 +48,15 @@ __device__ __forceinline__ void add_evidence(const KernelModel<float> &m, int cx
     return;
   }
   const size_t c = static_cast<size_t>(cx) * m.size_y + cy;
-  atomicAdd(logodds + c, __logf(p / (1.0f - p)) - m.logodds_prior);
+  const float x = __logf(p / (1.0f - p)) - m.logodds_prior;
+  const long long q = __float2ll_rn(x * static_cast<float>(1 << kFixedFracBits));
+  atomicAdd(sums + c, (static_cast<unsigned long long>(q) << kFixedCountBits) + 1ull);
   ++*count;
 }
 
 __global__ void __launch_bounds__(kWarpsPerBlock * 32)
     float_map_kernel(KernelModel<float> m, const FloatScan *scans, int num_scans, int parts, const float *ranges,
-                     float *logodds, unsigned long long *counters) {
+                     unsigned long long *sums, unsigned long long *counters) {
   const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
   unsigned used = 0, skipped = 0, updates = 0;
   // `parts` blocks share a scan (several when a few scans are inserted, so
@@ -75,7 +80,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
         if (lane == 0) {
           bool stop = false;
           egrid::walk_line(sc.x1, sc.y1, x2, y2, m.table_size, [&](int cx, int cy, int) {
-            add_evidence(m, cx, cy, sc.x1, sc.y1, r, logodds, &updates, &stop);
+            add_evidence(m, cx, cy, sc.x1, sc.y1, r, sums, &updates, &stop);
             return !stop;
           });
         }
@@ -99,7 +104,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
         if (p.flipped) mn = -mn;
         const int cx = p.steep ? mn : maj, cy = p.steep ? maj : mn;
         bool stop = false;
-        add_evidence(m, cx, cy, sc.x1, sc.y1, r, logodds, &updates, &stop);
+        add_evidence(m, cx, cy, sc.x1, sc.y1, r, sums, &updates, &stop);
       }
     }
   }
@@ -130,12 +135,20 @@ __global__ void finalize_kernel(KernelModel<float> m, float *grid, const uint8_t
   }
 }
 
-__global__ void from_prob_kernel(KernelModel<float> m, float *grid, size_t n) {
+__global__ void from_prob_kernel(KernelModel<float> m, const float *probs, unsigned long long *sums, size_t n) {
+  // 0 and 1 (log-odds -inf and +inf) saturate at +-2^20 log-odds, which no
+  // later update can bring back (the host's kFixedLimit check).
+  const float kSaturated = 1048576.0f;
   for (size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x; c < n;
        c += static_cast<size_t>(gridDim.x) * blockDim.x) {
-    const float p = grid[c];
-    // -1: untouched (-0.0f); 0 and 1 give -inf and +inf, which stay saturated.
-    grid[c] = p == egrid::kUnknown ? -0.0f : logf(p / (1.0f - p)) - m.logodds_prior;
+    const float p = probs[c];
+    if (p == egrid::kUnknown) {
+      sums[c] = 0;
+      continue;
+    }
+    const float x = fminf(fmaxf(logf(p / (1.0f - p)) - m.logodds_prior, -kSaturated), kSaturated);
+    const long long q = __float2ll_rn(x * static_cast<float>(1 << kFixedFracBits));
+    sums[c] = (static_cast<unsigned long long>(q) << kFixedCountBits) + 1ull;
   }
 }
 
@@ -158,28 +171,27 @@ void launch_fill(float *cells, size_t num_cells, float value, cudaStream_t strea
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_float_from_prob(const KernelModel<float> &m, float *grid, size_t num_cells, cudaStream_t stream) {
+void launch_float_from_prob(const KernelModel<float> &m, const float *probs, unsigned long long *sums,
+                            size_t num_cells, cudaStream_t stream) {
   if (num_cells == 0) return;
-  from_prob_kernel<<<fill_blocks(num_cells), 256, 0, stream>>>(m, grid, num_cells);
+  from_prob_kernel<<<fill_blocks(num_cells), 256, 0, stream>>>(m, probs, sums, num_cells);
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_float_clear(float *logodds, size_t num_cells, cudaStream_t stream) {
+void launch_float_clear(unsigned long long *sums, size_t num_cells, cudaStream_t stream) {
   if (num_cells == 0) return;
-  const unsigned blocks = static_cast<unsigned>(std::min<size_t>((num_cells + 255) / 256, 65536));
-  fill_kernel<<<blocks, 256, 0, stream>>>(logodds, num_cells, -0.0f);
-  VG_CUDA_CHECK_LAUNCH();
+  VG_CUDA_CHECK(cudaMemsetAsync(sums, 0, num_cells * sizeof(unsigned long long), stream));
 }
 
 void launch_float_map(const KernelModel<float> &m, const FloatScan *scans, int num_scans,
-                      const float *ranges, float *logodds, unsigned long long *counters,
+                      const float *ranges, unsigned long long *sums, unsigned long long *counters,
                       cudaStream_t stream) {
   if (num_scans <= 0) return;
   // A full render has thousands of scans: a block each. An insert of a few
   // scans splits each over up to 48 blocks (a warp per beam either way).
   const int parts = num_scans >= 1024 ? 1 : std::min(48, (1024 + num_scans - 1) / num_scans);
   float_map_kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, scans, num_scans, parts, ranges,
-                                                                           logodds, counters);
+                                                                           sums, counters);
   VG_CUDA_CHECK_LAUNCH();
 }
 

@@ -90,22 +90,46 @@ void CudaRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
   geo_ = geo;
   params_ = params;
   const size_t cells = geo.num_cells();
-  if (cells > grid_.size()) check_fits((cells - grid_.size()) * sizeof(float), "the evidence grid");
-  reserve(grid_, cells);
   if (exact()) {
+    if (cells > grid_.size()) check_fits((cells - grid_.size()) * sizeof(float), "the evidence grid");
+    reserve(grid_, cells);
     cuda::launch_fill(grid_.get(), cells, egrid::kUnknown, stream_->get());
     build_tables();
   } else {
-    cuda::launch_float_clear(grid_.get(), cells, stream_->get());
+    if (cells > sums_.size())
+      check_fits((cells - sums_.size()) * sizeof(unsigned long long), "the evidence grid");
+    reserve(sums_, cells);
+    cuda::launch_float_clear(sums_.get(), cells, stream_->get());
+    fixed_bound_ = 0;
   }
 }
 
+// Float mode: refuses, before any update, a batch that could carry a cell's
+// fixed-point sum past kFixedLimit (egrid_kernels.h). The largest increment
+// is at the evidence values themselves; vasco's defaults allow 2 x 10^7
+// beams, far beyond any log.
+void CudaRenderer::check_fixed_headroom(uint64_t beams) {
+  auto logit = [](double p) { return std::log(p / (1 - p)); };
+  const double step = std::max(std::fabs(logit(params_.p_occ) - logit(params_.p_prior)),
+                               std::fabs(logit(params_.p_emp) - logit(params_.p_prior)));
+  const double bound = fixed_bound_ + static_cast<double>(beams) * step;
+  if (bound > cuda::kFixedLimit)
+    throw std::runtime_error("cuda float mode: " + std::to_string(beams) +
+                             " more beams could push a cell's log-odds past the fixed-point range "
+                             "(+-2^22); use the exact mode or a CPU backend for this log");
+  fixed_bound_ = bound;
+}
 
-cuda::GridEncoding CudaRenderer::encoding() const {
-  cuda::GridEncoding e;
-  e.logodds = !exact();
-  e.logodds_prior = kernel_model_of<float>(params_, geo_).logodds_prior;
-  return e;
+
+cuda::GridCells CudaRenderer::cells() const {
+  cuda::GridCells c;
+  if (exact()) {
+    c.probs = grid_.get();
+  } else {
+    c.sums = sums_.get();
+    c.logodds_prior = kernel_model_of<float>(params_, geo_).logodds_prior;
+  }
+  return c;
 }
 
 // The exact mode's distance and odds-factor tables, built once per
@@ -181,6 +205,7 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
   const auto t_prep = Clock::now();
   if (scans.beam_offset[last] > UINT32_MAX)
     throw std::runtime_error("cuda float mode: more than 2^32 beams stored");
+  check_fixed_headroom(scans.beam_offset[last] - scans.beam_offset[first]);
   upload_ranges(scans, last);
   // Scan records of [first, last), placed with scan 0 fixing the start pose.
   oracle::GridFrame frame;
@@ -213,8 +238,8 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
                                 cudaMemcpyHostToDevice, stream_->get()));
   VG_CUDA_CHECK(cudaMemsetAsync(counters_.get(), 0, 3 * sizeof(unsigned long long), stream_->get()));
   e_up.record(stream_->get());
-  cuda::launch_float_map(kernel_model_of<float>(params_, geo_), scan_records_.get(), static_cast<int>(n), ranges_.get(), grid_.get(),
-                         counters_.get(), stream_->get());
+  cuda::launch_float_map(kernel_model_of<float>(params_, geo_), scan_records_.get(), static_cast<int>(n),
+                         ranges_.get(), sums_.get(), counters_.get(), stream_->get());
   e_map.record(stream_->get());
   reserve(staging_counters_, 3);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), counters_.get(), 3 * sizeof(unsigned long long),
@@ -359,7 +384,7 @@ FinishedMap CudaRenderer::finish(int downsample, int border) {
   staging_bbox_[2] = ny - border - 1;
   staging_bbox_[3] = border;
   VG_CUDA_CHECK(cudaMemcpyAsync(bbox_.get(), staging_bbox_.get(), 4 * sizeof(int), cudaMemcpyHostToDevice, s));
-  cuda::launch_finish_blocks(grid_.get(), geo_.size_x, geo_.size_y, ds, encoding(), blocks_.get(), bbox_.get(), s);
+  cuda::launch_finish_blocks(cells(), geo_.size_x, geo_.size_y, ds, blocks_.get(), bbox_.get(), s);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_bbox_.get(), bbox_.get(), 4 * sizeof(int), cudaMemcpyDeviceToHost, s));
   VG_CUDA_CHECK(cudaStreamSynchronize(s));
   const int min_x = std::max(staging_bbox_[0] - border, 0), max_x = std::min(staging_bbox_[1] + border, nx - 1);
@@ -387,7 +412,7 @@ std::vector<float> CudaRenderer::read(const GridWindow &w) {
   reserve(window_, std::max<size_t>(n, 1));
   VG_CUDA_CHECK(cudaStreamSynchronize(s));
   reserve(staging_out_, std::max<size_t>(n, 1));
-  cuda::launch_read_window(grid_.get(), geo_.size_y, encoding(), w.x0, w.y0, w.width, w.height, window_.get(), s);
+  cuda::launch_read_window(cells(), geo_.size_y, w.x0, w.y0, w.width, w.height, window_.get(), s);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_out_.get(), window_.get(), n * sizeof(float), cudaMemcpyDeviceToHost, s));
   VG_CUDA_CHECK(cudaStreamSynchronize(s));
   return std::vector<float>(staging_out_.get(), staging_out_.get() + n);
@@ -395,8 +420,12 @@ std::vector<float> CudaRenderer::read(const GridWindow &w) {
 
 void CudaRenderer::upload_grid(const float *probabilities) {
   const size_t cells = geo_.num_cells();
+  reserve(grid_, cells);  // float mode: the probabilities pass through it
   VG_CUDA_CHECK(cudaMemcpy(grid_.get(), probabilities, cells * sizeof(float), cudaMemcpyHostToDevice));
-  if (!exact()) cuda::launch_float_from_prob(kernel_model_of<float>(params_, geo_), grid_.get(), cells, stream_->get());
+  if (exact()) return;
+  cuda::launch_float_from_prob(kernel_model_of<float>(params_, geo_), grid_.get(), sums_.get(), cells,
+                               stream_->get());
+  fixed_bound_ = 1048576.0;  // from_prob's saturation
 }
 
 void CudaRenderer::forget_scans() { stored_beams_ = 0; }

@@ -31,7 +31,8 @@ class CudaRenderer : public Renderer {
 
  private:
   bool exact() const { return options_.cuda_mode == CudaMode::Exact; }
-  cuda::GridEncoding encoding() const;
+  cuda::GridCells cells() const;
+  void check_fixed_headroom(uint64_t beams);
   void build_tables();
   uint64_t exact_beams_per_launch() const;
   void upload_ranges(const ScanBatch &scans, size_t last);
@@ -47,7 +48,11 @@ class CudaRenderer : public Renderer {
   std::unique_ptr<cuda::Event> e_start_, e_uploaded_, e_mapped_;  // phase times of an apply
   GridGeometry geo_;
   MapperParams params_;
-  cuda::DeviceBuffer<float> grid_;  // probabilities (exact) or log-odds sums (float)
+  cuda::DeviceBuffer<float> grid_;                // exact mode: probabilities
+  cuda::DeviceBuffer<unsigned long long> sums_;  // float mode: fixed-point log-odds sums
+  // Float mode: a bound on any cell's |log-odds sum| since the grid was
+  // cleared (one update per beam at most), against kFixedLimit.
+  double fixed_bound_ = 0;
   // Float mode: the stored scans' ranges (append-only) and per-scan records.
   cuda::DeviceBuffer<float> ranges_;
   uint64_t stored_beams_ = 0;
