@@ -186,49 +186,69 @@ std::string self_dir(const char *argv0) {
   return s == std::string::npos ? "." : p.substr(0, s);
 }
 
-}  // namespace
-
-int main(int argc, char **argv) {
+// The command line.
+struct Options {
   int runs = 5, threads = 0;
   bool ablation = true;
-  std::string only;
+  std::string only;  // --dataset: only this one
+};
+
+// Parses the command line into *o (threads 0 or less: all cores); false, after the usage line on stderr,
+// for anything it does not know.
+bool parse_options(int argc, char **argv, Options *o) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--runs" && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else if (a == "--quick") runs = 1;
-    else if (a == "--threads" && i + 1 < argc) threads = std::atoi(argv[++i]);
-    else if (a == "--no-ablation") ablation = false;
-    else if (a == "--dataset" && i + 1 < argc) only = argv[++i];
+    if (a == "--runs" && i + 1 < argc) o->runs = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--quick") o->runs = 1;
+    else if (a == "--threads" && i + 1 < argc) o->threads = std::atoi(argv[++i]);
+    else if (a == "--no-ablation") o->ablation = false;
+    else if (a == "--dataset" && i + 1 < argc) o->only = argv[++i];
     else {
       std::fprintf(stderr, "usage: mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset fr079|fr101]\n");
-      return 2;
+      return false;
     }
   }
-  if (threads <= 0) threads = vasco::hardware_threads();
+  if (o->threads <= 0) o->threads = vasco::hardware_threads();
+  return true;
+}
 
+// The logs measured, fr079 first (the end-to-end section uses it).
+std::vector<Dataset> bench_datasets() {
   const std::string src = VASCO_SOURCE_DIR;
-  const std::vector<Dataset> datasets = {{"fr079", src + "/logs/fr079-complete.gfs.log.gz"},
-                                         {"fr101", src + "/logs/fr101.carmen.log.gz"}};
+  return {{"fr079", src + "/logs/fr079-complete.gfs.log.gz"}, {"fr101", src + "/logs/fr101.carmen.log.gz"}};
+}
+
+// The parameter sets measured on every log.
+std::vector<ParamSet> bench_param_sets() {
   vasco::MapperParams paper;
   paper.range_max = 6.4;  // the paper's setting, at vasco's 2.5 cm cells
-  const std::vector<ParamSet> param_sets = {{"paper", paper},
-                                            {"vasco_default_raw", vasco::MapperParams{}}};
+  return {{"paper", paper}, {"vasco_default_raw", vasco::MapperParams{}}};
+}
 
-  bool gpu = false;
-  std::string gpu_desc = "none";
-  double cuda_init_s = 0;
+// Whether a GPU is usable, what it is (or why not), and how long the CUDA context took to start.
+struct GpuInfo {
+  bool usable = false;
+  std::string desc = "none";
+  double init_s = 0;
+};
+
+// Probes device 0 (starting the CUDA context) when built with CUDA.
+GpuInfo probe_gpu() {
+  GpuInfo g;
 #if defined(VASCO_HAVE_CUDA)
-  {
-    const double t0 = now_s();
-    std::string why;
-    gpu = vasco::cuda_usable(0, &why);
-    cuda_init_s = now_s() - t0;
-    gpu_desc = gpu ? vasco::cuda_device_description(0) : "none (" + why + ")";
-  }
+  const double t0 = now_s();
+  std::string why;
+  g.usable = vasco::cuda_usable(0, &why);
+  g.init_s = now_s() - t0;
+  g.desc = g.usable ? vasco::cuda_device_description(0) : "none (" + why + ")";
 #else
-  gpu_desc = "none (built without CUDA)";
+  g.desc = "none (built without CUDA)";
 #endif
+  return g;
+}
 
+// The backends measured: the CPU ones, and both CUDA modes when a GPU is usable.
+std::vector<BackendSpec> backend_specs(bool gpu) {
   std::vector<BackendSpec> specs = {{"cpu_double", "cpu_double", {}, false},
                                     {"cpu_threads", "cpu_threads", {}, false},
                                     {"cpu_float", "cpu_float", {}, false}};
@@ -238,79 +258,129 @@ int main(int argc, char **argv) {
     specs.push_back({"cuda float", "cuda", f, true});
     specs.push_back({"cuda exact", "cuda", e, true});
   }
+  return specs;
+}
 
-  std::printf("vasco_gpu mapping_bench: median of %d runs after a warm-up; times in ms\n", runs);
-  std::printf("CPU threads: %d; GPU: %s", threads, gpu_desc.c_str());
-  if (gpu) std::printf(" (CUDA context start-up %.0f ms, not in the rows)", cuda_init_s * 1e3);
+// The lines above the table: runs, threads, GPU.
+void print_header(const Options &opt, const GpuInfo &gpu) {
+  std::printf("vasco_gpu mapping_bench: median of %d runs after a warm-up; times in ms\n", opt.runs);
+  std::printf("CPU threads: %d; GPU: %s", opt.threads, gpu.desc.c_str());
+  if (gpu.usable) std::printf(" (CUDA context start-up %.0f ms, not in the rows)", gpu.init_s * 1e3);
   std::printf("\n");
-  if (!gpu) std::printf("No usable GPU: CPU rows only.\n");
+  if (!gpu.usable) std::printf("No usable GPU: CPU rows only.\n");
+}
 
+// Ablation results: "dataset / params" -> (variant, median map time) in the order run.
+using AblationRows = std::map<std::string, std::vector<std::pair<std::string, double>>>;
+
+// What the benchmark sections share: the options, the backends, whether a GPU is usable, and the
+// results gathered so far.
+struct Bench {
+  Options opt;
+  std::vector<BackendSpec> specs;
+  bool gpu = false;
   std::vector<Row> rows;
-  std::map<std::string, std::vector<std::pair<std::string, double>>> ablation_rows;
-  for (const Dataset &ds : datasets) {
-    if (!only.empty() && ds.name != only) continue;
-    if (access(ds.path.c_str(), R_OK) != 0) {
-      std::printf("%s: %s not found, skipped\n", ds.name.c_str(), ds.path.c_str());
-      continue;
-    }
-    for (const ParamSet &ps : param_sets) {
-      // Parse: the same for every backend.
-      std::vector<double> parse_t;
-      vasco::ScanBatch batch;
-      for (int r = 0; r < runs + 1; ++r) {
-        vasco::LogLoadStats ls;
-        const double t0 = now_s();
-        batch = vasco::load_scans(ds.path, ps.params, carmen::LogReaderOptions{}, &ls);
-        if (r > 0) parse_t.push_back(now_s() - t0);
-      }
-      const vasco::GridGeometry geo = vasco::size_grid(batch, ps.params);
-      std::fprintf(stderr, "%s / %s: %zu scans, grid %d x %d\n", ds.name.c_str(), ps.name.c_str(),
-                   batch.num_scans(), geo.size_x, geo.size_y);
-      for (const BackendSpec &spec : specs) {
-        std::fprintf(stderr, "  %s ...\n", spec.label.c_str());
-        Phases ph, warm;
-        run_session_once(spec, threads, batch, ps.params, &warm);
-        for (int r = 0; r < runs; ++r) run_session_once(spec, threads, batch, ps.params, &ph);
-        Row row;
-        row.dataset = ds.name;
-        row.params = ps.name;
-        row.backend = spec.label;
-        row.scans = batch.num_scans();
-        row.beams = ph.stats.beams_used;
-        row.updates = ph.stats.cell_updates;
-        row.parse = median(parse_t);
-        row.prep = median(ph.prep);
-        row.upload = median(ph.upload);
-        row.map = median(ph.map);
-        row.download = median(ph.download);
-        row.finish = median(ph.finish);
-        row.write = median(ph.write);
-        row.total = row.parse + median(ph.total);
-        rows.push_back(row);
-      }
-#if defined(VASCO_HAVE_CUDA)
-      if (gpu && ablation) {
-        using vasco::cuda::PaperVariant;
-        const std::pair<const char *, int> variants[] = {
-            {"paper: launch per scan, beam data in shared, params in constant", int(PaperVariant::PerScan)},
-            {"  - without shared memory (each thread places the beam)", int(PaperVariant::PerScanNoShared)},
-            {"  - without constant memory (params from global)", int(PaperVariant::PerScanNoConst)},
-            {"  + all scans fused into one launch", int(PaperVariant::Fused)},
-            {"ours: warp per beam, block per scan, one launch", -1}};
-        for (const auto &v : variants) {
-          auto backend = v.second < 0 ? vasco::make_backend("cuda", vasco::BackendOptions{})
-                                      : vasco::make_paper_backend(static_cast<PaperVariant>(v.second));
-          Phases ph, warm;
-          run_once(*backend, batch, ps.params, geo, &warm);
-          for (int r = 0; r < runs; ++r) run_once(*backend, batch, ps.params, geo, &ph);
-          ablation_rows[ds.name + " / " + ps.name].push_back({v.first, median(ph.map)});
-        }
-      }
-#endif
-    }
-  }
+  AblationRows ablation_rows;
+};
 
-  // The table.
+// Parses a log with a parameter set a warm-up and then `runs` times; the timed runs' parse times go to
+// *parse_t. Returns the scans.
+vasco::ScanBatch timed_parse(const Dataset &ds, const ParamSet &ps, int runs, std::vector<double> *parse_t) {
+  vasco::ScanBatch batch;
+  for (int r = 0; r < runs + 1; ++r) {
+    vasco::LogLoadStats ls;
+    const double t0 = now_s();
+    batch = vasco::load_scans(ds.path, ps.params, carmen::LogReaderOptions{}, &ls);
+    if (r > 0) parse_t->push_back(now_s() - t0);
+  }
+  return batch;
+}
+
+// The table row of one backend: counts and the medians of its phases (total includes the parse).
+Row make_row(const Dataset &ds, const ParamSet &ps, const BackendSpec &spec, const vasco::ScanBatch &batch,
+             const std::vector<double> &parse_t, const Phases &ph) {
+  Row row;
+  row.dataset = ds.name;
+  row.params = ps.name;
+  row.backend = spec.label;
+  row.scans = batch.num_scans();
+  row.beams = ph.stats.beams_used;
+  row.updates = ph.stats.cell_updates;
+  row.parse = median(parse_t);
+  row.prep = median(ph.prep);
+  row.upload = median(ph.upload);
+  row.map = median(ph.map);
+  row.download = median(ph.download);
+  row.finish = median(ph.finish);
+  row.write = median(ph.write);
+  row.total = row.parse + median(ph.total);
+  return row;
+}
+
+// Every backend through a mapping session on one log and parameter set: a warm-up, then the timed runs,
+// one table row each.
+void bench_backends(Bench *b, const Dataset &ds, const ParamSet &ps, const vasco::ScanBatch &batch,
+                    const std::vector<double> &parse_t) {
+  for (const BackendSpec &spec : b->specs) {
+    std::fprintf(stderr, "  %s ...\n", spec.label.c_str());
+    Phases ph, warm;
+    run_session_once(spec, b->opt.threads, batch, ps.params, &warm);
+    for (int r = 0; r < b->opt.runs; ++r) run_session_once(spec, b->opt.threads, batch, ps.params, &ph);
+    b->rows.push_back(make_row(ds, ps, spec, batch, parse_t, ph));
+  }
+}
+
+#if defined(VASCO_HAVE_CUDA)
+// The ablation of the paper's kernel design on one log and parameter set: each variant a warm-up and
+// then the timed runs, the median map time recorded.
+void bench_ablation(Bench *b, const Dataset &ds, const ParamSet &ps, const vasco::ScanBatch &batch,
+                    const vasco::GridGeometry &geo) {
+  using vasco::cuda::PaperVariant;
+  const std::pair<const char *, int> variants[] = {
+      {"paper: launch per scan, beam data in shared, params in constant", int(PaperVariant::PerScan)},
+      {"  - without shared memory (each thread places the beam)", int(PaperVariant::PerScanNoShared)},
+      {"  - without constant memory (params from global)", int(PaperVariant::PerScanNoConst)},
+      {"  + all scans fused into one launch", int(PaperVariant::Fused)},
+      {"ours: warp per beam, block per scan, one launch", -1}};
+  for (const auto &v : variants) {
+    auto backend = v.second < 0 ? vasco::make_backend("cuda", vasco::BackendOptions{})
+                                : vasco::make_paper_backend(static_cast<PaperVariant>(v.second));
+    Phases ph, warm;
+    run_once(*backend, batch, ps.params, geo, &warm);
+    for (int r = 0; r < b->opt.runs; ++r) run_once(*backend, batch, ps.params, geo, &ph);
+    b->ablation_rows[ds.name + " / " + ps.name].push_back({v.first, median(ph.map)});
+  }
+}
+#endif
+
+// One log with one parameter set: the parse, every backend, and the ablation when asked for and a GPU is
+// usable.
+void bench_param_set(Bench *b, const Dataset &ds, const ParamSet &ps) {
+  // Parse: the same for every backend.
+  std::vector<double> parse_t;
+  const vasco::ScanBatch batch = timed_parse(ds, ps, b->opt.runs, &parse_t);
+  const vasco::GridGeometry geo = vasco::size_grid(batch, ps.params);
+  std::fprintf(stderr, "%s / %s: %zu scans, grid %d x %d\n", ds.name.c_str(), ps.name.c_str(),
+               batch.num_scans(), geo.size_x, geo.size_y);
+  bench_backends(b, ds, ps, batch, parse_t);
+#if defined(VASCO_HAVE_CUDA)
+  if (b->gpu && b->opt.ablation) bench_ablation(b, ds, ps, batch, geo);
+#endif
+}
+
+// One log with every parameter set, unless --dataset names another or the log is missing.
+void bench_dataset(Bench *b, const Dataset &ds) {
+  if (!b->opt.only.empty() && ds.name != b->opt.only) return;
+  if (access(ds.path.c_str(), R_OK) != 0) {
+    std::printf("%s: %s not found, skipped\n", ds.name.c_str(), ds.path.c_str());
+    return;
+  }
+  for (const ParamSet &ps : bench_param_sets()) bench_param_set(b, ds, ps);
+}
+
+// The main table, one line per row, with the speed-ups over cpu_double and cpu_threads of the same data,
+// and its legend.
+void print_table(const std::vector<Row> &rows) {
   const int width = 176;
   print_rule(width);
   std::printf("%-6s %-17s %-11s %5s %8s %10s %7s %7s %7s %8s %8s %7s %6s %8s %9s %8s %8s\n", "data",
@@ -338,23 +408,43 @@ int main(int argc, char **argv) {
               "placement is prep). total = parse + the wall time of map, finish and write (GPU\n"
               "rows: prep, upload and download included). x1core / xthreads: map-phase\n"
               "speed-up over cpu_double and over cpu_threads on the same data in this run.\n");
+}
 
-  if (!ablation_rows.empty()) {
-    std::printf("\nAblation of the paper's kernel (float, no lost updates), map phase in ms:\n");
-    for (const auto &kv : ablation_rows) {
-      std::printf("  %s\n", kv.first.c_str());
-      for (const auto &v : kv.second) std::printf("    %-66s %9s\n", v.first.c_str(), ms(v.second).c_str());
-    }
+// The ablation table, when there is one.
+void print_ablation(const AblationRows &ablation_rows) {
+  if (ablation_rows.empty()) return;
+  std::printf("\nAblation of the paper's kernel (float, no lost updates), map phase in ms:\n");
+  for (const auto &kv : ablation_rows) {
+    std::printf("  %s\n", kv.first.c_str());
+    for (const auto &v : kv.second) std::printf("    %-66s %9s\n", v.first.c_str(), ms(v.second).c_str());
   }
+}
 
-  // End to end: a whole log2map process on fr079 to .map.gz.
-  const std::string log2map = self_dir(argv[0]) + "/log2map";
-  if (access(log2map.c_str(), X_OK) == 0 && (only.empty() || only == "fr079")) {
-    std::printf("\nlog2map end to end (process start to .map.gz written), fr079, median of %d:\n", runs);
-    for (const char *b : {"cpu_double", "auto"}) {
-      const double t = log2map_wall(log2map, datasets[0].path, b, runs);
-      std::printf("  --backend %-10s %8s ms\n", b, t < 0 ? "failed" : ms(t).c_str());
-    }
+// End to end: a whole log2map process (the one beside this binary) on fr079 to .map.gz, when there is
+// one and fr079 is benchmarked.
+void print_end_to_end(const char *argv0, const std::string &fr079, const Options &opt) {
+  const std::string log2map = self_dir(argv0) + "/log2map";
+  if (access(log2map.c_str(), X_OK) != 0 || !(opt.only.empty() || opt.only == "fr079")) return;
+  std::printf("\nlog2map end to end (process start to .map.gz written), fr079, median of %d:\n", opt.runs);
+  for (const char *b : {"cpu_double", "auto"}) {
+    const double t = log2map_wall(log2map, fr079, b, opt.runs);
+    std::printf("  --backend %-10s %8s ms\n", b, t < 0 ? "failed" : ms(t).c_str());
   }
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  Bench b;
+  if (!parse_options(argc, argv, &b.opt)) return 2;
+  const std::vector<Dataset> datasets = bench_datasets();
+  const GpuInfo gpu = probe_gpu();
+  b.gpu = gpu.usable;
+  b.specs = backend_specs(gpu.usable);
+  print_header(b.opt, gpu);
+  for (const Dataset &ds : datasets) bench_dataset(&b, ds);
+  print_table(b.rows);
+  print_ablation(b.ablation_rows);
+  print_end_to_end(argv[0], datasets[0].path, b.opt);
   return 0;
 }

@@ -471,28 +471,31 @@ void bind_module(nb::module_ &m) {
       "tenths of a second).");
 }
 
-void bind_params(nb::module_ &m) {
-  auto params_class = nb::class_<vasco::MapperParams>(m, "Params",
-                                  "The mapper's parameters: carmen.ini's ``vasco_*`` keys without the prefix.\n\n"
-                                  "``Params(p_occ=0.9, resolution=0.05)`` (the ``vasco_`` prefix is accepted\n"
-                                  "too: ``Params(vasco_p_occ=0.9)``) starts from vasco's defaults and is\n"
-                                  "validated; an unknown keyword is a TypeError, a value out of range a\n"
-                                  "ValueError naming the key. Attributes may be changed afterwards; the Mapper\n"
-                                  "validates them again.\n\n"
-                                  "Keys (default): resolution (0.025 m), p_prior (0.5), p_occ (0.55), p_emp\n"
-                                  "(0.45), range_sure (5.0 m), range_max (10.0 m), wall_size (0.2 m), downsample\n"
-                                  "(4), border (20), first_scan (0), num_scans (-1: all).")
-      .def(
-          "__init__",
-          [](vasco::MapperParams *self, nb::kwargs kwargs) {
-            vasco::MapperParams p;
-            for (auto [k, v] : kwargs) set_param(p, nb::cast<std::string>(k), v);
-            p.validate();
-            new (self) vasco::MapperParams(p);
-          },
-          nb::sig("def __init__(self, **params: float | int) -> None"),
-          "Parameters from keywords (ini key names, with or without ``vasco_``); the rest keep vasco's\n"
-          "defaults. Validated.")
+// The docstring of the class Params.
+constexpr const char *kParamsDoc =
+    "The mapper's parameters: carmen.ini's ``vasco_*`` keys without the prefix.\n\n"
+    "``Params(p_occ=0.9, resolution=0.05)`` (the ``vasco_`` prefix is accepted\n"
+    "too: ``Params(vasco_p_occ=0.9)``) starts from vasco's defaults and is\n"
+    "validated; an unknown keyword is a TypeError, a value out of range a\n"
+    "ValueError naming the key. Attributes may be changed afterwards; the Mapper\n"
+    "validates them again.\n\n"
+    "Keys (default): resolution (0.025 m), p_prior (0.5), p_occ (0.55), p_emp\n"
+    "(0.45), range_sure (5.0 m), range_max (10.0 m), wall_size (0.2 m), downsample\n"
+    "(4), border (20), first_scan (0), num_scans (-1: all).";
+
+// Params' constructors (keywords, from_ini) and keys().
+void bind_params_constructors(nb::class_<vasco::MapperParams> &cls) {
+  cls.def(
+         "__init__",
+         [](vasco::MapperParams *self, nb::kwargs kwargs) {
+           vasco::MapperParams p;
+           for (auto [k, v] : kwargs) set_param(p, nb::cast<std::string>(k), v);
+           p.validate();
+           new (self) vasco::MapperParams(p);
+         },
+         nb::sig("def __init__(self, **params: float | int) -> None"),
+         "Parameters from keywords (ini key names, with or without ``vasco_``); the rest keep vasco's\n"
+         "defaults. Validated.")
       .def_static(
           "from_ini",
           [](const fs::path &path, const std::string &robot, nb::kwargs overrides) {
@@ -511,9 +514,13 @@ void bind_params(nb::module_ &m) {
           "reads them), keywords overriding the file. Errors raise FileError naming FILE:LINE.")
       .def_static(
           "keys", []() { return vasco::mapper_param_keys(); },
-          "The ini keys the mapper understands (vasco_resolution, ...).")
-      .def("validate", &vasco::MapperParams::validate,
-           "Raises ValueError naming the key when a value is out of range.")
+          "The ini keys the mapper understands (vasco_resolution, ...).");
+}
+
+// Params' methods: validate, to_dict, repr, equality and copies.
+void bind_params_methods(nb::class_<vasco::MapperParams> &cls) {
+  cls.def("validate", &vasco::MapperParams::validate,
+          "Raises ValueError naming the key when a value is out of range.")
       .def("to_dict", &params_dict, "The parameters as a dict (keys without ``vasco_``).")
       .def("__repr__", &params_repr)
       .def("__eq__",
@@ -522,8 +529,12 @@ void bind_params(nb::module_ &m) {
              return nb::bool_(params_dict(a).equal(params_dict(nb::cast<const vasco::MapperParams &>(b))));
            }, nb::sig("def __eq__(self, other: object) -> bool"))
       .def("__copy__", [](const vasco::MapperParams &p) { return p; })
-      .def("__deepcopy__", [](const vasco::MapperParams &p, nb::handle) { return p; }, "memo"_a)
-      .def_rw("resolution", &vasco::MapperParams::resolution, "vasco_resolution: cell size in metres.")
+      .def("__deepcopy__", [](const vasco::MapperParams &p, nb::handle) { return p; }, "memo"_a);
+}
+
+// Params' attributes, one per ini key.
+void bind_params_attributes(nb::class_<vasco::MapperParams> &cls) {
+  cls.def_rw("resolution", &vasco::MapperParams::resolution, "vasco_resolution: cell size in metres.")
       .def_rw("p_prior", &vasco::MapperParams::p_prior, "vasco_p_prior: prior occupancy.")
       .def_rw("p_occ", &vasco::MapperParams::p_occ, "vasco_p_occ: evidence of a hit.")
       .def_rw("p_emp", &vasco::MapperParams::p_emp, "vasco_p_emp: evidence of a free cell.")
@@ -537,6 +548,14 @@ void bind_params(nb::module_ &m) {
               "vasco_first_scan: first laser message used by load_log.")
       .def_rw("num_scans", &vasco::MapperParams::num_scans,
               "vasco_num_scans: laser messages used by load_log (-1: all).");
+}
+
+// The class Params.
+void bind_params(nb::module_ &m) {
+  auto params_class = nb::class_<vasco::MapperParams>(m, "Params", kParamsDoc);
+  bind_params_constructors(params_class);
+  bind_params_methods(params_class);
+  bind_params_attributes(params_class);
   params_class.attr("__hash__") = nb::none();  // mutable, compared by value
 }
 
@@ -572,33 +591,39 @@ void bind_frame(nb::module_ &m) {
       });
 }
 
-void bind_scans(nb::module_ &m) {
-  nb::class_<vasco::ScanBatch>(
-      m, "Scans",
-      "Laser scans, stored as CARMEN reads them: a pose (x, y, theta of the laser, float64) and beam\n"
-      "geometry (first_angle relative to theta, angle_step) per scan, ranges as float32, all scans'\n"
-      "beams concatenated.\n\n"
-      "``ranges``, ``x``, ``y``, ``theta``, ``first_angle``, ``angle_step``, ``beam_offsets`` and\n"
-      "``lines`` are writable NumPy views of the object's memory (they keep it alive); ``poses``\n"
-      "and ``beam_counts`` are new arrays.")
-      .def(
-          "__init__",
-          [](vasco::ScanBatch *self, nb::handle poses, nb::handle ranges, nb::handle beam_counts,
-             nb::handle first_angle, nb::handle angle_step) {
-            new (self) vasco::ScanBatch(make_scans(poses, ranges, beam_counts, first_angle, angle_step));
-          },
-          "poses"_a, "ranges"_a, "beam_counts"_a, "first_angle"_a, "angle_step"_a,
-          nb::sig("def __init__(self, poses: numpy.typing.ArrayLike, ranges: numpy.typing.ArrayLike, "
-                  "beam_counts: numpy.typing.ArrayLike, first_angle: float | numpy.typing.ArrayLike, "
-                  "angle_step: float | numpy.typing.ArrayLike) -> None"),
-          "Scans from arrays (copied): poses (n, 3), ranges (sum of beam_counts,), beam_counts (n,),\n"
-          "first_angle and angle_step a number or one value per scan (radians; CARMEN's 181-beam SICK:\n"
-          "first_angle=-pi/2, angle_step=pi/180).")
+// The docstring of the class Scans.
+constexpr const char *kScansDoc =
+    "Laser scans, stored as CARMEN reads them: a pose (x, y, theta of the laser, float64) and beam\n"
+    "geometry (first_angle relative to theta, angle_step) per scan, ranges as float32, all scans'\n"
+    "beams concatenated.\n\n"
+    "``ranges``, ``x``, ``y``, ``theta``, ``first_angle``, ``angle_step``, ``beam_offsets`` and\n"
+    "``lines`` are writable NumPy views of the object's memory (they keep it alive); ``poses``\n"
+    "and ``beam_counts`` are new arrays.";
+
+// Scans' constructor from arrays, its length and beam count.
+void bind_scans_constructor(nb::class_<vasco::ScanBatch> &cls) {
+  cls.def(
+         "__init__",
+         [](vasco::ScanBatch *self, nb::handle poses, nb::handle ranges, nb::handle beam_counts,
+            nb::handle first_angle, nb::handle angle_step) {
+           new (self) vasco::ScanBatch(make_scans(poses, ranges, beam_counts, first_angle, angle_step));
+         },
+         "poses"_a, "ranges"_a, "beam_counts"_a, "first_angle"_a, "angle_step"_a,
+         nb::sig("def __init__(self, poses: numpy.typing.ArrayLike, ranges: numpy.typing.ArrayLike, "
+                 "beam_counts: numpy.typing.ArrayLike, first_angle: float | numpy.typing.ArrayLike, "
+                 "angle_step: float | numpy.typing.ArrayLike) -> None"),
+         "Scans from arrays (copied): poses (n, 3), ranges (sum of beam_counts,), beam_counts (n,),\n"
+         "first_angle and angle_step a number or one value per scan (radians; CARMEN's 181-beam SICK:\n"
+         "first_angle=-pi/2, angle_step=pi/180).")
       .def("__len__", &vasco::ScanBatch::num_scans)
-      .def_prop_ro("num_beams", &vasco::ScanBatch::num_beams)
-      .def_prop_ro(
-          "ranges", [](nb::handle_t<vasco::ScanBatch> self) { return view1(nb::cast<vasco::ScanBatch &>(self).range, self); }, nb::rv_policy::reference,
-          "All beams' ranges, float32, scan after scan (a view).")
+      .def_prop_ro("num_beams", &vasco::ScanBatch::num_beams);
+}
+
+// Scans' arrays that are views of its memory.
+void bind_scans_views(nb::class_<vasco::ScanBatch> &cls) {
+  cls.def_prop_ro(
+         "ranges", [](nb::handle_t<vasco::ScanBatch> self) { return view1(nb::cast<vasco::ScanBatch &>(self).range, self); }, nb::rv_policy::reference,
+         "All beams' ranges, float32, scan after scan (a view).")
       .def_prop_ro(
           "x", [](nb::handle_t<vasco::ScanBatch> self) { return view1(nb::cast<vasco::ScanBatch &>(self).x, self); }, nb::rv_policy::reference,
           "Laser x per scan (a view).")
@@ -627,10 +652,14 @@ void bind_scans(nb::module_ &m) {
           "Scan s owns ranges[beam_offsets[s]:beam_offsets[s + 1]] (uint64, n + 1 entries, a view).")
       .def_prop_ro(
           "lines", [](nb::handle_t<vasco::ScanBatch> self) { return view1(nb::cast<vasco::ScanBatch &>(self).line, self); }, nb::rv_policy::reference,
-          "Line of each scan in its log (a view).")
-      .def_prop_ro(
-          "poses", [](const vasco::ScanBatch &b) { return poses_of(b.x, b.y, b.theta); }, nb::rv_policy::reference,
-          "(n, 3) float64 array of (x, y, theta): a new array.")
+          "Line of each scan in its log (a view).");
+}
+
+// Scans' new arrays, one scan's ranges, select and repr.
+void bind_scans_methods(nb::class_<vasco::ScanBatch> &cls) {
+  cls.def_prop_ro(
+         "poses", [](const vasco::ScanBatch &b) { return poses_of(b.x, b.y, b.theta); }, nb::rv_policy::reference,
+         "(n, 3) float64 array of (x, y, theta): a new array.")
       .def_prop_ro(
           "beam_counts",
           [](const vasco::ScanBatch &b) {
@@ -653,6 +682,14 @@ void bind_scans(nb::module_ &m) {
       .def("__repr__", [](const vasco::ScanBatch &b) {
         return nb::str("Scans({} scans, {} beams)").format(b.num_scans(), b.num_beams());
       });
+}
+
+// The class Scans.
+void bind_scans(nb::module_ &m) {
+  nb::class_<vasco::ScanBatch> cls(m, "Scans", kScansDoc);
+  bind_scans_constructor(cls);
+  bind_scans_views(cls);
+  bind_scans_methods(cls);
 }
 
 void bind_log(nb::module_ &m) {
@@ -715,32 +752,42 @@ void bind_log(nb::module_ &m) {
       "released while the log is read.");
 }
 
-void bind_map(nb::module_ &m) {
-  nb::class_<Map>(m, "Map",
-                  "A finished occupancy map (or one read from a file).\n\n"
-                  "``cells`` is a writable 2-D float32 NumPy view of the map's memory, shape (size_x,\n"
-                  "size_y), x-major as CARMEN stores it: ``cells[x, y]`` is the cell x columns right of and y\n"
-                  "rows above the lower-left corner; -1 is unknown, else the occupancy probability.\n"
-                  "``image`` is the same memory seen as a picture (``cells.T[::-1]``: row 0 at the top, +y up),\n"
-                  "also a view. ``origin`` is the world pose (x, y, theta) of the lower-left corner of cell\n"
-                  "(0, 0), as CARMEN's OFFSET chunk and map_server's YAML give it.")
-      .def(
-          "__init__",
-          [](Map *self, nb::handle cells, double resolution, std::tuple<double, double, double> origin) {
-            auto a = as_array<float>(cells, "float32", "cells", 2);
-            Map mp;
-            mp.grid.size_x = static_cast<int>(a.shape(0));
-            mp.grid.size_y = static_cast<int>(a.shape(1));
-            mp.grid.resolution = resolution;
-            mp.grid.cells.assign(a.data(), a.data() + a.size());
-            mp.origin = {std::get<0>(origin), std::get<1>(origin), std::get<2>(origin)};
-            mp.has_origin = true;
-            new (self) Map(std::move(mp));
-          },
-          "cells"_a, "resolution"_a, "origin"_a = std::make_tuple(0.0, 0.0, 0.0),
-          nb::sig("def __init__(self, cells: numpy.typing.ArrayLike, resolution: float, "
-                  "origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None"),
-          "A map from x-major cells (size_x, size_y), copied into the map.")
+// The docstring of the class Map.
+constexpr const char *kMapDoc =
+    "A finished occupancy map (or one read from a file).\n\n"
+    "``cells`` is a writable 2-D float32 NumPy view of the map's memory, shape (size_x,\n"
+    "size_y), x-major as CARMEN stores it: ``cells[x, y]`` is the cell x columns right of and y\n"
+    "rows above the lower-left corner; -1 is unknown, else the occupancy probability.\n"
+    "``image`` is the same memory seen as a picture (``cells.T[::-1]``: row 0 at the top, +y up),\n"
+    "also a view. ``origin`` is the world pose (x, y, theta) of the lower-left corner of cell\n"
+    "(0, 0), as CARMEN's OFFSET chunk and map_server's YAML give it.";
+
+// The docstring of write_map.
+constexpr const char *kWriteMapDoc =
+    "Writes a map, the format chosen by the name: ``.map`` / ``.map.gz`` (CARMEN, with an OFFSET\n"
+    "chunk when the map has an origin), ``.pgm`` (ROS map_server image plus a ``.yaml`` beside it;\n"
+    "``mode`` trinary, scale or raw) or ``.png`` (grey: white free, black occupied, mid grey\n"
+    "unknown). Atomic: a failure leaves no file behind. Raises FileError naming the file.";
+
+// Map's constructor from cells and its two views of them (cells, image).
+void bind_map_cells(nb::class_<Map> &cls) {
+  cls.def(
+         "__init__",
+         [](Map *self, nb::handle cells, double resolution, std::tuple<double, double, double> origin) {
+           auto a = as_array<float>(cells, "float32", "cells", 2);
+           Map mp;
+           mp.grid.size_x = static_cast<int>(a.shape(0));
+           mp.grid.size_y = static_cast<int>(a.shape(1));
+           mp.grid.resolution = resolution;
+           mp.grid.cells.assign(a.data(), a.data() + a.size());
+           mp.origin = {std::get<0>(origin), std::get<1>(origin), std::get<2>(origin)};
+           mp.has_origin = true;
+           new (self) Map(std::move(mp));
+         },
+         "cells"_a, "resolution"_a, "origin"_a = std::make_tuple(0.0, 0.0, 0.0),
+         nb::sig("def __init__(self, cells: numpy.typing.ArrayLike, resolution: float, "
+                 "origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None"),
+         "A map from x-major cells (size_x, size_y), copied into the map.")
       .def_prop_ro(
           "cells",
           [](nb::handle_t<Map> self) {
@@ -760,8 +807,12 @@ void bind_map(nb::module_ &m) {
                                  self, {-1, sy});
           }, nb::rv_policy::reference,
           nb::sig("def image(self) -> numpy.typing.NDArray[numpy.float32]"),
-          "(size_y, size_x) float32 view with row 0 at the top (``cells.T[::-1]``), for plotting.")
-      .def_prop_ro("size_x", [](const Map &mp) { return mp.grid.size_x; })
+          "(size_y, size_x) float32 view with row 0 at the top (``cells.T[::-1]``), for plotting.");
+}
+
+// Map's size, resolution, origin and finish's crop, its digest and repr.
+void bind_map_properties(nb::class_<Map> &cls) {
+  cls.def_prop_ro("size_x", [](const Map &mp) { return mp.grid.size_x; })
       .def_prop_ro("size_y", [](const Map &mp) { return mp.grid.size_y; })
       .def_prop_ro("shape", [](const Map &mp) { return std::make_tuple(mp.grid.size_x, mp.grid.size_y); })
       .def_prop_rw(
@@ -789,7 +840,10 @@ void bind_map(nb::module_ &m) {
         return nb::str("Map(size_x={}, size_y={}, resolution={}, origin=({}, {}, {}))")
             .format(mp.grid.size_x, mp.grid.size_y, mp.grid.resolution, mp.origin.x, mp.origin.y, mp.origin.theta);
       });
+}
 
+// The module functions that read and write maps: _read_map, write_map.
+void bind_map_files(nb::module_ &m) {
   m.def(
       "_read_map",
       [](const fs::path &path) {
@@ -817,17 +871,53 @@ void bind_map(nb::module_ &m) {
       },
       "path"_a, "map"_a, "mode"_a = "trinary", "description"_a = "",
       nb::sig("def write_map(path: str | os.PathLike, map: Map, mode: str = 'trinary', description: str = '') -> None"),
-      "Writes a map, the format chosen by the name: ``.map`` / ``.map.gz`` (CARMEN, with an OFFSET\n"
-      "chunk when the map has an origin), ``.pgm`` (ROS map_server image plus a ``.yaml`` beside it;\n"
-      "``mode`` trinary, scale or raw) or ``.png`` (grey: white free, black occupied, mid grey\n"
-      "unknown). Atomic: a failure leaves no file behind. Raises FileError naming the file.");
+      kWriteMapDoc);
 }
 
-void bind_compare(nb::module_ &m) {
-  nb::class_<vasco::GridComparison>(
-      m, "Comparison",
-      "DESIGN section 4's agreement table of map B against map A (the reference), over their overlap.")
-      .def_prop_ro("cells", [](const vasco::GridComparison &c) { return c.agreement.cells; }, "Cells compared (the overlap).")
+// The class Map and the functions that read and write maps.
+void bind_map(nb::module_ &m) {
+  nb::class_<Map> cls(m, "Map", kMapDoc);
+  bind_map_cells(cls);
+  bind_map_properties(cls);
+  bind_map_files(m);
+}
+
+// The docstring of compare.
+constexpr const char *kCompareDoc =
+    "Compares map B with map A (the reference): DESIGN section 4's table (class agreement,\n"
+    "known/unknown differences, |dp| > 0.1, max |dp|, bit-identical cells). Maps whose origins\n"
+    "are a whole number of cells apart are aligned by them (``align=False``: cell (0, 0) on cell\n"
+    "(0, 0)). ``top``: how many of the largest differences to keep in ``.largest``.";
+
+// Every count of a comparison as a dict (Comparison.to_dict).
+nb::dict comparison_dict(const vasco::GridComparison &c) {
+  const vasco::Agreement &a = c.agreement;
+  nb::dict d;
+  d["cells"] = a.cells;
+  d["both_known"] = a.both_known;
+  d["status_differs"] = a.status_differs;
+  d["identical"] = a.identical;
+  d["max_abs_diff"] = a.max_abs_diff;
+  d["large_diffs"] = a.large_diffs;
+  d["class_agree"] = a.class_agree;
+  d["class_agreement"] = a.class_agreement();
+  d["occupied_ref"] = a.occupied_ref;
+  d["occupied_agree"] = a.occupied_agree;
+  d["free_ref"] = a.free_ref;
+  d["free_agree"] = a.free_agree;
+  d["unknown_ref"] = a.unknown_ref;
+  d["unknown_agree"] = a.unknown_agree;
+  d["shift_x"] = c.shift_x;
+  d["shift_y"] = c.shift_y;
+  d["outside"] = c.outside;
+  d["outside_known"] = c.outside_known;
+  d["same_cells"] = c.same_cells();
+  return d;
+}
+
+// Comparison's agreement counts over the overlap.
+void bind_comparison_counts(nb::class_<vasco::GridComparison> &cls) {
+  cls.def_prop_ro("cells", [](const vasco::GridComparison &c) { return c.agreement.cells; }, "Cells compared (the overlap).")
       .def_prop_ro("both_known", [](const vasco::GridComparison &c) { return c.agreement.both_known; })
       .def_prop_ro("status_differs", [](const vasco::GridComparison &c) { return c.agreement.status_differs; },
                    "Known in one map, unknown in the other.")
@@ -845,8 +935,12 @@ void bind_compare(nb::module_ &m) {
       .def_prop_ro("free_ref", [](const vasco::GridComparison &c) { return c.agreement.free_ref; })
       .def_prop_ro("free_agree", [](const vasco::GridComparison &c) { return c.agreement.free_agree; })
       .def_prop_ro("unknown_ref", [](const vasco::GridComparison &c) { return c.agreement.unknown_ref; })
-      .def_prop_ro("unknown_agree", [](const vasco::GridComparison &c) { return c.agreement.unknown_agree; })
-      .def_ro("shift_x", &vasco::GridComparison::shift_x, "B's cell (bx, by) lies on A's (bx + shift_x, by + shift_y).")
+      .def_prop_ro("unknown_agree", [](const vasco::GridComparison &c) { return c.agreement.unknown_agree; });
+}
+
+// Comparison's alignment, the cells outside the overlap and the largest differences.
+void bind_comparison_extent(nb::class_<vasco::GridComparison> &cls) {
+  cls.def_ro("shift_x", &vasco::GridComparison::shift_x, "B's cell (bx, by) lies on A's (bx + shift_x, by + shift_y).")
       .def_ro("shift_y", &vasco::GridComparison::shift_y)
       .def_ro("outside", &vasco::GridComparison::outside, "Cells of A or B outside the overlap (they differ).")
       .def_ro("outside_known", &vasco::GridComparison::outside_known)
@@ -860,33 +954,15 @@ void bind_compare(nb::module_ &m) {
             for (const auto &d : c.largest) v.emplace_back(d.x, d.y, d.a, d.b);
             return v;
           },
-          "Up to `top` cells known in both whose bits differ, largest |a - b| first: (x, y, a, b).")
-      .def("table", [](const vasco::GridComparison &c, const std::string &title) { return c.agreement.table(title); },
-           "title"_a = "B against A", "The table as text.")
-      .def("to_dict", [](const vasco::GridComparison &c) {
-        const vasco::Agreement &a = c.agreement;
-        nb::dict d;
-        d["cells"] = a.cells;
-        d["both_known"] = a.both_known;
-        d["status_differs"] = a.status_differs;
-        d["identical"] = a.identical;
-        d["max_abs_diff"] = a.max_abs_diff;
-        d["large_diffs"] = a.large_diffs;
-        d["class_agree"] = a.class_agree;
-        d["class_agreement"] = a.class_agreement();
-        d["occupied_ref"] = a.occupied_ref;
-        d["occupied_agree"] = a.occupied_agree;
-        d["free_ref"] = a.free_ref;
-        d["free_agree"] = a.free_agree;
-        d["unknown_ref"] = a.unknown_ref;
-        d["unknown_agree"] = a.unknown_agree;
-        d["shift_x"] = c.shift_x;
-        d["shift_y"] = c.shift_y;
-        d["outside"] = c.outside;
-        d["outside_known"] = c.outside_known;
-        d["same_cells"] = c.same_cells();
-        return d;
-      }, "Every count as a dict.")
+          "Up to `top` cells known in both whose bits differ, largest |a - b| first: (x, y, a, b).");
+}
+
+// Comparison's table, dict, str and repr.
+void bind_comparison_methods(nb::class_<vasco::GridComparison> &cls) {
+  cls.def("table", [](const vasco::GridComparison &c, const std::string &title) { return c.agreement.table(title); },
+          "title"_a = "B against A", "The table as text.")
+      .def(
+          "to_dict", [](const vasco::GridComparison &c) { return comparison_dict(c); }, "Every count as a dict.")
       .def("__str__", [](const vasco::GridComparison &c) { return c.agreement.table("B against A"); })
       .def("__repr__", [](const vasco::GridComparison &c) {
         const vasco::Agreement &a = c.agreement;
@@ -895,6 +971,16 @@ void bind_compare(nb::module_ &m) {
             .format(a.cells, a.class_agreement(), a.status_differs, a.large_diffs, a.max_abs_diff, a.identical,
                     c.outside);
       });
+}
+
+// The class Comparison and the function compare.
+void bind_compare(nb::module_ &m) {
+  nb::class_<vasco::GridComparison> cls(
+      m, "Comparison",
+      "DESIGN section 4's agreement table of map B against map A (the reference), over their overlap.");
+  bind_comparison_counts(cls);
+  bind_comparison_extent(cls);
+  bind_comparison_methods(cls);
 
   m.def(
       "compare",
@@ -907,64 +993,70 @@ void bind_compare(nb::module_ &m) {
         }
         return vasco::compare_grids(a.grid, b.grid, sx, sy, top);
       },
-      "a"_a, "b"_a, "align"_a = true, "top"_a = 0,
-      "Compares map B with map A (the reference): DESIGN section 4's table (class agreement,\n"
-      "known/unknown differences, |dp| > 0.1, max |dp|, bit-identical cells). Maps whose origins\n"
-      "are a whole number of cells apart are aligned by them (``align=False``: cell (0, 0) on cell\n"
-      "(0, 0)). ``top``: how many of the largest differences to keep in ``.largest``.");
+      "a"_a, "b"_a, "align"_a = true, "top"_a = 0, kCompareDoc);
 }
 
-void bind_mapper(nb::module_ &m) {
-  nb::class_<PyMapper>(
-      m, "Mapper",
-      "A mapping session (DESIGN section 7): scans stored once (on the GPU for ``cuda``), poses\n"
-      "replaceable as a whole, the evidence grid kept between calls.\n\n"
-      "    mapper = vasco_gpu.Mapper(params, backend='cuda', cuda_mode='exact')\n"
-      "    mapper.insert(log.scans)          # new scans continue the grid\n"
-      "    mapper.render(new_poses)          # a loop closure: every pose moved, recomputed\n"
-      "    m = mapper.finish()               # CARMEN's finish -> Map\n\n"
-      "Backends: cpu_double (CARMEN's routine, bit-identical), cpu_threads (the same bytes on every\n"
-      "core), cpu_float (single precision), cuda (cuda_mode 'float', the default, or 'exact':\n"
-      "CARMEN's bytes), auto (cuda when a GPU is usable, else cpu_threads); 'cuda_exact' and\n"
-      "'cuda_float' name the CUDA modes too. The GIL is released while the session maps; calls on\n"
-      "one Mapper from several threads are serialised.")
-      .def(
-          "__init__",
-          [](PyMapper *self, std::optional<vasco::MapperParams> params, const std::string &backend,
-             std::optional<std::string> cuda_mode, int threads, std::optional<vasco::GridGeometry> frame,
-             int cuda_device, uint64_t max_memory_bytes) {
-            std::string name;
-            const vasco::BackendOptions o =
-                backend_options(backend, cuda_mode, threads, cuda_device, max_memory_bytes, &name);
-            const vasco::MapperParams p = params ? *params : vasco::MapperParams();
-            std::unique_ptr<vasco::Mapper> mp;
-            {
-              nb::gil_scoped_release release;
-              p.validate();
-              mp = frame ? std::make_unique<vasco::Mapper>(p, *frame, name, o) : std::make_unique<vasco::Mapper>(p, name, o);
-            }
-            auto *pm = new (self) PyMapper();
-            pm->mapper = std::move(mp);
-          },
-          "params"_a = nb::none(), "backend"_a = "cpu_double", "cuda_mode"_a = nb::none(), "threads"_a = 0,
-          "frame"_a = nb::none(), "cuda_device"_a = 0, "max_memory_bytes"_a = vasco::kDefaultMaxMemoryBytes,
-          "A session with ``params`` (vasco's defaults when None) on ``backend``.\n\n"
-          "cuda_mode: 'float' (default) or 'exact'. threads: cpu_threads' threads (0: all cores).\n"
-          "frame: a fixed Frame (cells outside it are skipped, as CARMEN does) instead of the PROTOCOL\n"
-          "frame, which grows as scans arrive. max_memory_bytes: host memory the session may use (0: no\n"
-          "limit). Raises ValueError for bad parameters or an unknown backend, RuntimeError when the\n"
-          "backend cannot run here (e.g. cuda without a GPU).")
-      .def(
-          "insert",
-          [](PyMapper &pm, const vasco::ScanBatch &scans) {
-            nb::gil_scoped_release release;
-            std::lock_guard<std::mutex> lock(pm.mutex);
-            pm.mapper->insert(scans);
-          },
-          "scans"_a,
-          "Stores ``scans`` after those stored and applies them to the grid (exact backends: the bytes\n"
-          "of mapping everything at once). Raises RuntimeError when the frame would be too large or the\n"
-          "session would exceed max_memory_bytes (nothing is stored then).")
+// The docstring of the class Mapper.
+constexpr const char *kMapperDoc =
+    "A mapping session (DESIGN section 7): scans stored once (on the GPU for ``cuda``), poses\n"
+    "replaceable as a whole, the evidence grid kept between calls.\n\n"
+    "    mapper = vasco_gpu.Mapper(params, backend='cuda', cuda_mode='exact')\n"
+    "    mapper.insert(log.scans)          # new scans continue the grid\n"
+    "    mapper.render(new_poses)          # a loop closure: every pose moved, recomputed\n"
+    "    m = mapper.finish()               # CARMEN's finish -> Map\n\n"
+    "Backends: cpu_double (CARMEN's routine, bit-identical), cpu_threads (the same bytes on every\n"
+    "core), cpu_float (single precision), cuda (cuda_mode 'float', the default, or 'exact':\n"
+    "CARMEN's bytes), auto (cuda when a GPU is usable, else cpu_threads); 'cuda_exact' and\n"
+    "'cuda_float' name the CUDA modes too. The GIL is released while the session maps; calls on\n"
+    "one Mapper from several threads are serialised.";
+
+// The docstring of Mapper.__init__.
+constexpr const char *kMapperInitDoc =
+    "A session with ``params`` (vasco's defaults when None) on ``backend``.\n\n"
+    "cuda_mode: 'float' (default) or 'exact'. threads: cpu_threads' threads (0: all cores).\n"
+    "frame: a fixed Frame (cells outside it are skipped, as CARMEN does) instead of the PROTOCOL\n"
+    "frame, which grows as scans arrive. max_memory_bytes: host memory the session may use (0: no\n"
+    "limit). Raises ValueError for bad parameters or an unknown backend, RuntimeError when the\n"
+    "backend cannot run here (e.g. cuda without a GPU).";
+
+// Mapper's constructor: a session with the given parameters on the given backend.
+void bind_mapper_constructor(nb::class_<PyMapper> &cls) {
+  cls.def(
+      "__init__",
+      [](PyMapper *self, std::optional<vasco::MapperParams> params, const std::string &backend,
+         std::optional<std::string> cuda_mode, int threads, std::optional<vasco::GridGeometry> frame,
+         int cuda_device, uint64_t max_memory_bytes) {
+        std::string name;
+        const vasco::BackendOptions o =
+            backend_options(backend, cuda_mode, threads, cuda_device, max_memory_bytes, &name);
+        const vasco::MapperParams p = params ? *params : vasco::MapperParams();
+        std::unique_ptr<vasco::Mapper> mp;
+        {
+          nb::gil_scoped_release release;
+          p.validate();
+          mp = frame ? std::make_unique<vasco::Mapper>(p, *frame, name, o) : std::make_unique<vasco::Mapper>(p, name, o);
+        }
+        auto *pm = new (self) PyMapper();
+        pm->mapper = std::move(mp);
+      },
+      "params"_a = nb::none(), "backend"_a = "cpu_double", "cuda_mode"_a = nb::none(), "threads"_a = 0,
+      "frame"_a = nb::none(), "cuda_device"_a = 0, "max_memory_bytes"_a = vasco::kDefaultMaxMemoryBytes,
+      kMapperInitDoc);
+}
+
+// Mapper's calls that change the grid or finish it: insert, render, finish.
+void bind_mapper_mapping(nb::class_<PyMapper> &cls) {
+  cls.def(
+         "insert",
+         [](PyMapper &pm, const vasco::ScanBatch &scans) {
+           nb::gil_scoped_release release;
+           std::lock_guard<std::mutex> lock(pm.mutex);
+           pm.mapper->insert(scans);
+         },
+         "scans"_a,
+         "Stores ``scans`` after those stored and applies them to the grid (exact backends: the bytes\n"
+         "of mapping everything at once). Raises RuntimeError when the frame would be too large or the\n"
+         "session would exceed max_memory_bytes (nothing is stored then).")
       .def(
           "render",
           [](PyMapper &pm, nb::handle poses) {
@@ -989,31 +1081,35 @@ void bind_mapper(nb::module_ &m) {
           "downsample"_a = nb::none(), "border"_a = nb::none(),
           "CARMEN's finish of the current grid (block means, crop to the known area plus ``border``),\n"
           "on the GPU for cuda; ``downsample``/``border`` default to the params'. Returns a Map whose\n"
-          "cells are moved, not copied, out of the session.")
-      .def(
-          "read",
-          [](PyMapper &pm, std::optional<std::tuple<int, int, int, int>> window) {
-            std::vector<float> v;
-            size_t w = 0, h = 0;
-            {
-              nb::gil_scoped_release release;
-              std::lock_guard<std::mutex> lock(pm.mutex);
-              vasco::GridWindow gw;
-              if (window) {
-                gw = {std::get<0>(*window), std::get<1>(*window), std::get<2>(*window), std::get<3>(*window)};
-              } else {
-                gw = {0, 0, pm.mapper->frame().size_x, pm.mapper->frame().size_y};
-              }
-              v = pm.mapper->read(gw);
-              w = static_cast<size_t>(gw.width);
-              h = static_cast<size_t>(gw.height);
-            }
-            return owned(std::move(v), {w, h});
-          },
-          "window"_a = nb::none(),
-          nb::sig("def read(self, window: tuple[int, int, int, int] | None = None) -> numpy.typing.NDArray[numpy.float32]"),
-          "The full-resolution grid, or the window (x0, y0, width, height) of it, as a (width, height)\n"
-          "float32 array, x-major (a new array that owns the cells C++ returned; no further copy).")
+          "cells are moved, not copied, out of the session.");
+}
+
+// Mapper's arrays out of the session: read (the grid) and poses.
+void bind_mapper_arrays(nb::class_<PyMapper> &cls) {
+  cls.def(
+         "read",
+         [](PyMapper &pm, std::optional<std::tuple<int, int, int, int>> window) {
+           std::vector<float> v;
+           size_t w = 0, h = 0;
+           {
+             nb::gil_scoped_release release;
+             std::lock_guard<std::mutex> lock(pm.mutex);
+             vasco::GridWindow gw;
+             if (window) {
+               gw = {std::get<0>(*window), std::get<1>(*window), std::get<2>(*window), std::get<3>(*window)};
+             } else {
+               gw = {0, 0, pm.mapper->frame().size_x, pm.mapper->frame().size_y};
+             }
+             v = pm.mapper->read(gw);
+             w = static_cast<size_t>(gw.width);
+             h = static_cast<size_t>(gw.height);
+           }
+           return owned(std::move(v), {w, h});
+         },
+         "window"_a = nb::none(),
+         nb::sig("def read(self, window: tuple[int, int, int, int] | None = None) -> numpy.typing.NDArray[numpy.float32]"),
+         "The full-resolution grid, or the window (x0, y0, width, height) of it, as a (width, height)\n"
+         "float32 array, x-major (a new array that owns the cells C++ returned; no further copy).")
       .def_prop_ro(
           "poses",
           [](PyMapper &pm) {
@@ -1027,11 +1123,15 @@ void bind_mapper(nb::module_ &m) {
             }
             return owned(std::move(flat), {p.size(), 3});
           }, nb::rv_policy::reference,
-          "The stored scans' poses, (n, 3) float64 (a new array).")
-      .def("__len__", [](PyMapper &pm) {
-        std::lock_guard<std::mutex> lock(pm.mutex);
-        return pm.mapper->num_scans();
-      })
+          "The stored scans' poses, (n, 3) float64 (a new array).");
+}
+
+// Mapper's state: size, frame, parameters, backend, statistics, renders and repr.
+void bind_mapper_state(nb::class_<PyMapper> &cls) {
+  cls.def("__len__", [](PyMapper &pm) {
+       std::lock_guard<std::mutex> lock(pm.mutex);
+       return pm.mapper->num_scans();
+     })
       .def_prop_ro("num_scans", [](PyMapper &pm) {
         std::lock_guard<std::mutex> lock(pm.mutex);
         return pm.mapper->num_scans();
@@ -1056,6 +1156,15 @@ void bind_mapper(nb::module_ &m) {
         std::lock_guard<std::mutex> lock(pm.mutex);
         return nb::str("Mapper(backend='{}', {} scans)").format(pm.mapper->backend_name(), pm.mapper->num_scans());
       });
+}
+
+// The class Mapper.
+void bind_mapper(nb::module_ &m) {
+  nb::class_<PyMapper> cls(m, "Mapper", kMapperDoc);
+  bind_mapper_constructor(cls);
+  bind_mapper_mapping(cls);
+  bind_mapper_arrays(cls);
+  bind_mapper_state(cls);
 }
 
 }  // namespace
