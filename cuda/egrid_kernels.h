@@ -149,6 +149,14 @@ struct FloatScan {
 constexpr int kFixedCountBits = 16, kFixedFracBits = 24;
 constexpr double kFixedLimit = 4194304.0;  // 2^22 log-odds
 
+// Float mode's increments per cell offset (i, j) from the start, for tables
+// of at most kMaxFloatTable entries per axis (32 MiB): {free, occupied} in
+// fixed-point units, or kFloatStops where the beam stops (d >= max_range).
+// They are the values an update computes in full, so a lookup changes no bit.
+constexpr int kMaxFloatTable = 2048;
+constexpr int kFloatStops = INT32_MIN;
+void launch_float_tables(const KernelModel<float> &m, int2 *increments, cudaStream_t stream);
+
 // Sets every cell to 0, float mode's "never updated".
 void launch_float_clear(unsigned long long *sums, size_t num_cells, cudaStream_t stream);
 
@@ -165,9 +173,10 @@ void launch_float_from_prob(const KernelModel<float> &m, const float *probs, uns
                             size_t num_cells, cudaStream_t stream);
 
 // Adds every beam's log-odds evidence to `sums` (integer atomics: no update
-// is lost, none depends on the order). counters: beams used, beams skipped,
-// cell updates.
-void launch_float_map(const KernelModel<float> &m, const FloatScan *scans, int num_scans,
+// is lost, none depends on the order). `increments`: launch_float_tables'
+// tables, or null to compute every update in full. counters: beams used,
+// beams skipped, cell updates.
+void launch_float_map(const KernelModel<float> &m, const int2 *increments, const FloatScan *scans, int num_scans,
                       const float *ranges, unsigned long long *sums, unsigned long long *counters,
                       cudaStream_t stream);
 

@@ -35,28 +35,111 @@ constexpr int kWarpsPerBlock = 8;
 // "never updated", and every update adds its count bit, so no separate
 // touched array and none of its stores.
 
+// The fixed-point increment of an update at distance d by a beam of range r
+// (egrid_kernels.h kFixedFracBits); false where the beam stops (d >= max).
+// The one expression of float mode's evidence: the tables hold its values.
+__device__ __forceinline__ bool fixed_increment(const KernelModel<float> &m, float d, float r, long long *q) {
+  float p;
+  if (!egrid::sensor_model(m.sensor, d, r, &p)) return false;
+  // |x| > 64 saturates a float probability anyway; the clamp keeps a p that
+  // rounds to 1.0f in float (a prior of 1 - 1e-9, say) a finite increment.
+  const float x = fminf(fmaxf(__logf(p / (1.0f - p)) - m.logodds_prior, -64.0f), 64.0f);
+  *q = __float2ll_rn(x * static_cast<float>(1 << kFixedFracBits));
+  return true;
+}
+
+__device__ __forceinline__ void add_fixed(unsigned long long *sums, size_t c, long long q) {
+  atomicAdd(sums + c, (static_cast<unsigned long long>(q) << kFixedCountBits) + 1ull);
+}
+
+// The distance of a cell i, j cells from the start, as the oracle's float
+// port has it (1e6 past the table: never updated).
+__device__ __forceinline__ float float_distance(const KernelModel<float> &m, int i, int j) {
+  return (i >= m.table_size || j >= m.table_size) ? 1e6f
+                                                  : sqrtf(static_cast<float>(i * i + j * j)) * m.resolution;
+}
+
+// One update of (cx, cy), computed in full (degenerate lines); sets *stop
+// where the beam stops.
 __device__ __forceinline__ void add_evidence(const KernelModel<float> &m, int cx, int cy, int x1, int y1,
                                              float r, unsigned long long *sums, unsigned *count, bool *stop) {
   if (cx < 0 || cx >= m.size_x || cy < 0 || cy >= m.size_y) return;
-  const int i = abs(cx - x1), j = abs(cy - y1);
-  const float d = (i >= m.table_size || j >= m.table_size)
-                      ? 1e6f
-                      : sqrtf(static_cast<float>(i * i + j * j)) * m.resolution;
-    float p;
-  if (!egrid::sensor_model(m.sensor, d, r, &p)) {
+  long long q;
+  if (!fixed_increment(m, float_distance(m, abs(cx - x1), abs(cy - y1)), r, &q)) {
     *stop = true;
     return;
   }
-  const size_t c = static_cast<size_t>(cx) * m.size_y + cy;
-  const float x = __logf(p / (1.0f - p)) - m.logodds_prior;
-  const long long q = __float2ll_rn(x * static_cast<float>(1 << kFixedFracBits));
-  atomicAdd(sums + c, (static_cast<unsigned long long>(q) << kFixedCountBits) + 1ull);
+  add_fixed(sums, static_cast<size_t>(cx) * m.size_y + cy, q);
   ++*count;
 }
 
+// increments[i * T + j] = {free, occupied} fixed-point increments at offset
+// (i, j), or kFloatStops where the beam stops.
+__global__ void float_tables_kernel(KernelModel<float> m, int2 *increments) {
+  const int T = m.table_size;
+  for (int idx = blockIdx.x * blockDim.x + threadIdx.x; idx < T * T; idx += gridDim.x * blockDim.x) {
+    const float d = float_distance(m, idx / T, idx % T);
+    long long f, o;
+    if (!fixed_increment(m, d, HUGE_VALF, &f) || !fixed_increment(m, d, -HUGE_VALF, &o)) {
+      increments[idx] = make_int2(kFloatStops, kFloatStops);
+    } else {
+      increments[idx] = make_int2(static_cast<int>(f), static_cast<int>(o));
+    }
+  }
+}
+
+// The closed-form walk of one beam, lane by lane: lane l takes steps l, l+32,
+// ... The minor offset (2b·k + bias) / 2a advances by a constant quotient and
+// remainder per 32 steps, so each lane divides once. With tables, an update
+// is a lookup and a comparison (d < r, the sensor model's free test, with the
+// same float distance); without, fixed_increment in full.
+__device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, const int2 *increments,
+                                                 const egrid::LineParams &p, int x1, int y1, float r, int lane,
+                                                 unsigned long long *sums, unsigned *updates) {
+  // Cells beyond table_size steps are never updated (see oracle.h); cells
+  // with d >= max are skipped, which equals the oracle's stop because d
+  // never decreases along the walk.
+  const int k_end = min(p.major_len, m.table_size - 1);
+  if (lane > k_end) return;
+  const int64_t two_a = p.a ? 2 * static_cast<int64_t>(p.a) : 1, two_b = p.a ? 2 * static_cast<int64_t>(p.b) : 0;
+  const int64_t num = two_b * lane + (p.a ? p.a - (p.inc < 0 ? 1 : 0) : 0), stride = two_b * 32;
+  int mm = static_cast<int>(num / two_a);
+  int64_t rem = num % two_a;
+  const int dq = static_cast<int>(stride / two_a);
+  const int64_t dr = stride % two_a;
+  const int sx1 = p.steep ? p.y1 : p.x1, sy1 = p.flipped ? -(p.steep ? p.x1 : p.y1) : (p.steep ? p.x1 : p.y1);
+  for (int k = lane; k <= k_end; k += 32) {
+    const int maj = sx1 + p.inc * k;
+    const int mn = p.flipped ? -(sy1 + p.inc * mm) : sy1 + p.inc * mm;
+    const int cx = p.steep ? mn : maj, cy = p.steep ? maj : mn;
+    if (cx >= 0 && cx < m.size_x && cy >= 0 && cy < m.size_y) {
+      const int i = p.steep ? mm : k, j = p.steep ? k : mm;  // |cx - x1|, |cy - y1|
+      long long q;
+      bool update;
+      if (increments) {
+        const int2 e = increments[i * m.table_size + j];
+        update = e.x != kFloatStops;
+        q = float_distance(m, i, j) < r ? e.x : e.y;
+      } else {
+        update = fixed_increment(m, float_distance(m, abs(cx - x1), abs(cy - y1)), r, &q);
+      }
+      if (update) {
+        add_fixed(sums, static_cast<size_t>(cx) * m.size_y + cy, q);
+        ++*updates;
+      }
+    }
+    mm += dq;
+    rem += dr;
+    if (rem >= two_a) {
+      rem -= two_a;
+      ++mm;
+    }
+  }
+}
+
 __global__ void __launch_bounds__(kWarpsPerBlock * 32)
-    float_map_kernel(KernelModel<float> m, const FloatScan *scans, int num_scans, int parts, const float *ranges,
-                     unsigned long long *sums, unsigned long long *counters) {
+    float_map_kernel(KernelModel<float> m, const int2 *increments, const FloatScan *scans, int num_scans, int parts,
+                     const float *ranges, unsigned long long *sums, unsigned long long *counters) {
   const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
   unsigned used = 0, skipped = 0, updates = 0;
   // `parts` blocks share a scan (several when a few scans are inserted, so
@@ -87,25 +170,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
         continue;
       }
       const egrid::LineParams p = egrid::line_params(sc.x1, sc.y1, x2, y2);
-      // Cells beyond table_size steps are never updated (see oracle.h); cells
-      // with d >= max are skipped, which equals the oracle's stop because d
-      // never decreases along the walk.
-      const int k_end = min(p.major_len, m.table_size - 1);
-      const int two_a = 2 * p.a;
-      const int64_t two_b = 2 * static_cast<int64_t>(p.b);
-      const int bias = p.a - (p.inc < 0 ? 1 : 0);
-      for (int k = lane; k <= k_end; k += 32) {
-        const int mm = p.a ? static_cast<int>((two_b * k + bias) / two_a) : 0;
-        const int sx1 = p.steep ? p.y1 : p.x1;
-        int sy1 = p.steep ? p.x1 : p.y1;
-        if (p.flipped) sy1 = -sy1;
-        const int maj = sx1 + p.inc * k;
-        int mn = sy1 + p.inc * mm;
-        if (p.flipped) mn = -mn;
-        const int cx = p.steep ? mn : maj, cy = p.steep ? maj : mn;
-        bool stop = false;
-        add_evidence(m, cx, cy, sc.x1, sc.y1, r, sums, &updates, &stop);
-      }
+      walk_closed_form(m, increments, p, sc.x1, sc.y1, r, lane, sums, &updates);
     }
   }
   // counters: beams used, beams skipped, cell updates
@@ -183,14 +248,21 @@ void launch_float_clear(unsigned long long *sums, size_t num_cells, cudaStream_t
   VG_CUDA_CHECK(cudaMemsetAsync(sums, 0, num_cells * sizeof(unsigned long long), stream));
 }
 
-void launch_float_map(const KernelModel<float> &m, const FloatScan *scans, int num_scans,
+void launch_float_tables(const KernelModel<float> &m, int2 *increments, cudaStream_t stream) {
+  const size_t n = static_cast<size_t>(m.table_size) * m.table_size;
+  if (n == 0) return;
+  float_tables_kernel<<<fill_blocks(n), 256, 0, stream>>>(m, increments);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+void launch_float_map(const KernelModel<float> &m, const int2 *increments, const FloatScan *scans, int num_scans,
                       const float *ranges, unsigned long long *sums, unsigned long long *counters,
                       cudaStream_t stream) {
   if (num_scans <= 0) return;
   // A full render has thousands of scans: a block each. An insert of a few
   // scans splits each over up to 48 blocks (a warp per beam either way).
   const int parts = num_scans >= 1024 ? 1 : std::min(48, (1024 + num_scans - 1) / num_scans);
-  float_map_kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, scans, num_scans, parts, ranges,
+  float_map_kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, increments, scans, num_scans, parts, ranges,
                                                                            sums, counters);
   VG_CUDA_CHECK_LAUNCH();
 }

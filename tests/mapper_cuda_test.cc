@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <random>
 
 #include "golden_support.h"
@@ -118,6 +119,23 @@ TEST_F(MapperCuda, FloatSessionIsTheSameBytesWhateverTheRunAndTheInserts) {
   Mapper pieces(params_, "cuda", mode(CudaMode::Float));
   for (size_t a = 0; a < scans_.num_scans(); a += 50) pieces.insert(scans_.select(static_cast<long>(a), 50));
   testing_support::expect_bit_identical(first, pieces.read(), geo, "float inserts of 50 scans");
+}
+
+// Both modes look updates up in per-(i, j) tables when the table is small
+// enough and compute them in full otherwise (VASCO_CUDA_NO_TABLES forces the
+// latter): the two must agree bit for bit, and exact mode with cpu_double.
+TEST_F(MapperCuda, TablesChangeNoBitInEitherMode) {
+  const GridGeometry geo = size_grid(scans_, params_);
+  for (CudaMode cm : {CudaMode::Float, CudaMode::Exact}) {
+    Mapper tabled(params_, "cuda", mode(cm));
+    tabled.insert(scans_);
+    ASSERT_EQ(setenv("VASCO_CUDA_NO_TABLES", "1", 1), 0);
+    Mapper computed(params_, "cuda", mode(cm));
+    computed.insert(scans_);
+    unsetenv("VASCO_CUDA_NO_TABLES");
+    testing_support::expect_bit_identical(tabled.read(), computed.read(), geo,
+                                          cm == CudaMode::Float ? "float, tables vs none" : "exact, tables vs none");
+  }
 }
 
 }  // namespace

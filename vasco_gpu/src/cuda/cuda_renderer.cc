@@ -71,6 +71,13 @@ uint64_t exact_pair_bound(const PlacedBeam *beams, size_t n, const std::vector<o
   return total;
 }
 
+// VASCO_CUDA_NO_TABLES=1 computes every update in full, as grids too large
+// for the tables are: the tests compare both ways bit for bit.
+bool tables_disabled() {
+  const char *v = std::getenv("VASCO_CUDA_NO_TABLES");
+  return v != nullptr && *v != '\0' && std::string(v) != "0";
+}
+
 }  // namespace
 
 CudaRenderer::CudaRenderer(const BackendOptions &options) : options_(options) {
@@ -137,7 +144,7 @@ cuda::GridCells CudaRenderer::cells() const {
 void CudaRenderer::build_tables() {
   const int T = params_.table_size();
   const size_t t2 = static_cast<size_t>(std::max(T, 0)) * static_cast<size_t>(std::max(T, 0));
-  use_tables_ = T > 0 && T <= cuda::kMaxExactTable;
+  use_tables_ = T > 0 && T <= cuda::kMaxExactTable && !tables_disabled();
   const auto key = std::make_tuple(T, params_.resolution, params_.p_prior, params_.p_occ, params_.p_emp,
                                    params_.range_sure, params_.range_max);
   if (!use_tables_ || (tables_built_ && key == tables_key_)) return;
@@ -146,6 +153,22 @@ void CudaRenderer::build_tables() {
   cuda::launch_exact_tables(kernel_model_of<double>(params_, geo_), factors_.get(), reach_.get(), stream_->get());
   tables_key_ = key;
   tables_built_ = true;
+}
+
+// Float mode's increment tables for the current parameters (built when they
+// change), or null when they would be too large.
+const int2 *CudaRenderer::float_tables() {
+  const int T = params_.table_size();
+  if (T <= 0 || T > cuda::kMaxFloatTable || tables_disabled()) return nullptr;
+  const auto key = std::make_tuple(T, params_.resolution, params_.p_prior, params_.p_occ, params_.p_emp,
+                                   params_.range_sure, params_.range_max);
+  if (!float_tables_built_ || key != float_tables_key_) {
+    reserve(increments_, static_cast<size_t>(T) * static_cast<size_t>(T));
+    cuda::launch_float_tables(kernel_model_of<float>(params_, geo_), increments_.get(), stream_->get());
+    float_tables_key_ = key;
+    float_tables_built_ = true;
+  }
+  return increments_.get();
 }
 
 void CudaRenderer::apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) {
@@ -238,8 +261,8 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
                                 cudaMemcpyHostToDevice, stream_->get()));
   VG_CUDA_CHECK(cudaMemsetAsync(counters_.get(), 0, 3 * sizeof(unsigned long long), stream_->get()));
   e_up.record(stream_->get());
-  cuda::launch_float_map(kernel_model_of<float>(params_, geo_), scan_records_.get(), static_cast<int>(n),
-                         ranges_.get(), sums_.get(), counters_.get(), stream_->get());
+  cuda::launch_float_map(kernel_model_of<float>(params_, geo_), float_tables(), scan_records_.get(),
+                         static_cast<int>(n), ranges_.get(), sums_.get(), counters_.get(), stream_->get());
   e_map.record(stream_->get());
   reserve(staging_counters_, 3);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), counters_.get(), 3 * sizeof(unsigned long long),

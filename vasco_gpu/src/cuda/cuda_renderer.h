@@ -34,6 +34,7 @@ class CudaRenderer : public Renderer {
   cuda::GridCells cells() const;
   void check_fixed_headroom(uint64_t beams);
   void build_tables();
+  const int2 *float_tables();
   uint64_t exact_beams_per_launch() const;
   void upload_ranges(const ScanBatch &scans, size_t last);
   void apply_float(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
@@ -53,6 +54,10 @@ class CudaRenderer : public Renderer {
   // Float mode: a bound on any cell's |log-odds sum| since the grid was
   // cleared (one update per beam at most), against kFixedLimit.
   double fixed_bound_ = 0;
+  // Float mode's increment tables (launch_float_tables), when small enough.
+  cuda::DeviceBuffer<int2> increments_;
+  bool float_tables_built_ = false;
+  std::tuple<int, double, double, double, double, double, double> float_tables_key_;
   // Float mode: the stored scans' ranges (append-only) and per-scan records.
   cuda::DeviceBuffer<float> ranges_;
   uint64_t stored_beams_ = 0;
