@@ -20,7 +20,6 @@
 // the oracle pinned at 1.0 can come back below 1 here if enough free updates
 // follow. Measured in the agreement tables (DESIGN §4).
 #include <algorithm>
-#include <cstdlib>
 
 #include "cuda_check.h"
 #include "egrid_kernels.h"
@@ -158,61 +157,49 @@ __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, co
   }
 }
 
-// The beams of scan sc this warp takes (every parts-th warp's, from `part`).
-__device__ __forceinline__ void map_scan_beams(const KernelModel<float> &m, const int2 *increments,
-                                               const FloatScan &sc, int part, int parts, const float *ranges,
-                                               const FixedAdder &adder, int lane, int warp, unsigned &used,
-                                               unsigned &skipped, unsigned &updates) {
-  for (int b = part * kWarpsPerBlock + warp; b < sc.beam_count; b += kWarpsPerBlock * parts) {
-    const float r = ranges[sc.beam_begin + b];
-    if (!(r < 50.0f)) {
-      skipped += lane == 0;
-      continue;
-    }
-    used += lane == 0;
-    float sn, cs;
-    sincosf(sc.theta + sc.first + static_cast<float>(b) * sc.step, &sn, &cs);
-    const int x2 = egrid::trunc_to_int(sc.lx + (r + m.wall) * cs / m.resolution);
-    const int y2 = egrid::trunc_to_int(sc.ly + (r + m.wall) * sn / m.resolution);
-    if (!egrid::is_closed_form_line(sc.x1, sc.y1, x2, y2)) {
-      // Degenerate line (a range of -inf): one lane walks it sequentially.
-      if (lane == 0) {
-        bool stop = false;
-        egrid::walk_line(sc.x1, sc.y1, x2, y2, m.table_size, [&](int cx, int cy, int) {
-          add_evidence(m, cx, cy, sc.x1, sc.y1, r, adder, &updates, &stop);
-          return !stop;
-        });
-      }
-      continue;
-    }
-    const egrid::LineParams p = egrid::line_params(sc.x1, sc.y1, x2, y2);
-    walk_closed_form(m, increments, p, sc.x1, sc.y1, r, lane, adder, &updates);
-  }
-}
-
 __global__ void __launch_bounds__(kWarpsPerBlock * 32)
     float_map_kernel(KernelModel<float> m, const int2 *increments, bool use_window, const FloatScan *scans,
-                     int num_scans, int group, int parts, const float *ranges, unsigned long long *sums,
+                     int num_scans, int parts, const float *ranges, unsigned long long *sums,
                      unsigned long long *counters) {
   __shared__ unsigned long long window[kWindow * kWindow];
   const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
   unsigned used = 0, skipped = 0, updates = 0;
-  // A block takes `group` consecutive scans (a robot moves a few cells
-  // between scans, so they share the window around the first one's start),
-  // or, with parts > 1 (an insert of a few scans, so that one scan still
-  // fills the GPU), every parts-th warp's beams of one scan.
-  const int num_groups = (num_scans + group - 1) / group;
-  for (int gp = blockIdx.x; gp < num_groups * parts; gp += gridDim.x) {
-    const int first = (gp / parts) * group, last = min(first + group, num_scans), part = gp % parts;
-    const FixedAdder adder{sums, m.size_y, use_window ? window : nullptr, scans[first].x1 - kWindow / 2,
-                           scans[first].y1 - kWindow / 2};
+  // `parts` blocks share a scan (several when a few scans are inserted, so
+  // that one scan still fills the GPU), each taking every parts-th warp's beams.
+  for (int sp = blockIdx.x; sp < num_scans * parts; sp += gridDim.x) {
+    const FloatScan sc = scans[sp / parts];
+    const int part = sp % parts;
+    const FixedAdder adder{sums, m.size_y, use_window ? window : nullptr, sc.x1 - kWindow / 2, sc.y1 - kWindow / 2};
     if (use_window) {
-      __syncthreads();  // the previous group's window is added
+      __syncthreads();  // the previous scan's window is added
       for (int i = threadIdx.x; i < kWindow * kWindow; i += blockDim.x) window[i] = 0;
       __syncthreads();
     }
-    for (int si = first; si < last; ++si)
-      map_scan_beams(m, increments, scans[si], part, parts, ranges, adder, lane, warp, used, skipped, updates);
+    for (int b = part * kWarpsPerBlock + warp; b < sc.beam_count; b += kWarpsPerBlock * parts) {
+      const float r = ranges[sc.beam_begin + b];
+      if (!(r < 50.0f)) {
+        skipped += lane == 0;
+        continue;
+      }
+      used += lane == 0;
+      float sn, cs;
+      sincosf(sc.theta + sc.first + static_cast<float>(b) * sc.step, &sn, &cs);
+      const int x2 = egrid::trunc_to_int(sc.lx + (r + m.wall) * cs / m.resolution);
+      const int y2 = egrid::trunc_to_int(sc.ly + (r + m.wall) * sn / m.resolution);
+      if (!egrid::is_closed_form_line(sc.x1, sc.y1, x2, y2)) {
+        // Degenerate line (a range of -inf): one lane walks it sequentially.
+        if (lane == 0) {
+          bool stop = false;
+          egrid::walk_line(sc.x1, sc.y1, x2, y2, m.table_size, [&](int cx, int cy, int) {
+            add_evidence(m, cx, cy, sc.x1, sc.y1, r, adder, &updates, &stop);
+            return !stop;
+          });
+        }
+        continue;
+      }
+      const egrid::LineParams p = egrid::line_params(sc.x1, sc.y1, x2, y2);
+      walk_closed_form(m, increments, p, sc.x1, sc.y1, r, lane, adder, &updates);
+    }
     if (use_window) {  // updated cells lie inside the grid; the others hold 0
       __syncthreads();
       for (int i = threadIdx.x; i < kWindow * kWindow; i += blockDim.x) {
@@ -266,13 +253,6 @@ __global__ void from_prob_kernel(KernelModel<float> m, const float *probs, unsig
   }
 }
 
-// Scans per window (VASCO_CUDA_WINDOW_SCANS, 1 to 64, for measuring it).
-int scans_per_window() {
-  const char *v = std::getenv("VASCO_CUDA_WINDOW_SCANS");
-  const int n = v ? std::atoi(v) : 4;
-  return std::max(1, std::min(n, 64));
-}
-
 unsigned fill_blocks(size_t n) { return static_cast<unsigned>(std::min<size_t>((n + 255) / 256, 65536)); }
 
 }  // namespace
@@ -319,13 +299,8 @@ void launch_float_map(const KernelModel<float> &m, const int2 *increments, bool 
   // A full render has thousands of scans: a block each. An insert of a few
   // scans splits each over up to 48 blocks (a warp per beam either way).
   const int parts = num_scans >= 1024 ? 1 : std::min(48, (1024 + num_scans - 1) / num_scans);
-  // The window pays off over whole scans; a block with a slice of one (an
-  // insert) adds straight to the grid.
-  window = window && parts == 1;
-  const int group = window ? scans_per_window() : 1;
-  const int blocks = (num_scans + group - 1) / group * parts;
-  float_map_kernel<<<blocks, kWarpsPerBlock * 32, 0, stream>>>(m, increments, window, scans, num_scans, group,
-                                                               parts, ranges, sums, counters);
+  float_map_kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, increments, window, scans, num_scans,
+                                                                           parts, ranges, sums, counters);
   VG_CUDA_CHECK_LAUNCH();
 }
 
