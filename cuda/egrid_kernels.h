@@ -182,11 +182,9 @@ void launch_float_from_prob(const KernelModel<float> &m, const float *probs, uns
 
 // Adds every beam's log-odds evidence to `sums` (integer atomics: no update
 // is lost, none depends on the order). `increments`: launch_float_tables'
-// tables, or null to compute every update in full; `window`: sum the cells
-// next to each scan's start in shared memory first (the same bits, fewer
-// global atomics). counters: beams used, beams skipped, cell updates.
-void launch_float_map(const KernelModel<float> &m, const int2 *increments, bool window, const FloatScan *scans,
-                      int num_scans,
+// tables, or null to compute every update in full. counters: beams used,
+// beams skipped, cell updates.
+void launch_float_map(const KernelModel<float> &m, const int2 *increments, const FloatScan *scans, int num_scans,
                       const float *ranges, unsigned long long *sums, unsigned long long *counters,
                       cudaStream_t stream);
 

@@ -48,29 +48,9 @@ __device__ __forceinline__ bool fixed_increment(const KernelModel<float> &m, flo
   return true;
 }
 
-// Cells within kWindow / 2 of a scan's start cell are crossed by many of
-// its beams (at 0.5 degrees apart, beams share cells up to ~115 cells out):
-// a block sums their updates in a shared-memory window and adds the window
-// to the grid once per scan, which saves global atomics, the kernel's
-// bound. Integer sums: the grid ends with the same bits either way.
-constexpr int kWindow = 64;
-
-struct FixedAdder {
-  unsigned long long *sums;
-  int size_y;
-  unsigned long long *window;  // null: every update straight to the grid
-  int wx0, wy0;                // the window's first cell
-
-  __device__ __forceinline__ void add(int cx, int cy, long long q) const {
-    const unsigned long long v = (static_cast<unsigned long long>(q) << kFixedCountBits) + 1ull;
-    const unsigned u = static_cast<unsigned>(cx - wx0), w = static_cast<unsigned>(cy - wy0);
-    if (window != nullptr && u < kWindow && w < kWindow) {
-      atomicAdd(window + u * kWindow + w, v);
-    } else {
-      atomicAdd(sums + static_cast<size_t>(cx) * size_y + cy, v);
-    }
-  }
-};
+__device__ __forceinline__ void add_fixed(unsigned long long *sums, size_t c, long long q) {
+  atomicAdd(sums + c, (static_cast<unsigned long long>(q) << kFixedCountBits) + 1ull);
+}
 
 // The distance of a cell i, j cells from the start, as the oracle's float
 // port has it (1e6 past the table: never updated).
@@ -82,14 +62,14 @@ __device__ __forceinline__ float float_distance(const KernelModel<float> &m, int
 // One update of (cx, cy), computed in full (degenerate lines); sets *stop
 // where the beam stops.
 __device__ __forceinline__ void add_evidence(const KernelModel<float> &m, int cx, int cy, int x1, int y1,
-                                             float r, const FixedAdder &adder, unsigned *count, bool *stop) {
+                                             float r, unsigned long long *sums, unsigned *count, bool *stop) {
   if (cx < 0 || cx >= m.size_x || cy < 0 || cy >= m.size_y) return;
   long long q;
   if (!fixed_increment(m, float_distance(m, abs(cx - x1), abs(cy - y1)), r, &q)) {
     *stop = true;
     return;
   }
-  adder.add(cx, cy, q);
+  add_fixed(sums, static_cast<size_t>(cx) * m.size_y + cy, q);
   ++*count;
 }
 
@@ -115,7 +95,7 @@ __global__ void float_tables_kernel(KernelModel<float> m, int2 *increments) {
 // same float distance); without, fixed_increment in full.
 __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, const int2 *increments,
                                                  const egrid::LineParams &p, int x1, int y1, float r, int lane,
-                                                 const FixedAdder &adder, unsigned *updates) {
+                                                 unsigned long long *sums, unsigned *updates) {
   // Cells beyond table_size steps are never updated (see oracle.h); cells
   // with d >= max are skipped, which equals the oracle's stop because d
   // never decreases along the walk.
@@ -144,7 +124,7 @@ __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, co
         update = fixed_increment(m, float_distance(m, abs(cx - x1), abs(cy - y1)), r, &q);
       }
       if (update) {
-        adder.add(cx, cy, q);
+        add_fixed(sums, static_cast<size_t>(cx) * m.size_y + cy, q);
         ++*updates;
       }
     }
@@ -158,10 +138,8 @@ __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, co
 }
 
 __global__ void __launch_bounds__(kWarpsPerBlock * 32)
-    float_map_kernel(KernelModel<float> m, const int2 *increments, bool use_window, const FloatScan *scans,
-                     int num_scans, int parts, const float *ranges, unsigned long long *sums,
-                     unsigned long long *counters) {
-  __shared__ unsigned long long window[kWindow * kWindow];
+    float_map_kernel(KernelModel<float> m, const int2 *increments, const FloatScan *scans, int num_scans, int parts,
+                     const float *ranges, unsigned long long *sums, unsigned long long *counters) {
   const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
   unsigned used = 0, skipped = 0, updates = 0;
   // `parts` blocks share a scan (several when a few scans are inserted, so
@@ -169,12 +147,6 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
   for (int sp = blockIdx.x; sp < num_scans * parts; sp += gridDim.x) {
     const FloatScan sc = scans[sp / parts];
     const int part = sp % parts;
-    const FixedAdder adder{sums, m.size_y, use_window ? window : nullptr, sc.x1 - kWindow / 2, sc.y1 - kWindow / 2};
-    if (use_window) {
-      __syncthreads();  // the previous scan's window is added
-      for (int i = threadIdx.x; i < kWindow * kWindow; i += blockDim.x) window[i] = 0;
-      __syncthreads();
-    }
     for (int b = part * kWarpsPerBlock + warp; b < sc.beam_count; b += kWarpsPerBlock * parts) {
       const float r = ranges[sc.beam_begin + b];
       if (!(r < 50.0f)) {
@@ -191,22 +163,14 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
         if (lane == 0) {
           bool stop = false;
           egrid::walk_line(sc.x1, sc.y1, x2, y2, m.table_size, [&](int cx, int cy, int) {
-            add_evidence(m, cx, cy, sc.x1, sc.y1, r, adder, &updates, &stop);
+            add_evidence(m, cx, cy, sc.x1, sc.y1, r, sums, &updates, &stop);
             return !stop;
           });
         }
         continue;
       }
       const egrid::LineParams p = egrid::line_params(sc.x1, sc.y1, x2, y2);
-      walk_closed_form(m, increments, p, sc.x1, sc.y1, r, lane, adder, &updates);
-    }
-    if (use_window) {  // updated cells lie inside the grid; the others hold 0
-      __syncthreads();
-      for (int i = threadIdx.x; i < kWindow * kWindow; i += blockDim.x) {
-        if (window[i] != 0)
-          atomicAdd(sums + static_cast<size_t>(adder.wx0 + i / kWindow) * m.size_y + (adder.wy0 + i % kWindow),
-                    window[i]);
-      }
+      walk_closed_form(m, increments, p, sc.x1, sc.y1, r, lane, sums, &updates);
     }
   }
   // counters: beams used, beams skipped, cell updates
@@ -291,16 +255,15 @@ void launch_float_tables(const KernelModel<float> &m, int2 *increments, cudaStre
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_float_map(const KernelModel<float> &m, const int2 *increments, bool window, const FloatScan *scans,
-                      int num_scans,
+void launch_float_map(const KernelModel<float> &m, const int2 *increments, const FloatScan *scans, int num_scans,
                       const float *ranges, unsigned long long *sums, unsigned long long *counters,
                       cudaStream_t stream) {
   if (num_scans <= 0) return;
   // A full render has thousands of scans: a block each. An insert of a few
   // scans splits each over up to 48 blocks (a warp per beam either way).
   const int parts = num_scans >= 1024 ? 1 : std::min(48, (1024 + num_scans - 1) / num_scans);
-  float_map_kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, increments, window, scans, num_scans,
-                                                                           parts, ranges, sums, counters);
+  float_map_kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, increments, scans, num_scans, parts, ranges,
+                                                                           sums, counters);
   VG_CUDA_CHECK_LAUNCH();
 }
 

@@ -72,8 +72,7 @@ uint64_t exact_pair_bound(const PlacedBeam *beams, size_t n, const std::vector<o
 }
 
 // VASCO_CUDA_NO_TABLES=1 computes every update in full, as grids too large
-// for the tables are, and (float mode) adds each straight to the grid: the
-// tests compare both ways bit for bit.
+// for the tables are: the tests compare both ways bit for bit.
 bool tables_disabled() {
   const char *v = std::getenv("VASCO_CUDA_NO_TABLES");
   return v != nullptr && *v != '\0' && std::string(v) != "0";
@@ -262,9 +261,8 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
                                 cudaMemcpyHostToDevice, stream_->get()));
   VG_CUDA_CHECK(cudaMemsetAsync(counters_.get(), 0, 3 * sizeof(unsigned long long), stream_->get()));
   e_up.record(stream_->get());
-  cuda::launch_float_map(kernel_model_of<float>(params_, geo_), float_tables(), !tables_disabled(),
-                         scan_records_.get(), static_cast<int>(n), ranges_.get(), sums_.get(), counters_.get(),
-                         stream_->get());
+  cuda::launch_float_map(kernel_model_of<float>(params_, geo_), float_tables(), scan_records_.get(),
+                         static_cast<int>(n), ranges_.get(), sums_.get(), counters_.get(), stream_->get());
   e_map.record(stream_->get());
   reserve(staging_counters_, 3);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), counters_.get(), 3 * sizeof(unsigned long long),
