@@ -114,86 +114,105 @@ void print_info(const std::string &path, const carmen::MapFile &m) {
   if (offlimits > 0) std::printf("off-limits cells: %zu\n", offlimits);
 }
 
-}  // namespace
-
-int main(int argc, char **argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
-  bool info = false;
-  bool mode_given = false;
+// The command line, parsed.
+struct Args {
+  bool info = false, mode_given = false, help = false;
   carmen::PgmMode mode = carmen::PgmMode::Trinary;
   std::vector<std::string> files;
+};
+
+// Parses argv into *a; returns 0, or usage_error's code.
+int parse_args(const std::vector<std::string> &args, Args *a) {
   for (size_t i = 0; i < args.size(); ++i) {
-    const std::string &a = args[i];
-    if (a == "--help" || a == "-h") {
-      std::fputs(kUsage, stdout);
+    const std::string &s = args[i];
+    if (s == "--help" || s == "-h") {
+      a->help = true;
       return 0;
-    } else if (a == "--info") {
-      info = true;
-    } else if (a == "--mode" || a.rfind("--mode=", 0) == 0) {
+    } else if (s == "--info") {
+      a->info = true;
+    } else if (s == "--mode" || s.rfind("--mode=", 0) == 0) {
       std::string value;
-      if (a == "--mode") {
+      if (s == "--mode") {
         if (i + 1 >= args.size()) return usage_error("--mode needs a value");
         value = args[++i];
       } else {
-        value = a.substr(7);
+        value = s.substr(7);
       }
-      if (!carmen::parse_pgm_mode(value, &mode)) {
+      if (!carmen::parse_pgm_mode(value, &a->mode)) {
         return usage_error("unknown --mode '" + value + "' (trinary, scale or raw)");
       }
-      mode_given = true;
-    } else if (a == "--") {
-      files.insert(files.end(), args.begin() + static_cast<long>(i) + 1, args.end());
+      a->mode_given = true;
+    } else if (s == "--") {
+      a->files.insert(a->files.end(), args.begin() + static_cast<long>(i) + 1, args.end());
       break;
-    } else if (a.size() > 1 && a[0] == '-') {
-      return usage_error("unknown option '" + a + "'");
+    } else if (s.size() > 1 && s[0] == '-') {
+      return usage_error("unknown option '" + s + "'");
     } else {
-      files.push_back(a);
+      a->files.push_back(s);
     }
   }
+  return 0;
+}
 
-  if (info) {
-    if (files.size() != 1) return usage_error("--info takes one map file");
-    if (mode_given) return usage_error("--mode applies to .pgm output, not --info");
-  } else if (files.size() != 2) {
-    return usage_error(files.empty() ? "no files given" : "expected IN and OUT");
+// Checks the files and options go together; sets *kind for a conversion.
+// Returns 0, or usage_error's code.
+int check_args(const Args &a, OutKind *kind) {
+  if (a.info) {
+    if (a.files.size() != 1) return usage_error("--info takes one map file");
+    if (a.mode_given) return usage_error("--mode applies to .pgm output, not --info");
+    return 0;
   }
+  if (a.files.size() != 2) return usage_error(a.files.empty() ? "no files given" : "expected IN and OUT");
+  *kind = kind_of(a.files[1]);
+  if (*kind == OutKind::None) {
+    return usage_error("cannot tell the output format of '" + a.files[1] + "' (use .map, .map.gz, .pgm or .png)");
+  }
+  if (a.mode_given && *kind != OutKind::Pgm) return usage_error("--mode applies to .pgm output only");
+  return 0;
+}
 
+// Writes map m, read from `in`, to `out` in the format `kind`.
+void convert(const std::string &in, const carmen::MapFile &m, const std::string &out, OutKind kind,
+             carmen::PgmMode mode) {
+  if (kind == OutKind::Map) {
+    carmen::write_map_file(out, m);
+    if (m.unknown_chunks > 0) {
+      std::fprintf(stderr, "mapconvert: note: %d chunk(s) of %s not copied (HMAP, unknown or repeated)\n",
+                   m.unknown_chunks, in.c_str());
+    }
+    return;
+  }
+  if (!m.gridmap) throw carmen::FileError(in, "has no GRIDMAP chunk: there is no image to make");
+  if (kind == OutKind::Pgm) {
+    carmen::write_pgm_with_yaml(out, *m.gridmap, m.offset.value_or(carmen::GlobalOffset{}), mode);
+  } else {
+    carmen::write_png(out, *m.gridmap);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  Args a;
+  if (const int rc = parse_args(std::vector<std::string>(argv + 1, argv + argc), &a)) return rc;
+  if (a.help) {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
   OutKind kind = OutKind::None;
-  if (!info) {
-    kind = kind_of(files[1]);
-    if (kind == OutKind::None) {
-      return usage_error("cannot tell the output format of '" + files[1] +
-                         "' (use .map, .map.gz, .pgm or .png)");
-    }
-    if (mode_given && kind != OutKind::Pgm) return usage_error("--mode applies to .pgm output only");
-  }
-
+  if (const int rc = check_args(a, &kind)) return rc;
   try {
-    const carmen::MapFile m = carmen::read_map_file(files[0]);
-    if (info) {
-      print_info(files[0], m);
-      return 0;
-    }
-    const std::string &out = files[1];
-    if (kind == OutKind::Map) {
-      carmen::write_map_file(out, m);
-      if (m.unknown_chunks > 0) {
-        std::fprintf(stderr, "mapconvert: note: %d chunk(s) of %s not copied (HMAP, unknown or repeated)\n",
-                     m.unknown_chunks, files[0].c_str());
-      }
+    const carmen::MapFile m = carmen::read_map_file(a.files[0]);
+    if (a.info) {
+      print_info(a.files[0], m);
     } else {
-      if (!m.gridmap) throw carmen::FileError(files[0], "has no GRIDMAP chunk: there is no image to make");
-      if (kind == OutKind::Pgm) {
-        carmen::write_pgm_with_yaml(out, *m.gridmap, m.offset.value_or(carmen::GlobalOffset{}), mode);
-      } else {
-        carmen::write_png(out, *m.gridmap);
-      }
+      convert(a.files[0], m, a.files[1], kind, a.mode);
     }
     return 0;
   } catch (const carmen::FileError &e) {
     std::fprintf(stderr, "mapconvert: %s\n", e.what());
   } catch (const std::exception &e) {
-    std::fprintf(stderr, "mapconvert: %s: %s\n", files[0].c_str(), e.what());
+    std::fprintf(stderr, "mapconvert: %s: %s\n", a.files[0].c_str(), e.what());
   }
   return 1;
 }
