@@ -8,7 +8,7 @@ CMAKE_FLAGS ?=
 GOLDEN_DIR ?= ../shared/golden
 GOLDEN_DATA ?= ../shared/data
 
-.PHONY: all configure test test-sanitize fuzz fuzz-smoke golden demo bench install deps clean
+.PHONY: all configure test test-sanitize fuzz fuzz-smoke golden demo bench bench-peers install deps clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -70,6 +70,15 @@ bench: all
 	$(BUILD)/bin/oracle_o2_bench
 	$(BUILD)/bin/mapping_bench
 	$(BUILD)/bin/session_bench
+
+# Our CPU backends beside MRPT's COccupancyGridMap2D and OctoMap's OcTree on the same logs and poses.
+# Needs the optional packages libmrpt-maps-dev and liboctomap-dev (neither `make deps` nor CI installs
+# them; without them the peers' rows say "not built"). The re-configure finds them when they were
+# installed after $(BUILD) was first configured.
+bench-peers: all
+	@cmake -S . -B $(BUILD) > /dev/null
+	cmake --build $(BUILD) -j $(JOBS) --target peer_bench
+	$(BUILD)/bin/peer_bench
 
 # Installs what is missing through apt-get (Debian/Ubuntu; needs root or
 # sudo); a no-op when everything is there. Every build runs it first.

@@ -30,6 +30,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_support.h"
 #include "carmen_compat/map_file.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/cpu_threads_backend.h"
@@ -45,25 +46,14 @@
 
 namespace {
 
+using bench::bench_datasets;
+using bench::bench_param_sets;
+using bench::Dataset;
+using bench::median;
+using bench::now_s;
+using bench::ParamSet;
+
 using Clock = std::chrono::steady_clock;
-
-double now_s() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-struct Dataset {
-  std::string name, path;
-};
-
-struct ParamSet {
-  std::string name;
-  vasco::MapperParams params;
-};
 
 struct BackendSpec {
   std::string label;
@@ -210,19 +200,6 @@ bool parse_options(int argc, char **argv, Options *o) {
   }
   if (o->threads <= 0) o->threads = vasco::hardware_threads();
   return true;
-}
-
-// The logs measured, fr079 first (the end-to-end section uses it).
-std::vector<Dataset> bench_datasets() {
-  const std::string src = VASCO_SOURCE_DIR;
-  return {{"fr079", src + "/logs/fr079-complete.gfs.log.gz"}, {"fr101", src + "/logs/fr101.carmen.log.gz"}};
-}
-
-// The parameter sets measured on every log.
-std::vector<ParamSet> bench_param_sets() {
-  vasco::MapperParams paper;
-  paper.range_max = 6.4;  // the paper's setting, at vasco's 2.5 cm cells
-  return {{"paper", paper}, {"vasco_default_raw", vasco::MapperParams{}}};
 }
 
 // Whether a GPU is usable, what it is (or why not), and how long the CUDA context took to start.

@@ -1,0 +1,528 @@
+// peer_bench — vasco's CPU backends beside two Debian-packaged occupancy mappers on the same CARMEN logs
+// and poses (`make bench-peers`): MRPT's mrpt::maps::COccupancyGridMap2D (libmrpt-maps-dev) and
+// OctoMap's octomap::OcTree (liboctomap-dev). Both are optional: without one, its rows say so.
+//
+// For each log (fr079-complete.gfs, fr101.carmen) and parameter set (mapping_bench's: paper = range_max
+// 6.4 m, vasco_default_raw = vasco's defaults; both at 2.5 cm) every mapper gets every scan in log order:
+// a warm-up, then N timed runs of the insertion alone, and the row is their median. The peers do not
+// implement CARMEN's sensor model (mrpt_grid and octomap_build say what differs), so a ratio compares the
+// cost of building a comparable map, not the same map; a sanity line per peer counts the cells its map
+// holds as occupied and as free beside cpu_double's, to show the maps cover the same ground.
+//
+//   peer_bench [--runs N] [--dataset fr079|fr101|all]
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "../bench_support.h"
+#include "vasco_gpu/backend.h"
+#include "vasco_gpu/cpu_threads_backend.h"
+#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/grid.h"
+#include "vasco_gpu/parallel.h"
+#include "vasco_gpu/params.h"
+#include "vasco_gpu/scan_batch.h"
+
+#if defined(VASCO_HAVE_MRPT)
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/poses/CPose3D.h>
+#endif
+#if defined(VASCO_HAVE_OCTOMAP)
+#include <octomap/OcTree.h>
+#endif
+
+namespace {
+
+using bench::bench_datasets;
+using bench::bench_param_sets;
+using bench::Dataset;
+using bench::median;
+using bench::now_s;
+using bench::ParamSet;
+
+const char *const kMrptLabel = "MRPT COccupancyGridMap2D";
+const char *const kOctomapLabel = "OctoMap OcTree";
+
+struct Options {
+  int runs = 3;
+  std::string dataset = "all";
+};
+
+// Cells of a map on either side of even odds; unknown cells (and any exactly at 0.5) are in neither.
+struct CellCounts {
+  uint64_t occupied = 0, free = 0;
+};
+
+// One table row; map_s < 0 when the mapper was not built (`missing` says what to install).
+struct Row {
+  std::string data, params, mapper, missing;
+  uint64_t scans = 0, beams = 0;
+  double map_s = -1;
+};
+
+// A peer's map beside cpu_double's, for the sanity lines.
+struct Sanity {
+  std::string data, params, mapper;
+  CellCounts peer, ours;
+};
+
+// What every mapper of one log and parameter set shares: the scans, parameters and our grid.
+struct Job {
+  std::string data, params;
+  vasco::MapperParams p;
+  vasco::ScanBatch batch;
+  vasco::GridGeometry geo;
+  int runs = 3;
+};
+
+struct Bench {
+  Options opt;
+  int threads = 1;
+  std::vector<Row> rows;
+  std::vector<Sanity> sanity;
+};
+
+// A beam the peers insert: one with a return. CARMEN skips ranges >= 50 m, NaN and +inf (egrid_math.h);
+// -inf, which CARMEN walks as a degenerate beam, has no sensible end point for a peer.
+[[maybe_unused]] bool has_return(float r) { return std::isfinite(r) && vasco::egrid::is_beam_used(r); }
+
+// A warm-up call of `run` (which times its own insertion and returns the seconds), then `runs` timed
+// calls: their median.
+double timed_median(int runs, const std::function<double()> &run) {
+  run();
+  std::vector<double> t;
+  for (int r = 0; r < runs; ++r) t.push_back(run());
+  return median(t);
+}
+
+Row make_row(const Job &job, const std::string &mapper) {
+  Row row;
+  row.data = job.data;
+  row.params = job.params;
+  row.mapper = mapper;
+  row.scans = job.batch.num_scans();
+  return row;
+}
+
+// The row of a peer this binary was built without.
+[[maybe_unused]] Row missing_row(const Job &job, const std::string &mapper, const std::string &package) {
+  Row row = make_row(job, mapper);
+  row.missing = "not built (install " + package + ")";
+  return row;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Our backends
+// ---------------------------------------------------------------------------------------------------------
+CellCounts count_ours(const std::vector<float> &cells) {
+  CellCounts c;
+  for (float v : cells) {
+    if (v == vasco::egrid::kUnknown) continue;
+    if (v > 0.5f) ++c.occupied;
+    else if (v < 0.5f) ++c.free;
+  }
+  return c;
+}
+
+// One of our backends: Backend::map on a fresh grid (its allocation included, as every CPU row of
+// mapping_bench). `counts`, when set, gets the cells of the last run's map.
+Row run_ours(const Job &job, const std::string &label, vasco::Backend &backend, CellCounts *counts) {
+  Row row = make_row(job, label);
+  vasco::MapStats stats;
+  std::vector<float> cells;
+  row.map_s = timed_median(job.runs, [&] {
+    stats = vasco::MapStats{};
+    const double t0 = now_s();
+    std::vector<float> out = backend.map(job.batch, job.p, job.geo, &stats);
+    const double t = now_s() - t0;
+    cells = std::move(out);  // the previous map is freed here, outside the timing
+    return t;
+  });
+  row.beams = stats.beams_used;
+  if (counts != nullptr) *counts = count_ours(cells);
+  return row;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// MRPT
+// ---------------------------------------------------------------------------------------------------------
+#if defined(VASCO_HAVE_MRPT)
+using mrpt::maps::COccupancyGridMap2D;
+
+// MRPT's per-beam updates as probabilities: its int8 log-odds step is 1/16 (CLogOddsGridMapLUT), a free
+// update adds max(1, p2l(freeness certainty)) steps and an occupied one subtracts 3 * max(1, p2l(occupancy
+// certainty)) (COccupancyGridMap2D_insert.cpp, MRPT 2.5).
+void mrpt_update_probs(const COccupancyGridMap2D::TInsertionOptions &io, double *p_occ, double *p_emp) {
+  const int occ = 3 * std::max(1, int(COccupancyGridMap2D::p2l(io.maxOccupancyUpdateCertainty)));
+  const int emp = std::max(1, int(COccupancyGridMap2D::p2l(io.maxFreenessUpdateCertainty)));
+  *p_occ = 1 / (1 + std::exp(-occ / 16.0));
+  *p_emp = 1 / (1 + std::exp(emp / 16.0));
+}
+
+// MRPT's insertion options as near ours as its model allows. What differs from CARMEN's model
+// (COccupancyGridMap2D_insert.cpp, "simple rays", MRPT 2.5):
+//  - a beam frees the cells from the laser to its end cell and marks that one cell occupied; CARMEN
+//    marks every cell from the hit to wall_size (0.2 m: 8 cells) behind it occupied;
+//  - the evidence is the same at every distance; CARMEN's fades to the prior from range_sure to range_max;
+//  - cells hold int8 log-odds in steps of 1/16 (Debian builds MRPT with 8-bit cells), saturating at
+//    +-127 steps, so the update is the nearest step to ours (mrpt_update_probs) and not exact; CARMEN
+//    keeps float probabilities updated in double odds;
+//  - MRPT multiplies the occupied update by 3: the occupancy certainty below is chosen so that 3 times
+//    its log-odds is log-odds(p_occ); the free update is log-odds(p_emp) through the freeness certainty;
+//  - like CARMEN, a beam longer than range_max frees the cells up to range_max and marks none (CARMEN's
+//    evidence there has faded to the prior), and a cell crossed by several beams of a scan is updated once
+//    per beam; there is no range_sure.
+void set_mrpt_options(const vasco::MapperParams &p, COccupancyGridMap2D::TInsertionOptions *io) {
+  const double logit_occ = std::log(p.p_occ / (1 - p.p_occ));
+  io->maxDistanceInsertion = float(p.range_max);
+  io->maxOccupancyUpdateCertainty = float(1 / (1 + std::exp(-logit_occ / 3)));
+  io->maxFreenessUpdateCertainty = float(1 - p.p_emp);
+  io->considerInvalidRangesAsFreeSpace = false;  // CARMEN skips beams without a return
+  io->wideningBeamsWithDistance = false;         // CARMEN traces one line per beam
+  io->decimation = 1;
+  io->useMapAltitude = false;
+}
+
+// A grid over our grid's world extent (allocated and cleared here, not in the timed loop).
+std::unique_ptr<COccupancyGridMap2D> mrpt_grid(const Job &job) {
+  const vasco::GridGeometry &g = job.geo;
+  // MRPT grows its grid (a copy of it, inside the timed loop) when an end point comes within 15 cells of
+  // an edge; 16 cells more on every side keep it at this size.
+  const double margin = 16 * g.resolution;
+  auto m = std::make_unique<COccupancyGridMap2D>(
+      float(g.world_x(0) - margin), float(g.world_x(g.size_x) + margin), float(g.world_y(0) - margin),
+      float(g.world_y(g.size_y) + margin), float(g.resolution));
+  set_mrpt_options(job.p, &m->insertionOptions);
+  return m;
+}
+
+// The scans as MRPT observations and robot poses, built once and not timed (our backends too get
+// the parsed batch).
+struct MrptScans {
+  std::vector<mrpt::obs::CObservation2DRangeScan> obs;
+  std::vector<mrpt::poses::CPose3D> poses;
+  uint64_t beams = 0;
+};
+
+MrptScans mrpt_scans(const vasco::ScanBatch &b) {
+  MrptScans m;
+  m.obs.resize(b.num_scans());
+  for (size_t s = 0; s < b.num_scans(); ++s) {
+    const int n = b.beams_in(s);
+    const float *r = b.ranges_of(s);
+    mrpt::obs::CObservation2DRangeScan &o = m.obs[s];
+    o.resizeScan(n);
+    // MRPT's insertion spaces n beams aperture / n apart from heading - aperture / 2 (rightToLeft; the
+    // mirror image otherwise): aperture = n |step| keeps our spacing, and the heading below puts its beam
+    // b on ours (it is our laser heading when the scan is symmetric about it, as MRPT assumes).
+    o.aperture = float(n * std::fabs(b.angle_step[s]));
+    o.rightToLeft = b.angle_step[s] >= 0;
+    o.maxRange = float(vasco::egrid::kLaserRangeLimit);
+    o.sensorPose = mrpt::poses::CPose3D();
+    for (int i = 0; i < n; ++i) {
+      const bool used = has_return(r[i]);
+      o.setScanRange(i, used ? r[i] : 0.0f);
+      o.setScanRangeValidity(i, used);
+      m.beams += used;
+    }
+    const double heading = b.theta[s] + b.first_angle[s] + 0.5 * n * b.angle_step[s];
+    m.poses.emplace_back(b.x[s], b.y[s], 0.0, heading, 0.0, 0.0);
+  }
+  return m;
+}
+
+// The grid stores the probability of being free (raw log-odds > 0: free; getCell gives 1 for free).
+CellCounts count_mrpt(const COccupancyGridMap2D &m) {
+  CellCounts c;
+  for (const auto v : m.getRawMap()) {
+    if (v < 0) ++c.occupied;
+    else if (v > 0) ++c.free;
+  }
+  return c;
+}
+
+// Every scan inserted into a grid allocated beforehand (the allocation is not timed).
+Row run_mrpt(const Job &job, CellCounts *counts) {
+  const MrptScans scans = mrpt_scans(job.batch);
+  Row row = make_row(job, kMrptLabel);
+  row.beams = scans.beams;
+  std::unique_ptr<COccupancyGridMap2D> last;
+  size_t refused = 0;
+  row.map_s = timed_median(job.runs, [&] {
+    last.reset();
+    auto m = mrpt_grid(job);
+    const unsigned size_x = m->getSizeX(), size_y = m->getSizeY();
+    const double t0 = now_s();
+    for (size_t s = 0; s < scans.obs.size(); ++s)
+      refused += !m->insertObservation(scans.obs[s], scans.poses[s]);
+    const double t = now_s() - t0;
+    if (m->getSizeX() != size_x || m->getSizeY() != size_y)
+      std::fprintf(stderr, "peer_bench: MRPT grew its grid during the run (timed)\n");
+    last = std::move(m);
+    return t;
+  });
+  if (refused > 0) std::fprintf(stderr, "peer_bench: MRPT refused %zu scans\n", refused);
+  *counts = count_mrpt(*last);
+  return row;
+}
+#endif  // VASCO_HAVE_MRPT
+
+// ---------------------------------------------------------------------------------------------------------
+// OctoMap
+// ---------------------------------------------------------------------------------------------------------
+#if defined(VASCO_HAVE_OCTOMAP)
+// The scans as point clouds of their end points and their laser positions, built once and not timed.
+// Positions are relative to the first scan's laser: at 2.5 cm the 16-level keys reach +-819 m about the
+// origin, and world coordinates of a log need not be small.
+struct OctoScans {
+  std::vector<octomap::Pointcloud> clouds;
+  std::vector<octomap::point3d> origins;
+  uint64_t beams = 0;
+};
+
+OctoScans octo_scans(const vasco::ScanBatch &b, const vasco::GridGeometry &g) {
+  OctoScans o;
+  o.clouds.resize(b.num_scans());
+  for (size_t s = 0; s < b.num_scans(); ++s) {
+    const double x = b.x[s] - g.x0, y = b.y[s] - g.y0;
+    const float *r = b.ranges_of(s);
+    octomap::Pointcloud &pc = o.clouds[s];
+    pc.reserve(b.beams_in(s));
+    for (int i = 0; i < b.beams_in(s); ++i) {
+      if (!has_return(r[i])) continue;
+      const double a = b.theta[s] + b.first_angle[s] + i * b.angle_step[s];
+      pc.push_back(float(x + r[i] * std::cos(a)), float(y + r[i] * std::sin(a)), 0.0f);
+      ++o.beams;
+    }
+    o.origins.emplace_back(float(x), float(y), 0.0f);
+  }
+  return o;
+}
+
+// Cells of the z = 0 layer: a leaf above the finest level (pruned) covers side x side of them.
+CellCounts count_octomap(const octomap::OcTree &tree) {
+  CellCounts c;
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    const uint64_t side = uint64_t(1) << (tree.getTreeDepth() - it.getDepth());
+    const double p = it->getOccupancy();
+    if (p > 0.5) c.occupied += side * side;
+    else if (p < 0.5) c.free += side * side;
+  }
+  return c;
+}
+
+// Every scan into an empty tree (OccupancyOcTreeBase::insertPointCloud, OctoMap 1.9.7). What differs from
+// CARMEN's model:
+//  - a 3-D octree (16 levels) rather than a 2-D grid; our scans fill the voxel layer z in [0, resolution);
+//  - per scan each voxel is updated at most once: the union of the beams' free voxels less the union of
+//    their end voxels (occupied wins); CARMEN updates a cell once per beam that crosses it, so the cells
+//    near the laser get hundreds of updates per scan there and one here;
+//  - one end voxel occupied, no wall behind it; the same evidence at every distance (no range_sure);
+//  - a beam longer than maxrange frees the voxels up to maxrange and marks none, as CARMEN's does;
+//  - float log-odds clamped to [0.12, 0.97] (its defaults, kept: the clamping is part of its model).
+// lazy_eval skips the inner nodes during the inserts; updateInnerOccupancy() then brings them up to date
+// once, as OctoMap's documentation recommends for speed (and it is timed).
+std::unique_ptr<octomap::OcTree> octomap_build(const Job &job, const OctoScans &scans, double *seconds) {
+  auto tree = std::make_unique<octomap::OcTree>(job.geo.resolution);
+  tree->setProbHit(job.p.p_occ);
+  tree->setProbMiss(job.p.p_emp);
+  const double t0 = now_s();
+  for (size_t s = 0; s < scans.clouds.size(); ++s)
+    tree->insertPointCloud(scans.clouds[s], scans.origins[s], job.p.range_max, /*lazy_eval=*/true);
+  tree->updateInnerOccupancy();
+  *seconds = now_s() - t0;
+  return tree;
+}
+
+Row run_octomap(const Job &job, CellCounts *counts) {
+  const OctoScans scans = octo_scans(job.batch, job.geo);
+  Row row = make_row(job, kOctomapLabel);
+  row.beams = scans.beams;
+  std::unique_ptr<octomap::OcTree> last;
+  row.map_s = timed_median(job.runs, [&] {
+    last.reset();  // the previous tree is freed outside the timing
+    double t = 0;
+    last = octomap_build(job, scans, &t);
+    return t;
+  });
+  *counts = count_octomap(*last);
+  return row;
+}
+#endif  // VASCO_HAVE_OCTOMAP
+
+// ---------------------------------------------------------------------------------------------------------
+// The benchmark
+// ---------------------------------------------------------------------------------------------------------
+// Both peers on one job: their rows and sanity lines, or the rows that say they were not built.
+void bench_peers(Bench *b, const Job &job, const CellCounts &ours) {
+  (void)ours;  // unused when neither peer is built
+#if defined(VASCO_HAVE_MRPT)
+  std::fprintf(stderr, "  %s ...\n", kMrptLabel);
+  CellCounts mrpt_cells;
+  b->rows.push_back(run_mrpt(job, &mrpt_cells));
+  b->sanity.push_back({job.data, job.params, kMrptLabel, mrpt_cells, ours});
+#else
+  b->rows.push_back(missing_row(job, kMrptLabel, "libmrpt-maps-dev"));
+#endif
+#if defined(VASCO_HAVE_OCTOMAP)
+  std::fprintf(stderr, "  %s ...\n", kOctomapLabel);
+  CellCounts octo_cells;
+  b->rows.push_back(run_octomap(job, &octo_cells));
+  b->sanity.push_back({job.data, job.params, kOctomapLabel, octo_cells, ours});
+#else
+  b->rows.push_back(missing_row(job, kOctomapLabel, "liboctomap-dev"));
+#endif
+}
+
+// One log with one parameter set: our three CPU backends, then the peers, on the same scans.
+void bench_param_set(Bench *b, const Dataset &ds, const ParamSet &ps) {
+  Job job;
+  job.data = ds.name;
+  job.params = ps.name;
+  job.p = ps.params;
+  job.runs = b->opt.runs;
+  vasco::LogLoadStats stats;
+  job.batch = vasco::load_scans(ds.path, job.p, carmen::LogReaderOptions{}, &stats);
+  job.geo = vasco::size_grid(job.batch, job.p);
+  std::fprintf(stderr, "%s / %s: %zu scans, grid %d x %d\n", ds.name.c_str(), ps.name.c_str(),
+               job.batch.num_scans(), job.geo.size_x, job.geo.size_y);
+  CellCounts ours;
+  std::fprintf(stderr, "  cpu_double, cpu_threads, cpu_float ...\n");
+  b->rows.push_back(run_ours(job, "cpu_double", *vasco::make_cpu_double_backend(), &ours));
+  b->rows.push_back(run_ours(job, "cpu_threads (" + std::to_string(b->threads) + ")",
+                             *vasco::make_cpu_threads_backend(b->threads), nullptr));
+  b->rows.push_back(run_ours(job, "cpu_float", *vasco::make_cpu_float_backend(), nullptr));
+  bench_peers(b, job, ours);
+}
+
+// Parses the command line into *o; false, after the usage line on stderr, for anything it does not know.
+bool parse_options(int argc, char **argv, Options *o) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--runs" && i + 1 < argc) {
+      o->runs = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--dataset" && i + 1 < argc) {
+      o->dataset = argv[++i];
+    } else {
+      std::fprintf(stderr, "usage: peer_bench [--runs N] [--dataset fr079|fr101|all]\n");
+      return false;
+    }
+  }
+  if (o->dataset != "all" && o->dataset != "fr079" && o->dataset != "fr101") {
+    std::fprintf(stderr, "peer_bench: --dataset %s: expected fr079, fr101 or all\n", o->dataset.c_str());
+    return false;
+  }
+  return true;
+}
+
+std::string ms(double s) {
+  char b[32];
+  std::snprintf(b, sizeof b, s < 1 ? "%.1f" : "%.0f", s * 1e3);
+  return b;
+}
+
+std::string ratio(double base, double t) {
+  if (base <= 0 || t <= 0) return "-";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f", base / t);
+  return b;
+}
+
+// The map time of the row of `mapper` (a prefix of its label) on the same data and parameters.
+double time_of(const std::vector<Row> &rows, const Row &r, const std::string &mapper) {
+  for (const Row &o : rows)
+    if (o.data == r.data && o.params == r.params && o.mapper.rfind(mapper, 0) == 0) return o.map_s;
+  return -1;
+}
+
+void print_header(const Bench &b) {
+  std::printf("vasco_gpu peer_bench: median of %d runs after a warm-up; CPU threads: %d\n", b.opt.runs,
+              b.threads);
+#if defined(VASCO_HAVE_MRPT)
+  std::printf("MRPT %s (libmrpt-maps-dev)", VASCO_MRPT_VERSION);
+#else
+  std::printf("MRPT: not built");
+#endif
+#if defined(VASCO_HAVE_OCTOMAP)
+  std::printf("; OctoMap %s (liboctomap-dev)\n\n", VASCO_OCTOMAP_VERSION);
+#else
+  std::printf("; OctoMap: not built\n\n");
+#endif
+}
+
+void print_table(const std::vector<Row> &rows) {
+  std::printf("| data | params | mapper | scans | beams inserted | map ms | × cpu_double "
+              "| × cpu_threads |\n");
+  std::printf("|---|---|---|--:|--:|--:|--:|--:|\n");
+  for (const Row &r : rows) {
+    if (r.map_s < 0) {
+      std::printf("| %s | %s | %s | - | - | %s | - | - |\n", r.data.c_str(), r.params.c_str(),
+                  r.mapper.c_str(), r.missing.c_str());
+      continue;
+    }
+    std::printf("| %s | %s | %s | %llu | %llu | %s | %s | %s |\n", r.data.c_str(), r.params.c_str(),
+                r.mapper.c_str(), (unsigned long long)r.scans, (unsigned long long)r.beams,
+                ms(r.map_s).c_str(), ratio(time_of(rows, r, "cpu_double"), r.map_s).c_str(),
+                ratio(time_of(rows, r, "cpu_threads"), r.map_s).c_str());
+  }
+  std::printf("\nmap ms: the insertion of every scan alone (ours: Backend::map on a fresh grid; MRPT: "
+              "insertObservation into a grid allocated beforehand; OctoMap: insertPointCloud into an empty "
+              "tree, then updateInnerOccupancy). × = cpu_double's (cpu_threads') time / this row's: bigger "
+              "is faster.\n"
+              "Not the same map: CARMEN (ours) updates every cell of every beam, with a 0.2 m occupied wall "
+              "behind the hit and evidence fading from range_sure to range_max; MRPT marks one end cell, "
+              "constant evidence, int8 log-odds; OctoMap updates each voxel at most once per scan (a 3-D "
+              "octree, one z layer used), one end voxel, clamped log-odds.\n");
+}
+
+void print_sanity(const std::vector<Sanity> &sanity) {
+  if (sanity.empty()) return;
+  std::printf("\nSanity (2.5 cm cells; occupied: p > 0.5, free: p < 0.5; OctoMap: voxels of the z = 0 "
+              "layer):\n");
+  for (const Sanity &s : sanity)
+    std::printf("  %s / %s: %s %llu occupied, %llu free; cpu_double %llu occupied, %llu free\n",
+                s.data.c_str(), s.params.c_str(), s.mapper.c_str(), (unsigned long long)s.peer.occupied,
+                (unsigned long long)s.peer.free, (unsigned long long)s.ours.occupied,
+                (unsigned long long)s.ours.free);
+  std::printf("  (cpu_double's occupied cells include CARMEN's 0.2 m wall behind every hit; the peers mark "
+              "one cell per hit)\n");
+#if defined(VASCO_HAVE_MRPT)
+  const vasco::MapperParams p;
+  COccupancyGridMap2D::TInsertionOptions io;
+  set_mrpt_options(p, &io);
+  double p_occ = 0, p_emp = 0;
+  mrpt_update_probs(io, &p_occ, &p_emp);
+  std::printf("  MRPT's per-beam update, the nearest its int8 log-odds allow: occupied p = %.3f, "
+              "free p = %.3f (ours: p_occ %.2f, p_emp %.2f)\n", p_occ, p_emp, p.p_occ, p.p_emp);
+#endif
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  Bench b;
+  if (!parse_options(argc, argv, &b.opt)) return 2;
+  b.threads = vasco::hardware_threads();
+  print_header(b);
+  for (const Dataset &ds : bench_datasets()) {
+    if (b.opt.dataset != "all" && ds.name != b.opt.dataset) continue;
+    if (access(ds.path.c_str(), R_OK) != 0) {
+      std::printf("%s: %s not found, skipped\n", ds.name.c_str(), ds.path.c_str());
+      continue;
+    }
+    for (const ParamSet &ps : bench_param_sets()) bench_param_set(&b, ds, ps);
+  }
+  print_table(b.rows);
+  print_sanity(b.sanity);
+  return 0;
+}
