@@ -138,5 +138,31 @@ TEST_F(MapperCuda, TablesChangeNoBitInEitherMode) {
   }
 }
 
+// Float mode sums in fixed point: a log whose beams could push a cell past
+// its range (here: evidence 0.999999, 13.8 log-odds a beam, so about 300,000
+// beams) is refused before anything changes, by insert and by render alike.
+TEST_F(MapperCuda, FloatRefusesBeamsPastItsFixedPointRangeAndChangesNothing) {
+  MapperParams sharp = params_;
+  sharp.p_occ = 0.999999;
+  Mapper m(sharp, "cuda", mode(CudaMode::Float));
+  m.insert(scans_.select(0, 100));
+  const std::vector<float> before = m.read();
+  const std::vector<Pose> poses = m.poses();
+  ScanBatch many;
+  for (int rep = 0; rep < 1000; ++rep)
+    many.add_scan(scans_.x[0], scans_.y[0], scans_.theta[0], scans_.first_angle[0], scans_.angle_step[0],
+                  scans_.ranges_of(0), scans_.beams_in(0), rep + 1);
+  try {
+    m.insert(many);
+    FAIL() << "inserting " << many.num_beams() << " beams of evidence 0.999999 was accepted";
+  } catch (const std::runtime_error &e) {
+    EXPECT_NE(std::string(e.what()).find("fixed-point range"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(m.poses().size(), poses.size());
+  testing_support::expect_bit_identical(before, m.read(), m.frame(), "after the refused insert");
+  m.render(poses);  // still renders
+  testing_support::expect_bit_identical(before, m.read(), m.frame(), "after a render");
+}
+
 }  // namespace
 }  // namespace vasco

@@ -125,6 +125,7 @@ void Mapper::insert(const ScanBatch &scans) {
   extent.add(scans, 0, scans.num_scans());
   const GridGeometry geo = frame_for(extent, scans);  // throws before anything changes
   check_memory(geo, scans_.num_beams() + scans.num_beams());
+  renderer_->check_capacity(scans_.num_beams() + scans.num_beams());
   const size_t before = scans_.num_scans();
   for (size_t s = 0; s < scans.num_scans(); ++s)
     scans_.add_scan(scans.x[s], scans.y[s], scans.theta[s], scans.first_angle[s], scans.angle_step[s],
@@ -160,6 +161,7 @@ void Mapper::render(const std::vector<Pose> &poses) {
   try {
     geo = frame_for(extent, scans_);
     check_memory(geo, scans_.num_beams());
+    renderer_->check_capacity(scans_.num_beams());
   } catch (...) {  // the old poses stay
     x.swap(scans_.x);
     y.swap(scans_.y);

@@ -27,6 +27,7 @@
 #define VASCO_GPU_MAPPER_HPP
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -63,6 +64,10 @@ class Renderer {
   // A window of the full-resolution grid, x-major (cells[x * height + y]);
   // the window must lie inside the grid.
   virtual std::vector<float> read(const GridWindow &window) = 0;
+  // Throws, changing nothing, when a grid cannot hold `beams` beams applied
+  // since its reset (CUDA float mode's fixed-point range); the Mapper asks
+  // before it stores scans or poses. By default every count fits.
+  virtual void check_capacity(uint64_t beams) const { (void)beams; }
 };
 
 // The renderer of a backend name (cpu_double, cpu_threads, cpu_float, cuda,

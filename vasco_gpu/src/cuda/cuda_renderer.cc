@@ -107,26 +107,25 @@ void CudaRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
       check_fits((cells - sums_.size()) * sizeof(unsigned long long), "the evidence grid");
     reserve(sums_, cells);
     cuda::launch_float_clear(sums_.get(), cells, stream_->get());
-    fixed_bound_ = 0;
+    float_beams_ = 0;
+    fixed_base_ = 0;
   }
 }
 
-// Float mode: refuses, before any update, a batch that could carry a cell's
-// fixed-point sum past kFixedLimit (egrid_kernels.h). The largest increment
-// is at the evidence values themselves; vasco's defaults allow 2 x 10^7
-// beams, far beyond any log.
-void CudaRenderer::check_fixed_headroom(uint64_t beams) {
+// Float mode: refuses a grid whose beams could carry a cell's fixed-point
+// sum past kFixedLimit (egrid_kernels.h): a cell takes one update per beam at
+// most, of at most `step` log-odds. vasco's defaults allow 2 x 10^7 beams,
+// far beyond any log.
+void CudaRenderer::check_capacity(uint64_t beams) const {
+  if (exact()) return;
   auto logit = [](double p) { return std::log(p / (1 - p)); };
   const double step = std::max(std::fabs(logit(params_.p_occ) - logit(params_.p_prior)),
                                std::fabs(logit(params_.p_emp) - logit(params_.p_prior)));
-  const double bound = fixed_bound_ + static_cast<double>(beams) * step;
-  if (bound > cuda::kFixedLimit)
+  if (fixed_base_ + static_cast<double>(beams) * step > cuda::kFixedLimit)
     throw std::runtime_error("cuda float mode: " + std::to_string(beams) +
-                             " more beams could push a cell's log-odds past the fixed-point range "
-                             "(+-2^22); use the exact mode or a CPU backend for this log");
-  fixed_bound_ = bound;
+                             " beams could push a cell's log-odds past the fixed-point range (+-2^22); "
+                             "use the exact mode or a CPU backend for this log");
 }
-
 
 cuda::GridCells CudaRenderer::cells() const {
   cuda::GridCells c;
@@ -228,7 +227,8 @@ void CudaRenderer::apply_float(const ScanBatch &scans, size_t first, size_t last
   const auto t_prep = Clock::now();
   if (scans.beam_offset[last] > UINT32_MAX)
     throw std::runtime_error("cuda float mode: more than 2^32 beams stored");
-  check_fixed_headroom(scans.beam_offset[last] - scans.beam_offset[first]);
+  check_capacity(float_beams_ + (scans.beam_offset[last] - scans.beam_offset[first]));  // before any update
+  float_beams_ += scans.beam_offset[last] - scans.beam_offset[first];
   upload_ranges(scans, last);
   // Scan records of [first, last), placed with scan 0 fixing the start pose.
   oracle::GridFrame frame;
@@ -448,7 +448,7 @@ void CudaRenderer::upload_grid(const float *probabilities) {
   if (exact()) return;
   cuda::launch_float_from_prob(kernel_model_of<float>(params_, geo_), grid_.get(), sums_.get(), cells,
                                stream_->get());
-  fixed_bound_ = 1048576.0;  // from_prob's saturation
+  fixed_base_ = 1048576.0;  // from_prob's saturation
 }
 
 void CudaRenderer::forget_scans() { stored_beams_ = 0; }

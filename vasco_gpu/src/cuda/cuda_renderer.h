@@ -32,7 +32,7 @@ class CudaRenderer : public Renderer {
  private:
   bool exact() const { return options_.cuda_mode == CudaMode::Exact; }
   cuda::GridCells cells() const;
-  void check_fixed_headroom(uint64_t beams);
+  void check_capacity(uint64_t beams) const override;
   void build_tables();
   const int2 *float_tables();
   uint64_t exact_beams_per_launch() const;
@@ -51,9 +51,10 @@ class CudaRenderer : public Renderer {
   MapperParams params_;
   cuda::DeviceBuffer<float> grid_;                // exact mode: probabilities
   cuda::DeviceBuffer<unsigned long long> sums_;  // float mode: fixed-point log-odds sums
-  // Float mode: a bound on any cell's |log-odds sum| since the grid was
-  // cleared (one update per beam at most), against kFixedLimit.
-  double fixed_bound_ = 0;
+  // Float mode: beams applied since the reset, and the |log-odds| a cell
+  // could hold before them (uploaded probabilities saturate at 2^20).
+  uint64_t float_beams_ = 0;
+  double fixed_base_ = 0;
   // Float mode's increment tables (launch_float_tables), when small enough.
   cuda::DeviceBuffer<int2> increments_;
   bool float_tables_built_ = false;
