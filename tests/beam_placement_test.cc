@@ -1,7 +1,7 @@
 // Beam placement: the end cells place_beams derives without a cos and a sin
 // per beam are, beam for beam, the ones the oracle's beam_end computes with
 // the host's libm, on the bundled logs, on random scans, and on scans built
-// so that many beams end within 1e-12 of a cell border (where only the
+// so that many beams end within 1e-9 of a cell border (where only the
 // oracle's own rounding decides the cell).
 #include <gtest/gtest.h>
 
