@@ -4,25 +4,13 @@
 #include <ctime>
 
 #include "carmen/map_io.h"
+#include "carmen_map_free.h"
 #include "fuzz_support.h"
 
 namespace {
 
-void free_map(carmen_map_t &m) {
-  std::free(m.map);
-  std::free(m.complete_map);
-  std::free(m.config.map_name);
-}
-
-void free_hmap(carmen_hmap_t &h) {
-  for (int i = 0; i < h.num_zones; ++i) std::free(h.zone_names[i]);
-  for (int i = 0; i < h.num_links; ++i) {
-    std::free(h.links[i].keys);
-    std::free(h.links[i].points);
-  }
-  std::free(h.zone_names);
-  std::free(h.links);
-}
+using maptest::free_hmap;
+using maptest::free_map;
 
 void read_everything(const char *file, const char *name) {
   carmen_map_t map{};

@@ -9,9 +9,12 @@
 #include <string>
 
 #include "carmen/map_io.h"
+#include "carmen_map_free.h"
 #include "map_test_support.h"
 
 namespace {
+
+using maptest::free_hmap;
 
 using maptest::chunk;
 using maptest::f32;
@@ -40,16 +43,6 @@ struct Sample {
            points(door_points, 4) + i32(2) + i32(3) + i32(0) + i32(1) + i32(2) + points(lift_points, 3);
   }
 };
-
-void free_hmap(carmen_hmap_t &h) {
-  for (int i = 0; i < h.num_zones; ++i) std::free(h.zone_names[i]);
-  for (int i = 0; i < h.num_links; ++i) {
-    std::free(h.links[i].keys);
-    std::free(h.links[i].points);
-  }
-  std::free(h.zone_names);
-  std::free(h.links);
-}
 
 class MapIoHmap : public ::testing::TestWithParam<const char *> {
  protected:

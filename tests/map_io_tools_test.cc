@@ -14,9 +14,12 @@
 #include <vector>
 
 #include "carmen/map_io.h"
+#include "carmen_map_free.h"
 #include "map_test_support.h"
 
 namespace {
+
+using maptest::free_map;
 
 using maptest::chunk;
 using maptest::f32;
@@ -46,12 +49,6 @@ void write_map(const std::string &path, const std::string &bytes) {
 std::string content(const std::string &path) {
   return path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0 ? maptest::gunzip_file(path)
                                                                          : read_bytes(path);
-}
-
-void free_map(carmen_map_t &m) {
-  std::free(m.map);
-  std::free(m.complete_map);
-  std::free(m.config.map_name);
 }
 
 TEST(MapIoMacros, AreCarmensValues) {
