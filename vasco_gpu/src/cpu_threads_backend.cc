@@ -71,7 +71,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
-#include <tuple>
+#include <optional>
 
 #include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/oracle.h"
@@ -449,12 +449,9 @@ class CpuThreadsBackend : public Backend {
   // rebuilt only when the parameters change.
   void build_table(const MapperParams &params, int nt) {
     const int T = params.table_size();
-    const auto key = std::make_tuple(T, params.resolution, params.p_prior, params.p_occ, params.p_emp,
-                                     params.range_sure, params.range_max);
-    if (table_built_ && key == table_key_) return;
+    if (table_key_ == params.table_key()) return;
     table_.clear();
-    table_key_ = key;
-    table_built_ = true;
+    table_key_ = params.table_key();
     if (static_cast<int64_t>(T) * T > kMaxTableEntries || T <= 0) return;
     const egrid::SensorModel<double> model = params.sensor_model();
     table_.resize(static_cast<size_t>(T) * static_cast<size_t>(T));
@@ -478,8 +475,7 @@ class CpuThreadsBackend : public Backend {
 
   int threads_;
   std::vector<Entry> table_;
-  bool table_built_ = false;
-  std::tuple<int, double, double, double, double, double, double> table_key_;
+  std::optional<MapperParams::TableKey> table_key_;  // of table_, once built
   CpuThreadsLoad load_;
   bool has_load_ = false;
 };

@@ -4,6 +4,7 @@
 #define VASCO_GPU_PARAMS_H
 
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "vasco_gpu/egrid_math.h"
@@ -44,6 +45,13 @@ struct MapperParams {
   egrid::SensorModel<Real> sensor_model() const {
     return {static_cast<Real>(p_prior), static_cast<Real>(p_occ), static_cast<Real>(p_emp),
             static_cast<Real>(range_sure), static_cast<Real>(range_max)};
+  }
+
+  // What the backends' per-(i, j) distance and evidence tables depend on:
+  // a table built for one key serves every grid with the same key.
+  using TableKey = std::tuple<int, double, double, double, double, double, double>;
+  TableKey table_key() const {
+    return {table_size(), resolution, p_prior, p_occ, p_emp, range_sure, range_max};
   }
 
   // Number of distance-table entries per axis: (int)(range_max / resolution).
