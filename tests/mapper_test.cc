@@ -144,14 +144,47 @@ INSTANTIATE_TEST_SUITE_P(Backends, MapperExact,
                                            ExactCase{"cpu_threads_3", "cpu_threads", 3}),
                          [](const ::testing::TestParamInfo<ExactCase> &i) { return std::string(i.param.name); });
 
-TEST(MapperSession, CpuFloatInsertsEqualItsOneShot) {
-  // cpu_float applies the same float operations in the same order whether
-  // the scans come in one call or many: the same bytes.
+TEST(MapperSession, CpuFloatInsertsAreRepeatableAndNearItsOneShot) {
+  // cpu_float sums a call's updates in double log-odds and turns each
+  // touched cell back into a float probability once per call: a session of
+  // 22 inserts rounds a cell 22 times where one call rounds it once. So: the
+  // same bytes for the same inserts, the same cells known as in one call,
+  // and values within the rounding. Bound: a float probability p carries a
+  // log-odds error of at most ulp(p) / (2 p (1 - p)); for p in [0.01, 0.99]
+  // that is 2^-25 / 0.0099 < 3.1e-6 per rounding, 21 roundings more than in
+  // one call < 6.6e-5 in log-odds, so |dp| <= |dL| / 4 + two final roundings
+  // (2^-24) < 1.7e-5. (The double sums add < 1e-12.) A cell that left
+  // [0.01, 0.99] after some insert is outside the bound: near 0 and 1 a float
+  // holds few log-odds bits, and at exactly 0 or 1 it is pinned for good.
   const Fixture f = fr079(150);
-  Mapper m(f.params, "cpu_float");
-  for (size_t a = 0; a < f.scans.num_scans(); a += 7) m.insert(part(f.scans, a, std::min(a + 7, f.scans.num_scans())));
-  const auto one_shot = make_cpu_float_backend()->map(f.scans, f.params, m.frame(), nullptr);
-  testing_support::expect_bit_identical(one_shot, m.read(), m.frame(), "cpu_float incremental");
+  // A fixed frame: a growing one would re-render everything in one call.
+  const GridGeometry frame = size_grid(f.scans, f.params);
+  std::vector<bool> left_range(frame.num_cells(), false);
+  auto session = [&] {
+    Mapper m(f.params, frame, "cpu_float", BackendOptions{});
+    for (size_t a = 0; a < f.scans.num_scans(); a += 7) {
+      m.insert(part(f.scans, a, std::min(a + 7, f.scans.num_scans())));
+      const std::vector<float> now = m.read();
+      for (size_t c = 0; c < now.size(); ++c)
+        if (now[c] != egrid::kUnknown && (now[c] < 0.01f || now[c] > 0.99f)) left_range[c] = true;
+    }
+    return m.read();
+  };
+  const std::vector<float> inserted = session();
+  testing_support::expect_bit_identical(inserted, session(), frame, "cpu_float, the same inserts again");
+  const auto one_shot = make_cpu_float_backend()->map(f.scans, f.params, frame, nullptr);
+  ASSERT_EQ(one_shot.size(), inserted.size());
+  size_t known = 0, compared = 0, beyond = 0;
+  for (size_t c = 0; c < one_shot.size(); ++c) {
+    ASSERT_EQ(one_shot[c] == egrid::kUnknown, inserted[c] == egrid::kUnknown) << "cell " << c;
+    if (one_shot[c] == egrid::kUnknown) continue;
+    ++known;
+    if (left_range[c] || one_shot[c] < 0.01f || one_shot[c] > 0.99f) continue;
+    ++compared;
+    if (std::fabs(one_shot[c] - inserted[c]) > 1.7e-5f) ++beyond;
+  }
+  EXPECT_GT(compared, known / 2) << "the bound must cover most known cells to mean anything";
+  EXPECT_EQ(beyond, 0u) << "of " << compared << " cells in [0.01, 0.99]";
 }
 
 TEST(MapperSession, ReadsAWindowOfTheGrid) {

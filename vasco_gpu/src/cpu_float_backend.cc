@@ -1,15 +1,298 @@
-// cpu_float: the paper's CPU port — the oracle's loops in single precision
-// (float pose arithmetic and trig, a float distance table, the float odds
-// update). Measured against the oracle, never promised equal to it.
+// cpu_float: the fast single-core backend — the oracle's beams and cells,
+// evidence as float log-odds increments from a table, summed in double.
+// Measured against the oracle (DESIGN §4), never promised equal to it.
+//
+// Where the time goes in the oracle: per cell update, a sensor model (one
+// division), an odds factor (two) and the odds update (two more), all in
+// double. Here an update is a table load and an add:
+//  * Geometry is the oracle's: beam end cells from place_beams (the oracle's
+//    own code), the closed-form walk (egrid_math.h LineParams), and the
+//    free / occupied / stop decisions in double exactly as the oracle makes
+//    them. So cpu_float updates exactly the cells cpu_double updates.
+//  * Along a walk, i = |cx - x1| and j = |cy - y1| never decrease (see
+//    cpu_threads_backend.cc), so n = i*i + j*j never decreases, and the
+//    oracle's decisions depend on the cell only through d = sqrt(n) * res:
+//    free iff n < n_free(range), stop iff n >= n_stop. Both limits are found
+//    once per beam; the evidence is a table over (i, j) of log-odds
+//    increments logit(p) - logit(prior), rounded to float, for a free and for
+//    an occupied cell.
+//  * The odds update multiplies odds, so a cell's updates add in log-odds.
+//    They are summed per call in a double scratch over the box the call's
+//    scans can reach (double: as fast here, and the sum's rounding drops out
+//    of the error), then each touched cell is converted once.
+// What this changes against the oracle: increments rounded to float, one
+// rounding of the probability per call instead of one per update, and a cell
+// the oracle pins at exactly 1.0 (or 0.0) can come back (as in the CUDA float
+// mode). A map built in several calls rounds its probabilities once per
+// call: the same bytes for the same calls, not the bytes of one call.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/egrid_math.h"
-#include "vasco_gpu/oracle.h"
 
 namespace vasco {
 namespace {
+
+// The scratch's "never updated" mark: -0.0. Every increment is normalized
+// to never be -0.0 (x + 0.0f turns -0.0 into +0.0), and in round-to-nearest
+// a sum with a term other than -0.0 is never -0.0 (x + (-x) is +0.0), so a
+// touched cell can never hold it.
+constexpr uint64_t kUntouchedBits = uint64_t(1) << 63;
+const double kUntouched = -0.0;
+
+bool untouched(double v) {
+  uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return bits == kUntouchedBits;
+}
+
+// A probability's log-odds; +-inf at exactly 1 and 0 (the oracle's pinned cells).
+double logit(double p) { return std::log(p / (1.0 - p)); }
+
+// The evidence of an update: log-odds increments logit(p) - logit(prior) of
+// a free and of an occupied cell, by the cell's offsets (i, j) from the
+// start, and the limits of the oracle's decisions in n = i*i + j*j.
+class EvidenceTable {
+ public:
+  // Tables past this many (i, j) entries (8 bytes each) are not built: the
+  // walks then compute increments per update (only absurd range_max /
+  // resolution reach it).
+  static constexpr int64_t kMaxEntries = int64_t(1) << 21;
+
+  explicit EvidenceTable(const MapperParams &params)
+      : model_(params.sensor_model()),
+        res_(params.resolution),
+        inverse_res_(1.0 / params.resolution),
+        logit_prior_(logit(model_.prior)),
+        size_(params.table_size()) {
+    const int64_t t = size_;
+    // n of a cell of the walk is at most 2 (t - 1)^2: steps k < table_size.
+    const int64_t n_max = t > 0 ? 2 * (t - 1) * (t - 1) : 0;
+    n_stop_ = egrid::first_square_not_below(std::max(model_.sure, model_.max), res_, n_max);
+    if (t <= 0 || t * t > kMaxEntries) return;
+    free_.assign(static_cast<size_t>(t * t), 0.0f);
+    occ_.assign(static_cast<size_t>(t * t), 0.0f);
+    // Row j (the minor offset), column i (the major one): a walk reads a
+    // row left to right and moves down a row at a minor step. j <= i.
+    for (int64_t j = 0; j < t; ++j)
+      for (int64_t i = j; i < t && i * i + j * j < n_stop_; ++i) {
+        const size_t e = static_cast<size_t>(j * t + i);
+        free_[e] = increment(i * i + j * j, true);
+        occ_[e] = increment(i * i + j * j, false);
+      }
+  }
+
+  int size() const { return size_; }
+  int64_t n_stop() const { return n_stop_; }
+  bool tabulated() const { return !free_.empty(); }
+  // The increments at (major offset i, minor offset j) are column[j * size + i].
+  const float *column(bool free) const { return free ? free_.data() : occ_.data(); }
+
+  // The smallest n whose distance is not below `range` (capped at n_stop):
+  // the oracle's free test d < range is n < n_free(range).
+  int64_t n_free(double range) const {
+    if (!(range > 0)) return 0;
+    // A guess near the answer (about ceil((range / res)^2)), then the
+    // oracle's own comparison decides: one or two square roots per beam.
+    const double t = range * inverse_res_;
+    int64_t n = t * t < static_cast<double>(n_stop_) ? static_cast<int64_t>(t * t) + 1 : n_stop_;
+    while (n > 0 && !(distance(n - 1) < range)) --n;
+    while (n < n_stop_ && distance(n) < range) ++n;
+    return n;
+  }
+
+  // The increment at n < n_stop, computed.
+  float increment(int64_t n, bool free) const {
+    double p = model_.prior;  // n < n_stop: never refused
+    egrid::sensor_model(model_, distance(n), free ? HUGE_VAL : -HUGE_VAL, &p);
+    // |x| > 64 saturates a float probability anyway; the clamp keeps an
+    // evidence of exactly 0 or 1 a finite increment (no inf - inf later).
+    const double x = std::clamp(logit(p) - logit_prior_, -64.0, 64.0);
+    return static_cast<float>(x) + 0.0f;
+  }
+
+  double logit_prior() const { return logit_prior_; }
+
+ private:
+  double distance(int64_t n) const { return std::sqrt(static_cast<double>(n)) * res_; }
+
+  egrid::SensorModel<double> model_;
+  double res_, inverse_res_, logit_prior_;
+  int size_;
+  int64_t n_stop_ = 0;
+  std::vector<float> free_, occ_;
+};
+
+// The cells a call's scans can reach (every updated cell is fewer than
+// table_size steps from its scan's start cell).
+struct Box {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+  size_t cells() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
+};
+
+Box reach_of(const std::vector<oracle::ScanStart> &starts, int table_size, const GridGeometry &geo) {
+  int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
+  const int64_t r = std::max(table_size - 1, 0);
+  for (const auto &s : starts) {
+    x0 = std::min<int64_t>(x0, int64_t(s.x1) - r);
+    x1 = std::max<int64_t>(x1, int64_t(s.x1) + r);
+    y0 = std::min<int64_t>(y0, int64_t(s.y1) - r);
+    y1 = std::max<int64_t>(y1, int64_t(s.y1) + r);
+  }
+  Box b;
+  x0 = std::max<int64_t>(x0, 0), y0 = std::max<int64_t>(y0, 0);
+  x1 = std::min<int64_t>(x1, geo.size_x - 1), y1 = std::min<int64_t>(y1, geo.size_y - 1);
+  if (starts.empty() || x0 > x1 || y0 > y1) return b;
+  b.x0 = static_cast<int>(x0), b.y0 = static_cast<int>(y0);
+  b.width = static_cast<int>(x1 - x0 + 1), b.height = static_cast<int>(y1 - y0 + 1);
+  return b;
+}
+
+// A closed-form walk (egrid::LineParams) in box-relative terms: the steps
+// whose cell lies in the box are [k_first, k_last] (both coordinates move
+// monotonically), the remainder's steps, and how the scratch index moves
+// per major and per minor step. (A layout with the major axis contiguous
+// for every line, a transposed scratch for x-major lines, measured no
+// faster: the walk is bound by its instructions, not by memory.)
+struct WalkFrame {
+  int64_t k_first, k_last;
+  int64_t two_a, two_b;
+  ptrdiff_t major_step, minor_stride;
+};
+
+// The walk at step k: minor offset m(k) = floor((2bk + c) / 2a), c = a -
+// [inc < 0] (egrid::line_minor_offset), its remainder, n = k*k + m*m, the
+// cell's scratch index and its table index m * table_size + k.
+struct WalkState {
+  int64_t k, m, rem, n;
+  ptrdiff_t idx, entry;
+};
+
+// Offsets t in [lo, hi] with origin + step * t in [0, size) (step = +-1).
+void range_in(int64_t origin, int step, int64_t size, int64_t *lo, int64_t *hi) {
+  *lo = step > 0 ? -origin : origin - (size - 1);
+  *hi = step > 0 ? size - 1 - origin : origin;
+}
+
+int64_t floor_div(int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
+
+// The steps k >= 0 whose minor offset lies in [m_lo, m_hi]: m(k) never
+// decreases, and m(k) >= M  <=>  2bk >= 2aM - c.
+void steps_with_minor_in(const egrid::LineParams &p, int64_t m_lo, int64_t m_hi, int64_t *k_lo, int64_t *k_hi) {
+  const int64_t two_a = 2 * int64_t(p.a), two_b = 2 * int64_t(p.b), c = p.a - (p.inc < 0 ? 1 : 0);
+  if (m_lo > m_hi || (p.b == 0 && (m_lo > 0 || m_hi < 0))) {
+    *k_lo = 1, *k_hi = 0;
+    return;
+  }
+  if (p.b == 0) {  // m is 0 throughout
+    *k_lo = 0, *k_hi = INT64_MAX;
+    return;
+  }
+  *k_lo = -floor_div(-(two_a * m_lo - c), two_b);         // ceil((2a m_lo - c) / 2b)
+  *k_hi = -floor_div(-(two_a * (m_hi + 1) - c), two_b) - 1;  // last k with m(k) <= m_hi
+}
+
+// Whether every cell within `reach` steps of the start lies in the box: then
+// the whole walk does, and no division is needed to clip it.
+bool reach_inside(int64_t origin, int64_t reach, int64_t size) { return origin >= reach && origin + reach < size; }
+
+WalkFrame frame_of(const egrid::LineParams &p, int table_size, const Box &box, WalkState *w) {
+  const int minor_inc = p.flipped ? -p.inc : p.inc;
+  const int64_t bx = int64_t(p.x1) - box.x0, by = int64_t(p.y1) - box.y0;
+  const int64_t major0 = p.steep ? by : bx, minor0 = p.steep ? bx : by;
+  const int64_t major_size = p.steep ? box.height : box.width, minor_size = p.steep ? box.width : box.height;
+  const int64_t k_end = std::min(p.major_len, table_size - 1);
+  WalkFrame f;
+  const ptrdiff_t h = box.height;  // the scratch is [x][y], as the grid
+  f.major_step = p.steep ? p.inc : p.inc * h;
+  f.minor_stride = p.steep ? minor_inc * h : minor_inc;
+  f.two_a = 2 * static_cast<int64_t>(p.a);
+  f.two_b = 2 * static_cast<int64_t>(p.b);
+  f.k_first = 0;
+  f.k_last = k_end;
+  if (!reach_inside(major0, k_end, major_size) || !reach_inside(minor0, k_end, minor_size)) {
+    int64_t m_lo, m_hi, k_lo, k_hi;
+    range_in(major0, p.inc, major_size, &f.k_first, &f.k_last);
+    range_in(minor0, minor_inc, minor_size, &m_lo, &m_hi);
+    steps_with_minor_in(p, m_lo, m_hi, &k_lo, &k_hi);
+    f.k_first = std::max({f.k_first, k_lo, int64_t(0)});
+    f.k_last = std::min({f.k_last, k_hi, k_end});
+  }
+  // The state at k_first, in closed form.
+  const int64_t k = std::min<int64_t>(f.k_first, INT32_MAX);
+  const int64_t m = k == 0 ? 0 : egrid::line_minor_offset(p, static_cast<int>(k));
+  w->k = k;
+  w->m = m;
+  w->rem = f.two_b * k + p.a - (p.inc < 0 ? 1 : 0) - f.two_a * m;
+  w->n = k * k + m * m;
+  w->idx = bx * h + by + k * f.major_step + m * f.minor_stride;
+  w->entry = m * table_size + k;
+  return f;
+}
+
+// Walks while n < n_limit, adding the increments of `column` (free or
+// occupied); returns the number of updates. The hot loop: a table load, a
+// float add, integer steps (n grows by 2k + 1 per step and 2m + 1 per minor
+// step), and pointers rather than indices: it keeps every value in a register.
+uint64_t walk_until(const WalkFrame &f, int table_size, int64_t n_limit, const float *column, double *acc,
+                    WalkState *state) {
+  const int64_t k0 = state->k, k_last = f.k_last, two_a = f.two_a, two_b = f.two_b;
+  const ptrdiff_t major_step = f.major_step;
+  const ptrdiff_t minor_stride = f.minor_stride;
+  int64_t k = k0, m = state->m, rem = state->rem, n = state->n;
+  double *cell = acc + state->idx;
+  const float *inc = column + state->entry;
+  for (; k <= k_last && n < n_limit; ++k) {
+    *cell += *inc;
+    n += 2 * k + 1;
+    rem += two_b;
+    cell += major_step;
+    ++inc;
+    if (rem >= two_a) {
+      rem -= two_a;
+      n += 2 * m + 1;
+      ++m;
+      cell += minor_stride;
+      inc += table_size;
+    }
+  }
+  *state = {k, m, rem, n, cell - acc, inc - column};
+  return static_cast<uint64_t>(k - k0);
+}
+
+// Adds one closed-form beam's evidence to the scratch; returns its number
+// of updates: the free cells (n < n_free), then the occupied ones (n < n_stop).
+uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &p, const Box &box, int64_t n_free,
+                              double *acc) {
+  WalkState w;
+  const WalkFrame f = frame_of(p, ev.size(), box, &w);
+  if (f.k_first > f.k_last) return 0;
+  const uint64_t free = walk_until(f, ev.size(), n_free, ev.column(true), acc, &w);
+  return free + walk_until(f, ev.size(), ev.n_stop(), ev.column(false), acc, &w);
+}
+
+// A line the closed form does not cover (e.g. from a range of -inf), or a
+// table too large to build: the oracle's sequential walk, with its stop at a
+// cell past the table, and increments computed.
+uint64_t add_walked_beam(const EvidenceTable &ev, int x1, int y1, int x2, int y2, const GridGeometry &geo,
+                         const Box &box, int64_t n_free, double *acc) {
+  uint64_t updates = 0;
+  const int t = ev.size();
+  egrid::walk_beam_cells(x1, y1, x2, y2, t, geo.size_x, geo.size_y, [&](int cx, int cy, int i, int j) {
+    if (i < 0 || j < 0 || i >= t || j >= t) return false;  // kFarDistance: stops
+    const int64_t n = int64_t(i) * i + int64_t(j) * j;
+    if (n >= ev.n_stop()) return false;
+    acc[static_cast<size_t>(cx - box.x0) * box.height + static_cast<size_t>(cy - box.y0)] +=
+        ev.increment(n, n < n_free);
+    ++updates;
+    return true;
+  });
+  return updates;
+}
 
 class CpuFloatBackend : public Backend {
  public:
@@ -18,69 +301,67 @@ class CpuFloatBackend : public Backend {
   void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
              const GridGeometry &geo, float *cells, MapStats *stats) override {
     const auto t0 = std::chrono::steady_clock::now();
-    const int sx = geo.size_x, sy = geo.size_y;
-    const float res = static_cast<float>(params.resolution);
-    const float wall = static_cast<float>(params.wall_size);
-    const egrid::SensorModel<float> model = params.sensor_model<float>();
-    const int table_size = params.table_size();
-    // A float distance table, as the paper's port has, unless it would be huge
-    // (then the same sqrtf on the fly).
-    const bool tabulated = table_size <= oracle::kMaxBuiltDistanceTable;
-    std::vector<float> table(tabulated ? static_cast<size_t>(table_size) * table_size : 0);
-    for (int i = 0; i < (tabulated ? table_size : 0); ++i)
-      for (int j = 0; j < table_size; ++j)
-        table[static_cast<size_t>(i) * table_size + j] =
-            std::sqrt(static_cast<float>(i * i + j * j)) * res;
-
     MapStats st;
+    last = std::min(last, batch.num_scans());
+    first = std::min(first, last);
     st.scans = last - first;
-    if (first >= last) {
-      if (stats != nullptr) *stats = st;
-      return;
-    }
-    const float start_x = static_cast<float>(batch.x[0]) / res;
-    const float start_y = static_cast<float>(batch.y[0]) / res;
-    const float c = static_cast<float>(geo.theta_offset) - static_cast<float>(batch.theta[0]);
-    const float cos_c = std::cos(c), sin_c = std::sin(c);
-    for (size_t s = first; s < last; ++s) {
-      const float px = static_cast<float>(batch.x[s]), py = static_cast<float>(batch.y[s]);
-      const float xr = px * cos_c - py * sin_c;
-      const float yr = px * sin_c + py * cos_c;
-      const float lx = sx / 2.0f + (xr / res - start_x);
-      const float ly = sy / 2.0f + (yr / res - start_y);
-      const int x1 = egrid::trunc_to_int(std::floor(lx));
-      const int y1 = egrid::trunc_to_int(std::floor(ly));
-      float angle = static_cast<float>(batch.theta[s]) + c + static_cast<float>(batch.first_angle[s]);
-      const float step = static_cast<float>(batch.angle_step[s]);
-      const float *range = batch.ranges_of(s);
-      const int n = batch.beams_in(s);
-      for (int b = 0; b < n; ++b, angle += step) {
-        const float r = range[b];
-        if (!(r < 50.0f)) {
-          ++st.beams_skipped;
-          continue;
-        }
-        ++st.beams_used;
-        const int x2 = egrid::trunc_to_int(lx + (r + wall) * std::cos(angle) / res);
-        const int y2 = egrid::trunc_to_int(ly + (r + wall) * std::sin(angle) / res);
-        // The oracle's walk; the distance and the update in single precision.
-        egrid::walk_beam_cells(x1, y1, x2, y2, table_size, sx, sy, [&](int cx, int cy, int i, int j) {
-          const float d = (i >= table_size || j >= table_size || i < 0 || j < 0)
-                              ? static_cast<float>(egrid::kFarDistance)
-                          : tabulated ? table[static_cast<size_t>(i) * table_size + j]
-                                      : std::sqrt(static_cast<float>(i * i + j * j)) * res;
-          float p;
-          if (!egrid::sensor_model(model, d, r, &p)) return false;
-          float &cell = cells[static_cast<size_t>(cx) * sy + cy];
-          cell = egrid::odds_update_f(cell, model.prior, p);
-          ++st.cell_updates;
-          return true;
-        });
-      }
+    if (first < last) {
+      const PlacedBeams placed = place_beams(batch, geo, params, 1, first, last);
+      st.beams_used = placed.beams.size();
+      st.beams_skipped = placed.skipped;
+      const EvidenceTable &ev = table_for(params);
+      const Box box = reach_of(placed.starts, params.table_size(), geo);
+      scratch_.assign(box.cells(), kUntouched);
+      st.cell_updates = add_beams(placed, ev, geo, box);
+      merge(ev, box, geo, cells);
     }
     st.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (stats != nullptr) *stats = st;
   }
+
+ private:
+  const EvidenceTable &table_for(const MapperParams &params) {
+    if (!table_ || table_key_ != params.table_key()) {
+      table_ = std::make_unique<EvidenceTable>(params);
+      table_key_ = params.table_key();
+    }
+    return *table_;
+  }
+
+  uint64_t add_beams(const PlacedBeams &placed, const EvidenceTable &ev, const GridGeometry &geo, const Box &box) {
+    uint64_t updates = 0;
+    double *acc = scratch_.data();
+    for (const PlacedBeam &b : placed.beams) {
+      const oracle::ScanStart &s = placed.starts[b.scan];
+      const int64_t n_free = ev.n_free(static_cast<double>(b.range));
+      if (ev.tabulated() && egrid::is_closed_form_line(s.x1, s.y1, b.x2, b.y2)) {
+        updates += add_closed_form_beam(ev, egrid::line_params(s.x1, s.y1, b.x2, b.y2), box, n_free, acc);
+      } else {
+        updates += add_walked_beam(ev, s.x1, s.y1, b.x2, b.y2, geo, box, n_free, acc);
+      }
+    }
+    return updates;
+  }
+
+  // Each touched cell once: its log-odds (the prior's if unknown) plus the
+  // sum, back to a probability.
+  void merge(const EvidenceTable &ev, const Box &box, const GridGeometry &geo, float *cells) const {
+    const double lp = ev.logit_prior();
+    for (int x = 0; x < box.width; ++x) {
+      const double *acc = scratch_.data() + static_cast<size_t>(x) * box.height;
+      float *col = cells + static_cast<size_t>(box.x0 + x) * geo.size_y + box.y0;
+      for (int y = 0; y < box.height; ++y) {
+        if (untouched(acc[y])) continue;
+        const double before = col[y] == egrid::kUnknown ? lp : logit(col[y]);
+        const double odds = std::exp(before + acc[y]);
+        col[y] = static_cast<float>(1.0 - 1.0 / (1.0 + odds));
+      }
+    }
+  }
+
+  std::unique_ptr<EvidenceTable> table_;
+  MapperParams::TableKey table_key_{};
+  std::vector<double> scratch_;  // the call's sums over its box, [x][y]; kept for its allocation
 };
 
 }  // namespace
