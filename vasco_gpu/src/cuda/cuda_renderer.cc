@@ -144,14 +144,11 @@ void CudaRenderer::build_tables() {
   const int T = params_.table_size();
   const size_t t2 = static_cast<size_t>(std::max(T, 0)) * static_cast<size_t>(std::max(T, 0));
   use_tables_ = T > 0 && T <= cuda::kMaxExactTable && !tables_disabled();
-  const auto key = std::make_tuple(T, params_.resolution, params_.p_prior, params_.p_occ, params_.p_emp,
-                                   params_.range_sure, params_.range_max);
-  if (!use_tables_ || (tables_built_ && key == tables_key_)) return;
+  if (!use_tables_ || tables_key_ == params_.table_key()) return;
   reserve(factors_, t2);
   reserve(reach_, static_cast<size_t>(T));
   cuda::launch_exact_tables(kernel_model_of<double>(params_, geo_), factors_.get(), reach_.get(), stream_->get());
-  tables_key_ = key;
-  tables_built_ = true;
+  tables_key_ = params_.table_key();
 }
 
 // Float mode's increment tables for the current parameters (built when they
@@ -159,13 +156,10 @@ void CudaRenderer::build_tables() {
 const int2 *CudaRenderer::float_tables() {
   const int T = params_.table_size();
   if (T <= 0 || T > cuda::kMaxFloatTable || tables_disabled()) return nullptr;
-  const auto key = std::make_tuple(T, params_.resolution, params_.p_prior, params_.p_occ, params_.p_emp,
-                                   params_.range_sure, params_.range_max);
-  if (!float_tables_built_ || key != float_tables_key_) {
+  if (float_tables_key_ != params_.table_key()) {
     reserve(increments_, static_cast<size_t>(T) * static_cast<size_t>(T));
     cuda::launch_float_tables(kernel_model_of<float>(params_, geo_), increments_.get(), stream_->get());
-    float_tables_key_ = key;
-    float_tables_built_ = true;
+    float_tables_key_ = params_.table_key();
   }
   return increments_.get();
 }

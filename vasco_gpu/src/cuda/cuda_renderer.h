@@ -4,8 +4,8 @@
 #define VASCO_GPU_SRC_CUDA_RENDERER_H
 
 #include <memory>
+#include <optional>
 #include <string>
-#include <tuple>
 
 #include "cuda_check.h"
 #include "egrid_kernels.h"
@@ -57,16 +57,15 @@ class CudaRenderer : public Renderer {
   double fixed_base_ = 0;
   // Float mode's increment tables (launch_float_tables), when small enough.
   cuda::DeviceBuffer<int2> increments_;
-  bool float_tables_built_ = false;
-  std::tuple<int, double, double, double, double, double, double> float_tables_key_;
+  std::optional<MapperParams::TableKey> float_tables_key_;  // what they were built for
   // Float mode: the stored scans' ranges (append-only) and per-scan records.
   cuda::DeviceBuffer<float> ranges_;
   uint64_t stored_beams_ = 0;
   cuda::DeviceBuffer<cuda::FloatScan> scan_records_;
   cuda::DeviceBuffer<unsigned long long> counters_;
   // Exact mode: tables, beams and the tile lists' scratch.
-  bool use_tables_ = false, tables_built_ = false;
-  std::tuple<int, double, double, double, double, double, double> tables_key_;
+  bool use_tables_ = false;
+  std::optional<MapperParams::TableKey> tables_key_;  // what they were built for
   cuda::DeviceBuffer<double2> factors_;  // (free, occupied) odds factors
   cuda::DeviceBuffer<int> reach_;
   uint64_t exact_beams_ = 0;  // placed by place_exact_beams, in staging_beams_
