@@ -176,13 +176,21 @@ __device__ void mark_chunk(const LineRec *sh, int n, int tx0, int ty0, unsigned 
   int k_lo = backward ? L.sx1 - (maj0 + kTile - 1) : maj0 - L.sx1;
   const int k_hi = min(k_lo + kTile - 1, L.k_max);
   k_lo = max(k_lo, 0);
+  // The walk's minor offset m(k) = (2b k + bias) / 2a (egrid_math.h
+  // line_minor_offset; every operand is below 2^30, kClosedFormLimit):
+  // divided once at k_lo, then carried step by step with its remainder.
+  const int num0 = closed ? L.two_b * k_lo + L.bias : 0;
+  int m_next = closed ? num0 / L.two_a : 0, rem = closed ? num0 - m_next * L.two_a : 0;
   for (int step = 0; step < kTile; ++step) {
     const int k = k_lo + step;
+    const int m = m_next;
+    rem += L.two_b;
+    if (rem >= L.two_a) {
+      rem -= L.two_a;
+      ++m_next;
+    }
     int cell = -1;
     if (closed && k <= k_hi) {
-      // The walk's minor offset after k steps (egrid_math.h
-      // line_minor_offset); every operand is below 2^30 (kClosedFormLimit).
-      const int m = (L.two_b * k + L.bias) / L.two_a;
       int mn = backward ? L.sy1 - m : L.sy1 + m;
       if (flipped) mn = -mn;
       const int du = (backward ? L.sx1 - k : L.sx1 + k) - maj0, dv = mn - min0;
@@ -227,26 +235,57 @@ struct FixedPoints {
   }
 };
 
-// The updates beam L makes to (cx, cy) with the tables built: whether there
-// is one (distance below max_range) and its odds factor. Independent of the
-// cell's value, so a batch of them is loaded before the dependent chain.
-__device__ __forceinline__ bool tabled_factor(const KernelModel<double> &m, const LineRec &L, int cx, int cy,
-                                              const int *reach, const double2 *factors, double *f) {
+// What the tables say for a thread's cell seen from one start cell: whether
+// a beam from there updates it, i*i + j*j, and the two odds factors. A tile
+// whose list is long is one the robot stood near, so most of its beams start
+// in the cell the previous one did; the thread then needs no table load (the
+// latency of those loads, on the longest lists, bounded the kernel).
+struct StartFactors {
+  int x1 = INT_MIN, y1 = INT_MIN;
+  bool update = false;
+  int n = 0;
+  double free = 0, occ = 0;
+};
+
+// The tables' answer for (cx, cy) from the start of L.
+__device__ __forceinline__ StartFactors start_factors(const KernelModel<double> &m, const LineRec &L, int cx,
+                                                      int cy, const int *reach, const double2 *factors) {
+  StartFactors s;
+  s.x1 = L.x1;
+  s.y1 = L.y1;
   const int i = egrid::wrap_abs(egrid::wrap_sub(cx, L.x1));
   const int j = egrid::wrap_abs(egrid::wrap_sub(cy, L.y1));
   // i, j <= k <= table_size - 1: inside the tables.
-  if (j >= reach[i]) return false;  // the oracle stops the beam here: no update
+  s.update = j < reach[i];  // else the oracle stops the beam here: no update
   // distance < range, and distance < max_sure_range, through i*i + j*j
   // (egrid_math.h first_square_not_below): no distance load.
-  const int n = i * i + j * j;
-  const bool free = n < L.free_below;
-  if (n < m.n_sure) {
-    *f = free ? m.factor_free_near : m.factor_occ_near;
-  } else {
+  s.n = i * i + j * j;
+  if (s.n < m.n_sure) {
+    s.free = m.factor_free_near;
+    s.occ = m.factor_occ_near;
+  } else if (s.update) {
     const double2 fs = factors[static_cast<size_t>(i) * m.table_size + j];
-    *f = free ? fs.x : fs.y;
+    s.free = fs.x;
+    s.occ = fs.y;
   }
-  return true;
+  return s;
+}
+
+// The update beam L makes to (cx, cy) with the tables built: whether there
+// is one (distance below max_range) and its odds factor, from `known` when L
+// starts where it was computed for. Independent of the cell's value, so a
+// batch of them is loaded before the dependent chain; *fresh gets the
+// lookup when `known` did not serve.
+__device__ __forceinline__ bool tabled_factor(const KernelModel<double> &m, const LineRec &L, int cx, int cy,
+                                              const int *reach, const double2 *factors, const StartFactors &known,
+                                              StartFactors *fresh, double *f) {
+  if (L.x1 == known.x1 && L.y1 == known.y1) {
+    *f = known.n < L.free_below ? known.free : known.occ;
+    return known.update;
+  }
+  *fresh = start_factors(m, L, cx, cy, reach, factors);
+  *f = fresh->n < L.free_below ? fresh->free : fresh->occ;
+  return fresh->update;
 }
 
 // The same without tables (table_size above 2^11): everything on the fly.
@@ -269,12 +308,16 @@ __device__ __forceinline__ bool computed_factor(const KernelModel<double> &m, co
 // nothing are skipped. Returns the updates made (skipped ones included).
 __device__ __forceinline__ unsigned drain_hits(const KernelModel<double> &m, const LineRec *sh, unsigned long long h,
                                                int cx, int cy, const int *reach, const double2 *factors,
-                                               FixedPoints *fixed, float *cell) {
+                                               FixedPoints *fixed, StartFactors *known, float *cell) {
   constexpr int kBatch = 4;
   unsigned count = 0;
   while (h != 0) {
     double f[kBatch];
     bool update[kBatch];
+    // Lookups of one batch compare against `known` as it was at the batch's
+    // start, so that their loads stay independent; the last one done
+    // becomes `known` after it.
+    StartFactors fresh;
 #pragma unroll
     for (int u = 0; u < kBatch; ++u) {
       update[u] = false;
@@ -282,9 +325,10 @@ __device__ __forceinline__ unsigned drain_hits(const KernelModel<double> &m, con
       if (h == 0) continue;
       const int e = __ffsll(static_cast<long long>(h)) - 1;
       h &= h - 1;
-      update[u] = reach ? tabled_factor(m, sh[e], cx, cy, reach, factors, &f[u])
+      update[u] = reach ? tabled_factor(m, sh[e], cx, cy, reach, factors, *known, &fresh, &f[u])
                         : computed_factor(m, sh[e], cx, cy, &f[u]);
     }
+    if (fresh.x1 != INT_MIN) *known = fresh;
 #pragma unroll
     for (int u = 0; u < kBatch; ++u) {
       if (!update[u]) continue;
@@ -327,6 +371,7 @@ __global__ void __launch_bounds__(kTileThreads)
   float cell = active ? grid[static_cast<size_t>(cx) * m.size_y + cy] : egrid::kUnknown;
   unsigned count = 0;
   FixedPoints fixed;
+  StartFactors known;
   const uint32_t begin = tile_begin[tile], end = tile_end[tile];
   for (uint32_t base = begin; base < end; base += kTileThreads) {
     const int n = static_cast<int>(min(static_cast<uint32_t>(kTileThreads), end - base));
@@ -337,7 +382,7 @@ __global__ void __launch_bounds__(kTileThreads)
     __syncthreads();
     const unsigned long long mine =
         (static_cast<unsigned long long>(hit[2 * threadIdx.x + 1]) << 32) | hit[2 * threadIdx.x];
-    if (active) count += drain_hits(m, sh, mine, cx, cy, reach, factors, &fixed, &cell);
+    if (active) count += drain_hits(m, sh, mine, cx, cy, reach, factors, &fixed, &known, &cell);
     __syncthreads();
   }
   if (active) grid[static_cast<size_t>(cx) * m.size_y + cy] = cell;
