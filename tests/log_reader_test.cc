@@ -926,4 +926,57 @@ TEST(LogReaderParseLine, FastNumberPathMatchesStrtod) {
   }
 }
 
+// Ranges in and near the shapes read eight bytes at a time ("1.65",
+// "81.91", "4.1": one or two digits, '.', one or two digits, a separator),
+// with every kind of byte around them, through a FLASER line: each range is
+// strtod's value as a float, bit for bit, and a token that is not a number
+// makes the line bad.
+TEST(LogReaderParseLine, ShortRangesMatchStrtod) {
+  std::mt19937 rng(vasco::testing_support::test_seed(5));
+  const char kBytes[] = "0123456789.-+eE \t:x\xb1\x80/";
+  const char kDigits[] = "0123456789";
+  LogMessage m;
+  carmen::LineError err;
+  int good_lines = 0;
+  for (int it = 0; it < 4000; ++it) {
+    std::vector<std::string> tokens;
+    std::string line = "FLASER 40";
+    const int damaged = rng() % 2 ? static_cast<int>(rng() % 40) : -1;  // one odd byte in half the lines
+    for (int i = 0; i < 40; ++i) {
+      std::string t;
+      const int len = 1 + static_cast<int>(rng() % 7);
+      for (int k = 0; k < len; ++k) t += kDigits[rng() % 10];
+      if (len > 1 && rng() % 8 != 0) t[1 + rng() % std::min(2, len - 1)] = '.';  // d.d.., dd.d..
+      if (i == damaged) t[rng() % t.size()] = kBytes[rng() % (sizeof kBytes - 1)];
+      if (rng() % 10 == 0) t = "-" + t;
+      tokens.push_back(t);
+      line += (rng() % 6 == 0 ? "\t" : rng() % 6 == 0 ? "  " : " ") + t;
+    }
+    line += " 1 2 0.5 1 2 0.5 100.5 host 100.5";
+    tokens = tokenize(line).t;  // an odd byte may have been a separator
+    tokens.erase(tokens.begin(), tokens.begin() + 2);
+    tokens.resize(std::min<size_t>(tokens.size(), 40));
+    const bool all_numbers = tokenize(line).t.size() == 2 + 40 + 9 &&
+                             std::all_of(tokens.begin(), tokens.end(), [](const std::string &t) {
+                               char *end = nullptr;
+                               std::strtod(t.c_str(), &end);  // strtod reads hex, from_chars not
+                               return *end == '\0' && t.find_first_of("xX") == std::string::npos;
+                             });
+    const LineKind k = carmen::parse_log_line(line.data(), line.data() + line.size(), m, &err);
+    if (!all_numbers) {
+      EXPECT_EQ(k, LineKind::BAD) << line;
+      continue;
+    }
+    ASSERT_EQ(k, LineKind::MESSAGE) << line << ": " << err.message;
+    ASSERT_EQ(m.laser.range.size(), 40u);
+    for (int i = 0; i < 40; ++i) {
+      const float want = static_cast<float>(std::strtod(tokens[static_cast<size_t>(i)].c_str(), nullptr));
+      ASSERT_EQ(std::memcmp(&want, &m.laser.range[static_cast<size_t>(i)], 4), 0)
+          << "'" << tokens[static_cast<size_t>(i)] << "' in " << line;
+    }
+    ++good_lines;
+  }
+  EXPECT_GT(good_lines, 2000);
+}
+
 }  // namespace

@@ -1,4 +1,4 @@
-// Helpers shared by the map, image and mapconvert tests: temporary
+// Helpers shared by the map, image, mapconvert and gzip tests: temporary
 // directories, whole-file I/O and little-endian byte builders that do not use
 // the library under test.
 #ifndef VASCO_TESTS_MAP_TEST_SUPPORT_H
