@@ -1,7 +1,16 @@
-// cpu_double: the oracle. DESIGN §2 to the letter, through the same code
-// (oracle.h) as CARMEN's C API in egrid.cc.
+// cpu_double: the oracle. DESIGN §2 to the letter: every beam's updates are
+// oracle::trace_beam's (the code CARMEN's C API in egrid.cc runs), applied
+// in (scan, beam) order with the oracle's arithmetic. Ordinary beams take the
+// two-pass form of beam_updates.h (same bytes, about 1.8x faster on fr079:
+// the argument is in beam_updates.cc); degenerate ones (a range of -inf) and an
+// empty table go through oracle::trace_beam itself. Pass 1 reads no cell, and
+// a beam's updates are all applied before the next beam is walked, so every
+// cell still sees its updates in (scan, beam) order.
 #include <chrono>
+#include <optional>
+#include <vector>
 
+#include "beam_updates.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/oracle.h"
 
@@ -9,7 +18,8 @@ namespace vasco {
 namespace {
 
 // The distance table as egrid.c builds it, with row pointers (none above
-// oracle::kMaxBuiltDistanceTable: trace_beam then computes distances).
+// oracle::kMaxBuiltDistanceTable: trace_beam then computes distances); read
+// by oracle::trace_beam only.
 class DistanceTable {
  public:
   DistanceTable(int size, double resolution) : size_(size) {
@@ -29,6 +39,15 @@ class DistanceTable {
   std::vector<double *> rows_;
 };
 
+// What a parameter set fixes, built once (a mapping session calls apply()
+// for every few scans).
+struct Tables {
+  DistanceTable distances;
+  beam_updates::Evidence evidence;
+  explicit Tables(const MapperParams &p)
+      : distances(p.table_size(), p.resolution), evidence(p.sensor_model(), p.resolution, p.table_size()) {}
+};
+
 class CpuDoubleBackend : public Backend {
  public:
   std::string name() const override { return "cpu_double"; }
@@ -43,20 +62,28 @@ class CpuDoubleBackend : public Backend {
     frame.theta_offset = geo.theta_offset;
     // CARMEN's first update call records the start pose: that is scan 0's.
     if (first > 0 && batch.num_scans() > 0) oracle::scan_start(frame, batch.x[0], batch.y[0], batch.theta[0]);
-    const egrid::SensorModel<double> model = params.sensor_model();
-    if (table_.size() != params.table_size() || table_resolution_ != params.resolution) {
-      table_ = DistanceTable(params.table_size(), params.resolution);
-      table_resolution_ = params.resolution;
+    if (key_ != params.table_key()) {
+      tables_.emplace(params);
+      key_ = params.table_key();
     }
     MapStats st;
+    beam_updates::BeamUpdates updates(params.table_size());
     for (size_t s = first; s < last; ++s) {
-      const auto c = oracle::update_scan(
-          cells, frame, model, params.wall_size, table_.size(), table_.rows(), batch.x[s],
-          batch.y[s], batch.theta[s], batch.beams_in(s), batch.ranges_of(s),
-          oracle::SteppedAngles{batch.first_angle[s], batch.angle_step[s]});
-      st.beams_used += c.beams_used;
-      st.beams_skipped += c.beams_skipped;
-      st.cell_updates += c.cell_updates;
+      const oracle::ScanStart start = oracle::scan_start(frame, batch.x[s], batch.y[s], batch.theta[s]);
+      oracle::SteppedAngles angle_of{batch.first_angle[s], batch.angle_step[s]};
+      const float *range = batch.ranges_of(s);
+      double angle = 0;
+      for (int i = 0; i < batch.beams_in(s); ++i) {  // oracle::update_scan's loop
+        angle_of(i, start.theta, &angle);
+        if (!oracle::beam_used(range[i])) {
+          ++st.beams_skipped;
+          continue;
+        }
+        ++st.beams_used;
+        int x2, y2;
+        oracle::beam_end(start, angle, range[i], params.wall_size, frame.resolution, &x2, &y2);
+        st.cell_updates += trace(cells, geo, start, x2, y2, range[i], &updates);
+      }
     }
     st.scans = last - first;
     st.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -64,8 +91,23 @@ class CpuDoubleBackend : public Backend {
   }
 
  private:
-  DistanceTable table_{0, 0.0};  // kept between calls: built once per parameter set
-  double table_resolution_ = 0;
+  // One beam's updates, applied; returns how many.
+  long trace(float *cells, const GridGeometry &geo, const oracle::ScanStart &s, int x2, int y2, double range,
+             beam_updates::BeamUpdates *updates) const {
+    const beam_updates::Evidence &evidence = tables_->evidence;
+    if (!beam_updates::walkable(evidence.table_size(), s.x1, s.y1, x2, y2)) {
+      const DistanceTable &d = tables_->distances;
+      return oracle::trace_beam(cells, geo.size_x, geo.size_y, s.x1, s.y1, x2, y2, range, evidence.model(),
+                                geo.resolution, d.size(), d.rows());
+    }
+    beam_updates::collect(evidence, {0, geo.size_x, 0, geo.size_y}, geo.size_y, s.x1, s.y1, x2, y2, range,
+                          updates);
+    beam_updates::apply(cells, *updates, evidence);
+    return updates->count;
+  }
+
+  std::optional<Tables> tables_;               // kept between calls
+  std::optional<MapperParams::TableKey> key_;  // of tables_
 };
 
 }  // namespace

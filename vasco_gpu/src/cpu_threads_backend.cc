@@ -16,47 +16,27 @@
 //      order. Lines that fail egrid::is_closed_form_line (degenerate, e.g.
 //      from a range of -inf) are listed in every stripe.
 //   4. Each stripe walks its beams in list order and applies the updates whose
-//      cell lies in the stripe, with the oracle's walker, sensor model and
-//      odds update (egrid_math.h).
+//      cell lies in the stripe: closed-form lines in beam_updates.h's two
+//      passes (the box: the stripe's columns), degenerate ones with the
+//      oracle's walker, sensor model and odds update (egrid_math.h).
 //
 // Why this equals the oracle.
 //  * Per cell, the oracle's result is the cell's updates applied in (scan,
 //    beam) order: a beam visits a cell at most once (the major coordinate
 //    strictly moves), and no update reads another cell. Here a cell is written
 //    by the one thread that holds its stripe, and a stripe applies its beams
-//    in (scan, beam) order; so it suffices that each stripe applies, for each
-//    beam, exactly the oracle's updates that fall in it.
-//  * The oracle (oracle::trace_beam) updates, among the steps k <= k_max, the
-//    in-grid cells before the first in-grid cell whose distance d makes
-//    sensor_model refuse (the "stop"). Stopping depends on d only and is
-//    monotone: it happens iff !(d < sure) && !(d < max), so if d stops, every
-//    d' >= d stops too.
-//  * Closed-form lines (|dx|, |dy| < 2^29): every cell lies between two ints,
-//    so nothing wraps; x and y each move monotonically (the major coordinate
-//    by inc every step, the minor by 0 or inc), starting at (x1, y1). Hence
-//    i = |cx - x1| and j = |cy - y1| never decrease, and i, j <= k < table_size,
-//    so d = sqrt((double)(i*i + j*j)) * res (the table's value; correctly
-//    rounded sqrt and product are monotone) never decreases along the walk.
-//    So the oracle's update set is simply {k <= k_max : cell in grid, d does
-//    not stop}, and within a stripe the first in-grid cell that stops is
-//    followed only by cells that stop: the stripe may break there.
-//    A stripe starts the walk at the first step k0 whose x is in the stripe:
-//    x changes by at most one per step, so |cx - x1| = M is reached first
-//    where M is the distance from x1 to the stripe's near edge; for a
-//    non-steep line k0 = M, for a steep one the closed form of the minor
-//    offset (line_minor_offset: floor((2bk + a - [inc < 0]) / 2a) >= M) gives
-//    k0 = ceil((2aM - a + [inc < 0]) / 2b). The walker's state after k0 steps
-//    with m = line_minor_offset(k0) diagonal steps is x + k0*inc,
-//    y + m*inc, D + (k0 - m)*E + m*NE (mod 2^32, as the sequential walk adds
-//    them), so the walk from k0 on is the oracle's walk, step for step; it
-//    leaves the stripe for good at the first cell beyond it (x is monotone).
+//    in (scan, beam) order (each beam's two passes before the next beam's);
+//    so it suffices that each stripe applies, for each beam, exactly the
+//    oracle's updates that fall in it.
+//  * Closed-form lines (|dx|, |dy| < 2^29): beam_updates::collect gives, of
+//    oracle::trace_beam's updates, exactly those whose cell lies in a box —
+//    here the stripe's columns of the grid — in walk order (the argument is
+//    at the top of beam_updates.cc: x and y move monotonically, so the steps
+//    in the box are one run, and the evidence and the stop depend on the
+//    cell's squared distance, which never decreases along the walk).
 //  * Degenerate lines are walked exactly as oracle::trace_beam walks them, from
 //    step 0, stopping at the oracle's stop, in every stripe; each applies only
 //    the updates in its own columns. No monotonicity is needed there.
-//  * The per-(i, j) odds factors, when tabulated, are odds_factor(prior, p)
-//    with p = sensor_model(d, +inf) for d < range and sensor_model(d, -inf)
-//    otherwise — the same p (sensor_model uses r only through d < r), and
-//    odds_apply(cell, prior, odds_factor(prior, p)) is odds_update bit for bit.
 //  * Counts: each oracle update is applied in exactly one stripe.
 #include "vasco_gpu/cpu_threads_backend.h"
 
@@ -68,11 +48,11 @@
 #include <exception>
 #include <limits>
 #include <mutex>
-#include <stdexcept>
 #include <string>
 #include <thread>
 #include <optional>
 
+#include "beam_updates.h"
 #include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/oracle.h"
 #include "vasco_gpu/parallel.h"
@@ -91,8 +71,6 @@ double seconds_since(Clock::time_point t0) {
 constexpr int kStripesPerThread = 4;
 // The per-column work histogram has at most this many buckets.
 constexpr int kMaxBuckets = 1 << 16;
-// Odds-factor tables only when small (as in the CUDA exact mode).
-constexpr int64_t kMaxTableEntries = int64_t(1) << 22;
 
 // A used beam, in (scan, beam) order.
 struct Beam {
@@ -103,37 +81,14 @@ struct Beam {
   uint32_t degenerate;  // fails egrid::is_closed_form_line: every stripe, walked from step 0
 };
 
-// What a cell i, j cells from the start gets (when tabulated).
-struct Entry {
-  double d;                // the distance table's value
-  double f_free, f_occ;    // odds_factor(prior, p) for d < range, resp. not
-  int32_t stop;            // sensor_model refuses d: the oracle stops the beam
-};
-
 struct Context {
   float *cells;
   int size_x, size_y;
   int table_size;
   double resolution;
   egrid::SensorModel<double> model;
-  const Entry *table;      // null: computed on the fly
+  const beam_updates::Evidence *evidence;
 };
-
-// The odds factor of a cell i, j cells from the start (0 <= i, j <
-// table_size) for a beam of range `range`; false where the oracle stops.
-inline bool evidence(const Context &c, int i, int j, double range, double *factor) {
-  if (c.table != nullptr) {
-    const Entry &e = c.table[static_cast<size_t>(i) * static_cast<size_t>(c.table_size) + j];
-    if (e.stop) return false;
-    *factor = e.d < range ? e.f_free : e.f_occ;
-    return true;
-  }
-  const double d = egrid::cell_distance(i, j, c.resolution);
-  double p;
-  if (!egrid::sensor_model(c.model, d, range, &p)) return false;
-  *factor = egrid::odds_factor(c.model.prior, p);
-  return true;
-}
 
 // Fills b.x_lo, b.x_hi, b.degenerate from the start cell and b.x2, b.y2;
 // returns the estimated work per column (steps walked / columns spanned).
@@ -161,58 +116,11 @@ double place_beam(Beam &b, const oracle::ScanStart &s, int size_x, int size_y, i
 }
 
 // Applies, of a closed-form beam's updates, those in columns [xa, xb).
-uint64_t walk_closed(const Context &c, const Beam &b, const oracle::ScanStart &s, int xa, int xb) {
-  const int x1 = s.x1, y1 = s.y1;
-  const egrid::LineParams p = egrid::line_params(x1, y1, b.x2, b.y2);
-  const int k_max = std::min(p.major_len, c.table_size - 1);
-  // M: columns between x1 and the stripe's near edge; k0: first step that far.
-  const int64_t M = x1 < xa ? int64_t(xa) - x1 : (x1 >= xb ? int64_t(x1) - (xb - 1) : 0);
-  int64_t k0 = 0;
-  if (M > 0) {
-    if (!p.steep) {
-      k0 = M;
-    } else {
-      if (p.b == 0) return 0;  // x never moves (binning never sends this)
-      const int64_t need = 2 * static_cast<int64_t>(p.a) * M - p.a + (p.inc < 0 ? 1 : 0);
-      const int64_t two_b = 2 * static_cast<int64_t>(p.b);
-      k0 = need <= 0 ? 0 : (need + two_b - 1) / two_b;
-    }
-  }
-  if (k0 > k_max) return 0;  // does not reach the stripe (binning never sends this)
-  egrid::BresenhamLine l;
-  egrid::bresenham_init(l, x1, y1, b.x2, b.y2);
-  if (k0 > 0) {
-    const int k = static_cast<int>(k0);
-    const int m = egrid::line_minor_offset(p, k);
-    l.x = egrid::wrap_add(l.x, egrid::wrap_mul(k, l.inc));
-    l.y = egrid::wrap_add(l.y, egrid::wrap_mul(m, l.inc));
-    l.d = egrid::wrap_add(l.d, egrid::wrap_add(egrid::wrap_mul(k - m, l.incr_e),
-                                               egrid::wrap_mul(m, l.incr_ne)));
-  }
-  const double range = b.range;
-  uint64_t updates = 0;
-  for (int k = static_cast<int>(k0);; ++k) {
-    int cx, cy;
-    egrid::bresenham_current(l, &cx, &cy);
-    if (cx < xa || cx >= xb) {
-      // The first cell must be in the stripe; a later one beyond it means the
-      // walk has passed the stripe for good.
-      if (k == k0) throw std::logic_error("cpu_threads: a walk does not enter its stripe");
-      break;
-    }
-    if (cy >= 0 && cy < c.size_y) {
-      const int i = egrid::wrap_abs(egrid::wrap_sub(cx, x1));
-      const int j = egrid::wrap_abs(egrid::wrap_sub(cy, y1));
-      double factor;
-      if (!evidence(c, i, j, range, &factor)) break;  // and every later cell stops too
-      float &cell = c.cells[static_cast<size_t>(cx) * static_cast<size_t>(c.size_y) + cy];
-      cell = egrid::odds_apply(cell, c.model.prior, factor);
-      ++updates;
-    }
-    if (k >= k_max) break;
-    egrid::bresenham_next(l);
-  }
-  return updates;
+uint64_t walk_closed(const Context &c, const Beam &b, const oracle::ScanStart &s, int xa, int xb,
+                     beam_updates::BeamUpdates *updates) {
+  beam_updates::collect(*c.evidence, {xa, xb, 0, c.size_y}, c.size_y, s.x1, s.y1, b.x2, b.y2, b.range, updates);
+  beam_updates::apply(c.cells, *updates, *c.evidence);
+  return static_cast<uint64_t>(updates->count);
 }
 
 // oracle::trace_beam, applying only the updates in columns [xa, xb).
@@ -368,6 +276,7 @@ void run_stripes(const Context &ctx, const Beam *beams, const std::vector<oracle
   run_on_threads(std::min(nt, nst), [&](int t) {
     const auto t_busy = Clock::now();
     uint64_t mine = 0;
+    beam_updates::BeamUpdates updates(ctx.table_size);
     for (;;) {
       const int q = next_stripe.fetch_add(1);
       if (q >= nst) break;
@@ -377,7 +286,7 @@ void run_stripes(const Context &ctx, const Beam *beams, const std::vector<oracle
       for (uint64_t e = bins.begin[s]; e < bins.begin[s + 1]; ++e) {
         const Beam &b = beams[bins.beams[e]];
         const oracle::ScanStart &start = starts[b.scan];
-        n += b.degenerate ? walk_degenerate(ctx, b, start, xa, xb) : walk_closed(ctx, b, start, xa, xb);
+        n += b.degenerate ? walk_degenerate(ctx, b, start, xa, xb) : walk_closed(ctx, b, start, xa, xb, &updates);
       }
       load->stripe_beams[s] = bins.begin[s + 1] - bins.begin[s];
       load->stripe_updates[s] = n;
@@ -429,14 +338,17 @@ class CpuThreadsBackend : public Backend {
     // 2. Column ranges and the work estimate; 3. stripes and their beams.
     std::unique_ptr<Beam[]> beams(new Beam[nb]);
     const Stripes stripes = cut_stripes(place_all(placed, size_x, size_y, T, nt, beams.get()), size_x, nt);
-    build_table(params, nt);  // kept between calls (a session's inserts)
+    if (evidence_key_ != params.table_key()) {  // kept between calls (a session's inserts)
+      evidence_.emplace(params.sensor_model(), params.resolution, T);
+      evidence_key_ = params.table_key();
+    }
     const Bins bins = bin_beams(beams.get(), nb, stripes, nt);
     st.prep_s = seconds_since(t0);
 
     // 4. The stripes.
     const auto t_stripes = Clock::now();
     const egrid::SensorModel<double> model = params.sensor_model();
-    const Context ctx{cells, size_x, size_y, T, geo.resolution, model, table_.empty() ? nullptr : table_.data()};
+    const Context ctx{cells, size_x, size_y, T, geo.resolution, model, &*evidence_};
     run_stripes(ctx, beams.get(), starts, stripes, bins, nt, &load);
     load.stripes_s = seconds_since(t_stripes);
     for (uint64_t n : load.thread_updates) st.cell_updates += n;
@@ -445,28 +357,6 @@ class CpuThreadsBackend : public Backend {
   }
 
  private:
-  // The per-(i, j) distance, stop flag and odds factors, when small enough;
-  // rebuilt only when the parameters change.
-  void build_table(const MapperParams &params, int nt) {
-    const int T = params.table_size();
-    if (table_key_ == params.table_key()) return;
-    table_.clear();
-    table_key_ = params.table_key();
-    if (static_cast<int64_t>(T) * T > kMaxTableEntries || T <= 0) return;
-    const egrid::SensorModel<double> model = params.sensor_model();
-    table_.resize(static_cast<size_t>(T) * static_cast<size_t>(T));
-    run_on_threads(std::min(nt, T), [&](int t) {
-      const int per = (T + nt - 1) / nt;
-      for (int i = t * per; i < std::min(T, (t + 1) * per); ++i) {
-        for (int j = 0; j < T; ++j) {
-          Entry &e = table_[static_cast<size_t>(i) * T + j];
-          e.d = egrid::cell_distance(i, j, params.resolution);
-          e.stop = egrid::odds_factors_at(model, e.d, &e.f_free, &e.f_occ) ? 0 : 1;
-        }
-      }
-    });
-  }
-
   void finish(MapStats *stats, const MapStats &st, CpuThreadsLoad &&load) {
     if (stats != nullptr) *stats = st;
     load_ = std::move(load);
@@ -474,8 +364,8 @@ class CpuThreadsBackend : public Backend {
   }
 
   int threads_;
-  std::vector<Entry> table_;
-  std::optional<MapperParams::TableKey> table_key_;  // of table_, once built
+  std::optional<beam_updates::Evidence> evidence_;
+  std::optional<MapperParams::TableKey> evidence_key_;  // of evidence_
   CpuThreadsLoad load_;
   bool has_load_ = false;
 };
