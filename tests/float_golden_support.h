@@ -8,8 +8,9 @@
 // maps be compared cell for cell).
 //
 // What single precision can change, and so what the bounds are.
-//  1. Where beams run. The float port places poses, accumulates beam angles
-//     and takes cos/sin in float. Over a 361-beam scan the accumulated angle
+//  1. Where beams run. (CUDA float mode; cpu_float walks the oracle's own
+//     beams and cells, so for it (1) and (2) change nothing.) CUDA float
+//     places poses, accumulates beam angles and takes cos/sin in float. Over a 361-beam scan the accumulated angle
 //     is off by up to about 361 * ulp(pi) / 2 = 4e-5 rad, which at the
 //     range_max cut (<= 400 cells here) moves a beam by up to 0.02 cell; the
 //     pose itself by 2^-11 cell. A Bresenham cell changes only where the ideal
@@ -22,8 +23,9 @@
 //     one of its updates reaches through a moved beam: a fringe cell seen once
 //     or twice. Fringe cells are a small part of the known area and 4 % of
 //     them at most change, so we allow 1 in 1000 known cells.
-//  3. Values. The float odds update rounds each of its six operations to
-//     2^-24 relative; in log-odds that is about 1e-6 per update, far below
+//  3. Values. Both float paths add log-odds increments rounded to float
+//     (cpu_float: 2^-24 relative, summed in double; CUDA: to 2^-24 log-odds,
+//     summed in fixed point): about 1e-7 per update, far below
 //     one update's step, so on its own it cannot move a cell's class or its p
 //     by 0.1 in fewer than 10^4 updates. It can however decide when a cell
 //     saturates: CARMEN stores exactly 0 or 1 once 1 - 1/(1+t) rounds there,

@@ -1,4 +1,4 @@
-// cpu_float (the paper's CPU port) against CARMEN's golden maps, on every
+// cpu_float (one core, table-driven log-odds) against CARMEN's golden maps, on every
 // golden case the project carries: the DESIGN §4 table, and the bounds argued
 // in float_golden_support.h.
 #include "float_golden_support.h"

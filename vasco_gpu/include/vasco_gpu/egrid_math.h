@@ -264,7 +264,7 @@ struct Exactly {
 };
 
 // The sensor model's parameters in the precision of the update that reads
-// them: double for CARMEN's update, float for the float port.
+// them: double for CARMEN's update, float for CUDA float mode's kernels.
 template <class Real>
 struct SensorModel {
   Real prior, occ, emp;  // prior_occ, occ_evidence, emp_evidence
@@ -366,17 +366,6 @@ VG_HD bool odds_factors_at(const SensorModel<double> &m, double d, double *f_fre
   sensor_model(m, d, -HUGE_VAL, &p);
   *f_occ = odds_factor(m.prior, p);
   return true;
-}
-
-// The float port (the paper's CPU version): the odds update in single precision.
-VG_HD float odds_update_f(float cell, float prior, float p) {
-  if (cell == kUnknown) cell = prior;
-  float t = (1.0f - prior) / prior;
-  t = t * p;
-  t = t / (1.0f - p);
-  t = t * cell;
-  t = t / (1.0f - cell);
-  return 1.0f - 1.0f / (1.0f + t);
 }
 
 }  // namespace egrid
