@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 #include "vasco_gpu/backend.h"
@@ -127,26 +128,36 @@ class EvidenceTable {
   std::vector<float> free_, occ_;
 };
 
-// The cells a call's scans can reach (every updated cell is fewer than
-// table_size steps from its scan's start cell).
+// The cells a call's scans can reach: a beam's updated cells lie within
+// min(max(|dx|, |dy|), table_size - 1) steps of its scan's start cell (the
+// walk stops at its end cell and before table_size steps), so the box is the
+// union over scans of the start cell widened by its longest beam's reach.
 struct Box {
   int x0 = 0, y0 = 0, width = 0, height = 0;
   size_t cells() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
 };
 
-Box reach_of(const std::vector<oracle::ScanStart> &starts, int table_size, const GridGeometry &geo) {
+Box reach_of(const PlacedBeams &placed, int table_size, const GridGeometry &geo) {
+  const int64_t t = std::max(table_size - 1, 0);
+  std::vector<int64_t> reach(placed.starts.size(), -1);  // -1: a scan without beams
+  for (const PlacedBeam &b : placed.beams) {
+    const oracle::ScanStart &s = placed.starts[b.scan];
+    const int64_t dx = std::abs(int64_t(b.x2) - s.x1), dy = std::abs(int64_t(b.y2) - s.y1);
+    reach[b.scan] = std::max(reach[b.scan], std::min(std::max(dx, dy), t));
+  }
   int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
-  const int64_t r = std::max(table_size - 1, 0);
-  for (const auto &s : starts) {
-    x0 = std::min<int64_t>(x0, int64_t(s.x1) - r);
-    x1 = std::max<int64_t>(x1, int64_t(s.x1) + r);
-    y0 = std::min<int64_t>(y0, int64_t(s.y1) - r);
-    y1 = std::max<int64_t>(y1, int64_t(s.y1) + r);
+  for (size_t i = 0; i < placed.starts.size(); ++i) {
+    if (reach[i] < 0) continue;
+    const oracle::ScanStart &s = placed.starts[i];
+    x0 = std::min<int64_t>(x0, int64_t(s.x1) - reach[i]);
+    x1 = std::max<int64_t>(x1, int64_t(s.x1) + reach[i]);
+    y0 = std::min<int64_t>(y0, int64_t(s.y1) - reach[i]);
+    y1 = std::max<int64_t>(y1, int64_t(s.y1) + reach[i]);
   }
   Box b;
   x0 = std::max<int64_t>(x0, 0), y0 = std::max<int64_t>(y0, 0);
   x1 = std::min<int64_t>(x1, geo.size_x - 1), y1 = std::min<int64_t>(y1, geo.size_y - 1);
-  if (starts.empty() || x0 > x1 || y0 > y1) return b;
+  if (x0 > x1 || y0 > y1) return b;
   b.x0 = static_cast<int>(x0), b.y0 = static_cast<int>(y0);
   b.width = static_cast<int>(x1 - x0 + 1), b.height = static_cast<int>(y1 - y0 + 1);
   return b;
@@ -310,7 +321,7 @@ class CpuFloatBackend : public Backend {
       st.beams_used = placed.beams.size();
       st.beams_skipped = placed.skipped;
       const EvidenceTable &ev = table_for(params);
-      const Box box = reach_of(placed.starts, params.table_size(), geo);
+      const Box box = reach_of(placed, params.table_size(), geo);
       scratch_.assign(box.cells(), kUntouched);
       st.cell_updates = add_beams(placed, ev, geo, box);
       merge(ev, box, geo, cells);
