@@ -46,24 +46,6 @@ namespace {
 // The most factor pairs tabulated beyond sure (16 bytes each: 1.9 MB at
 // vasco's defaults); longer tables are computed per cell instead.
 constexpr int64_t kMaxTabulated = int64_t(1) << 18;
-// Beyond any step: a minor offset a line with b == 0 never reaches.
-constexpr int64_t kNever = int64_t(1) << 62;
-
-// egrid::first_square_not_below(limit, resolution, n_max), stepping from an
-// estimate instead of bisecting (it is needed once per beam, where 20 square
-// roots would cost as much as the walk). The same n: d is monotone, and the
-// loops end where d(n - 1) < limit <= d(n).
-int64_t first_square_near(double limit, double resolution, int64_t n_max) {
-  if (!(limit > 0)) return 0;  // d(0) = 0 is not below it
-  auto below = [&](int64_t n) { return std::sqrt(static_cast<double>(n)) * resolution < limit; };
-  const double cells = limit / resolution;
-  const double guess = cells * cells;
-  int64_t n = guess >= static_cast<double>(n_max) ? n_max + 1 : static_cast<int64_t>(guess);
-  while (n > 0 && !below(n - 1)) --n;
-  while (n <= n_max && below(n)) ++n;
-  return n;
-}
-
 // The steps of a closed-form line whose cell lies in a box, walked in order
 // (see the top of the file).
 class Walker {
@@ -84,13 +66,6 @@ class Walker {
   }
 
  private:
-  // The first step k whose minor offset line_minor_offset(p, k) is >= m.
-  int64_t first_step_with_offset(int64_t m) const {
-    if (m <= 0) return 0;
-    if (two_b_ == 0) return kNever;
-    return (two_a_ * m - a_minus_c_ + two_b_ - 1) / two_b_;
-  }
-
   // Whether the minor coordinate moves is written as a select; GCC makes it
   // a branch, which measured faster on fr079 than a branch-free mask (the
   // remainder's update is the loop's critical path).
@@ -112,19 +87,9 @@ class Walker {
 Walker::Walker(const egrid::LineParams &p, int k_max, const Box &box, int size_y)
     : two_a_(2 * static_cast<int64_t>(p.a)), two_b_(2 * static_cast<int64_t>(p.b)),
       a_minus_c_(p.a - (p.inc < 0 ? 1 : 0)) {
-  const int64_t major = p.steep ? p.y1 : p.x1, minor = p.steep ? p.x1 : p.y1;
-  const int64_t major_lo = p.steep ? box.y_lo : box.x_lo, major_hi = p.steep ? box.y_hi : box.x_hi;
-  const int64_t minor_lo = p.steep ? box.x_lo : box.y_lo, minor_hi = p.steep ? box.x_hi : box.y_hi;
   const int minor_sign = p.flipped ? -p.inc : p.inc;
-  // Steps whose major coordinate, major + inc * k, is in the box ...
-  int64_t k_lo = p.inc > 0 ? major_lo - major : major - (major_hi - 1);
-  int64_t k_hi = p.inc > 0 ? major_hi - 1 - major : major - major_lo;
-  // ... and whose minor offset m puts minor + minor_sign * m in the box.
-  const int64_t m_lo = minor_sign > 0 ? minor_lo - minor : minor - (minor_hi - 1);
-  const int64_t m_hi = minor_sign > 0 ? minor_hi - 1 - minor : minor - minor_lo;
-  k_lo = std::max({k_lo, int64_t(0), first_step_with_offset(m_lo)});
-  k_hi = std::min({k_hi, static_cast<int64_t>(k_max), first_step_with_offset(m_hi + 1) - 1});
-  if (k_lo > k_hi) k_lo = 0, k_hi = -1;  // no cell in the box
+  int64_t k_lo, k_hi;
+  steps_in_box(p, k_max, box, &k_lo, &k_hi);
   k_begin_ = k_ = k_lo;
   k_end_ = k_hi;
   // The walk's state after k_lo steps (k_lo <= k_max < 2^15).
@@ -173,6 +138,49 @@ void apply_run(float *cells, const int64_t *index, int n, double prior, FactorAt
 }
 
 }  // namespace
+
+// egrid::first_square_not_below(limit, resolution, n_max), stepping from an
+// estimate instead of bisecting (it is needed once per beam, where 20 square
+// roots would cost as much as the walk). The same n: d is monotone, and the
+// loops end where d(n - 1) < limit <= d(n).
+int64_t first_square_near(double limit, double resolution, int64_t n_max) {
+  if (!(limit > 0)) return 0;  // d(0) = 0 is not below it
+  auto below = [&](int64_t n) { return std::sqrt(static_cast<double>(n)) * resolution < limit; };
+  const double cells = limit / resolution;
+  const double guess = cells * cells;
+  int64_t n = guess >= static_cast<double>(n_max) ? n_max + 1 : static_cast<int64_t>(guess);
+  while (n > 0 && !below(n - 1)) --n;
+  while (n <= n_max && below(n)) ++n;
+  return n;
+}
+
+void steps_in_box(const egrid::LineParams &p, int k_max, const Box &box, int64_t *k_first, int64_t *k_last) {
+  const int64_t two_a = 2 * static_cast<int64_t>(p.a), two_b = 2 * static_cast<int64_t>(p.b);
+  const int64_t a_minus_c = p.a - (p.inc < 0 ? 1 : 0);
+  // The first step k whose minor offset line_minor_offset(p, k) is >= m.
+  auto first_step_with_offset = [&](int64_t m) -> int64_t {
+    if (m <= 0) return 0;
+    if (two_b == 0) return int64_t(1) << 62;  // never
+    return (two_a * m - a_minus_c + two_b - 1) / two_b;
+  };
+  const int64_t major = p.steep ? p.y1 : p.x1, minor = p.steep ? p.x1 : p.y1;
+  const int64_t major_lo = p.steep ? box.y_lo : box.x_lo, major_hi = p.steep ? box.y_hi : box.x_hi;
+  const int64_t minor_lo = p.steep ? box.x_lo : box.y_lo, minor_hi = p.steep ? box.x_hi : box.y_hi;
+  const int minor_sign = p.flipped ? -p.inc : p.inc;
+  // Steps whose major coordinate, major + inc * k, is in the box ...
+  int64_t k_lo = p.inc > 0 ? major_lo - major : major - (major_hi - 1);
+  int64_t k_hi = p.inc > 0 ? major_hi - 1 - major : major - major_lo;
+  // ... and whose minor offset m puts minor + minor_sign * m in the box.
+  // m(k) <= k (b <= a), so a bound m_hi >= k_max limits nothing: a beam that
+  // stays inside the box needs no division here.
+  const int64_t m_lo = minor_sign > 0 ? minor_lo - minor : minor - (minor_hi - 1);
+  const int64_t m_hi = minor_sign > 0 ? minor_hi - 1 - minor : minor - minor_lo;
+  k_lo = std::max({k_lo, int64_t(0), first_step_with_offset(m_lo)});
+  k_hi = std::min({k_hi, static_cast<int64_t>(k_max), m_hi >= k_max ? k_max : first_step_with_offset(m_hi + 1) - 1});
+  if (k_lo > k_hi) k_lo = 0, k_hi = -1;  // no cell in the box
+  *k_first = k_lo;
+  *k_last = k_hi;
+}
 
 Evidence::Evidence(const egrid::SensorModel<double> &model, double resolution, int table_size)
     : model_(model), resolution_(resolution), table_size_(table_size) {

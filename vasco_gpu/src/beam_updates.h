@@ -78,6 +78,16 @@ struct Box {
   int x_lo, x_hi, y_lo, y_hi;
 };
 
+// egrid::first_square_not_below(limit, resolution, n_max), stepping from an
+// estimate instead of bisecting (it is needed once per beam, where 20 square
+// roots would cost as much as the walk). The same n.
+int64_t first_square_near(double limit, double resolution, int64_t n_max);
+
+// The steps k of a closed-form line whose cell lies in `box`, k <= k_max:
+// one run [*k_first, *k_last] (x and y move monotonically), empty as
+// [0, -1]. Shared by the exact backends' walker and cpu_float's.
+void steps_in_box(const egrid::LineParams &p, int k_max, const Box &box, int64_t *k_first, int64_t *k_last);
+
 // Whether collect() can walk the line (x1, y1) -> (x2, y2): a closed-form
 // line (egrid::is_closed_form_line) and steps to walk. Other beams go through
 // oracle::trace_beam.

@@ -31,6 +31,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "beam_updates.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/egrid_math.h"
@@ -67,7 +68,6 @@ class EvidenceTable {
   explicit EvidenceTable(const MapperParams &params)
       : model_(params.sensor_model()),
         res_(params.resolution),
-        inverse_res_(1.0 / params.resolution),
         logit_prior_(logit(model_.prior)),
         size_(params.table_size()) {
     const int64_t t = size_;
@@ -93,18 +93,9 @@ class EvidenceTable {
   // The increments at (major offset i, minor offset j) are column[j * size + i].
   const float *column(bool free) const { return free ? free_.data() : occ_.data(); }
 
-  // The smallest n whose distance is not below `range` (capped at n_stop):
+  // The smallest n whose distance is not below `range` (at most n_stop):
   // the oracle's free test d < range is n < n_free(range).
-  int64_t n_free(double range) const {
-    if (!(range > 0)) return 0;
-    // A guess near the answer (about ceil((range / res)^2)), then the
-    // oracle's own comparison decides: one or two square roots per beam.
-    const double t = range * inverse_res_;
-    int64_t n = t * t < static_cast<double>(n_stop_) ? static_cast<int64_t>(t * t) + 1 : n_stop_;
-    while (n > 0 && !(distance(n - 1) < range)) --n;
-    while (n < n_stop_ && distance(n) < range) ++n;
-    return n;
-  }
+  int64_t n_free(double range) const { return beam_updates::first_square_near(range, res_, n_stop_ - 1); }
 
   // The increment at n < n_stop, computed.
   float increment(int64_t n, bool free) const {
@@ -122,7 +113,7 @@ class EvidenceTable {
   double distance(int64_t n) const { return std::sqrt(static_cast<double>(n)) * res_; }
 
   egrid::SensorModel<double> model_;
-  double res_, inverse_res_, logit_prior_;
+  double res_, logit_prior_;
   int size_;
   int64_t n_stop_ = 0;
   std::vector<float> free_, occ_;
@@ -183,58 +174,19 @@ struct WalkState {
   ptrdiff_t idx, entry;
 };
 
-// Offsets t in [lo, hi] with origin + step * t in [0, size) (step = +-1).
-void range_in(int64_t origin, int step, int64_t size, int64_t *lo, int64_t *hi) {
-  *lo = step > 0 ? -origin : origin - (size - 1);
-  *hi = step > 0 ? size - 1 - origin : origin;
-}
-
-int64_t floor_div(int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
-
-// The steps k >= 0 whose minor offset lies in [m_lo, m_hi]: m(k) never
-// decreases, and m(k) >= M  <=>  2bk >= 2aM - c.
-void steps_with_minor_in(const egrid::LineParams &p, int64_t m_lo, int64_t m_hi, int64_t *k_lo, int64_t *k_hi) {
-  const int64_t two_a = 2 * int64_t(p.a), two_b = 2 * int64_t(p.b), c = p.a - (p.inc < 0 ? 1 : 0);
-  if (m_lo > m_hi || (p.b == 0 && (m_lo > 0 || m_hi < 0))) {
-    *k_lo = 1, *k_hi = 0;
-    return;
-  }
-  if (p.b == 0) {  // m is 0 throughout
-    *k_lo = 0, *k_hi = INT64_MAX;
-    return;
-  }
-  *k_lo = -floor_div(-(two_a * m_lo - c), two_b);         // ceil((2a m_lo - c) / 2b)
-  *k_hi = -floor_div(-(two_a * (m_hi + 1) - c), two_b) - 1;  // last k with m(k) <= m_hi
-}
-
-// Whether every cell within `reach` steps of the start lies in the box: then
-// the whole walk does, and no division is needed to clip it.
-bool reach_inside(int64_t origin, int64_t reach, int64_t size) { return origin >= reach && origin + reach < size; }
-
 WalkFrame frame_of(const egrid::LineParams &p, int table_size, const Box &box, WalkState *w) {
   const int minor_inc = p.flipped ? -p.inc : p.inc;
   const int64_t bx = int64_t(p.x1) - box.x0, by = int64_t(p.y1) - box.y0;
-  const int64_t major0 = p.steep ? by : bx, minor0 = p.steep ? bx : by;
-  const int64_t major_size = p.steep ? box.height : box.width, minor_size = p.steep ? box.width : box.height;
-  const int64_t k_end = std::min(p.major_len, table_size - 1);
   WalkFrame f;
   const ptrdiff_t h = box.height;  // the scratch is [x][y], as the grid
   f.major_step = p.steep ? p.inc : p.inc * h;
   f.minor_stride = p.steep ? minor_inc * h : minor_inc;
   f.two_a = 2 * static_cast<int64_t>(p.a);
   f.two_b = 2 * static_cast<int64_t>(p.b);
-  f.k_first = 0;
-  f.k_last = k_end;
-  if (!reach_inside(major0, k_end, major_size) || !reach_inside(minor0, k_end, minor_size)) {
-    int64_t m_lo, m_hi, k_lo, k_hi;
-    range_in(major0, p.inc, major_size, &f.k_first, &f.k_last);
-    range_in(minor0, minor_inc, minor_size, &m_lo, &m_hi);
-    steps_with_minor_in(p, m_lo, m_hi, &k_lo, &k_hi);
-    f.k_first = std::max({f.k_first, k_lo, int64_t(0)});
-    f.k_last = std::min({f.k_last, k_hi, k_end});
-  }
+  beam_updates::steps_in_box(p, std::min(p.major_len, table_size - 1),
+                             {box.x0, box.x0 + box.width, box.y0, box.y0 + box.height}, &f.k_first, &f.k_last);
   // The state at k_first, in closed form.
-  const int64_t k = std::min<int64_t>(f.k_first, INT32_MAX);
+  const int64_t k = f.k_first;
   const int64_t m = k == 0 ? 0 : egrid::line_minor_offset(p, static_cast<int>(k));
   w->k = k;
   w->m = m;
