@@ -1,9 +1,5 @@
 #include "vasco_gpu/mapper.hpp"
 
-#if defined(VASCO_HAVE_CUDA)
-#include "vasco_gpu/cuda_backend.h"
-#endif
-
 #include <chrono>
 #include <sstream>
 #include <stdexcept>
@@ -11,44 +7,6 @@
 
 namespace vasco {
 namespace {
-
-// A renderer whose grid lives in host memory and whose backend applies
-// scans to it in place: every CPU backend (CUDA sessions have their own
-// renderer, cuda_renderer.cc).
-class HostRenderer : public Renderer {
- public:
-  explicit HostRenderer(std::unique_ptr<Backend> backend) : backend_(std::move(backend)) {}
-  std::string name() const override { return backend_->name(); }
-
-  void reset(const GridGeometry &geo, const MapperParams &params) override {
-    geo_ = geo;
-    params_ = params;
-    cells_.assign(geo.num_cells(), -1.0f);  // keeps the allocation when the size does not grow
-  }
-
-  void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) override {
-    backend_->apply(scans, first, last, params_, geo_, cells_.data(), stats);
-  }
-
-  FinishedMap finish(int downsample, int border) override {
-    return finish_grid(cells_.data(), geo_.size_x, geo_.size_y, geo_.resolution, downsample, border);
-  }
-
-  std::vector<float> read(const GridWindow &w) override {
-    std::vector<float> out(static_cast<size_t>(w.width) * static_cast<size_t>(w.height));
-    for (int x = 0; x < w.width; ++x) {
-      const float *col = cells_.data() + static_cast<size_t>(w.x0 + x) * geo_.size_y + w.y0;
-      std::copy(col, col + w.height, out.begin() + static_cast<size_t>(x) * w.height);
-    }
-    return out;
-  }
-
- private:
-  std::unique_ptr<Backend> backend_;
-  GridGeometry geo_;
-  MapperParams params_;
-  std::vector<float> cells_;
-};
 
 void check_window(const GridWindow &w, const GridGeometry &geo) {
   if (w.width < 0 || w.height < 0 || w.x0 < 0 || w.y0 < 0 ||
@@ -60,16 +18,6 @@ void check_window(const GridWindow &w, const GridGeometry &geo) {
 }
 
 }  // namespace
-
-std::unique_ptr<Renderer> make_renderer(const std::string &backend, const BackendOptions &options) {
-#if defined(VASCO_HAVE_CUDA)
-  std::string why;
-  if ((backend == "cuda" || backend == "auto") &&
-      cuda_usable(options.cuda_device, &why))
-    return make_cuda_renderer(options);
-#endif
-  return std::make_unique<HostRenderer>(make_backend(backend, options));
-}
 
 Mapper::Mapper(const MapperParams &params, const std::string &backend, const BackendOptions &options)
     : params_(params), options_(options), renderer_(make_renderer(backend, options)) {
@@ -102,7 +50,7 @@ GridGeometry Mapper::frame_for(const PoseExtent &extent, const ScanBatch &scans)
 // backends, the CUDA renderer's pinned staging: 64 bytes a beam at most).
 void Mapper::check_memory(const GridGeometry &geo, uint64_t beams) const {
   if (options_.max_memory_bytes == 0) return;
-  const bool device_grid = renderer_->name().rfind("cuda", 0) == 0;
+  const bool device_grid = renderer_->traits().grid_on_device;
   const double need = (device_grid ? 0.0 : 4.0 * static_cast<double>(geo.num_cells())) + 68.0 * beams;
   if (need <= static_cast<double>(options_.max_memory_bytes)) return;
   std::ostringstream m;

@@ -35,44 +35,10 @@
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/renderer.h"
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco {
-
-// A laser pose in the world frame.
-struct Pose {
-  double x = 0, y = 0, theta = 0;
-};
-
-// A rectangle of cells of the full-resolution grid: [x0, x0 + width) x [y0, y0 + height).
-struct GridWindow {
-  int x0 = 0, y0 = 0, width = 0, height = 0;
-};
-
-// Owns one evidence grid and applies scans to it with one backend.
-class Renderer {
- public:
-  virtual ~Renderer() = default;
-  virtual std::string name() const = 0;
-  // Starts over: every cell of a grid of `geo` unknown.
-  virtual void reset(const GridGeometry &geo, const MapperParams &params) = 0;
-  // Applies scans [first, last) of `scans` (poses included) after those
-  // applied since the reset; scan 0 fixes CARMEN's start pose.
-  virtual void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) = 0;
-  // CARMEN's finish of the current grid (DESIGN §2 step 7).
-  virtual FinishedMap finish(int downsample, int border) = 0;
-  // A window of the full-resolution grid, x-major (cells[x * height + y]);
-  // the window must lie inside the grid.
-  virtual std::vector<float> read(const GridWindow &window) = 0;
-  // Throws, changing nothing, when a grid cannot hold `beams` beams applied
-  // since its reset (CUDA float mode's fixed-point range); the Mapper asks
-  // before it stores scans or poses. By default every count fits.
-  virtual void check_capacity(uint64_t beams) const { (void)beams; }
-};
-
-// The renderer of a backend name (cpu_double, cpu_threads, cpu_float, cuda,
-// auto); throws as make_backend does.
-std::unique_ptr<Renderer> make_renderer(const std::string &backend, const BackendOptions &options = {});
 
 class Mapper {
  public:

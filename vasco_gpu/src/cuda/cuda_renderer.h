@@ -19,6 +19,7 @@ class CudaRenderer : public Renderer {
   explicit CudaRenderer(const BackendOptions &options);
   ~CudaRenderer() override;
   std::string name() const override;
+  RendererTraits traits() const override { return {exact(), true}; }
   void reset(const GridGeometry &geo, const MapperParams &params) override;
   void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) override;
   FinishedMap finish(int downsample, int border) override;
