@@ -12,6 +12,9 @@
 // size; gzip files: the payload is read in bounded pieces, so a short stream
 // fails with a clean error before the claimed size is ever allocated), and
 // every error is a carmen::FileError naming the file, the chunk and the offset.
+// Whether a file is gzip is told by its name (file_names.h: ".gz" in any case).
+// Reading is map_file_read.cc, writing map_file_write.cc; map_format.h picks a
+// format (CARMEN map, PGM + YAML, PNG) by extension.
 #ifndef CARMEN_COMPAT_MAP_FILE_H
 #define CARMEN_COMPAT_MAP_FILE_H
 
@@ -144,6 +147,9 @@ struct ChunkInfo {
   bool named() const { return (type & kNamedChunkFlag) != 0; }
   int base_type() const { return type & ~kNamedChunkFlag; }
   bool used = false;  // parsed into MapFile (false: unknown, unsupported or a duplicate)
+  // A named chunk of a kind MapFile holds, indexed but not read
+  // (NamedChunkReading::Index): read_named_chunk() reads it when asked.
+  bool deferred = false;
 };
 
 struct MapFile {
@@ -168,6 +174,15 @@ struct MapFile {
 // ---------------------------------------------------------------------------
 // Reading
 // ---------------------------------------------------------------------------
+// What the reader does with named chunks. A file may hold thousands of named
+// GRIDMAPs that compress to almost nothing: Index lists them (MapFile::chunks,
+// deferred = true) and keeps none of their cells, so a reader that wants the
+// main map or a summary (mapconvert --info) needs memory for one grid only.
+enum class NamedChunkReading {
+  Parse,  // every named chunk parsed into MapFile::named (checked, counted in max_kept_bytes)
+  Index,  // headers only; MapFile::named stays empty; read one with read_named_chunk()
+};
+
 struct MapReadOptions {
   // Reject gridmaps holding values outside valid_cell_value(). On: a damaged
   // map (NaN, huge or negative garbage) is reported, not passed on.
@@ -177,6 +192,7 @@ struct MapReadOptions {
   // file that needs more is refused with the number to raise. 1 GiB holds a
   // 16000 x 16000 grid.
   uint64_t max_kept_bytes = uint64_t(1) << 30;
+  NamedChunkReading named_chunks = NamedChunkReading::Parse;
 };
 
 // Reads a whole map file; ".gz" names are gunzipped (as carmen_fopen does:
@@ -184,6 +200,12 @@ struct MapReadOptions {
 // what is wrong and where) for anything unreadable, truncated or damaged.
 MapFile read_map_file(const std::string &path);
 MapFile read_map_file(const std::string &path, const MapReadOptions &options);
+
+// Reads the one named chunk `chunk` (an entry of MapFile::chunks or of
+// list_map_chunks() for this file), checked as read_map_file checks it.
+// Throws carmen::FileError when the file no longer holds that chunk there.
+NamedChunk read_named_chunk(const std::string &path, const ChunkInfo &chunk,
+                            const MapReadOptions &options = MapReadOptions{});
 
 // Scans the chunk headers only (payloads are skipped, not parsed or kept).
 // Throws carmen::FileError like read_map_file for a damaged layout.
