@@ -76,6 +76,25 @@ void write_all(AtomicOutput &out, const std::string &header, const std::vector<u
   }
 }
 
+// One PNG through libpng's simplified API: grey (1 byte a pixel) or RGB (3).
+void write_png_pixels(AtomicOutput &out, int width, int height, png_uint_32 format, const uint8_t *pixels) {
+  const std::string &path = out.final_path();
+  FILE *f = out.take_stdio();
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  image.width = static_cast<png_uint_32>(width);
+  image.height = static_cast<png_uint_32>(height);
+  image.format = format;
+  const auto stride = static_cast<png_int_32>(PNG_IMAGE_PIXEL_CHANNELS(format) * width);
+  const int ok = png_image_write_to_stdio(&image, f, 0, pixels, stride, nullptr);
+  const std::string message = ok ? std::string() : std::string(image.message);
+  png_image_free(&image);
+  const bool closed = std::fclose(f) == 0;
+  if (!ok) throw FileError(path, "PNG write failed: " + message, ErrorCode::Io);
+  if (!closed) throw FileError(path, std::string("write failed: ") + std::strerror(errno), ErrorCode::Io);
+}
+
 }  // namespace
 
 const char *pgm_mode_name(PgmMode mode) {
@@ -193,22 +212,22 @@ void write_pgm_with_yaml(const std::string &pgm_path, const GridMap &map,
 }
 
 void write_png(AtomicOutput &out, const GridMap &map) {
-  const std::string &path = out.final_path();
   const std::vector<uint8_t> pixels = map_to_png_pixels(map);
-  FILE *f = out.take_stdio();
-  png_image image;
-  std::memset(&image, 0, sizeof image);
-  image.version = PNG_IMAGE_VERSION;
-  image.width = static_cast<png_uint_32>(map.size_x);
-  image.height = static_cast<png_uint_32>(map.size_y);
-  image.format = PNG_FORMAT_GRAY;
-  const int ok =
-      png_image_write_to_stdio(&image, f, 0, pixels.data(), static_cast<png_int_32>(map.size_x), nullptr);
-  const std::string message = ok ? std::string() : std::string(image.message);
-  png_image_free(&image);
-  const bool closed = std::fclose(f) == 0;
-  if (!ok) throw FileError(path, "PNG write failed: " + message);
-  if (!closed) throw FileError(path, std::string("write failed: ") + std::strerror(errno));
+  write_png_pixels(out, map.size_x, map.size_y, PNG_FORMAT_GRAY, pixels.data());
+}
+
+void write_rgb_png(AtomicOutput &out, int width, int height, const std::vector<uint8_t> &rgb) {
+  if (width <= 0 || height <= 0 || rgb.size() != size_t(width) * size_t(height) * 3)
+    throw std::invalid_argument(out.final_path() + ": an RGB picture of " + std::to_string(width) + " x " +
+                                std::to_string(height) + " needs 3 bytes a pixel, not " +
+                                std::to_string(rgb.size()) + " bytes");
+  write_png_pixels(out, width, height, PNG_FORMAT_RGB, rgb.data());
+}
+
+void write_rgb_png(const std::string &path, int width, int height, const std::vector<uint8_t> &rgb) {
+  AtomicOutput out(path);
+  write_rgb_png(out, width, height, rgb);
+  out.commit();
 }
 
 void write_png(const std::string &path, const GridMap &map) {

@@ -80,6 +80,42 @@ std::string yaml_path_for(const std::string &pgm_path);
 void write_png(const std::string &path, const GridMap &map);
 void write_png(AtomicOutput &out, const GridMap &map);
 
+// Writes an 8-bit RGB PNG of width x height pixels from `rgb` (3 bytes a
+// pixel, row 0 at the top), atomically (mapdiff's difference picture).
+// Throws std::invalid_argument when rgb.size() != 3 * width * height or a
+// side is not positive, carmen::FileError naming the file on failure.
+void write_rgb_png(const std::string &path, int width, int height, const std::vector<uint8_t> &rgb);
+void write_rgb_png(AtomicOutput &out, int width, int height, const std::vector<uint8_t> &rgb);
+
+// ---------------------------------------------------------------------------
+// Reading (image_read.cc). Images are lossy: they give back what their grey
+// levels can say. Every failure is a carmen::FileError naming the file (and
+// the YAML line where there is one).
+// ---------------------------------------------------------------------------
+
+// A PNG written by write_png (any PNG: libpng converts it to 8-bit grey):
+// kPngUnknown is unknown (-1), any other level v is 1 - v / 255. The
+// resolution is 0: a PNG does not carry one.
+GridMap read_png(const std::string &path);
+
+// A map_server pair: the PGM (binary P5, maxval up to 255) at `pgm_path` and
+// the YAML beside it (yaml_path_for). The YAML is map_server's flat
+// "key: value" form (as write_pgm_with_yaml writes it; '#' comments; image
+// plain or double-quoted); resolution and origin are required, negate
+// (default 0), mode (default trinary), occupied_thresh and free_thresh
+// (defaults 0.65 and 0.196) are optional; the PGM read is the one named
+// here, not the YAML's image key. Levels are turned back into cells as
+// map_server reads them, occ = (255 - v) / 255 (negate 1: v / 255):
+//   trinary: occ > occupied_thresh 1.0, occ < free_thresh 0.0, else -1;
+//   scale:   kPgmUnknown -1 (write_pgm_with_yaml's unknown), else occ;
+//   raw:     kPgmRawUnknown -1, else v / 100 (a level over 100 is an error).
+struct PgmMap {
+  GridMap grid;
+  GlobalOffset origin;  // the YAML's origin: world pose of cell (0, 0)'s lower-left corner
+  PgmMode mode = PgmMode::Trinary;
+};
+PgmMap read_pgm_with_yaml(const std::string &pgm_path);
+
 }  // namespace carmen
 
 #endif  // CARMEN_COMPAT_IMAGE_IO_H

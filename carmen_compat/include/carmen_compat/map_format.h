@@ -1,0 +1,85 @@
+// map_format.h — the map formats, one table: which extension is which
+// format, and how each is read and written (Open3D's t/io extension tables
+// are the model). Adding a format is one row in map_format.cc and its reader
+// and writer.
+//
+// The rule (file_names.h): the extension decides, compared without regard to
+// ASCII case, so "x.PNG" is a PNG and "x.Map.Gz" a gzipped CARMEN map. Every
+// tool and binding asks this table, so they all accept the same names.
+//
+//   .map      CARMEN map: comments, id, CREATOR, GRIDMAP, OFFSET (when known)
+//   .map.gz   the same, gzipped
+//   .pgm      map_server / nav2 image plus a .yaml beside it (two files)
+//   .png      8-bit grey picture (lossy; no resolution, no origin)
+#ifndef CARMEN_COMPAT_MAP_FORMAT_H
+#define CARMEN_COMPAT_MAP_FORMAT_H
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/atomic_file.h"
+#include "carmen_compat/image_io.h"
+#include "carmen_compat/map_file.h"
+
+namespace carmen {
+
+enum class MapFormat { CarmenMap, CarmenMapGz, PgmYaml, Png };
+
+// Everything a writer needs, for every format.
+struct MapToWrite {
+  GridMap grid;
+  // World pose of the lower-left corner of cell (0, 0): the OFFSET chunk of
+  // a .map, the YAML's origin of a .pgm ((0, 0, 0) when absent).
+  std::optional<GlobalOffset> origin;
+  // Who made it, for a .map's comment block and CREATOR chunk:
+  std::string author = "vasco_gpu";  // comments' "Map author", CREATOR user
+  std::string source;                // comments' "Origin" (log2map: the log's file name)
+  std::string creator_origin;        // CREATOR origin; empty: the same as source
+  std::string description;           // comments' and CREATOR's description
+  int64_t time = 0;                  // seconds since 1970 (0 is written as it is)
+  PgmMode pgm_mode = PgmMode::Trinary;
+};
+
+// What a reader gives back.
+struct MapRead {
+  GridMap grid;
+  std::optional<GlobalOffset> origin;  // as above; none for a PNG or a .map without OFFSET
+};
+
+struct MapFormatEntry {
+  MapFormat format;
+  const char *extension;  // lower case, with the dot: ".map.gz"
+  const char *what;       // for help texts
+  MapRead (*read)(const std::string &path);
+  void (*write)(OutputTransaction &tx, const std::string &path, const MapToWrite &map);
+};
+
+// Every format, in the order help texts list them.
+const std::vector<MapFormatEntry> &map_formats();
+// ".map, .map.gz, .pgm, .png": for messages.
+std::string known_map_extensions();
+
+// The format of `path` by the rule above; nullptr when none matches.
+const MapFormatEntry *find_map_format(const std::string &path);
+// The same, or carmen::Error(Usage) naming the path and the known extensions.
+const MapFormatEntry &map_format_of(const std::string &path);
+
+// Every file writing `path` creates: the path, and for a .pgm its .yaml.
+// Throws like map_format_of.
+std::vector<std::string> map_output_files(const std::string &path);
+
+// Reads the map at `path` in its format. Throws carmen::Error(Usage) for an
+// unknown extension and carmen::FileError naming the file for a bad one.
+MapRead read_map(const std::string &path);
+// Writes `map` to `path` in its format, atomically (both files of a .pgm or
+// neither). Throws like read_map, and std::invalid_argument for an empty or
+// inconsistent grid.
+void write_map(const std::string &path, const MapToWrite &map);
+// The same as part of the caller's transaction (renamed by tx.commit()).
+void write_map(OutputTransaction &tx, const std::string &path, const MapToWrite &map);
+
+}  // namespace carmen
+
+#endif  // CARMEN_COMPAT_MAP_FORMAT_H
