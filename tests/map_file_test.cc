@@ -821,3 +821,20 @@ TEST(MapFilePlaces, TypeCodesAreCarmens) {
 }
 
 }  // namespace
+
+// Names from the file reach messages through carmen::printable: control
+// bytes (a terminal escape among them) are shown as \xNN, never sent raw.
+TEST(MapFileBad, ChunkNamesInMessagesArePrintable) {
+  TempDir dir;
+  const std::string path = dir.file("esc.map");
+  write_bytes(path, maptest::kId + maptest::chunk(4, "PLACES", maptest::i32(-1), "a\x1b[2Jb", true));
+  try {
+    carmen::read_map_file(path);
+    ADD_FAILURE() << "a negative place count was accepted";
+  } catch (const FileError &e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("(named \"a\\x1b[2Jb\")"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\x1b'), std::string::npos) << what;
+  }
+  EXPECT_EQ(carmen::printable(std::string("x\ty\x7f\xc3\xa9", 6)), "x\\x09y\\x7f\xc3\xa9");
+}
