@@ -1,6 +1,7 @@
 #include "vasco_gpu/log_input.h"
 
 #include <stdexcept>
+#include <utility>
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/ini_file.h"
@@ -23,13 +24,13 @@ LogInput load_log_input(const LogInputOptions &options) {
   all.num_scans = -1;
   carmen::LogReaderOptions reader;
   reader.strict = !options.lenient;
-  const ScanBatch every = load_scans(options.log, all, reader, &in.load, options.progress);
+  ScanBatch every = load_scans(options.log, all, reader, &in.load, options.progress);
   for (size_t i = 0; i < in.load.params.size(); ++i)
     params.add_fallback(in.load.params[i].first, in.load.params[i].second, options.log,
                         in.load.param_lines[i]);
   in.params = MapperParams::from_params(params, &in.warnings);
 
-  in.batch = every.select(in.params.first_scan, in.params.num_scans);
+  in.batch = std::move(every).select(in.params.first_scan, in.params.num_scans);  // no copy of the ranges
   in.load.scans_used = static_cast<long>(in.batch.num_scans());
   if (in.batch.num_scans() == 0)
     throw carmen::FileError(
@@ -40,9 +41,9 @@ LogInput load_log_input(const LogInputOptions &options) {
                                                std::to_string(in.load.laser_messages) + " laser messages)"
                                          : ""));
   try {
-    in.geo = size_grid(in.batch, in.params);
-  } catch (const std::runtime_error &e) {
-    throw carmen::FileError(options.log, e.what());
+    in.geo = size_grid(in.batch, in.params);  // the frame a Mapper's first insert of in.batch takes
+  } catch (const carmen::Error &e) {
+    throw carmen::FileError(options.log, e.what(), e.code());
   }
   // A block larger than the grid leaves nothing to finish: say so, naming
   // where the value came from.

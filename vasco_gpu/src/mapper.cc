@@ -1,37 +1,76 @@
 #include "vasco_gpu/mapper.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <sstream>
-#include <stdexcept>
 #include <string>
+#include <utility>
+
+#include "vasco_gpu/error.h"
 
 namespace vasco {
 namespace {
 
 void check_window(const GridWindow &w, const GridGeometry &geo) {
   if (w.width < 0 || w.height < 0 || w.x0 < 0 || w.y0 < 0 ||
-      static_cast<long>(w.x0) + w.width > geo.size_x || static_cast<long>(w.y0) + w.height > geo.size_y)
-    throw std::invalid_argument("Mapper::read: window [" + std::to_string(w.x0) + ", +" +
-                                std::to_string(w.width) + ") x [" + std::to_string(w.y0) + ", +" +
-                                std::to_string(w.height) + ") is not inside the " +
-                                std::to_string(geo.size_x) + " x " + std::to_string(geo.size_y) + " grid");
+      static_cast<int64_t>(w.x0) + w.width > geo.size_x || static_cast<int64_t>(w.y0) + w.height > geo.size_y)
+    throw Error(ErrorCode::Usage, "Mapper::read: window [" + std::to_string(w.x0) + ", +" +
+                                      std::to_string(w.width) + ") x [" + std::to_string(w.y0) + ", +" +
+                                      std::to_string(w.height) + ") is not inside the " +
+                                      std::to_string(geo.size_x) + " x " + std::to_string(geo.size_y) + " grid");
+}
+
+void check_fixed_frame(const GridGeometry &frame, const MapperParams &params) {
+  if (frame.size_x <= 0 || frame.size_y <= 0)
+    throw Error(ErrorCode::Usage, "Mapper: a fixed frame needs a size of at least 1 x 1 cells");
+  if (frame.num_cells() > kMaxGridCells)
+    throw Error(ErrorCode::TooLarge, "Mapper: a fixed frame of " + std::to_string(frame.size_x) + " x " +
+                                         std::to_string(frame.size_y) + " cells is beyond the limit of " +
+                                         std::to_string(kMaxGridCells) + " cells");
+  if (frame.resolution != params.resolution)
+    throw Error(ErrorCode::Usage, "Mapper: the frame's resolution differs from vasco_resolution");
+  if (!std::isfinite(frame.theta_offset))
+    throw Error(ErrorCode::Usage, "Mapper: the fixed frame's theta_offset is not finite");
+}
+
+void check_poses(const std::vector<Pose> &poses) {
+  for (size_t s = 0; s < poses.size(); ++s)
+    if (!std::isfinite(poses[s].x) || !std::isfinite(poses[s].y) || !std::isfinite(poses[s].theta))
+      throw Error(ErrorCode::BadInput, "Mapper::render: pose " + std::to_string(s) + " is not finite");
+}
+
+// One axis of a grown PROTOCOL frame: as wide as needed, and at least half
+// as wide again as now (sizes are 2 * half + 2), in 64 bits.
+int64_t grown_size(int need, int current) {
+  if (need <= current) return current;
+  const int64_t half_now = (current - 2) / 2, half_need = (need - 2) / 2;
+  return 2 * std::max(half_need, half_now + half_now / 2) + 2;
+}
+
+// What the session keeps in host memory, estimated before it is allocated:
+// the grid (4 bytes a cell; CPU renderers), the stored scans (4 bytes a beam)
+// and a renderer's per-beam scratch (placement and stripe lists of the CPU
+// backends, the CUDA renderer's pinned staging: 64 bytes a beam at most).
+double memory_need(const GridGeometry &geo, uint64_t beams, bool grid_on_device) {
+  return (grid_on_device ? 0.0 : 4.0 * static_cast<double>(geo.num_cells())) + 68.0 * static_cast<double>(beams);
 }
 
 }  // namespace
 
 Mapper::Mapper(const MapperParams &params, const std::string &backend, const BackendOptions &options)
-    : params_(params), options_(options), renderer_(make_renderer(backend, options)) {
+    : Mapper(params, make_renderer(backend, options), options) {}
+
+Mapper::Mapper(const MapperParams &params, std::unique_ptr<Renderer> renderer, const BackendOptions &options)
+    : params_(params), options_(options), renderer_(std::move(renderer)) {
+  if (!renderer_) throw Error(ErrorCode::Usage, "Mapper: no renderer");
   params_.validate();
 }
 
 Mapper::Mapper(const MapperParams &params, const GridGeometry &frame, const std::string &backend,
                const BackendOptions &options)
     : Mapper(params, backend, options) {
-  if (frame.size_x <= 0 || frame.size_y <= 0 || frame.num_cells() > kMaxGridCells)
-    throw std::invalid_argument("Mapper: a fixed frame needs a size between 1 and " +
-                                std::to_string(kMaxGridCells) + " cells");
-  if (frame.resolution != params.resolution)
-    throw std::invalid_argument("Mapper: the frame's resolution differs from vasco_resolution");
+  check_fixed_frame(frame, params);
   fixed_frame_ = true;
   geo_ = frame;
 }
@@ -44,21 +83,51 @@ GridGeometry Mapper::frame_for(const PoseExtent &extent, const ScanBatch &scans)
   return g;
 }
 
-// What the session keeps in host memory, estimated before it is allocated:
-// the grid (4 bytes a cell; CPU renderers), the stored scans (4 bytes a beam)
-// and a renderer's per-beam scratch (placement and stripe lists of the CPU
-// backends, the CUDA renderer's pinned staging: 64 bytes a beam at most).
+// The frame an insert grows to: `need` widened by the margin where it fits
+// the size limit and the memory budget, else `need` itself.
+GridGeometry Mapper::grown_frame(const GridGeometry &need, uint64_t beams) const {
+  const int64_t sx = grown_size(need.size_x, geo_.size_x), sy = grown_size(need.size_y, geo_.size_y);
+  if (sx >= INT32_MAX || sy >= INT32_MAX || static_cast<uint64_t>(sx) * static_cast<uint64_t>(sy) > kMaxGridCells)
+    return need;
+  GridGeometry g = need;
+  g.size_x = static_cast<int>(sx);
+  g.size_y = static_cast<int>(sy);
+  return fits_memory(g, beams) ? g : need;
+}
+
+bool Mapper::fits_memory(const GridGeometry &geo, uint64_t beams) const {
+  return options_.max_memory_bytes == 0 ||
+         memory_need(geo, beams, renderer_->traits().grid_on_device) <= static_cast<double>(options_.max_memory_bytes);
+}
+
 void Mapper::check_memory(const GridGeometry &geo, uint64_t beams) const {
-  if (options_.max_memory_bytes == 0) return;
-  const bool device_grid = renderer_->traits().grid_on_device;
-  const double need = (device_grid ? 0.0 : 4.0 * static_cast<double>(geo.num_cells())) + 68.0 * beams;
-  if (need <= static_cast<double>(options_.max_memory_bytes)) return;
+  if (fits_memory(geo, beams)) return;
+  const double need = memory_need(geo, beams, renderer_->traits().grid_on_device);
   std::ostringstream m;
   m << "the map needs about " << static_cast<uint64_t>(need / (1 << 20)) << " MiB of memory (a grid of "
     << geo.size_x << " x " << geo.size_y << " cells at " << geo.resolution << " m and " << beams
     << " beams), more than the budget of " << (options_.max_memory_bytes >> 20)
     << " MiB: raise it (log2map --max-memory MiB), or use a coarser vasco_resolution";
-  throw std::runtime_error(m.str());
+  throw Error(ErrorCode::OutOfMemory, m.str());
+}
+
+void Mapper::set_max_memory_bytes(uint64_t bytes) {
+  const uint64_t old = options_.max_memory_bytes;
+  options_.max_memory_bytes = bytes;
+  try {
+    if (scans_.num_scans() > 0) check_memory(geo_, scans_.num_beams());
+  } catch (...) {
+    options_.max_memory_bytes = old;
+    throw;
+  }
+}
+
+void Mapper::check_grid_usable(const char *what) const {
+  if (scans_.num_scans() == 0) throw Error(ErrorCode::State, std::string(what) + ": no scans inserted");
+  if (grid_lost_)
+    throw Error(ErrorCode::State, std::string(what) +
+                                      ": the grid was lost when a failed call could not restore it; "
+                                      "render(poses()) or an insert renders it again");
 }
 
 void Mapper::rerender() {
@@ -67,68 +136,122 @@ void Mapper::rerender() {
   ++renders_;
 }
 
-void Mapper::insert(const ScanBatch &scans) {
-  if (scans.num_scans() == 0) return;
-  PoseExtent extent = extent_;
-  extent.add(scans, 0, scans.num_scans());
-  const GridGeometry geo = frame_for(extent, scans);  // throws before anything changes
-  check_memory(geo, scans_.num_beams() + scans.num_beams());
-  renderer_->check_capacity(scans_.num_beams() + scans.num_beams());
-  const size_t before = scans_.num_scans();
-  for (size_t s = 0; s < scans.num_scans(); ++s)
-    scans_.add_scan(scans.x[s], scans.y[s], scans.theta[s], scans.first_angle[s], scans.angle_step[s],
-                    scans.ranges_of(s), scans.beams_in(s), scans.line[s]);
-  extent_ = extent;
-  stats_ = MapStats{};
-  const bool same_frame = before > 0 && geo.size_x == geo_.size_x && geo.size_y == geo_.size_y;
-  geo_ = geo;
-  if (!same_frame) {
-    rerender();
-    return;
+// Puts back what `saved` holds (scans_ already truncated to saved.scans) and
+// renders the grid again; a render that fails too leaves the grid marked lost.
+void Mapper::restore(const Saved &saved) noexcept {
+  geo_ = saved.geo;
+  extent_ = saved.extent;
+  grid_lost_ = false;
+  if (saved.scans > 0) {
+    try {
+      rerender();
+    } catch (...) {
+      grid_lost_ = true;
+    }
   }
-  renderer_->apply(scans_, before, scans_.num_scans(), &stats_);
+  stats_ = saved.stats;
+}
+
+Mapper::InsertPlan Mapper::plan_insert(const ScanBatch &scans) const {
+  const size_t before = scans_.num_scans();
+  const uint64_t beams = scans_.num_beams() + scans.num_beams();
+  InsertPlan plan;
+  plan.extent = extent_;
+  for (size_t s = 0; s < scans.num_scans(); ++s) plan.extent.add_pose(scans.x[s], scans.y[s], scans.theta[s], s);
+  const GridGeometry need = frame_for(plan.extent, scans);
+  const bool fits = before > 0 && need.size_x <= geo_.size_x && need.size_y <= geo_.size_y;
+  plan.geo = fits || fixed_frame_ ? (before > 0 ? geo_ : need) : (before > 0 ? grown_frame(need, beams) : need);
+  plan.full_render = before == 0 || grid_lost_ || !fits;
+  check_memory(plan.geo, beams);
+  renderer_->check_capacity(beams);
+  return plan;
+}
+
+void Mapper::apply_insert(const InsertPlan &plan, size_t before) {
+  extent_ = plan.extent;
+  geo_ = plan.geo;
+  stats_ = MapStats{};
+  if (plan.full_render)
+    rerender();
+  else
+    renderer_->apply(scans_, before, scans_.num_scans(), &stats_);
+  grid_lost_ = false;
+}
+
+void Mapper::insert(const ScanBatch &scans) {
+  scans.validate_for_mapping();
+  if (scans.num_scans() == 0) return;
+  const InsertPlan plan = plan_insert(scans);  // throws before anything changes
+  const Saved saved = save();
+  scans_.append(scans);  // all or nothing
+  try {
+    apply_insert(plan, saved.scans);
+  } catch (...) {
+    scans_.truncate(saved.scans);
+    restore(saved);
+    throw;
+  }
+}
+
+void Mapper::insert(ScanBatch &&scans) {
+  if (scans_.num_scans() > 0) return insert(static_cast<const ScanBatch &>(scans));  // appended: one copy
+  scans.validate_for_mapping();
+  if (scans.num_scans() == 0) return;
+  const InsertPlan plan = plan_insert(scans);
+  const Saved saved = save();
+  scans_ = std::move(scans);
+  try {
+    apply_insert(plan, 0);
+  } catch (...) {
+    scans = std::move(scans_);
+    scans_ = ScanBatch();
+    restore(saved);
+    throw;
+  }
 }
 
 void Mapper::render(const std::vector<Pose> &poses) {
   if (poses.size() != scans_.num_scans())
-    throw std::invalid_argument("Mapper::render: " + std::to_string(poses.size()) + " poses for " +
-                                std::to_string(scans_.num_scans()) + " stored scans");
+    throw Error(ErrorCode::Usage, "Mapper::render: " + std::to_string(poses.size()) + " poses for " +
+                                      std::to_string(scans_.num_scans()) + " stored scans");
+  check_poses(poses);
   if (poses.empty()) return;
-  std::vector<double> x(poses.size()), y(poses.size()), theta(poses.size());
-  for (size_t s = 0; s < poses.size(); ++s) {
-    x[s] = poses[s].x;
-    y[s] = poses[s].y;
-    theta[s] = poses[s].theta;
-  }
-  x.swap(scans_.x);
-  y.swap(scans_.y);
-  theta.swap(scans_.theta);
   PoseExtent extent;
-  extent.add(scans_, 0, scans_.num_scans());
-  GridGeometry geo;
-  try {
-    geo = frame_for(extent, scans_);
-    check_memory(geo, scans_.num_beams());
-    renderer_->check_capacity(scans_.num_beams());
-  } catch (...) {  // the old poses stay
+  for (size_t s = 0; s < poses.size(); ++s) extent.add_pose(poses[s].x, poses[s].y, poses[s].theta, s);
+  const GridGeometry geo = frame_for(extent, scans_);
+  check_memory(geo, scans_.num_beams());
+  renderer_->check_capacity(scans_.num_beams());
+  std::vector<double> x(poses.size()), y(poses.size()), theta(poses.size());
+  for (size_t s = 0; s < poses.size(); ++s) x[s] = poses[s].x, y[s] = poses[s].y, theta[s] = poses[s].theta;
+  const Saved saved = save();
+  auto swap_poses = [&] {
     x.swap(scans_.x);
     y.swap(scans_.y);
     theta.swap(scans_.theta);
-    throw;
-  }
+  };
+  swap_poses();
   extent_ = extent;
   geo_ = geo;
   stats_ = MapStats{};
-  rerender();
+  try {
+    rerender();
+    grid_lost_ = false;
+  } catch (...) {
+    swap_poses();  // the old poses back
+    restore(saved);
+    throw;
+  }
 }
 
 FinishedMap Mapper::finish(int downsample, int border) const {
-  if (scans_.num_scans() == 0) throw std::logic_error("Mapper::finish: no scans inserted");
+  check_grid_usable("Mapper::finish");
+  if (downsample < 1) throw Error(ErrorCode::Usage, "Mapper::finish: downsample must be at least 1");
+  if (border < 0) throw Error(ErrorCode::Usage, "Mapper::finish: border must not be negative");
   return renderer_->finish(downsample, border);
 }
 
 std::vector<float> Mapper::read(const GridWindow &window) const {
-  if (scans_.num_scans() == 0) throw std::logic_error("Mapper::read: no scans inserted");
+  check_grid_usable("Mapper::read");
   check_window(window, geo_);
   return renderer_->read(window);
 }

@@ -2,44 +2,59 @@
 #include "vasco_gpu/mapper.h"
 
 #include <cstring>
+#include <mutex>
 #include <memory>
 #include <new>
 #include <stdexcept>
 #include <string>
 
+#include "vasco_gpu/error.h"
 #include "vasco_gpu/mapper.hpp"
 
 struct vasco_mapper {
   std::unique_ptr<vasco::Mapper> mapper;
   vasco::FinishedMap finished;  // what the last vasco_mapper_finish returned points into
   std::string error;
+  mutable std::mutex lock;  // one call at a time (mapper.h: Threads)
 };
 
 namespace {
 
 thread_local std::string create_error;
 
-// Runs `f`, turning exceptions into a status and a message kept in `error`.
+vasco_status status_of(vasco::ErrorCode code) {
+  switch (code) {
+    case vasco::ErrorCode::Usage:
+    case vasco::ErrorCode::BadInput: return VASCO_ERR_INVALID_ARGUMENT;
+    case vasco::ErrorCode::TooLarge: return VASCO_ERR_TOO_LARGE;
+    case vasco::ErrorCode::OutOfMemory: return VASCO_ERR_OUT_OF_MEMORY;
+    case vasco::ErrorCode::NoGpu: return VASCO_ERR_BACKEND;
+    case vasco::ErrorCode::State: return VASCO_ERR_STATE;
+    case vasco::ErrorCode::Io: return VASCO_ERR_IO;
+    case vasco::ErrorCode::Internal: return VASCO_ERR_INTERNAL;
+  }
+  return VASCO_ERR_INTERNAL;
+}
+
+// Runs `f`, turning exceptions into a status (by the error's code, never by
+// its words) and a message kept in `error`. std::invalid_argument is a bad
+// argument from code that does not throw vasco::Error yet.
 template <class F>
 vasco_status guarded(std::string *error, F &&f) {
   try {
     f();
     return VASCO_OK;
+  } catch (const vasco::Error &e) {
+    *error = e.what();
+    return status_of(e.code());
   } catch (const std::bad_alloc &) {
     *error = "out of memory";
     return VASCO_ERR_OUT_OF_MEMORY;
   } catch (const std::invalid_argument &e) {
     *error = e.what();
-    return std::string(e.what()).find("backend") != std::string::npos ? VASCO_ERR_BACKEND
-                                                                     : VASCO_ERR_INVALID_ARGUMENT;
-  } catch (const std::logic_error &e) {
+    return VASCO_ERR_INVALID_ARGUMENT;
+  } catch (const std::exception &e) {
     *error = e.what();
-    return VASCO_ERR_STATE;
-  } catch (const std::runtime_error &e) {
-    *error = e.what();
-    const std::string w = e.what();
-    if (w.find("too large") != std::string::npos) return VASCO_ERR_TOO_LARGE;
-    if (w.find("GPU") != std::string::npos || w.find("CUDA") != std::string::npos) return VASCO_ERR_BACKEND;
     return VASCO_ERR_INTERNAL;
   } catch (...) {
     *error = "unknown error";
@@ -68,9 +83,14 @@ vasco_status create(const vasco_mapper_params *params, const char *backend, cons
     return VASCO_ERR_INVALID_ARGUMENT;
   }
   *out = nullptr;
+  vasco::BackendOptions opt;
+  std::string name;
+  // An unknown name is the one failure of resolving it: VASCO_ERR_BACKEND.
+  const vasco_status known = guarded(&create_error, [&] {
+    name = vasco::resolve_backend_name(backend != nullptr ? backend : "cpu_double", &opt);
+  });
+  if (known != VASCO_OK) return known == VASCO_ERR_INVALID_ARGUMENT ? VASCO_ERR_BACKEND : known;
   return guarded(&create_error, [&] {
-    vasco::BackendOptions opt;
-    const std::string name = vasco::resolve_backend_name(backend != nullptr ? backend : "cpu_double", &opt);
     auto h = std::make_unique<vasco_mapper>();
     const vasco::MapperParams p = to_params(*params);
     h->mapper = frame ? std::make_unique<vasco::Mapper>(p, *frame, name, opt)
@@ -115,6 +135,7 @@ vasco_status vasco_mapper_insert(vasco_mapper *m, size_t num_scans, const double
                                  const int *beam_counts, const float *ranges, const double *first_angles,
                                  const double *angle_steps) {
   if (m == nullptr) return VASCO_ERR_INVALID_ARGUMENT;
+  const std::lock_guard<std::mutex> hold(m->lock);
   if (num_scans > 0 && (poses == nullptr || beam_counts == nullptr || first_angles == nullptr ||
                         angle_steps == nullptr))
     return fail(m, VASCO_ERR_INVALID_ARGUMENT, "vasco_mapper_insert: NULL argument");
@@ -130,12 +151,13 @@ vasco_status vasco_mapper_insert(vasco_mapper *m, size_t num_scans, const double
                  beam_counts[s], static_cast<long>(m->mapper->num_scans() + s + 1));
       r += beam_counts[s];
     }
-    m->mapper->insert(b);
+    m->mapper->insert(std::move(b));
   });
 }
 
 vasco_status vasco_mapper_render(vasco_mapper *m, size_t num_scans, const double *poses) {
   if (m == nullptr) return VASCO_ERR_INVALID_ARGUMENT;
+  const std::lock_guard<std::mutex> hold(m->lock);
   if (num_scans > 0 && poses == nullptr) return fail(m, VASCO_ERR_INVALID_ARGUMENT, "vasco_mapper_render: NULL poses");
   return guarded(&m->error, [&] {
     std::vector<vasco::Pose> p(num_scans);
@@ -146,6 +168,7 @@ vasco_status vasco_mapper_render(vasco_mapper *m, size_t num_scans, const double
 
 vasco_status vasco_mapper_finish(vasco_mapper *m, int downsample, int border, vasco_map *out) {
   if (m == nullptr) return VASCO_ERR_INVALID_ARGUMENT;
+  const std::lock_guard<std::mutex> hold(m->lock);
   if (out == nullptr) return fail(m, VASCO_ERR_INVALID_ARGUMENT, "vasco_mapper_finish: NULL map");
   return guarded(&m->error, [&] {
     m->finished = m->mapper->finish(downsample, border);
@@ -160,6 +183,7 @@ vasco_status vasco_mapper_finish(vasco_mapper *m, int downsample, int border, va
 
 vasco_status vasco_mapper_grid_size(const vasco_mapper *m, int *size_x, int *size_y) {
   if (m == nullptr || size_x == nullptr || size_y == nullptr) return VASCO_ERR_INVALID_ARGUMENT;
+  const std::lock_guard<std::mutex> hold(m->lock);
   *size_x = m->mapper->frame().size_x;
   *size_y = m->mapper->frame().size_y;
   return VASCO_OK;
@@ -167,17 +191,31 @@ vasco_status vasco_mapper_grid_size(const vasco_mapper *m, int *size_x, int *siz
 
 vasco_status vasco_mapper_read(vasco_mapper *m, int x0, int y0, int width, int height, float *out) {
   if (m == nullptr) return VASCO_ERR_INVALID_ARGUMENT;
-  if (out == nullptr) return fail(m, VASCO_ERR_INVALID_ARGUMENT, "vasco_mapper_read: NULL output");
+  const std::lock_guard<std::mutex> hold(m->lock);
+  if (out == nullptr && width != 0 && height != 0)
+    return fail(m, VASCO_ERR_INVALID_ARGUMENT, "vasco_mapper_read: NULL output");
   return guarded(&m->error, [&] {
     const std::vector<float> w = m->mapper->read(vasco::GridWindow{x0, y0, width, height});
-    std::memcpy(out, w.data(), w.size() * sizeof(float));
+    if (!w.empty()) std::memcpy(out, w.data(), w.size() * sizeof(float));
   });
 }
 
-size_t vasco_mapper_num_scans(const vasco_mapper *m) { return m != nullptr ? m->mapper->num_scans() : 0; }
+vasco_status vasco_mapper_set_max_memory(vasco_mapper *m, unsigned long long bytes) {
+  if (m == nullptr) return VASCO_ERR_INVALID_ARGUMENT;
+  const std::lock_guard<std::mutex> hold(m->lock);
+  return guarded(&m->error, [&] { m->mapper->set_max_memory_bytes(bytes); });
+}
+
+size_t vasco_mapper_num_scans(const vasco_mapper *m) {
+  if (m == nullptr) return 0;
+  const std::lock_guard<std::mutex> hold(m->lock);
+  return m->mapper->num_scans();
+}
 
 const char *vasco_last_error(const vasco_mapper *m) {
-  return m != nullptr ? m->error.c_str() : create_error.c_str();
+  if (m == nullptr) return create_error.c_str();
+  const std::lock_guard<std::mutex> hold(m->lock);
+  return m->error.c_str();
 }
 
 }  // extern "C"

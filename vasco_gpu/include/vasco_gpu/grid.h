@@ -11,6 +11,9 @@ namespace vasco {
 
 struct MapperParams;
 struct ScanBatch;
+namespace oracle {
+struct GridFrame;  // vasco_gpu/oracle.h
+}
 
 // Where the evidence grid lies: its size and the first scan's pose, which
 // fixes the frame (theta_offset = the first scan's heading, so the grid axes
@@ -41,13 +44,23 @@ struct PoseExtent {
   // Adds scans [first, last) of `batch` (scan 0 of the batch is the first
   // scan when the extent is empty).
   void add(const ScanBatch &batch, size_t first, size_t last);
+  // Adds one pose, scan `index` of the batch it belongs to.
+  void add_pose(double x, double y, double theta, size_t index);
 };
 
-// Sizes the grid for a batch (DESIGN §3 step 2). Throws std::runtime_error
-// when the batch is empty or the grid would be absurdly large (naming the
-// source lines of the first and the farthest scans).
+// Sizes the grid for a batch (DESIGN §3 step 2): the PROTOCOL frame, the one
+// function log2map's input and every Mapper size their grid with. Throws
+// vasco::Error(BadInput) when the batch is empty, Error(TooLarge) when the
+// grid would be absurdly large (naming the source lines of the first and the
+// farthest scans).
 GridGeometry size_grid(const ScanBatch &batch, const MapperParams &params);
 GridGeometry size_grid(const PoseExtent &extent, const ScanBatch &batch, const MapperParams &params);
+
+// The oracle's frame of a grid of `geo` with the start pose recorded from
+// scan 0 of `batch` (when it has one), as CARMEN's first update records it:
+// what every exact backend places scans [first, last) of a batch with, for
+// any first. The one GridGeometry -> oracle::GridFrame conversion.
+oracle::GridFrame start_frame(const GridGeometry &geo, const ScanBatch &batch);
 
 // The result of finish: a downsampled, cropped grid.
 struct FinishedMap {
@@ -60,8 +73,10 @@ struct FinishedMap {
 
 // CARMEN's finish (DESIGN §2 step 7): block means of known cells (summed in
 // double), crop to the known bounding box plus `border`, new size max - min
-// (no +1), resolution times `downsample`. Throws std::invalid_argument for a
-// downsample < 1 or border < 0.
+// (no +1), resolution times `downsample`. The bounds are 64-bit, so any
+// border (INT_MAX included) crops to the grid instead of overflowing; for
+// borders CARMEN's int arithmetic holds they are CARMEN's. Throws
+// vasco::Error(Usage) for a downsample < 1 or border < 0.
 FinishedMap finish_grid(const float *cells, int size_x, int size_y, double resolution,
                         int downsample, int border);
 

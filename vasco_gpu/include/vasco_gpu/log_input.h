@@ -34,7 +34,9 @@ struct LogInput {
   MapperParams params;                // validated
   ScanBatch batch;                    // the selected scans, in log order
   LogLoadStats load;                  // counts of the whole log
-  GridGeometry geo;                   // DESIGN §3 step 2, from the selected scans
+  GridGeometry geo;                   // DESIGN §3 step 2 (size_grid), from the selected scans: the
+                                      // frame a Mapper's first insert of `batch` takes (use the
+                                      // Mapper's frame() once it has mapped them)
   std::vector<std::string> warnings;  // unknown vasco_* keys and the like
 };
 

@@ -19,7 +19,14 @@
  * see vasco_gpu/mapper.hpp), or fixed with vasco_mapper_create_fixed.
  * Functions return VASCO_OK or an error code; vasco_last_error(m) says what
  * went wrong in the last failed call on m (with m NULL: in this thread's
- * last failed create). A failed call leaves the session as it was. */
+ * last failed create). A failed call leaves the session as it was.
+ *
+ * Threads: every call on a handle takes the handle's lock, so one handle may
+ * be used from several threads (calls run one at a time, in the order they
+ * get the lock). What a call hands out — the cells of vasco_mapper_finish,
+ * the text of vasco_last_error — stays valid until the next call on the
+ * handle from any thread: threads sharing a handle copy it before they let
+ * another call run. vasco_mapper_destroy must not overlap another call. */
 #ifndef VASCO_GPU_MAPPER_H
 #define VASCO_GPU_MAPPER_H
 
@@ -38,7 +45,8 @@ typedef enum {
   VASCO_ERR_OUT_OF_MEMORY = 3,
   VASCO_ERR_TOO_LARGE = 4,        /* the poses span a grid beyond the size limit */
   VASCO_ERR_STATE = 5,            /* e.g. finish before any scan was inserted */
-  VASCO_ERR_INTERNAL = 6
+  VASCO_ERR_INTERNAL = 6,
+  VASCO_ERR_IO = 7                /* the file system refused (open, write, rename) */
 } vasco_status;
 
 typedef struct {
@@ -65,6 +73,11 @@ vasco_status vasco_mapper_create(const vasco_mapper_params *params, const char *
 vasco_status vasco_mapper_create_fixed(const vasco_mapper_params *params, const char *backend, int size_x,
                                        int size_y, double theta_offset, vasco_mapper **out);
 void vasco_mapper_destroy(vasco_mapper *m);
+/* The host-memory budget of the session in bytes (0: none; by default 2 GiB).
+ * An insert or render that would need more fails with VASCO_ERR_OUT_OF_MEMORY
+ * and changes nothing; so does this call, keeping the old budget, when the
+ * session already needs more than `bytes`. */
+vasco_status vasco_mapper_set_max_memory(vasco_mapper *m, unsigned long long bytes);
 
 vasco_status vasco_mapper_insert(vasco_mapper *m, size_t num_scans, const double *poses,
                                  const int *beam_counts, const float *ranges, const double *first_angles,
@@ -72,7 +85,8 @@ vasco_status vasco_mapper_insert(vasco_mapper *m, size_t num_scans, const double
 /* New poses (num_scans == vasco_mapper_num_scans) and the grid recomputed. */
 vasco_status vasco_mapper_render(vasco_mapper *m, size_t num_scans, const double *poses);
 vasco_status vasco_mapper_finish(vasco_mapper *m, int downsample, int border, vasco_map *out);
-/* The full-resolution grid's size, and a window of it into out[width * height] (x-major). */
+/* The full-resolution grid's size, and a window of it into out[width * height]
+ * (x-major; out may be NULL when width or height is 0). */
 vasco_status vasco_mapper_grid_size(const vasco_mapper *m, int *size_x, int *size_y);
 vasco_status vasco_mapper_read(vasco_mapper *m, int x0, int y0, int width, int height, float *out);
 size_t vasco_mapper_num_scans(const vasco_mapper *m);

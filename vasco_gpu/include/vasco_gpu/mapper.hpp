@@ -7,22 +7,42 @@
 //   m.render(poses);                        // a loop closure: every pose moved, recomputed
 //   vasco::FinishedMap map = m.finish();    // CARMEN's finish (downsample, crop)
 //
-// Exactness. With cpu_double, cpu_threads and CUDA exact mode the grid after
-// inserting scans 0..k in any number of calls is bit-identical to mapping
-// 0..k at once, and a render with poses P is bit-identical to a fresh map of a
-// log carrying P (and so, for a CARMEN log, to CARMEN's map).
+// Exactness. With cpu_double, cpu_threads and CUDA exact mode the grid is
+// always bit-identical to a fresh render of the stored scans in frame() (a
+// fixed-frame Mapper of frame()'s size and heading, or CARMEN's egrid.c with
+// them, fed the same scans): inserting scans 0..k in any number of calls
+// gives the bytes of one call in the same frame. A render with poses P is
+// bit-identical to a fresh map of a log carrying P (and so, for a CARMEN
+// log, to CARMEN's map), and so is the first insert of a session.
 //
 // The grid frame. By default the frame is the golden PROTOCOL's (DESIGN §3):
 // centred on the first scan's pose, 2 * ceil((max |x - x0| + range_max + res)
 // / res) + 2 cells wide (likewise in y), theta_offset = the first scan's
-// heading — what log2map uses, so its maps stay CARMEN's. An insert whose
-// scans lie farther out grows the frame to the PROTOCOL frame of all scans
-// stored, and a render recomputes it from the new poses; either way the grid
-// is then rendered afresh in the new frame, so a grown map equals a fresh
-// render in the grown frame (growth costs one full render: give a fixed frame
-// when scans arrive one by one far beyond the start). A fixed frame (given
-// size, resolution and heading; centred on the first scan, as CARMEN's
-// egrid.c) never changes: cells outside it are skipped, as CARMEN skips them.
+// heading — what log2map uses, so its maps stay CARMEN's. The first insert
+// and every render() use exactly this frame. An insert whose scans need a
+// wider frame grows it, in each axis that must grow, to the larger of what
+// the stored scans need and 1.5 times the current half-width (so n inserts
+// of a robot driving away cost O(log n) full renders, not n), falling back to
+// what they need when the margin would pass kMaxGridCells or the memory
+// budget. A grown frame is larger than the PROTOCOL frame of the stored
+// scans: the finished map then equals the PROTOCOL frame's only when the
+// crop did not reach that frame's edge and the margin is a multiple of the
+// downsample (and a cell coordinate size/2 + d rounds at the larger grid's
+// magnitude). `render(poses())` brings the session back to the PROTOCOL
+// frame, CARMEN's map. A fixed frame (given size, resolution and heading;
+// centred on the first scan, as CARMEN's egrid.c) never changes: cells
+// outside it are skipped, as CARMEN skips them.
+//
+// Failures. A failed call (vasco::Error with its code, or std::bad_alloc)
+// leaves the session as it was: scans, poses, frame and grid. Everything that
+// can be checked is checked before anything changes; when a renderer fails
+// after the grid changed, the stored state is restored and the grid rendered
+// again from it. Should that render fail too, finish() and read() refuse with
+// Error(State) until an insert or render() has rendered the grid again: a
+// map that does not match the stored scans is never returned.
+//
+// Threads: a Mapper is one session; calls on one Mapper from several threads
+// must be serialized by the caller (the C API's handle does it).
 #ifndef VASCO_GPU_MAPPER_HPP
 #define VASCO_GPU_MAPPER_HPP
 
@@ -42,29 +62,45 @@ namespace vasco {
 
 class Mapper {
  public:
-  // PROTOCOL frame. Throws std::invalid_argument for bad parameters or an
-  // unknown backend, std::runtime_error when the backend cannot run here.
+  // PROTOCOL frame. Throws for bad parameters or an unknown backend, and when
+  // the backend cannot run here (the registry's errors).
   Mapper(const MapperParams &params, const std::string &backend = "cpu_double",
          const BackendOptions &options = {});
   // Fixed frame: `frame.size_x`, `size_y`, `resolution` (must equal
-  // params.resolution) and `theta_offset` are used; x0 and y0 are taken from
-  // the first scan.
+  // params.resolution) and `theta_offset` (finite) are used; x0 and y0 are
+  // taken from the first scan. Error(Usage) for a bad frame, Error(TooLarge)
+  // beyond kMaxGridCells.
   Mapper(const MapperParams &params, const GridGeometry &frame, const std::string &backend,
          const BackendOptions &options = {});
+  // PROTOCOL frame on a renderer of the caller's (a backend of its own).
+  Mapper(const MapperParams &params, std::unique_ptr<Renderer> renderer, const BackendOptions &options = {});
 
   // Stores `scans` (ranges, beam geometry and poses) after those stored and
-  // applies them to the current grid. Throws std::runtime_error when the
-  // PROTOCOL frame would be too large, or the session would need more host
-  // memory than BackendOptions::max_memory_bytes (nothing is stored then).
+  // applies them to the current grid. Throws, storing nothing:
+  // Error(BadInput) for a batch whose arrays disagree or a non-finite pose
+  // (ScanBatch::validate_for_mapping, naming the scan), Error(TooLarge) when
+  // the frame would be too large, Error(OutOfMemory) when the session would
+  // need more host memory than the budget. The && form takes the batch's
+  // arrays instead of copying them into an empty session (given back on a
+  // failure).
   void insert(const ScanBatch &scans);
-  // New poses for every stored scan (poses.size() == num_scans()), and the
-  // grid recomputed from scratch with them.
+  void insert(ScanBatch &&scans);
+  // New poses for every stored scan (poses.size() == num_scans(), else
+  // Error(Usage); a non-finite pose: Error(BadInput) naming it), and the grid
+  // recomputed from scratch with them in their PROTOCOL (or the fixed) frame.
   void render(const std::vector<Pose> &poses);
 
+  // CARMEN's finish; Error(State) before any insert, Error(Usage) for a
+  // downsample < 1 or a negative border (any larger border crops to the grid).
   FinishedMap finish() const { return finish(static_cast<int>(params_.downsample), static_cast<int>(params_.border)); }
   FinishedMap finish(int downsample, int border) const;
+  // Error(Usage) for a window not inside frame(), Error(State) before any insert.
   std::vector<float> read(const GridWindow &window) const;
   std::vector<float> read() const;  // the whole full-resolution grid
+
+  // A new host-memory budget (0: none). Error(OutOfMemory), keeping the old
+  // one, when the session already needs more.
+  void set_max_memory_bytes(uint64_t bytes);
 
   size_t num_scans() const { return scans_.num_scans(); }
   const ScanBatch &scans() const { return scans_; }
@@ -74,12 +110,34 @@ class Mapper {
   std::string backend_name() const { return renderer_->name(); }
   // Counts and times of the last insert or render (a growth re-render included).
   const MapStats &last_stats() const { return stats_; }
-  // Full renders since construction: one per render(), per growth, and the first insert.
+  // Full renders since construction: one per render(), per growth, the first
+  // insert, and one per restore after a renderer failed.
   size_t renders() const { return renders_; }
 
  private:
+  // What an insert will do, decided before anything changes.
+  struct InsertPlan {
+    PoseExtent extent;
+    GridGeometry geo;
+    bool full_render = false;
+  };
+  // What a failed call restores.
+  struct Saved {
+    size_t scans;
+    GridGeometry geo;
+    PoseExtent extent;
+    MapStats stats;
+  };
+
   GridGeometry frame_for(const PoseExtent &extent, const ScanBatch &scans) const;
+  GridGeometry grown_frame(const GridGeometry &need, uint64_t beams) const;
+  bool fits_memory(const GridGeometry &geo, uint64_t beams) const;
   void check_memory(const GridGeometry &geo, uint64_t beams) const;
+  void check_grid_usable(const char *what) const;
+  InsertPlan plan_insert(const ScanBatch &scans) const;
+  void apply_insert(const InsertPlan &plan, size_t before);
+  Saved save() const { return Saved{scans_.num_scans(), geo_, extent_, stats_}; }
+  void restore(const Saved &saved) noexcept;
   void rerender();
 
   MapperParams params_;
@@ -91,6 +149,7 @@ class Mapper {
   std::unique_ptr<Renderer> renderer_;
   MapStats stats_;
   size_t renders_ = 0;
+  bool grid_lost_ = false;  // a failed restore: the grid does not match the stored scans
 };
 
 }  // namespace vasco

@@ -27,15 +27,36 @@ struct ScanBatch {
   ScanBatch() : beam_offset{0} {}
   size_t num_scans() const { return x.size(); }
   size_t num_beams() const { return range.size(); }
+  // The accessors trust the arrays: call validate() first on a batch that
+  // came from outside (bindings, callers' own arrays).
   int beams_in(size_t s) const { return static_cast<int>(beam_offset[s + 1] - beam_offset[s]); }
   const float *ranges_of(size_t s) const { return range.data() + beam_offset[s]; }
 
+  // Throws vasco::Error(BadInput) naming the first scan whose arrays do not
+  // agree: every per-scan array num_scans() long, beam_offset num_scans() + 1
+  // long, starting at 0, never decreasing, ending at num_beams(), and every
+  // scan's beam count an int.
+  void validate() const;
+  // validate(), then every pose (x, y, theta) finite: Error(BadInput) naming
+  // the first bad pose. What a mapping session accepts.
+  void validate_for_mapping() const;
+  // Scan s's ranges after checking s and its offsets (for bindings that hand
+  // out one scan): Error(Usage) for s out of range, else as validate().
+  const float *checked_ranges_of(size_t s) const;
+
   void add_scan(double px, double py, double ptheta, double first, double step, const float *r,
                 int n, long source_line);
+  // Appends every scan of `other` (validated first).
+  void append(const ScanBatch &other);
+  // Keeps the first `scans` scans and their beams (scans <= num_scans());
+  // never throws: how a failed append is undone.
+  void truncate(size_t scans) noexcept;
 
   // Scans [first, first + count) (count < 0: to the end), clipped to the
-  // batch: vasco_first_scan / vasco_num_scans.
-  ScanBatch select(long first, long count) const;
+  // batch: vasco_first_scan / vasco_num_scans. Validates the batch first. The
+  // && form reuses this batch's arrays instead of copying them.
+  ScanBatch select(long first, long count) const &;
+  ScanBatch select(long first, long count) &&;
 };
 
 // What reading a log produced, besides the scans.
