@@ -1,4 +1,4 @@
-#include "vasco_gpu/compare.h"
+#include "carmen_compat/map_compare.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include "carmen_compat/image_io.h"
 
-namespace vasco {
+namespace carmen {
 namespace {
 
 enum class CellClass { Unknown, Free, Occupied, Even };
@@ -71,7 +71,7 @@ void add_cell(Agreement &a, float r, float t) {
   }
 }
 
-void check_grid(const carmen::GridMap &g, const char *which) {
+void check_grid(const GridMap &g, const char *which) {
   if (g.size_x < 0 || g.size_y < 0 || g.cells.size() != size_t(g.size_x) * size_t(g.size_y))
     throw std::invalid_argument(std::string("compare_grids: grid ") + which + " has " +
                                 std::to_string(g.cells.size()) + " cells for " + std::to_string(g.size_x) +
@@ -136,7 +136,7 @@ Agreement compare_maps(const std::vector<float> &ref, const std::vector<float> &
   return a;
 }
 
-GridComparison compare_grids(const carmen::GridMap &a, const carmen::GridMap &b, int64_t shift_x,
+GridComparison compare_grids(const GridMap &a, const GridMap &b, int64_t shift_x,
                              int64_t shift_y, size_t top_n) {
   check_grid(a, "A");
   check_grid(b, "B");
@@ -170,7 +170,7 @@ GridComparison compare_grids(const carmen::GridMap &a, const carmen::GridMap &b,
   return c;
 }
 
-bool offset_shift(const carmen::GlobalOffset &a, const carmen::GlobalOffset &b, double resolution,
+bool offset_shift(const GlobalOffset &a, const GlobalOffset &b, double resolution,
                   int64_t *shift_x, int64_t *shift_y, std::string *why) {
   const double fx = (b.x - a.x) / resolution, fy = (b.y - a.y) / resolution;
   std::string reason;
@@ -220,7 +220,7 @@ Rgb difference_colour(float a, float b) {
 
 }  // namespace
 
-std::vector<uint8_t> difference_image_rgb(const carmen::GridMap &a, const carmen::GridMap &b,
+std::vector<uint8_t> difference_image_rgb(const GridMap &a, const GridMap &b,
                                           const GridComparison &cmp) {
   std::vector<uint8_t> rgb(size_t(cmp.width) * size_t(cmp.height) * 3);
   uint8_t *p = rgb.data();
@@ -231,7 +231,7 @@ std::vector<uint8_t> difference_image_rgb(const carmen::GridMap &a, const carmen
       const float vb = b.cells[size_t((x - cmp.shift_x) * int64_t(b.size_y) + (y - cmp.shift_y))];
       Rgb c;
       if (same_bits(va, vb)) {
-        const uint8_t g = carmen::png_pixel(va);
+        const uint8_t g = png_pixel(va);
         c = {g, g, g};
       } else {
         c = difference_colour(va, vb);
@@ -261,4 +261,4 @@ std::string Agreement::table(const std::string &title) const {
   return buf;
 }
 
-}  // namespace vasco
+}  // namespace carmen

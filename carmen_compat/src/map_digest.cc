@@ -1,4 +1,4 @@
-#include "vasco_gpu/map_digest.h"
+#include "carmen_compat/map_digest.h"
 
 #include <openssl/evp.h>
 
@@ -7,7 +7,7 @@
 #include <memory>
 #include <stdexcept>
 
-namespace vasco {
+namespace carmen {
 namespace {
 
 // The payload is little-endian, and cells are hashed straight from memory: a
@@ -56,4 +56,4 @@ std::string gridmap_payload_sha256(int size_x, int size_y, double resolution,
   return out;
 }
 
-}  // namespace vasco
+}  // namespace carmen
