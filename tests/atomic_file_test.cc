@@ -3,11 +3,19 @@
 
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -28,6 +36,20 @@ void write_text(const std::string &path, const std::string &text) {
   ASSERT_NE(f, nullptr) << path;
   std::fputs(text.c_str(), f);
   std::fclose(f);
+}
+
+// Runs `action`, which must throw a carmen::FileError naming `file`, of code
+// I/O, whose message holds `part`.
+template <class Action>
+void expect_refused(Action action, const std::string &file, const std::string &part) {
+  try {
+    action();
+    ADD_FAILURE() << file << ": not refused";
+  } catch (const carmen::FileError &e) {
+    EXPECT_EQ(e.file(), file);
+    EXPECT_EQ(e.code(), carmen::ErrorCode::Io) << e.what();
+    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
 }
 
 TEST(MapAtomicOutput, TempFileIsHiddenBesideTheTarget) {
@@ -192,17 +214,21 @@ TEST(MapOutputTransaction, CommitRenamesEveryOutput) {
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"a.map", "a.yaml"}));
 }
 
-TEST(MapAtomicOutput, RenameFailureIsReportedAndCleanedUp) {
+// A directory is refused when the output is made (before any temporary
+// appears), and again at commit should one have taken the target's place.
+TEST(MapAtomicOutput, ADirectoryTargetIsRefused) {
   TempDir dir;
-  // The target is a non-empty directory: rename() cannot replace it.
   const std::string target = dir.file("sub");
   ASSERT_TRUE(std::filesystem::create_directory(target));
-  write_bytes(target + "/keep", "k");
-  carmen::AtomicOutput out(target);
-  write_text(out.temp_path(), "x");
-  EXPECT_THROW(out.commit(), carmen::FileError);
-  EXPECT_FALSE(out.committed());
+  expect_refused([&] { carmen::AtomicOutput out(target); }, target, "is a directory");
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"sub"});
+
+  carmen::AtomicOutput late(dir.file("late"));
+  ASSERT_TRUE(std::filesystem::create_directory(dir.file("late")));
+  write_bytes(dir.file("late") + "/keep", "k");
+  expect_refused([&] { late.commit(); }, dir.file("late"), "is a directory");
+  EXPECT_FALSE(late.committed());
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"late", "sub"}));
 }
 
 TEST(MapAtomicOutput, RejectsPathsWithoutAFileName) {
@@ -221,6 +247,205 @@ TEST(MapAtomicWrite, WritesAndReportsErrors) {
     EXPECT_EQ(e.file(), dir.file("missing/w.bin"));
   }
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"w.bin"});
+}
+
+// --- What a target must be before anything is renamed -------------------------
+
+// Writes `text` into a new output of `tx`.
+void add_output(carmen::OutputTransaction &tx, const std::string &path, const std::string &text) {
+  FILE *f = tx.add(path).take_stdio();
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+}
+
+// A rename that fails after others succeeded (EPERM: another user's file in
+// a sticky /tmp; EBUSY: a bind-mounted target) undoes the earlier ones: the
+// old files are back, a new one is gone, nothing hidden is left.
+TEST(MapOutputTransaction, ALaterRenameFailureRestoresTheEarlierTargets) {
+  for (const int err : {EPERM, EBUSY}) {
+    TempDir dir;
+    write_text(dir.file("mine.map"), "old map");
+    write_text(dir.file("run.yaml"), "old yaml");
+    carmen::OutputTransaction tx;
+    add_output(tx, dir.file("mine.map"), "new map");
+    add_output(tx, dir.file("run.pgm"), "new pgm");
+    add_output(tx, dir.file("run.yaml"), "new yaml");
+    carmen::OutputTransaction::fail_rename_for_testing(3, err);
+    expect_refused([&] { tx.commit(); }, dir.file("run.yaml"), std::strerror(err));
+    carmen::OutputTransaction::fail_rename_for_testing(0, 0);
+    EXPECT_EQ(read_text(dir.file("mine.map")), "old map");
+    EXPECT_EQ(read_text(dir.file("run.yaml")), "old yaml");
+    EXPECT_EQ(dir.entries(), (std::vector<std::string>{"mine.map", "run.yaml"}));
+  }
+}
+
+TEST(MapOutputTransaction, TheOldFilesGoOnceAllAreRenamed) {
+  TempDir dir;
+  write_text(dir.file("a.map"), "old");
+  carmen::OutputTransaction tx;
+  add_output(tx, dir.file("a.map"), "new a");
+  add_output(tx, dir.file("b.png"), "new b");
+  tx.commit();
+  EXPECT_EQ(read_text(dir.file("a.map")), "new a");
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"a.map", "b.png"}));
+}
+
+// One directory spelled several ways (a "./", a "//", a symlink to it) is
+// locked once: the commit neither waits for itself nor fails.
+TEST(MapOutputTransaction, OneDirectorySpelledTwoWaysIsLockedOnce) {
+  TempDir dir;
+  ASSERT_EQ(::symlink(dir.path().c_str(), dir.file("alias").c_str()), 0);
+  carmen::OutputTransaction tx;
+  tx.set_lock_timeout_ms(2000);
+  add_output(tx, dir.file("x.map"), "x");
+  add_output(tx, dir.path() + "/./x.png", "p");
+  add_output(tx, dir.path() + "//y.pgm", "y");
+  add_output(tx, dir.file("alias/z.png"), "z");
+  const auto t0 = std::chrono::steady_clock::now();
+  tx.commit();
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(1));
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"alias", "x.map", "x.png", "y.pgm", "z.png"}));
+}
+
+TEST(MapOutputTransaction, TheSameTargetTwiceIsAUsageError) {
+  TempDir dir;
+  carmen::OutputTransaction tx;
+  tx.add(dir.file("d.map"));
+  try {
+    tx.add(dir.path() + "/./d.map");
+    ADD_FAILURE() << "the same output was accepted twice";
+  } catch (const carmen::Error &e) {
+    EXPECT_EQ(e.code(), carmen::ErrorCode::Usage);
+    EXPECT_NE(std::string(e.what()).find("give each output once"), std::string::npos) << e.what();
+  }
+}
+
+// Someone else holds the directory's lock: the commit gives up after the
+// timeout, names the holder (here this very process) and renames nothing.
+TEST(MapOutputTransaction, AHeldLockTimesOutNamingTheHolder) {
+  TempDir dir;
+  write_text(dir.file("a.map"), "old");
+  const int fd = ::open(dir.path().c_str(), O_RDONLY | O_DIRECTORY);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+  carmen::OutputTransaction tx;
+  tx.set_lock_timeout_ms(200);
+  add_output(tx, dir.file("a.map"), "new");
+  const auto t0 = std::chrono::steady_clock::now();
+  expect_refused([&] { tx.commit(); }, dir.path() + "/", "pid " + std::to_string(::getpid()));
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
+  ::close(fd);
+  EXPECT_EQ(read_text(dir.file("a.map")), "old");
+  EXPECT_EQ(carmen::OutputTransaction::kDefaultLockTimeoutMs, 10000);
+}
+
+// A device, a FIFO, a link to a device: never renamed over, and no
+// temporary is made beside them.
+TEST(MapCheckReplaceable, SpecialFilesAreRefused) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo(dir.file("pipe").c_str(), 0600), 0);
+  ASSERT_EQ(::symlink("/dev/null", dir.file("null.png").c_str()), 0);
+  expect_refused([&] { carmen::AtomicOutput out(dir.file("pipe")); }, dir.file("pipe"), "is a FIFO");
+  expect_refused([&] { carmen::check_replaceable(dir.file("null.png")); }, dir.file("null.png"),
+                 "is a character device");
+  expect_refused([&] { carmen::AtomicOutput out("/dev/full"); }, "/dev/full", "is a character device");
+  struct stat st;
+  ASSERT_EQ(::stat("/dev/full", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode));
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"null.png", "pipe"}));
+  carmen::check_replaceable(dir.file("new.map"));  // a new file, and
+  write_text(dir.file("old.map"), "x");
+  carmen::check_replaceable(dir.file("old.map"));  // an old regular one, pass
+  expect_refused([&] { carmen::check_replaceable(dir.file("none/x.map")); }, dir.file("none/x.map"),
+                 "does not exist");
+}
+
+// Mount points listed by /proc/self/mountinfo (read here with no code of the
+// library): a file bind-mounted there cannot be replaced (EBUSY).
+std::string a_mounted_regular_file() {
+  std::ifstream mounts("/proc/self/mountinfo");
+  std::string line;
+  while (std::getline(mounts, line)) {
+    std::istringstream fields(line);
+    std::string skip, point;
+    for (int i = 0; i < 4; ++i) fields >> skip;
+    fields >> point;
+    struct stat st;
+    if (point.find('\\') == std::string::npos && ::lstat(point.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return point;
+  }
+  return std::string();
+}
+
+TEST(MapCheckReplaceable, AMountPointIsRefused) {
+  const std::string mounted = a_mounted_regular_file();
+  if (!mounted.empty())
+    expect_refused([&] { carmen::check_replaceable(mounted); }, mounted, "is a mount point");
+  // A file bind-mounted over an output, where this process may mount: the
+  // commit is refused before a.map appears.
+  TempDir dir;
+  write_text(dir.file("src"), "source");
+  write_text(dir.file("bound.png"), "bound");
+  if (::mount(dir.file("src").c_str(), dir.file("bound.png").c_str(), nullptr, MS_BIND, nullptr) != 0) {
+    if (mounted.empty()) GTEST_SKIP() << "no bind-mounted file here, and mount: " << std::strerror(errno);
+    return;
+  }
+  {
+    carmen::OutputTransaction tx;
+    add_output(tx, dir.file("a.map"), "new");
+    expect_refused([&] { add_output(tx, dir.file("bound.png"), "new"); }, dir.file("bound.png"),
+                   "is a mount point");
+    tx.commit();  // what was added before the refusal still commits
+  }
+  ::umount2(dir.file("bound.png").c_str(), MNT_DETACH);
+  EXPECT_EQ(read_text(dir.file("bound.png")), "bound");
+}
+
+// In a sticky directory another user's file cannot be replaced by us (the
+// rename would fail EPERM); our own can. Root ignores the rule, so the check
+// runs in a child that gives up root.
+TEST(MapCheckReplaceable, AnotherUsersFileInAStickyDirectoryIsRefused) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to make a file of another user";
+  TempDir dir;
+  ASSERT_EQ(::chmod(dir.path().c_str(), 0755), 0);
+  const std::string sticky = dir.file("tmp");
+  ASSERT_EQ(::mkdir(sticky.c_str(), 0777), 0);
+  ASSERT_EQ(::chmod(sticky.c_str(), 01777), 0);
+  write_text(sticky + "/theirs.png", "root's");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    if (::setuid(65534) != 0) ::_exit(3);
+    int status = 0;
+    try {
+      carmen::check_replaceable(sticky + "/theirs.png");
+      status = 1;
+    } catch (const carmen::FileError &e) {
+      if (std::string(e.what()).find("sticky") == std::string::npos) status = 2;
+    }
+    try {
+      write_text(sticky + "/mine.map", "mine");
+      carmen::check_replaceable(sticky + "/mine.map");
+    } catch (...) {
+      status = 4;
+    }
+    ::_exit(status);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+  EXPECT_EQ(read_text(sticky + "/theirs.png"), "root's");
+}
+
+TEST(MapSameTarget, ByDirectoryAndNameOrByInode) {
+  TempDir dir;
+  write_text(dir.file("log"), "x");
+  ASSERT_EQ(::link(dir.file("log").c_str(), dir.file("hard").c_str()), 0);
+  ASSERT_EQ(::symlink(dir.path().c_str(), dir.file("alias").c_str()), 0);
+  EXPECT_TRUE(carmen::same_target(dir.file("d.map"), dir.path() + "/./d.map"));  // new, one directory
+  EXPECT_TRUE(carmen::same_target(dir.file("d.map"), dir.file("alias/d.map")));
+  EXPECT_TRUE(carmen::same_target(dir.file("log"), dir.file("hard")));  // one inode
+  EXPECT_FALSE(carmen::same_target(dir.file("d.map"), dir.file("e.map")));
+  EXPECT_FALSE(carmen::same_target(dir.file("log"), dir.file("none/log")));
 }
 
 }  // namespace

@@ -1,24 +1,33 @@
 // AtomicOutput: an exclusively created temp file in the target's directory +
-// rename; OutputTransaction: several of them renamed together; the registry
-// of live temporaries that the signal handlers remove.
+// rename; OutputTransaction: several of them renamed together under one lock
+// a directory, undone should a later rename fail; the checks that a target
+// can be replaced; the registry of live temporaries that the signal handlers
+// remove.
 #include "carmen_compat/atomic_file.h"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <climits>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <mutex>
 #include <random>
-#include <set>
+#include <sstream>
 #include <stdexcept>
+#include <thread>
+#include <tuple>
 
 #include "carmen_compat/error.h"
 
@@ -39,6 +48,19 @@ void split_path(const std::string &path, std::string *dir, std::string *base) {
   }
 }
 
+// The directory a path's file lies in, fit for open() and stat().
+std::string directory_of(const std::string &path) {
+  std::string dir, base;
+  split_path(path, &dir, &base);
+  return dir.empty() ? std::string(".") : dir;
+}
+
+std::string file_name_of(const std::string &path) {
+  std::string dir, base;
+  split_path(path, &dir, &base);
+  return base;
+}
+
 bool fsync_path(const std::string &path, bool directory) {
   const int fd = ::open(path.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDONLY);
   if (fd < 0) return false;
@@ -46,6 +68,8 @@ bool fsync_path(const std::string &path, bool directory) {
   ::close(fd);
   return ok;
 }
+
+FileError io_error(const std::string &path, const std::string &why) { return FileError(path, why, ErrorCode::Io); }
 
 // --- Names -----------------------------------------------------------------
 std::mutex name_mutex;
@@ -62,6 +86,14 @@ std::string random_part() {
   std::string s;
   for (int i = 0; i < 12; ++i) s += digits[rng() % 36];
   return s;
+}
+
+// ".NAME.ROLE.PID.RANDOM" beside `path`: hidden, never ending in the target's
+// extension, so extension-based tools ignore it.
+std::string hidden_name(const std::string &path, const char *role) {
+  std::string dir, base;
+  split_path(path, &dir, &base);
+  return dir + "." + base + "." + role + "." + std::to_string(static_cast<long>(::getpid())) + "." + random_part();
 }
 
 // --- The registry of live temporaries ----------------------------------------
@@ -96,24 +128,236 @@ extern "C" void remove_temporaries_and_die(int sig) {
   ::raise(sig);
 }
 
-// An exclusive lock on a directory for the renames of one commit.
+// The signals whose handlers remove temporaries, held back while targets are
+// renamed: a commit is not cut between its renames and their undoing.
+class SignalsHeld {
+ public:
+  SignalsHeld() {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, sig);
+    ::pthread_sigmask(SIG_BLOCK, &set, &old_);
+  }
+  ~SignalsHeld() { ::pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
+  SignalsHeld(const SignalsHeld &) = delete;
+  SignalsHeld &operator=(const SignalsHeld &) = delete;
+
+ private:
+  sigset_t old_;
+};
+
+// --- Renames (with the failure tests inject) ----------------------------------
+std::atomic<int> renames_until_failure{0};
+std::atomic<int> injected_errno{0};
+
+// True (and errno set) when a test asked this rename to fail.
+bool injected_failure() {
+  if (renames_until_failure.load() <= 0) return false;
+  if (--renames_until_failure != 0) return false;
+  errno = injected_errno.load();
+  return true;
+}
+
+int exchange_names(const std::string &a, const std::string &b) {
+  return ::renameat2(AT_FDCWD, a.c_str(), AT_FDCWD, b.c_str(), RENAME_EXCHANGE);
+}
+
+// --- What a rename cannot or must not replace --------------------------------
+const char *kind_of_file(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+// "/a/b\040c" in /proc/self/mountinfo is "/a/b c".
+std::string unescape_mount_path(const std::string &s) {
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '\\' && i + 3 < s.size()) {
+      out += static_cast<char>(std::strtol(s.substr(i + 1, 3).c_str(), nullptr, 8));
+      i += 3;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
+// Whether `path` (its directory resolved) is a mount point: a file bind-
+// mounted there cannot be renamed over (EBUSY). Best effort: false when the
+// mount table cannot be read.
+bool is_mount_point(const std::string &path) {
+  char *dir = ::realpath(directory_of(path).c_str(), nullptr);
+  if (dir == nullptr) return false;
+  const std::string full = (std::string(dir) == "/" ? std::string() : std::string(dir)) + "/" + file_name_of(path);
+  std::free(dir);
+  std::ifstream mounts("/proc/self/mountinfo");
+  std::string line;
+  while (std::getline(mounts, line)) {
+    std::istringstream fields(line);
+    std::string id, parent, devno, root, mount_point;
+    if ((fields >> id >> parent >> devno >> root >> mount_point) && unescape_mount_path(mount_point) == full)
+      return true;
+  }
+  return false;
+}
+
+void check_directory(const std::string &path, const std::string &dir, struct stat *dir_st) {
+  if (::stat(dir.c_str(), dir_st) != 0)
+    throw io_error(path, "cannot write here: directory '" + dir + "' " +
+                             (errno == ENOENT ? std::string("does not exist") : errno_text(errno)));
+  if (!S_ISDIR(dir_st->st_mode)) throw io_error(path, "cannot write here: '" + dir + "' is not a directory");
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw io_error(path, "cannot write here: directory '" + dir + "' is not writable (" + errno_text(errno) + ")");
+}
+
+// In a sticky directory only the file's owner, the directory's owner or root
+// may replace a file (the rename fails EPERM).
+bool sticky_forbids(const struct stat &dir_st, const struct stat &st) {
+  const uid_t me = ::geteuid();
+  return (dir_st.st_mode & S_ISVTX) != 0 && me != 0 && st.st_uid != me && dir_st.st_uid != me;
+}
+
+void check_existing_target(const std::string &path, const std::string &dir, const struct stat &dir_st) {
+  struct stat st;
+  if (::lstat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) return;  // a new file
+    throw io_error(path, "cannot look at it: " + errno_text(errno));
+  }
+  struct stat target = st;
+  if (S_ISLNK(st.st_mode) && ::stat(path.c_str(), &target) != 0) target = st;  // a dangling link: replaced
+  if (!S_ISREG(target.st_mode) && !S_ISLNK(target.st_mode)) {
+    if (S_ISDIR(target.st_mode)) throw io_error(path, "is a directory: cannot write there");
+    throw io_error(path, std::string("is ") + kind_of_file(target.st_mode) +
+                             ": only a regular file is replaced by an output");
+  }
+  if (sticky_forbids(dir_st, st))
+    throw io_error(path, "belongs to another user in the sticky directory '" + dir + "': it cannot be replaced");
+  if (st.st_dev != dir_st.st_dev || is_mount_point(path))
+    throw io_error(path, "is a mount point: it cannot be replaced");
+}
+
+// --- Directory locks ----------------------------------------------------------
+struct DirKey {
+  dev_t dev;
+  ino_t ino;
+  bool operator<(const DirKey &o) const { return std::tie(dev, ino) < std::tie(o.dev, o.ino); }
+  bool operator==(const DirKey &o) const { return dev == o.dev && ino == o.ino; }
+};
+
+// "pid 1234, log2map" of the process /proc/locks says holds a flock on the
+// file (dev, ino); empty when it does not say.
+std::string lock_holder(const DirKey &key) {
+  char id[64];
+  std::snprintf(id, sizeof id, "%02x:%02x:%lu", major(key.dev), minor(key.dev), static_cast<unsigned long>(key.ino));
+  std::ifstream locks("/proc/locks");
+  std::string line;
+  while (std::getline(locks, line)) {
+    std::istringstream fields(line);
+    std::string number, type, advisory, mode, pid, file;
+    if (!(fields >> number >> type >> advisory >> mode >> pid >> file) || type != "FLOCK" || file != id) continue;
+    std::ifstream comm_file("/proc/" + pid + "/comm");
+    std::string comm;
+    std::getline(comm_file, comm);
+    return "pid " + pid + (comm.empty() ? std::string() : ", " + comm);
+  }
+  return std::string();
+}
+
+// An exclusive lock on a directory for the renames of one commit, waited for
+// at most timeout_ms.
 class DirectoryLock {
  public:
-  explicit DirectoryLock(const std::string &dir) {
-    fd_ = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd_ >= 0) ::flock(fd_, LOCK_EX);  // best effort: without it the renames still work
+  DirectoryLock(int fd, const DirKey &key, const std::string &name, int timeout_ms) : fd_(fd) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+    while (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      if (errno != EWOULDBLOCK && errno != EINTR) return;  // no locks here (ENOLCK): the renames still work
+      if (std::chrono::steady_clock::now() >= deadline) {
+        const std::string holder = lock_holder(key);
+        ::close(fd_);
+        char waited[32];
+        std::snprintf(waited, sizeof waited, "%g s", timeout_ms / 1000.0);
+        throw io_error(name, "the directory is locked by another writer (" +
+                                 (holder.empty() ? std::string("holder unknown") : holder) + ") for more than " +
+                                 waited + ": nothing was written");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
   }
-  ~DirectoryLock() {
-    if (fd_ >= 0) ::close(fd_);  // closing releases the lock
-  }
+  ~DirectoryLock() { ::close(fd_); }  // closing releases the lock
   DirectoryLock(const DirectoryLock &) = delete;
   DirectoryLock &operator=(const DirectoryLock &) = delete;
 
  private:
-  int fd_ = -1;
+  int fd_;
 };
 
+struct OpenDirectory {
+  DirKey key;
+  int fd;
+  std::string name;
+};
+
+// One open descriptor per directory (by device and inode), in key order.
+std::vector<OpenDirectory> open_directories(const std::vector<std::string> &paths) {
+  std::vector<OpenDirectory> dirs;
+  for (const std::string &p : paths) {
+    const std::string dir = directory_of(p);
+    const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    struct stat st;
+    if (fd < 0) continue;  // the rename will say what is wrong
+    if (::fstat(fd, &st) != 0) {
+      ::close(fd);
+      continue;
+    }
+    const DirKey key{st.st_dev, st.st_ino};
+    const bool seen = std::any_of(dirs.begin(), dirs.end(), [&](const OpenDirectory &d) { return d.key == key; });
+    if (seen) ::close(fd);
+    else dirs.push_back({key, fd, dir});
+  }
+  std::sort(dirs.begin(), dirs.end(), [](const OpenDirectory &a, const OpenDirectory &b) { return a.key < b.key; });
+  return dirs;
+}
+
+// Locks every directory of `paths`; on a timeout the descriptors not yet
+// locked are closed before the error leaves.
+std::vector<std::unique_ptr<DirectoryLock>> lock_directories(const std::vector<std::string> &paths, int timeout_ms) {
+  std::vector<OpenDirectory> dirs = open_directories(paths);
+  std::vector<std::unique_ptr<DirectoryLock>> locks;
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    try {
+      locks.push_back(std::make_unique<DirectoryLock>(dirs[i].fd, dirs[i].key, dirs[i].name, timeout_ms));
+    } catch (...) {
+      for (size_t j = i + 1; j < dirs.size(); ++j) ::close(dirs[j].fd);
+      throw;
+    }
+  }
+  return locks;
+}
+
 }  // namespace
+
+void check_replaceable(const std::string &path) {
+  const std::string base = file_name_of(path);
+  if (base.empty() || base == "." || base == "..")
+    throw FileError(path, "not a file name (cannot write to it)", ErrorCode::Io);
+  const std::string dir = directory_of(path);
+  struct stat dir_st;
+  check_directory(path, dir, &dir_st);
+  check_existing_target(path, dir, dir_st);
+}
+
+bool same_target(const std::string &a, const std::string &b) {
+  struct stat fa, fb;
+  if (::stat(a.c_str(), &fa) == 0 && ::stat(b.c_str(), &fb) == 0 && fa.st_dev == fb.st_dev && fa.st_ino == fb.st_ino)
+    return true;
+  struct stat da, db;
+  return file_name_of(a) == file_name_of(b) && ::stat(directory_of(a).c_str(), &da) == 0 &&
+         ::stat(directory_of(b).c_str(), &db) == 0 && da.st_dev == db.st_dev && da.st_ino == db.st_ino;
+}
 
 void AtomicOutput::set_name_source_for_testing(std::function<std::string()> source) {
   std::lock_guard<std::mutex> lock(name_mutex);
@@ -121,14 +365,9 @@ void AtomicOutput::set_name_source_for_testing(std::function<std::string()> sour
 }
 
 AtomicOutput::AtomicOutput(std::string final_path) : final_path_(std::move(final_path)) {
-  std::string dir, base;
-  split_path(final_path_, &dir, &base);
-  if (base.empty() || base == "." || base == "..") {
-    throw FileError(final_path_, "not a file name (cannot write to it)");
-  }
-  const std::string prefix = dir + "." + base + ".tmp." + std::to_string(static_cast<long>(::getpid())) + ".";
+  check_replaceable(final_path_);  // before a temporary appears beside a device or in a directory we cannot use
   for (int attempt = 0; attempt < 100; ++attempt) {
-    const std::string candidate = prefix + random_part();
+    const std::string candidate = hidden_name(final_path_, "tmp");
     const int fd = ::open(candidate.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
     if (fd >= 0) {
       fd_ = fd;
@@ -138,10 +377,10 @@ AtomicOutput::AtomicOutput(std::string final_path) : final_path_(std::move(final
     }
     if (errno != EEXIST) {
       throw FileError(final_path_, "cannot create a temporary file beside it (" + candidate + "): " +
-                                       errno_text(errno));
+                                       errno_text(errno), ErrorCode::Io);
     }
   }
-  throw FileError(final_path_, "cannot create a temporary file beside it: 100 names were taken");
+  throw FileError(final_path_, "cannot create a temporary file beside it: 100 names were taken", ErrorCode::Io);
 }
 
 AtomicOutput::~AtomicOutput() { abandon(); }
@@ -152,7 +391,7 @@ FILE *AtomicOutput::take_stdio() {
   if (f == nullptr) {
     const int err = errno;
     ::close(fd);
-    throw FileError(final_path_, "cannot write " + temp_path_ + ": " + errno_text(err));
+    throw FileError(final_path_, "cannot write " + temp_path_ + ": " + errno_text(err), ErrorCode::Io);
   }
   return f;
 }
@@ -176,7 +415,7 @@ void AtomicOutput::abandon() noexcept {
   }
 }
 
-void AtomicOutput::commit(bool durable) {
+void AtomicOutput::close_and_verify() {
   if (committed_) throw std::logic_error("AtomicOutput::commit called twice for " + final_path_);
   if (fd_ >= 0) {  // never taken: an empty file
     ::close(fd_);
@@ -187,52 +426,111 @@ void AtomicOutput::commit(bool durable) {
     const int err = errno;
     abandon();
     throw FileError(final_path_, "nothing was written (temporary file " + temp_path_ + " is missing or was replaced" +
-                                     (err ? ": " + errno_text(err) : std::string()) + ")");
-  }
-  if (durable && !fsync_path(temp_path_, false)) {
-    const int err = errno;
-    abandon();
-    throw FileError(final_path_, "cannot sync the data to disk: " + errno_text(err));
-  }
-  if (std::rename(temp_path_.c_str(), final_path_.c_str()) != 0) {
-    const int err = errno;
-    abandon();
-    throw FileError(final_path_, "cannot move the finished file into place: " + errno_text(err));
-  }
-  committed_ = true;
-  unregister_temp(slot_);
-  slot_ = -1;
-  if (durable) {
-    std::string dir, base;
-    split_path(final_path_, &dir, &base);
-    if (!fsync_path(dir.empty() ? std::string(".") : dir, true)) {
-      throw FileError(final_path_, "written, but syncing its directory failed: " + errno_text(errno));
-    }
+                                     (err ? ": " + errno_text(err) : std::string()) + ")", ErrorCode::Io);
   }
 }
 
+// Keeps the old file under a hidden hard link, or, where the file system
+// refuses links, swaps it with the temporary in one exchange.
+AtomicOutput::Replaced AtomicOutput::replace_target() {
+  Replaced r;
+  struct stat st;
+  r.existed = ::lstat(final_path_.c_str(), &st) == 0;
+  const bool refused = injected_failure();
+  if (r.existed && !refused) {
+    const std::string kept = hidden_name(final_path_, "old");
+    if (::link(final_path_.c_str(), kept.c_str()) == 0) {
+      r.kept = kept;
+    } else if (exchange_names(temp_path_, final_path_) == 0) {
+      r.kept = temp_path_;
+      r.exchanged = true;
+      return r;
+    }
+  }
+  if (refused || std::rename(temp_path_.c_str(), final_path_.c_str()) != 0) {
+    const int err = errno;
+    if (!r.kept.empty()) ::unlink(r.kept.c_str());
+    abandon();
+    throw FileError(final_path_, "cannot move the finished file into place: " + errno_text(err), ErrorCode::Io);
+  }
+  return r;
+}
+
+void AtomicOutput::undo(const Replaced &r) noexcept {
+  if (r.exchanged) {
+    exchange_names(temp_path_, final_path_);  // the old file back; the new one goes with the temporary
+    ::unlink(temp_path_.c_str());
+  } else if (!r.kept.empty()) {
+    std::rename(r.kept.c_str(), final_path_.c_str());
+  } else if (!r.existed) {
+    ::unlink(final_path_.c_str());
+  }  // else: the file system kept no old file to go back to
+  committed_ = false;
+  temp_path_.clear();
+  unregister_temp(slot_);
+  slot_ = -1;
+}
+
+void AtomicOutput::finish(const Replaced &r) noexcept {
+  if (!r.kept.empty()) ::unlink(r.kept.c_str());
+  committed_ = true;
+  unregister_temp(slot_);
+  slot_ = -1;
+}
+
+void AtomicOutput::commit(bool durable) {
+  close_and_verify();
+  if (durable && !fsync_path(temp_path_, false)) {
+    const int err = errno;
+    abandon();
+    throw FileError(final_path_, "cannot sync the data to disk: " + errno_text(err), ErrorCode::Io);
+  }
+  try {
+    check_replaceable(final_path_);
+  } catch (...) {
+    abandon();
+    throw;
+  }
+  finish(replace_target());
+  if (durable && !fsync_path(directory_of(final_path_), true)) {
+    throw FileError(final_path_, "written, but syncing its directory failed: " + errno_text(errno), ErrorCode::Io);
+  }
+}
+
+void OutputTransaction::fail_rename_for_testing(int n, int err) {
+  injected_errno = err;
+  renames_until_failure = n;
+}
+
 AtomicOutput &OutputTransaction::add(const std::string &final_path) {
+  for (const auto &o : outputs_) {
+    if (same_target(o->final_path(), final_path))
+      throw Error(ErrorCode::Usage, final_path + ": the same file as the output " + o->final_path() +
+                                        ": give each output once");
+  }
   outputs_.push_back(std::make_unique<AtomicOutput>(final_path));
   return *outputs_.back();
 }
 
 void OutputTransaction::commit() {
-  std::set<std::string> dirs;
-  for (const auto &o : outputs_) {
-    std::string dir, base;
-    split_path(o->final_path(), &dir, &base);
-    dirs.insert(dir);
-  }
-  std::vector<std::unique_ptr<DirectoryLock>> locks;  // in a fixed order: no deadlock between runs
-  for (const std::string &d : dirs) locks.push_back(std::make_unique<DirectoryLock>(d));
+  std::vector<std::string> paths;
+  for (const auto &o : outputs_) paths.push_back(o->final_path());
+  const auto locks = lock_directories(paths, lock_timeout_ms_);
   // What would make a rename fail is checked for every output before the
   // first one moves, so that a refused commit touches none.
-  for (const auto &o : outputs_) {
-    struct stat st;
-    if (::stat(o->final_path().c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-      throw FileError(o->final_path(), "is a directory: cannot write there");
+  for (const auto &o : outputs_) o->close_and_verify();
+  for (const auto &o : outputs_) check_replaceable(o->final_path());
+  const SignalsHeld held;
+  std::vector<AtomicOutput::Replaced> done;
+  try {
+    for (const auto &o : outputs_) done.push_back(o->replace_target());
+  } catch (const FileError &e) {
+    for (size_t i = done.size(); i-- > 0;) outputs_[i]->undo(done[i]);
+    if (done.empty()) throw;
+    throw FileError(e.file(), e.line(), e.message() + " (the outputs renamed before it have their old files back)",
+                    e.code());
   }
-  for (const auto &o : outputs_) o->commit();
+  for (size_t i = 0; i < done.size(); ++i) outputs_[i]->finish(done[i]);
 }
 
 void write_file_atomically(const std::string &path, std::string_view contents, bool durable) {
@@ -242,7 +540,8 @@ void write_file_atomically(const std::string &path, std::string_view contents, b
   const int write_errno = errno;
   const bool close_ok = std::fclose(f) == 0;
   if (written != contents.size() || !close_ok) {
-    throw FileError(path, "write failed: " + errno_text(written != contents.size() ? write_errno : errno));
+    throw FileError(path, "write failed: " + errno_text(written != contents.size() ? write_errno : errno),
+                    ErrorCode::Io);
   }
   out.commit(durable);
 }

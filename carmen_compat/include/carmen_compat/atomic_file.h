@@ -31,7 +31,8 @@ namespace carmen {
 class AtomicOutput {
  public:
   // Throws carmen::FileError(final_path, ...) when the path has no file name
-  // (empty, or ending in '/') or the temporary file cannot be created.
+  // (empty, or ending in '/'), check_replaceable refuses it, or the temporary
+  // file cannot be created.
   explicit AtomicOutput(std::string final_path);
   ~AtomicOutput();  // removes the temporary file unless committed
   AtomicOutput(const AtomicOutput &) = delete;
@@ -48,8 +49,9 @@ class AtomicOutput {
   // Renames the temporary file over the final path. The file must be
   // complete and closed. With durable = true the data and the directory entry
   // are fsync'ed too (slower; for files that must survive a power cut).
-  // Throws carmen::FileError naming the final path when the rename fails (the
-  // temporary file is then removed). Calling it twice is an error
+  // Throws carmen::FileError naming the final path when check_replaceable
+  // refuses the target or the rename fails (the temporary file is then
+  // removed). Calling it twice is an error
   // (std::logic_error).
   void commit(bool durable = false);
   bool committed() const noexcept { return committed_; }
@@ -62,6 +64,18 @@ class AtomicOutput {
   static void set_name_source_for_testing(std::function<std::string()> source);
 
  private:
+  friend class OutputTransaction;
+  // What replace_target() did, so that undo() can put the old file back.
+  struct Replaced {
+    std::string kept;         // the old file's hidden name; empty: none kept
+    bool existed = false;     // the target existed before
+    bool exchanged = false;   // kept is the temporary's name (an exchange)
+  };
+  void close_and_verify();    // the temporary must be a complete regular file
+  Replaced replace_target();  // the rename (throws carmen::FileError)
+  void undo(const Replaced &r) noexcept;
+  void finish(const Replaced &r) noexcept;  // removes the kept old file
+
   std::string final_path_;
   std::string temp_path_;
   int fd_ = -1;
@@ -72,17 +86,56 @@ class AtomicOutput {
 // Several outputs as one transaction: every file is written to its
 // temporary first and renamed only by commit(), when all are written; until
 // then (an exception, a signal) no target is touched and the temporaries go.
-// The renames of one commit run under an exclusive lock on each directory
-// involved (flock), so two concurrent runs writing the same pair of files
-// (an image and its YAML) leave both files from the same run.
+//
+// commit():
+//  1. locks each directory involved once (by device and inode, however it is
+//     spelled: "x.map ./x.png", "a//b", a symlinked directory), with flock, in
+//     a fixed order, so two concurrent runs writing the same pair of files (an
+//     image and its YAML) leave both files from the same run. It waits at most
+//     lock_timeout() (kDefaultLockTimeout, 10 s) for another holder, then
+//     fails naming the directory and, where /proc/locks tells, the holder's pid;
+//  2. checks every target with check_replaceable() before the first rename;
+//  3. renames, with SIGINT, SIGTERM and SIGHUP held back, keeping each old
+//     file under a hidden name (a hard link ".NAME.old.PID.RANDOM", or the
+//     temporary's name by an atomic exchange where hard links are refused):
+//     should a later rename fail, the earlier targets get their old files
+//     back (a target that did not exist is removed), and the error names the
+//     target that failed. Once all are renamed the old files are removed.
 class OutputTransaction {
  public:
+  static constexpr int kDefaultLockTimeoutMs = 10000;
+
+  // Throws carmen::Error(ErrorCode::Usage) when `final_path` names a target
+  // this transaction already has (see same_target), or AtomicOutput's errors.
   AtomicOutput &add(const std::string &final_path);
   void commit();
 
+  void set_lock_timeout_ms(int ms) { lock_timeout_ms_ = ms; }
+  int lock_timeout_ms() const { return lock_timeout_ms_; }
+
+  // Tests only: the n-th rename (1-based) of the next commit in this process
+  // fails with `err` as if the file system had refused it; 0 disarms.
+  static void fail_rename_for_testing(int n, int err);
+
  private:
   std::vector<std::unique_ptr<AtomicOutput>> outputs_;
+  int lock_timeout_ms_ = kDefaultLockTimeoutMs;
 };
+
+// Refuses, by throwing carmen::FileError(path, why, ErrorCode::Io), a target
+// that a rename could not replace, or must not:
+//  - its directory is missing, not a directory, or not writable (EROFS too);
+//  - it exists and is not a regular file (a directory, a device such as
+//    /dev/full, a FIFO, a socket; a symlink is judged by what it points to);
+//  - it lies in a sticky directory (/tmp) and belongs to another user;
+//  - it is a mount point (a bind-mounted file: the rename would fail EBUSY).
+// AtomicOutput checks it when it is created and again before its rename.
+void check_replaceable(const std::string &path);
+
+// True when `a` and `b` name one target: the same name in the same directory
+// (by device and inode), or one existing file (by device and inode, following
+// symlinks). Paths that do not resolve are compared by nothing else: false.
+bool same_target(const std::string &a, const std::string &b);
 
 // Writes `contents` to `path` atomically (binary). Throws carmen::FileError.
 void write_file_atomically(const std::string &path, std::string_view contents, bool durable = false);
