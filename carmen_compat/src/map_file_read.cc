@@ -140,6 +140,17 @@ PlaceList parse_places(const std::vector<unsigned char> &b) {
   return places;
 }
 
+// A count, then that many x1 y1 x2 y2 quadruples (off-limits lines or rectangles).
+void read_segments(Cursor &cur, const char *items, const char *item, std::vector<OffLimits::Segment> *out) {
+  out->resize(cur.count(16, items));
+  for (auto &sg : *out) {
+    sg.x1 = cur.i32(item);
+    sg.y1 = cur.i32(item);
+    sg.x2 = cur.i32(item);
+    sg.y2 = cur.i32(item);
+  }
+}
+
 OffLimits parse_offlimits(const std::vector<unsigned char> &b) {
   Cursor cur(b.data(), b.size());
   OffLimits o;
@@ -149,22 +160,8 @@ OffLimits parse_offlimits(const std::vector<unsigned char> &b) {
     pt.x = cur.i32("a point");
     pt.y = cur.i32("a point");
   }
-  const size_t nl = cur.count(16, "lines");
-  o.lines.resize(nl);
-  for (auto &l : o.lines) {
-    l.x1 = cur.i32("a line");
-    l.y1 = cur.i32("a line");
-    l.x2 = cur.i32("a line");
-    l.y2 = cur.i32("a line");
-  }
-  const size_t nr = cur.count(16, "rectangles");
-  o.rects.resize(nr);
-  for (auto &r : o.rects) {
-    r.x1 = cur.i32("a rectangle");
-    r.y1 = cur.i32("a rectangle");
-    r.x2 = cur.i32("a rectangle");
-    r.y2 = cur.i32("a rectangle");
-  }
+  read_segments(cur, "lines", "a line", &o.lines);
+  read_segments(cur, "rectangles", "a rectangle", &o.rects);
   cur.expect_end();
   return o;
 }
