@@ -160,11 +160,17 @@ std::unique_ptr<MemberDecoder> MemberDecoder::create(Codec codec) {
 
 // ---------------------------------------------------------------------------
 
-GzipInflater::GzipInflater(std::FILE *fp, Codec codec, std::size_t in_chunk)
+GzipInflater::GzipInflater(std::FILE *fp, Codec codec, std::size_t in_chunk, const std::string &prefix)
     : fp_(fp),
       codec_(codec),
       dec_(MemberDecoder::create(codec)),
-      in_(std::max<std::size_t>(in_chunk, 1)) {}
+      in_(std::max<std::size_t>({in_chunk, prefix.size(), 1})) {
+  std::memcpy(in_.data(), prefix.data(), prefix.size());
+  next_in_ = in_.data();
+  avail_in_ = prefix.size();
+  file_pos_ = prefix.size();
+  comp_read_.store(file_pos_, std::memory_order_relaxed);
+}
 
 std::size_t GzipInflater::read(char *dst, std::size_t cap, bool *eof, std::string *error) {
   auto *out = reinterpret_cast<unsigned char *>(dst);
@@ -288,8 +294,8 @@ std::string GzipInflater::fault(MemberDecoder::Status status) const {
 
 // ---------------------------------------------------------------------------
 
-BackgroundInflater::BackgroundInflater(std::FILE *fp, std::size_t block_size)
-    : inflater_(fp), block_size_(block_size), thread_([this] { produce(); }) {}
+BackgroundInflater::BackgroundInflater(std::FILE *fp, std::size_t block_size, const std::string &prefix)
+    : inflater_(fp, default_codec(), std::size_t(256) << 10, prefix), block_size_(block_size), thread_([this] { produce(); }) {}
 
 BackgroundInflater::~BackgroundInflater() {
   {

@@ -66,9 +66,11 @@ class MemberDecoder {
 class GzipInflater {
  public:
   // in_chunk: compressed bytes per fread (tests make it small, to cut the
-  // gzip headers and trailers across reads).
+  // gzip headers and trailers across reads). prefix: the file's first bytes,
+  // already read from fp by the caller (to sniff the magic without seeking a
+  // pipe); inflated before what fp holds.
   explicit GzipInflater(std::FILE *fp, Codec codec = default_codec(),
-                        std::size_t in_chunk = std::size_t(256) << 10);
+                        std::size_t in_chunk = std::size_t(256) << 10, const std::string &prefix = {});
   GzipInflater(const GzipInflater &) = delete;
   GzipInflater &operator=(const GzipInflater &) = delete;
 
@@ -107,7 +109,8 @@ class GzipInflater {
 // or error) after the last. Memory: kQueuedBlocks + 1 blocks of block_size.
 class BackgroundInflater {
  public:
-  BackgroundInflater(std::FILE *fp, std::size_t block_size);
+  // prefix: as GzipInflater's.
+  BackgroundInflater(std::FILE *fp, std::size_t block_size, const std::string &prefix = {});
   ~BackgroundInflater();
 
   // Copies up to cap bytes of the stream into dst; 0 at the end, with `eof`

@@ -1,5 +1,8 @@
 // Streaming reader for CARMEN 0.7.4 text logs (.log, .clf, and gzip when the
-// name ends in ".gz").
+// name ends in ".gz"), from a file, a FIFO or a pipe, or standard input
+// ("-"). The input is read once from start to end, never rewound; from a
+// pipe, gzip is recognised by its magic bytes. A leading UTF-8 byte order
+// mark is skipped.
 //
 // One line is one message. The reader dispatches on the exact first token
 // (FLASER, RLASER, ROBOTLASER1/2, RAWLASER1..4, ODOM, TRUEPOS, PARAM, SYNC);
@@ -50,6 +53,8 @@ const char *message_type_name(MessageType type);
 bool message_type_from_name(const char *name, std::size_t length, MessageType *type);
 // FLASER, RLASER, ROBOTLASERn and RAWLASERn.
 bool is_laser_message(MessageType type);
+// The bit of `type` in LogReaderOptions::budget_types.
+constexpr uint32_t message_type_bit(MessageType type) { return uint32_t(1) << static_cast<int>(type); }
 
 struct Point { double x = 0, y = 0, theta = 0; };
 
@@ -129,12 +134,35 @@ struct LineError {
   std::string message;  // without file and line
 };
 
+// What the memory budget charges for each message it counts, besides its
+// ranges or text: a consumer's per-scan pose and offsets, or a PARAM's two
+// strings and line number.
+constexpr uint64_t kBudgetBytesPerMessage = 64;
+
 struct LogReaderOptions {
   bool strict = true;
   // Longest line accepted, in bytes (without the '\n'); clamped to 16 B..1 GiB.
   // The read buffer is this plus 256 KiB. A 100000-beam line written with
   // "%.3f" is about 1 MB.
   std::size_t max_line_length = std::size_t(4) << 20;
+  // Bytes the caller may keep of what it reads (0: no limit). Each message of
+  // a type in budget_types charges kBudgetBytesPerMessage plus 4 bytes a range
+  // (laser types) or the bytes of its name and value (PARAM), counted in
+  // LogStats::kept_bytes as it is read; the message that passes the budget
+  // throws FileError(file, line, ..., ErrorCode::OutOfMemory) naming the
+  // budget and budget_option, before a larger log is read any further.
+  uint64_t memory_budget = 0;
+  // The types the caller keeps (message_type_bit of each); every laser type
+  // and PARAM by default.
+  uint32_t budget_types = ((message_type_bit(MessageType::RAWLASER4) << 1) - 1) |  // FLASER..RAWLASER4
+                          message_type_bit(MessageType::PARAM);
+  // How the user raises the budget, as the error names it ("--max-memory").
+  std::string budget_option = "LogReaderOptions::memory_budget";
+  // A FIFO, pipe or device named by its path is opened without waiting for a
+  // writer, then waited on this long (ms) for its first byte before the
+  // reader gives up with a FileError; < 0: no limit. Standard input ("-") is
+  // not waited on.
+  int fifo_wait_ms = 60000;
 };
 
 struct LogStats {
@@ -152,6 +180,7 @@ struct LogStats {
   uint64_t inf_ranges = 0;       // +inf or -inf
   uint64_t negative_ranges = 0;  // finite and < 0
   uint64_t bytes = 0;  // uncompressed bytes read so far (up to 256 KiB ahead of the last line)
+  uint64_t kept_bytes = 0;  // charged against LogReaderOptions::memory_budget so far
 
   uint64_t count(MessageType type) const { return messages[static_cast<int>(type)]; }
   uint64_t laser_messages() const;  // all laser types together
@@ -162,9 +191,12 @@ struct LogStats {
 
 class LogReader {
  public:
-  // Opens the log; a name ending in ".gz" is inflated (a .gz file that is not
-  // gzip data is read as plain text, as zlib's gzread does). Throws FileError
-  // when the file cannot be opened, is empty, or its first block is damaged.
+  // Opens the log ("-": standard input, named "<stdin>" in errors and by
+  // path()). gzip data is inflated when the name ends in ".gz" or the input
+  // is not a regular file (a .gz file that is not gzip data is read as plain
+  // text, as zlib's gzread does). Throws FileError when the file cannot be
+  // opened (ErrorCode::Io), is empty, or its first block is damaged, and when
+  // a FIFO stays silent longer than options.fifo_wait_ms.
   explicit LogReader(const std::string &path, LogReaderOptions options = {});
   ~LogReader();
   LogReader(const LogReader &) = delete;
@@ -186,7 +218,8 @@ class LogReader {
   const LogStats &stats() const;
   const std::string &path() const;
   const LogReaderOptions &options() const;
-  // For a progress bar: bytes read from the file so far and its size.
+  // For a progress bar: bytes read from the file so far and its size (0 for
+  // a pipe).
   uint64_t compressed_bytes_read() const;
   uint64_t file_size() const;
   bool compressed() const;  // true when the data is being inflated
