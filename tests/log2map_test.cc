@@ -114,7 +114,7 @@ TEST(Log2Map, MissingLogIsAnError) {
 TEST(Log2Map, ParameterErrorsNameTheKeyAndWhere) {
   TempDir dir;
   const ToolRun cli = log2map({"--vasco_p_occ", "1.5", kIntel, dir.file("o.map")});
-  EXPECT_EQ(cli.status, 1);
+  EXPECT_EQ(cli.status, 2);  // a bad value on the command line is a usage error
   EXPECT_TRUE(contains(cli.output, "vasco_p_occ")) << cli.output;
   const std::string ini = write_text(dir, "bad.ini", "[*]\nvasco_resolution 0.05\nvasco_range_sure 20\n");
   const ToolRun f = log2map({"--param-file", ini, kIntel, dir.file("o.map")});
@@ -147,7 +147,7 @@ TEST(Log2Map, CudaWithoutAGpuIsAClearError) {
   const ToolRun v = log2map({"--backend", "cuda", "--vasco_num_scans", "5", kIntel, dir.file("o.map")});
   if (v.status == 0) GTEST_SKIP() << "a GPU is usable here: this checks the no-GPU error";
   EXPECT_EQ(v.status, 1);
-  EXPECT_TRUE(contains(v.output, "--backend cuda")) << v.output;
+  EXPECT_TRUE(contains(v.output, "backend cuda")) << v.output;
   EXPECT_TRUE(dir.entries().empty());
 }
 
@@ -267,7 +267,7 @@ TEST(Log2Map, SmallDefectsGiveClearErrors) {
   EXPECT_EQ(ds.status, 1);
   EXPECT_TRUE(contains(ds.output, "command line: vasco_downsample = 1000000 is larger than the grid")) << ds.output;
   const ToolRun rm = log2map({"--vasco_range_max", "0", kIntel, dir.file("a.map")});
-  EXPECT_EQ(rm.status, 1);
+  EXPECT_EQ(rm.status, 2);
   EXPECT_TRUE(contains(rm.output, "vasco_range_max = 0")) << rm.output;
   // vasco_first_scan near LONG_MAX: no overflow, a clear "nothing selected".
   const ToolRun fs = log2map({"--vasco_first_scan", "9223372036854775800", "--vasco_num_scans", "100", kIntel,
@@ -294,6 +294,131 @@ TEST(Log2Map, EscapeCodesFromAFileAreNotEchoedRaw) {
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << r.output;
   EXPECT_TRUE(contains(r.output, "\\x1b[31mRED")) << r.output;
+}
+
+// --- The output transaction, end to end ---------------------------------------
+
+const std::vector<std::string> kFew = {"--backend", "cpu_double", "--quiet", "--vasco_num_scans", "20"};
+
+ToolRun log2map_few(std::vector<std::string> args) {
+  args.insert(args.begin(), kFew.begin(), kFew.end());
+  return log2map(args);
+}
+
+std::string read_all(const std::string &path) { return maptest::read_bytes(path); }
+
+// An output that is an input, or one output named twice: refused (usage)
+// before anything is written; the input stays as it was.
+TEST(Log2Map, AnOutputThatIsAnInputOrNamedTwiceIsRefused) {
+  TempDir dir;
+  const std::string log = write_text(dir, "run.yaml", "FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1 t 0\n");
+  const ToolRun yaml = log2map_few({log, dir.file("run.pgm")});  // run.pgm writes run.yaml
+  EXPECT_EQ(yaml.status, 2) << yaml.output;
+  EXPECT_TRUE(contains(yaml.output, "is the input")) << yaml.output;
+  EXPECT_EQ(read_all(log), "FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1 t 0\n");
+  for (const std::string &again : {dir.file("d.map"), dir.path() + "/./d.map", dir.path() + "//d.map"}) {
+    const ToolRun twice = log2map_few({kIntel, dir.file("d.map"), again});
+    EXPECT_EQ(twice.status, 2) << again << "\n" << twice.output;
+    EXPECT_TRUE(contains(twice.output, "give each output once")) << twice.output;
+  }
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"run.yaml"}));
+}
+
+// One directory spelled two ways, or through a symlink, is locked once: the
+// run ends (it waited on itself forever before).
+TEST(Log2Map, OneDirectorySpelledTwoWaysDoesNotHang) {
+  TempDir dir;
+  ASSERT_EQ(::symlink(dir.path().c_str(), dir.file("alias").c_str()), 0);
+  const ToolRun r = log2map_few({kIntel, dir.file("x.map"), dir.path() + "/./x.png", dir.path() + "//y.png",
+                                 dir.file("alias/z.png")});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"alias", "x.map", "x.png", "y.png", "z.png"}));
+}
+
+// A device, a FIFO or a link to a device is not an output: refused before
+// any work, and left as it was.
+TEST(Log2Map, SpecialFilesAreNeverReplaced) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo(dir.file("p.png").c_str(), 0600), 0);
+  ASSERT_EQ(::symlink("/dev/full", dir.file("full.map").c_str()), 0);
+  const ToolRun fifo = log2map_few({kIntel, dir.file("p.png")});
+  EXPECT_EQ(fifo.status, 1);
+  EXPECT_TRUE(contains(fifo.output, "p.png: is a FIFO")) << fifo.output;
+  const ToolRun dev = log2map_few({kIntel, dir.file("full.map")});
+  EXPECT_EQ(dev.status, 1);
+  EXPECT_TRUE(contains(dev.output, "is a character device")) << dev.output;
+  struct stat st;
+  ASSERT_EQ(::lstat(dir.file("p.png").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  ASSERT_EQ(::stat("/dev/full", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode));
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"full.map", "p.png"}));
+}
+
+// In a sticky directory, another user's theirs.png cannot be replaced: the
+// run is refused before mine.map is touched. Run as an ordinary user (root
+// ignores the rule), so only where the test may switch to one.
+TEST(Log2Map, AnotherUsersFileInAStickyDirectoryTouchesNoOutput) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to make a file of another user";
+  TempDir dir;
+  ASSERT_EQ(::chmod(dir.path().c_str(), 0755), 0);
+  const std::string sticky = dir.file("tmp");
+  ASSERT_EQ(::mkdir(sticky.c_str(), 0777), 0);
+  ASSERT_EQ(::chmod(sticky.c_str(), 01777), 0);
+  write_text(dir, "tmp/theirs.png", "root's");
+  write_text(dir, "tmp/mine.map", "old map");
+  ASSERT_EQ(::chown((sticky + "/mine.map").c_str(), 65534, 65534), 0);
+  const std::string cmd = "setpriv --reuid=65534 --regid=65534 --clear-groups " +
+                          tooltest::quote(std::string(VASCO_BIN_DIR) + "/log2map") + " --quiet --vasco_num_scans 20 " +
+                          tooltest::quote(kIntel) + " " + tooltest::quote(sticky + "/mine.map") + " " +
+                          tooltest::quote(sticky + "/theirs.png") + " 2>&1";
+  FILE *p = ::popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string out;
+  char buf[512];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+  const int st = ::pclose(p);
+  if (WIFEXITED(st) && WEXITSTATUS(st) == 127) GTEST_SKIP() << "no setpriv here: " << out;
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << st << " " << out;
+  EXPECT_TRUE(contains(out, "sticky")) << out;
+  EXPECT_EQ(read_all(sticky + "/mine.map"), "old map");
+  EXPECT_EQ(read_all(sticky + "/theirs.png"), "root's");
+}
+
+// --max-memory takes whole MiB that fit in 64 bits as bytes; anything else
+// is a usage error (17592186044417 MiB wrapped to 1 MiB before).
+TEST(Log2Map, MaxMemoryOutOfRangeIsAUsageError) {
+  TempDir dir;
+  for (const char *bad : {"17592186044417", "18446744073709551616", "-1", "1.5", "", "12abc"}) {
+    const ToolRun r = log2map_few({"--max-memory", bad, kIntel, dir.file("a.map")});
+    EXPECT_EQ(r.status, 2) << bad << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "--max-memory")) << r.output;
+  }
+  EXPECT_EQ(log2map_few({"--max-memory", "17592186044415", kIntel, dir.file("a.map")}).status, 0);
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"a.map"}));
+}
+
+// --json with standard output closed: refused before the maps are made.
+TEST(Log2Map, JsonToAClosedStdoutFailsBeforeAnyWork) {
+  TempDir dir;
+  const std::string cmd = tooltest::quote(std::string(VASCO_BIN_DIR) + "/log2map") + " --json --quiet " +
+                          tooltest::quote(kIntel) + " " + tooltest::quote(dir.file("a.map")) + " >&- 2>" +
+                          tooltest::quote(dir.file("err.txt"));
+  const int st = std::system(cmd.c_str());
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << st;
+  EXPECT_TRUE(contains(read_all(dir.file("err.txt")), "standard output is closed")) << read_all(dir.file("err.txt"));
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"err.txt"}));
+}
+
+// A full stdout is seen only once the maps are written: the message says so.
+TEST(Log2Map, JsonToAFullStdoutSaysTheMapsWereWritten) {
+  TempDir dir;
+  const std::string cmd = tooltest::quote(std::string(VASCO_BIN_DIR) + "/log2map") + " --json --quiet " +
+                          tooltest::quote(kIntel) + " " + tooltest::quote(dir.file("a.map")) + " >/dev/full 2>" +
+                          tooltest::quote(dir.file("err.txt"));
+  const int st = std::system(cmd.c_str());
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << st;
+  EXPECT_TRUE(contains(read_all(dir.file("err.txt")), "the maps were written")) << read_all(dir.file("err.txt"));
 }
 
 }  // namespace

@@ -21,10 +21,11 @@ inline std::string quote(const std::string &s) {
   return q + "'";
 }
 
-// Runs <build>/bin/TOOL with `args` (shell-quoted).
+// Runs <build>/bin/TOOL with `args` (shell-quoted); a run that hangs is
+// stopped after two minutes (status 124).
 inline ToolRun run_tool(const std::string &tool, const std::vector<std::string> &args,
                         bool with_stderr = true) {
-  std::string cmd = quote(std::string(VASCO_BIN_DIR) + "/" + tool);
+  std::string cmd = "timeout -k 5 120 " + quote(std::string(VASCO_BIN_DIR) + "/" + tool);
   for (const std::string &a : args) cmd += " " + quote(a);
   cmd += with_stderr ? " 2>&1" : " 2>/dev/null";
   ToolRun r;

@@ -23,12 +23,12 @@
 
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
-#include "carmen_compat/image_io.h"
-#include "carmen_compat/ini_file.h"
-#include "carmen_compat/map_file.h"
+#include "carmen_compat/map_format.h"
+#include "cli_support.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/log_input.h"
+#include "vasco_gpu/map_output.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"
@@ -39,25 +39,8 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-enum class OutputKind { CarmenMap, Pgm, Png };
-
-bool ends_with(const std::string &s, const std::string &suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-bool output_kind(const std::string &path, OutputKind *kind) {
-  if (ends_with(path, ".map") || ends_with(path, ".map.gz")) *kind = OutputKind::CarmenMap;
-  else if (ends_with(path, ".pgm")) *kind = OutputKind::Pgm;
-  else if (ends_with(path, ".png")) *kind = OutputKind::Png;
-  else return false;
-  return true;
-}
+using cli::Clock;
+using cli::seconds_since;
 
 // A one-line progress bar on stderr, only when stderr is a terminal.
 class ProgressBar {
@@ -87,75 +70,20 @@ class ProgressBar {
   bool shown_ = false;
 };
 
-std::string json_escape(const std::string &s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
 std::string basename_of(const std::string &path) {
   const size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-std::string yaml_beside(const std::string &pgm) { return pgm.substr(0, pgm.size() - 4) + ".yaml"; }
-
-// Writes one output (two for a PGM: the image and its YAML) into `tx`; the
-// transaction renames them all at the end.
-void write_output(carmen::OutputTransaction &tx, const std::string &out, OutputKind kind,
-                  const carmen::GridMap &grid, const carmen::GlobalOffset &origin, const std::string &log,
-                  const std::string &backend_name) {
-  switch (kind) {
-    case OutputKind::CarmenMap: {
-      carmen::MapFile mf;
-      const std::string desc = "vasco_gpu " + std::string(vasco::version()) + " " + backend_name;
-      const auto now = static_cast<int64_t>(std::time(nullptr));
-      mf.comments = carmen::standard_map_comments(grid.size_x, grid.size_y, grid.resolution,
-                                                  basename_of(log), desc, "log2map", now);
-      carmen::CreatorInfo creator;
-      creator.user = "log2map";
-      creator.origin = basename_of(log);
-      creator.description = desc;
-      creator.time = now;
-      mf.creator = creator;
-      mf.gridmap = grid;
-      mf.offset = origin;
-      carmen::write_map_file(tx.add(out), mf);
-      break;
-    }
-    case OutputKind::Pgm: {
-      carmen::AtomicOutput &pgm = tx.add(out);
-      carmen::write_pgm_with_yaml(pgm, tx.add(yaml_beside(out)), grid, origin);
-      break;
-    }
-    case OutputKind::Png:
-      carmen::write_png(tx.add(out), grid);
-      break;
+// Every file the run creates (a .pgm's .yaml too), for the checks made
+// before any work.
+std::vector<std::string> files_written(const std::vector<std::string> &outputs) {
+  std::vector<std::string> files;
+  for (const std::string &out : outputs) {
+    const std::vector<std::string> of_one = carmen::map_output_files(out);
+    files.insert(files.end(), of_one.begin(), of_one.end());
   }
-}
-
-// Refuses, before any work is done, an output that is a directory or whose
-// directory cannot be written.
-void check_writable(const std::string &out) {
-  struct stat st;
-  if (::stat(out.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-    throw carmen::FileError(out, "is a directory: cannot write a map there");
-  const size_t slash = out.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : out.substr(0, slash));
-  if (access(dir.c_str(), W_OK) != 0)
-    throw carmen::FileError(out, "cannot write here: directory '" + dir + "' " +
-                                     (access(dir.c_str(), F_OK) != 0 ? "does not exist" : "is not writable"));
+  return files;
 }
 
 struct Options {
@@ -166,7 +94,7 @@ struct Options {
   std::string backend = "auto";
   std::string cuda_mode = "float";
   int threads = 0;
-  uint64_t max_memory_mib = vasco::kDefaultMaxMemoryBytes >> 20;
+  uint64_t max_memory_bytes = vasco::kDefaultMaxMemoryBytes;
   bool lenient = false, json = false, quiet = false;
   std::map<std::string, std::string> overrides;  // --vasco_KEY VALUE
 };
@@ -176,7 +104,7 @@ struct RunResult {
   vasco::LogInput input;
   vasco::MapStats stats;
   vasco::FinishedMap map;
-  carmen::GlobalOffset origin;
+  carmen::GlobalOffset origin;  // of the map's cell (0, 0), in the world
   std::string backend;
   uint64_t known = 0;
   double parse_s = 0, map_total_s = 0, finish_s = 0, write_s = 0, total_s = 0;
@@ -228,15 +156,14 @@ vasco::LogInput read_input(const Options &opt) {
 // Every output as one transaction: all are written to temporaries first and
 // renamed only when every one is written, so a failure touches no output
 // (an existing file stays as it was) and leaves no temporary.
-void write_outputs(const Options &opt, const std::vector<OutputKind> &kinds, const RunResult &r) {
-  carmen::GridMap grid;
-  grid.size_x = r.map.size_x;
-  grid.size_y = r.map.size_y;
-  grid.resolution = r.map.resolution;
-  grid.cells = r.map.cells;
+void write_outputs(const Options &opt, const RunResult &r) {
+  carmen::MapToWrite map = vasco::map_to_write(r.map, r.input.geo);
+  map.author = "log2map";
+  map.source = basename_of(opt.log);
+  map.description = "vasco_gpu " + std::string(vasco::version()) + " " + r.backend;
+  map.time = static_cast<int64_t>(std::time(nullptr));
   carmen::OutputTransaction tx;
-  for (size_t i = 0; i < opt.outputs.size(); ++i)
-    write_output(tx, opt.outputs[i], kinds[i], grid, r.origin, opt.log, r.backend);
+  for (const std::string &out : opt.outputs) carmen::write_map(tx, out, map);
   tx.commit();
 }
 
@@ -273,8 +200,8 @@ void print_json(const Options &opt, const RunResult &r) {
   const vasco::GridGeometry &geo = r.input.geo;
   std::ostringstream j;
   j.precision(9);
-  j << "{\"log\":\"" << json_escape(opt.log) << "\",\"backend\":\"" << r.backend
-    << "\",\"scans\":" << r.input.batch.num_scans() << ",\"laser_messages\":" << r.input.load.laser_messages
+  j << "{\"log\":" << cli::json_string(opt.log) << ",\"backend\":" << cli::json_string(r.backend)
+    << ",\"scans\":" << r.input.batch.num_scans() << ",\"laser_messages\":" << r.input.load.laser_messages
     << ",\"beams_used\":" << ms.beams_used << ",\"beams_skipped\":" << ms.beams_skipped
     << ",\"cell_updates\":" << ms.cell_updates << ",\"nan_ranges\":" << ls.nan_ranges
     << ",\"inf_ranges\":" << ls.inf_ranges << ",\"negative_ranges\":" << ls.negative_ranges
@@ -285,42 +212,30 @@ void print_json(const Options &opt, const RunResult &r) {
     << ",\"map\":" << ms.map_s << ",\"map_total\":" << r.map_total_s << ",\"download\":" << ms.download_s
     << ",\"finish\":" << r.finish_s << ",\"write\":" << r.write_s << ",\"total\":" << r.total_s
     << "},\"outputs\":[";
-  for (size_t i = 0; i < opt.outputs.size(); ++i) j << (i ? "," : "") << "\"" << json_escape(opt.outputs[i]) << "\"";
+  for (size_t i = 0; i < opt.outputs.size(); ++i) j << (i ? "," : "") << cli::json_string(opt.outputs[i]);
   j << "]}\n";
   std::fputs(j.str().c_str(), stdout);
 }
 
-int run(const Options &opt) {
-  const auto t_start = Clock::now();
-  carmen::remove_temporaries_on_signals();
-  std::vector<OutputKind> kinds(opt.outputs.size());
-  for (size_t i = 0; i < opt.outputs.size(); ++i) output_kind(opt.outputs[i], &kinds[i]);
-  for (size_t i = 0; i < opt.outputs.size(); ++i) {
-    check_writable(opt.outputs[i]);
-    if (kinds[i] == OutputKind::Pgm) check_writable(yaml_beside(opt.outputs[i]));
-  }
-  vasco::BackendOptions bopt;
-  bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
-  bopt.threads = opt.threads;
-  bopt.max_memory_bytes = opt.max_memory_mib << 20;
-  std::future<bool> gpu_ready = start_cuda(opt, bopt);
+// Everything refused before the log is read: outputs that cannot or must
+// not be written, and a --json with nowhere to go.
+void check_before_work(const Options &opt) {
+  cli::check_outputs({opt.log, opt.param_file}, files_written(opt.outputs));
+  if (opt.json) cli::check_stdout_writable("--json");
+}
 
-  RunResult r;
-  auto t = Clock::now();
-  r.input = read_input(opt);
-  r.parse_s = seconds_since(t);
-  if (gpu_ready.valid()) gpu_ready.wait();
-  // A mapping session in the PROTOCOL frame, fed every scan at once.
+// The mapping session in the PROTOCOL frame, fed every scan at once.
+void make_map(const Options &opt, const vasco::BackendOptions &bopt, RunResult &r) {
   vasco::Mapper mapper(r.input.params, opt.backend, bopt);
   r.backend = mapper.backend_name();
   if (opt.backend == "auto" && r.backend.rfind("cuda", 0) != 0 && !opt.quiet)
     std::fprintf(stderr, "log2map: --backend auto: %s: using %s\n", no_gpu_reason(bopt).c_str(), r.backend.c_str());
-  t = Clock::now();
+  auto t = Clock::now();
   try {
     mapper.insert(r.input.batch);
-  } catch (const std::runtime_error &e) {
-    // Too large for the memory budget: the log's poses decide, so name it.
-    if (std::string(e.what()).rfind("the map needs about", 0) == 0) throw carmen::FileError(opt.log, e.what());
+  } catch (const carmen::Error &e) {
+    // Over the memory budget: the log's poses decide the grid, so name it.
+    if (e.code() == carmen::ErrorCode::OutOfMemory) throw carmen::FileError(opt.log, e.what(), e.code());
     throw;
   }
   r.stats = mapper.last_stats();
@@ -330,21 +245,42 @@ int run(const Options &opt) {
   r.finish_s = seconds_since(t);
   for (float v : r.map.cells) r.known += v != -1.0f;
   if (r.known == 0) r.input.warnings.push_back(opt.log + ": no cell was updated: the map is all unknown");
-  const vasco::GridGeometry &geo = r.input.geo;
-  r.origin.x = geo.world_x(static_cast<double>(r.map.min_x) * r.map.downsample);
-  r.origin.y = geo.world_y(static_cast<double>(r.map.min_y) * r.map.downsample);
-  r.origin.theta = 0;  // theta_offset is the first scan's heading, so the grid axes are the world axes
-  t = Clock::now();
-  write_outputs(opt, kinds, r);
-  r.write_s = seconds_since(t);
-  r.total_s = seconds_since(t_start);
+  r.origin = vasco::world_origin(r.map, r.input.geo);
+}
 
+// The statistics come after the maps are in place: a failure to print them
+// says so, so that nobody takes the exit status for a missing map.
+void print_report(const Options &opt, const RunResult &r) {
   for (const auto &w : r.input.warnings)
     std::fprintf(stderr, "log2map: warning: %s\n", carmen::printable(w).c_str());
   if (!opt.quiet) print_summary(opt, r);
   if (opt.json) print_json(opt, r);
   if (std::fflush(stdout) != 0 || std::ferror(stdout))
-    throw std::runtime_error(std::string("cannot write to standard output: ") + std::strerror(errno));
+    throw carmen::Error(carmen::ErrorCode::Io, std::string("the maps were written, but the statistics could not be "
+                                                           "written to standard output: ") + std::strerror(errno));
+}
+
+int run(const Options &opt) {
+  const auto t_start = Clock::now();
+  carmen::remove_temporaries_on_signals();
+  check_before_work(opt);
+  vasco::BackendOptions bopt;
+  bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
+  bopt.threads = opt.threads;
+  bopt.max_memory_bytes = opt.max_memory_bytes;
+  std::future<bool> gpu_ready = start_cuda(opt, bopt);
+
+  RunResult r;
+  auto t = Clock::now();
+  r.input = read_input(opt);
+  r.parse_s = seconds_since(t);
+  if (gpu_ready.valid()) gpu_ready.wait();
+  make_map(opt, bopt, r);
+  t = Clock::now();
+  write_outputs(opt, r);
+  r.write_s = seconds_since(t);
+  r.total_s = seconds_since(t_start);
+  print_report(opt, r);
   return 0;
 }
 
@@ -371,9 +307,9 @@ int main(int argc, char **argv) {
       ->check(CLI::Range(0, 1024));
   app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
       ->check(CLI::IsMember({"float", "exact"}));
-  app.add_option("--max-memory", opt.max_memory_mib,
-                 "host memory the map may use, in MiB (default 2048; 0: no limit)")
-      ->check(CLI::NonNegativeNumber);
+  std::string max_memory;
+  app.add_option("--max-memory", max_memory, "host memory the map may use, in MiB (default 2048; 0: no limit)")
+      ->type_name("MiB");
   app.add_flag("--lenient", opt.lenient, "skip bad log lines (and report them) instead of stopping");
   app.add_flag("--json", opt.json, "print machine-readable statistics on stdout");
   app.add_flag("--quiet", opt.quiet, "no progress and no summary");
@@ -389,12 +325,12 @@ int main(int argc, char **argv) {
   }
   for (const auto &kv : raw)
     if (app.count("--" + kv.first) > 0) opt.overrides[kv.first] = kv.second;
-  for (const auto &out : opt.outputs) {
-    OutputKind k;
-    if (!output_kind(out, &k)) {
-      std::fprintf(stderr, "log2map: %s: unknown output type (use .map, .map.gz, .pgm or .png)\n", out.c_str());
-      return 2;
-    }
+  try {
+    if (app.count("--max-memory") > 0) opt.max_memory_bytes = cli::parse_mebibytes(max_memory, "--max-memory");
+    for (const auto &out : opt.outputs) carmen::map_format_of(out);  // an unknown extension: a usage error
+  } catch (const carmen::Error &e) {
+    std::fprintf(stderr, "log2map: %s\n", carmen::printable(e.what()).c_str());
+    return 2;
   }
   try {
     return run(opt);
@@ -402,6 +338,7 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "log2map: out of memory\n");
   } catch (const std::exception &e) {
     std::fprintf(stderr, "log2map: %s\n", carmen::printable(e.what()).c_str());
+    return cli::exit_status(e);
   }
   return 1;
 }

@@ -1,0 +1,85 @@
+// The tools' shared helpers (cli_support.h).
+#include "cli_support.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <charconv>
+#include <cstdio>
+
+#include "carmen_compat/atomic_file.h"
+#include "carmen_compat/error.h"
+
+namespace cli {
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string json_string(const std::string &text) {
+  std::string out = "\"";
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+int exit_status(const std::exception &e, int usage, int other) {
+  const auto *error = dynamic_cast<const carmen::Error *>(&e);
+  return error != nullptr && error->code() == carmen::ErrorCode::Usage ? usage : other;
+}
+
+namespace {
+
+void check_not_an_input(const std::string &out, const std::vector<std::string> &inputs) {
+  for (const std::string &in : inputs) {
+    if (!in.empty() && carmen::same_target(out, in))
+      throw carmen::Error(carmen::ErrorCode::Usage,
+                          out + ": is the input " + in + ": an output must not overwrite what is read");
+  }
+}
+
+}  // namespace
+
+void check_outputs(const std::vector<std::string> &inputs, const std::vector<std::string> &outputs) {
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    check_not_an_input(outputs[i], inputs);
+    for (size_t j = 0; j < i; ++j) {
+      if (carmen::same_target(outputs[j], outputs[i]))
+        throw carmen::Error(carmen::ErrorCode::Usage, outputs[i] + ": the same file as the output " + outputs[j] +
+                                                          ": give each output once");
+    }
+  }
+  for (const std::string &out : outputs) carmen::check_replaceable(out);
+}
+
+uint64_t parse_mebibytes(const std::string &text, const std::string &option) {
+  uint64_t mib = 0;
+  const char *end = text.data() + text.size();
+  const auto [stop, ec] = std::from_chars(text.data(), end, mib);
+  const bool digits_only = !text.empty() && stop == end && text.find_first_not_of("0123456789") == std::string::npos;
+  if (!digits_only || ec != std::errc())
+    throw carmen::Error(carmen::ErrorCode::Usage, option + " " + text + ": not a whole number of MiB from 0 to " +
+                                                      std::to_string(UINT64_MAX >> 20));
+  if (mib > (UINT64_MAX >> 20))
+    throw carmen::Error(carmen::ErrorCode::Usage, option + " " + text + ": more than the largest budget, " +
+                                                      std::to_string(UINT64_MAX >> 20) + " MiB");
+  return mib << 20;
+}
+
+void check_stdout_writable(const std::string &why) {
+  const int flags = ::fcntl(STDOUT_FILENO, F_GETFL);
+  if (flags == -1 || (flags & O_ACCMODE) == O_RDONLY)
+    throw carmen::Error(carmen::ErrorCode::Io, "standard output is " +
+                                                   std::string(flags == -1 ? "closed" : "not open for writing") +
+                                                   ": " + why + " has nowhere to go");
+}
+
+}  // namespace cli
