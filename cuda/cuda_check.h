@@ -11,20 +11,41 @@
 #include <string>
 #include <utility>
 
+#include "carmen_compat/error.h"
+
 namespace vasco {
 namespace cuda {
 
+// The project's error code of a CUDA failure: no device or a driver or
+// build that cannot run here is NoGpu, a failed allocation OutOfMemory, any
+// other failure Internal (nothing we foresaw).
+inline carmen::ErrorCode error_code_of(cudaError_t code) {
+  switch (code) {
+    case cudaErrorNoDevice:
+    case cudaErrorInvalidDevice:
+    case cudaErrorInsufficientDriver:
+    case cudaErrorNoKernelImageForDevice:
+    case cudaErrorDevicesUnavailable:
+      return carmen::ErrorCode::NoGpu;
+    case cudaErrorMemoryAllocation:
+      return carmen::ErrorCode::OutOfMemory;
+    default:
+      return carmen::ErrorCode::Internal;
+  }
+}
+
 // A failed CUDA call: what() names the call, the file and line, and the error.
-class CudaError : public std::runtime_error {
+class CudaError : public carmen::Error {
  public:
   CudaError(cudaError_t code, const char *call, const char *file, int line)
-      : std::runtime_error(std::string(file) + ":" + std::to_string(line) + ": " + call + " failed: " +
-                           cudaGetErrorName(code) + " (" + cudaGetErrorString(code) + ")"),
-        code_(code) {}
-  cudaError_t code() const { return code_; }
+      : carmen::Error(error_code_of(code), std::string(file) + ":" + std::to_string(line) + ": " + call +
+                                               " failed: " + cudaGetErrorName(code) + " (" +
+                                               cudaGetErrorString(code) + ")"),
+        cuda_code_(code) {}
+  cudaError_t cuda_code() const { return cuda_code_; }
 
  private:
-  cudaError_t code_;
+  cudaError_t cuda_code_;
 };
 
 }  // namespace cuda

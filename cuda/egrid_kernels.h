@@ -12,6 +12,7 @@
 #include <string>
 
 #include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/finish_math.h"
 #include "vasco_gpu/placed_beam.h"
 
 namespace vasco {
@@ -195,8 +196,8 @@ void launch_float_finalize(const KernelModel<float> &m, float *grid_logodds, con
                            size_t num_cells, cudaStream_t stream);
 
 // ---------------------------------------------------------------------------
-// CARMEN's finish on the device (finish_kernels.cu): block means summed in
-// double in CARMEN's order, the known bounding box, the crop. Only the
+// CARMEN's finish on the device (finish_kernels.cu), with finish_math.h's
+// functions: block means, the known bounding box, the crop. Only the
 // finished map then crosses the bus.
 // ---------------------------------------------------------------------------
 
@@ -208,14 +209,14 @@ struct GridCells {
   float logodds_prior = 0;
 };
 
-// blocks[bx * ny + by] for nx = size_x / ds, ny = size_y / ds, and bbox =
-// {min_x, max_x, min_y, max_y} widened by every known block (initialised by
-// the caller to CARMEN's start values).
-void launch_finish_blocks(GridCells grid, int size_x, int size_y, int ds, float *blocks, int *bbox,
+// blocks[bx * ny + by] for the block grid of finish::blocks_of(size_x,
+// size_y, ds), and `known` widened by every known block (the caller sets it
+// to an empty finish::KnownBox first).
+void launch_finish_blocks(GridCells grid, int size_x, int size_y, int ds, float *blocks, finish::KnownBox *known,
                           cudaStream_t stream);
 
-// out[x * out_y + y] = blocks[(x + min_x) * ny + (y + min_y)].
-void launch_crop(const float *blocks, int ny, int min_x, int min_y, int out_x, int out_y, float *out,
+// out[x * crop.size_y + y] = blocks[finish::cropped_block(crop, blocks_grid, x, y)].
+void launch_crop(const float *blocks, finish::Blocks blocks_grid, finish::Crop crop, float *out,
                  cudaStream_t stream);
 
 // A window of the grid as probabilities: out[x * height + y].

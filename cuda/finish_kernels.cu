@@ -1,7 +1,7 @@
 // CARMEN's finish (DESIGN §2 step 7) on the device, so that a mapping
-// session downloads only the finished map. One thread per ds x ds block sums
-// its cells in double in CARMEN's order (i outer, j inner) and divides once,
-// as finish_grid does on the host: the same float, bit for bit.
+// session downloads only the finished map. One thread per ds x ds block
+// runs finish_math.h's block_mean, the very code of the host's finish: the
+// same float, bit for bit.
 #include <algorithm>
 
 #include "cuda_check.h"
@@ -15,38 +15,32 @@ __device__ __forceinline__ float cell_prob(const GridCells &grid, size_t c) {
   return grid.sums ? prob_of_fixed(grid.logodds_prior, grid.sums[c]) : grid.probs[c];
 }
 
-__global__ void finish_blocks_kernel(GridCells grid, int size_y, int ds, int nx, int ny, float *blocks,
-                                     int *bbox) {
+// finish::block_mean's view of the grid.
+struct CellProb {
+  GridCells grid;
+  __device__ float operator()(int64_t c) const { return cell_prob(grid, static_cast<size_t>(c)); }
+};
+
+__global__ void finish_blocks_kernel(GridCells grid, int size_y, int ds, finish::Blocks blocks_grid, float *blocks,
+                                     finish::KnownBox *known) {
   const size_t b = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
-  if (b >= static_cast<size_t>(nx) * ny) return;
-  const int bx = static_cast<int>(b / ny), by = static_cast<int>(b % ny);
-  double sum = 0;
-  int count = 0;
-  for (int i = bx * ds; i < (bx + 1) * ds; ++i) {
-    for (int j = by * ds; j < (by + 1) * ds; ++j) {
-      const float v = cell_prob(grid, static_cast<size_t>(i) * size_y + j);
-      if (v != -1.0f) {
-        sum += v;
-        ++count;
-      }
-    }
+  if (b >= static_cast<size_t>(blocks_grid.count())) return;
+  const int bx = static_cast<int>(b / blocks_grid.ny), by = static_cast<int>(b % blocks_grid.ny);
+  const finish::BlockMean m = finish::block_mean(CellProb{grid}, size_y, ds, bx, by);
+  if (m.known) {
+    atomicMin(&known->min_x, bx);
+    atomicMax(&known->max_x, bx);
+    atomicMin(&known->min_y, by);
+    atomicMax(&known->max_y, by);
   }
-  float v = -1.0f;
-  if (count > 0) {
-    v = static_cast<float>(__ddiv_rn(sum, static_cast<double>(count)));
-    atomicMin(&bbox[0], bx);
-    atomicMax(&bbox[1], bx);
-    atomicMin(&bbox[2], by);
-    atomicMax(&bbox[3], by);
-  }
-  blocks[b] = v;
+  blocks[b] = m.value;
 }
 
-__global__ void crop_kernel(const float *blocks, int ny, int min_x, int min_y, int out_x, int out_y, float *out) {
+__global__ void crop_kernel(const float *blocks, finish::Blocks blocks_grid, finish::Crop crop, float *out) {
   const size_t c = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
-  if (c >= static_cast<size_t>(out_x) * out_y) return;
-  const int x = static_cast<int>(c / out_y), y = static_cast<int>(c % out_y);
-  out[c] = blocks[static_cast<size_t>(x + min_x) * ny + (y + min_y)];
+  if (c >= static_cast<size_t>(crop.count())) return;
+  const int x = static_cast<int>(c / crop.size_y), y = static_cast<int>(c % crop.size_y);
+  out[c] = blocks[finish::cropped_block(crop, blocks_grid, x, y)];
 }
 
 __global__ void window_kernel(GridCells grid, int size_y, int x0, int y0, int width, int height, float *out) {
@@ -60,20 +54,20 @@ unsigned blocks_of(size_t n) { return static_cast<unsigned>((n + 255) / 256); }
 
 }  // namespace
 
-void launch_finish_blocks(GridCells grid, int size_x, int size_y, int ds, float *blocks, int *bbox,
+void launch_finish_blocks(GridCells grid, int size_x, int size_y, int ds, float *blocks, finish::KnownBox *known,
                           cudaStream_t stream) {
-  const int nx = size_x / ds, ny = size_y / ds;
-  const size_t n = static_cast<size_t>(nx) * ny;
+  const finish::Blocks blocks_grid = finish::blocks_of(size_x, size_y, ds);
+  const size_t n = static_cast<size_t>(blocks_grid.count());
   if (n == 0) return;
-  finish_blocks_kernel<<<blocks_of(n), 256, 0, stream>>>(grid, size_y, ds, nx, ny, blocks, bbox);
+  finish_blocks_kernel<<<blocks_of(n), 256, 0, stream>>>(grid, size_y, ds, blocks_grid, blocks, known);
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_crop(const float *blocks, int ny, int min_x, int min_y, int out_x, int out_y, float *out,
+void launch_crop(const float *blocks, finish::Blocks blocks_grid, finish::Crop crop, float *out,
                  cudaStream_t stream) {
-  const size_t n = static_cast<size_t>(out_x) * out_y;
+  const size_t n = static_cast<size_t>(crop.count());
   if (n == 0) return;
-  crop_kernel<<<blocks_of(n), 256, 0, stream>>>(blocks, ny, min_x, min_y, out_x, out_y, out);
+  crop_kernel<<<blocks_of(n), 256, 0, stream>>>(blocks, blocks_grid, crop, out);
   VG_CUDA_CHECK_LAUNCH();
 }
 

@@ -7,6 +7,9 @@
 
 #include "vasco_gpu/backend.h"
 
+// CUDA's stream type without CUDA's headers: cudaStream_t is CUstream_st *.
+struct CUstream_st;
+
 namespace vasco {
 
 // Whether CUDA device `device` can be used; initialises the CUDA context on
@@ -18,14 +21,16 @@ bool cuda_usable(int device, std::string *why);
 // The device's name and memory, for messages ("NVIDIA H100 80GB HBM3, 79 GiB").
 std::string cuda_device_description(int device);
 
-// mode Float: single precision, scans fused (fast). mode Exact: GRIDMAP
-// bit-identical to cpu_double. Throws std::runtime_error without a usable GPU.
-std::unique_ptr<Backend> make_cuda_backend(const BackendOptions &options);
-
 class Renderer;
 // A mapping session's renderer on the GPU (vasco::Mapper with backend "cuda"):
-// grid, ranges and scratch resident between calls. Throws without a usable GPU.
-std::unique_ptr<Renderer> make_cuda_renderer(const BackendOptions &options);
+// grid, ranges and scratch resident between calls. options.cuda_mode Float:
+// single precision, scans fused (fast); Exact: GRIDMAP bit-identical to
+// cpu_double. `stream` (a cudaStream_t of options.cuda_device), when given,
+// carries all of the renderer's work and is not destroyed by it (the caller
+// keeps it alive while the renderer lives); without one the renderer owns
+// its own. Every call returns with the stream idle. Throws vasco::Error
+// (ErrorCode::NoGpu) without a usable GPU.
+std::unique_ptr<Renderer> make_cuda_renderer(const BackendOptions &options, CUstream_st *stream = nullptr);
 
 }  // namespace vasco
 

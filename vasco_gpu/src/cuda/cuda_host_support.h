@@ -1,9 +1,11 @@
-// cuda_host_support.h — host-side helpers shared by the CUDA backend and the
-// CUDA renderer: the GPU-memory check and the per-stage profile.
+// cuda_host_support.h — host-side helpers shared by the CUDA renderers:
+// the GPU-memory check, buffer growth, the per-stage profile, the kernels'
+// model of a grid.
 #ifndef VASCO_GPU_SRC_CUDA_HOST_SUPPORT_H
 #define VASCO_GPU_SRC_CUDA_HOST_SUPPORT_H
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +18,7 @@
 
 #include "cuda_check.h"
 #include "egrid_kernels.h"
+#include "vasco_gpu/error.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
 
@@ -36,9 +39,20 @@ inline void check_fits(size_t bytes, const char *what) {
   VG_CUDA_CHECK(cudaMemGetInfo(&free_b, &total_b));
   // Keep a margin for CUB scratch rounding and the context.
   if (bytes + (size_t(64) << 20) > free_b)
-    throw std::runtime_error(std::string("the map does not fit in GPU memory: ") + what + " needs " +
-                             mib(bytes) + ", " + mib(free_b) + " free of " + mib(total_b) +
-                             " (use a coarser vasco_resolution or a CPU backend)");
+    throw Error(ErrorCode::OutOfMemory, std::string("the map does not fit in GPU memory: ") + what + " needs " +
+                                            mib(bytes) + ", " + mib(free_b) + " free of " + mib(total_b) +
+                                            " (use a coarser vasco_resolution or a CPU backend)");
+}
+
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// VASCO_CUDA_NO_TABLES=1 computes every update in full, as grids too large
+// for the tables are: the tests compare both ways bit for bit.
+inline bool tables_disabled() {
+  const char *v = std::getenv("VASCO_CUDA_NO_TABLES");
+  return v != nullptr && *v != '\0' && std::string(v) != "0";
 }
 
 // With VASCO_CUDA_PROFILE set, prints the time of each GPU stage to stderr
@@ -66,15 +80,23 @@ class StageTimer {
 };
 
 
-// Grows a device buffer to at least n elements (half as much again, so that
-// a session appending scans reallocates rarely); its contents are dropped.
-template <class T>
-void reserve(cuda::DeviceBuffer<T> &b, size_t n) {
-  if (n > b.size()) b.resize(std::max(n, b.size() + b.size() / 2));
+// The size a buffer of `have` elements grows to for `n` (half as much again,
+// so that a session appending scans reallocates rarely).
+inline size_t grown_size(size_t have, size_t n) { return n > have ? std::max(n, have + have / 2) : have; }
+
+// Grows a buffer to at least n elements; its contents are dropped.
+template <class Buffer>
+void reserve(Buffer &b, size_t n) {
+  if (n > b.size()) b.resize(grown_size(b.size(), n));
 }
+
+// reserve() of a device buffer, refused first (check_fits) when the growth
+// would not fit in GPU memory: a refusal leaves the buffer as it was.
 template <class T>
-void reserve(cuda::PinnedBuffer<T> &b, size_t n) {
-  if (n > b.size()) b.resize(std::max(n, b.size() + b.size() / 2));
+void reserve_checked(cuda::DeviceBuffer<T> &b, size_t n, const char *what) {
+  if (n <= b.size()) return;
+  check_fits((grown_size(b.size(), n) - b.size()) * sizeof(T), what);
+  reserve(b, n);
 }
 
 }  // namespace cuda_host

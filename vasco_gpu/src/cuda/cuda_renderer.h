@@ -1,94 +1,100 @@
-// cuda_renderer.h — the CUDA renderer of a mapping session (private to the
-// library: make_cuda_renderer in cuda_backend.h creates one).
+// cuda_renderer.h — what the CUDA renderers of float and exact mode share
+// (private to the library: make_cuda_renderer in cuda_backend.h creates
+// one): the device, the stream (the caller's, or one of its own), the phase
+// events, the frame and parameters of the last reset, CARMEN's finish and
+// the window read on the device, and the grid's state.
+//
+// Every call is strongly exception-safe where the device allows it: a mode
+// checks (GPU memory, fixed-point range) and allocates before it changes
+// anything, so a refused reset or apply leaves the renderer as it was. A
+// failure after the grid began to change (a later launch of a long exact
+// apply, a CUDA error, an allocation refused after check_fits passed) leaves
+// the grid lost: apply, finish and read then throw ErrorCode::State until a
+// reset succeeds.
 #ifndef VASCO_GPU_SRC_CUDA_RENDERER_H
 #define VASCO_GPU_SRC_CUDA_RENDERER_H
 
 #include <memory>
-#include <optional>
 #include <string>
+#include <vector>
 
 #include "cuda_check.h"
+#include "cuda_host_support.h"
 #include "egrid_kernels.h"
 #include "vasco_gpu/cuda_backend.h"
-#include "vasco_gpu/mapper.hpp"
+#include "vasco_gpu/renderer.h"
 
 namespace vasco {
 
 class CudaRenderer : public Renderer {
  public:
-  explicit CudaRenderer(const BackendOptions &options);
   ~CudaRenderer() override;
-  std::string name() const override;
-  RendererTraits traits() const override { return {exact(), true}; }
-  void reset(const GridGeometry &geo, const MapperParams &params) override;
-  void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) override;
-  FinishedMap finish(int downsample, int border) override;
-  std::vector<float> read(const GridWindow &window) override;
+  RendererTraits traits() const override { return {exact_, true}; }
+  void reset(const GridGeometry &geo, const MapperParams &params) final;
+  void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) final;
+  FinishedMap finish(int downsample, int border) final;
+  std::vector<float> read(const GridWindow &window) final;
 
-  // For the one-shot backend: a grid of probabilities to continue (after
-  // reset), and a batch that is not the one whose ranges are on the device.
-  void upload_grid(const float *probabilities);
-  void forget_scans();
+ protected:
+  // `stream`: the caller's (used, never destroyed), or null for one of the
+  // renderer's own. It must belong to options.cuda_device.
+  CudaRenderer(const BackendOptions &options, cudaStream_t stream, bool exact);
+
+  // The mode's part of reset, before anything changes: refuses (check_fits)
+  // or allocates what a grid of `geo` needs. Growing the grid drops its
+  // contents: do it with grow_grid.
+  virtual void reserve_grid(const GridGeometry &geo) = 0;
+  // After the reset is committed (geo() and params() are the new ones):
+  // every cell unknown.
+  virtual void clear_grid() = 0;
+  // Scans [first, last), first < last, onto the grid. Checks and allocates
+  // first; brackets the launches that change the grid with begin_update()
+  // and end_update().
+  virtual void apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) = 0;
+  // The grid as finish and read see it.
+  virtual cuda::GridCells cells() const = 0;
+
+  template <class T>
+  void grow_grid(cuda::DeviceBuffer<T> &grid, size_t cells) {
+    if (cells <= grid.size()) return;
+    cuda_host::check_fits((cuda_host::grown_size(grid.size(), cells) - grid.size()) * sizeof(T),
+                          "the evidence grid");
+    state_ = GridState::Lost;  // the reallocation drops the old grid
+    cuda_host::reserve(grid, cells);
+  }
+  void begin_update() { state_ = GridState::Lost; }  // until end_update: a throw leaves it lost
+  void end_update() { state_ = GridState::Valid; }
+
+  void select_device() const;
+  cudaStream_t stream() const { return stream_; }
+  const GridGeometry &geo() const { return geo_; }
+  const MapperParams &params() const { return params_; }
+
+  // The phase times of an apply: start, uploaded, mapped.
+  struct PhaseEvents {
+    cuda::Event start, uploaded, mapped;
+    void add_times(MapStats *st) const;
+  };
+  PhaseEvents &events() { return *events_; }
 
  private:
-  bool exact() const { return options_.cuda_mode == CudaMode::Exact; }
-  cuda::GridCells cells() const;
-  void check_capacity(uint64_t beams) const override;
-  void build_tables();
-  const int2 *float_tables();
-  uint64_t exact_beams_per_launch() const;
-  void upload_ranges(const ScanBatch &scans, size_t last);
-  void apply_float(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
-  void apply_exact(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
-  uint64_t place_exact_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
-  void reserve_exact_scratch(uint64_t pair_bound, size_t tiles);
-  void launch_exact_apply(uint64_t pair_bound, MapStats *st);
-  void report_tile_lists(uint64_t pair_bound, size_t tiles);
+  enum class GridState { None, Valid, Lost };
+  void require_grid(const char *call) const;
+  cuda::PinnedBuffer<float> &download(const float *device, size_t n);
 
   BackendOptions options_;
-  std::unique_ptr<cuda::Stream> stream_;
-  std::unique_ptr<cuda::Event> e_start_, e_uploaded_, e_mapped_;  // phase times of an apply
+  bool exact_;
+  std::unique_ptr<cuda::Stream> own_stream_;  // null when the caller gave one
+  cudaStream_t stream_ = nullptr;
+  std::unique_ptr<PhaseEvents> events_;
   GridGeometry geo_;
   MapperParams params_;
-  cuda::DeviceBuffer<float> grid_;                // exact mode: probabilities
-  cuda::DeviceBuffer<unsigned long long> sums_;  // float mode: fixed-point log-odds sums
-  // Float mode: beams applied since the reset, and the |log-odds| a cell
-  // could hold before them (uploaded probabilities saturate at 2^20).
-  uint64_t float_beams_ = 0;
-  double fixed_base_ = 0;
-  // Float mode's increment tables (launch_float_tables), when small enough.
-  cuda::DeviceBuffer<int2> increments_;
-  std::optional<MapperParams::TableKey> float_tables_key_;  // what they were built for
-  // Float mode: the stored scans' ranges (append-only) and per-scan records.
-  cuda::DeviceBuffer<float> ranges_;
-  uint64_t stored_beams_ = 0;
-  cuda::DeviceBuffer<cuda::FloatScan> scan_records_;
-  cuda::DeviceBuffer<unsigned long long> counters_;
-  // Exact mode: tables, beams and the tile lists' scratch.
-  bool use_tables_ = false;
-  std::optional<MapperParams::TableKey> tables_key_;  // what they were built for
-  cuda::DeviceBuffer<double2> factors_;  // (free, occupied) odds factors
-  cuda::DeviceBuffer<int> reach_;
-  uint64_t exact_beams_ = 0;  // placed by place_exact_beams, in staging_beams_
-  size_t exact_scans_ = 0;
-  cuda::DeviceBuffer<PlacedBeam> beams_;
-  cuda::DeviceBuffer<cuda::StartCell> starts_;
-  cuda::DeviceBuffer<cuda::LineRec> lines_;
-  cuda::DeviceBuffer<uint32_t> counts_, offsets_, tile_begin_, tile_end_, order_, order_keys_, order_keys_out_,
-      order_ids_, pair_tile_, pair_beam_, sorted_tile_, sorted_beam_;
-  cuda::DeviceBuffer<unsigned char> scan_tmp_, order_tmp_, sort_tmp_;
-  cuda::DeviceBuffer<unsigned long long> updates_;
+  GridState state_ = GridState::None;
   // Finish and read.
   cuda::DeviceBuffer<float> blocks_, finished_, window_;
-  cuda::DeviceBuffer<int> bbox_;
-  // Pinned staging, both ways.
-  cuda::PinnedBuffer<float> staging_ranges_, staging_out_;
-  cuda::PinnedBuffer<cuda::FloatScan> staging_scans_;
-  cuda::PinnedBuffer<PlacedBeam> staging_beams_;
-  cuda::PinnedBuffer<cuda::StartCell> staging_starts_;
-  cuda::PinnedBuffer<unsigned long long> staging_counters_;
-  cuda::PinnedBuffer<uint32_t> staging_pairs_;
-  cuda::PinnedBuffer<int> staging_bbox_;
+  cuda::DeviceBuffer<finish::KnownBox> known_;
+  cuda::PinnedBuffer<finish::KnownBox> staging_known_;
+  cuda::PinnedBuffer<float> staging_out_;
 };
 
 }  // namespace vasco

@@ -1,0 +1,187 @@
+// CUDA exact mode, in three parts per launch: place the beams on the host
+// into pinned staging; upload and list (tile, beam) pairs; apply them tile by
+// tile. No wait between the parts: the pair arrays are sized by a host bound
+// (exact_pair_bound).
+#include "cuda_exact_renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+
+#include "exact_pair_bound.h"
+#include "vasco_gpu/beam_placement.h"
+
+namespace vasco {
+
+using cuda_host::reserve;
+
+void CudaExactRenderer::reserve_grid(const GridGeometry &geo) { grow_grid(grid_, geo.num_cells()); }
+
+void CudaExactRenderer::clear_grid() {
+  cuda::launch_fill(grid_.get(), geo().num_cells(), egrid::kUnknown, stream());
+}
+
+cuda::GridCells CudaExactRenderer::cells() const {
+  cuda::GridCells c;
+  c.probs = grid_.get();
+  return c;
+}
+
+// The tables for the current parameters, built when they change.
+void CudaExactRenderer::ensure_tables() {
+  const int T = params().table_size();
+  use_tables_ = T > 0 && T <= cuda::kMaxExactTable && !cuda_host::tables_disabled();
+  if (!use_tables_) return;
+  tables_key_.ensure(params(), [&] {
+    reserve(factors_, static_cast<size_t>(T) * static_cast<size_t>(T));
+    reserve(reach_, static_cast<size_t>(T));
+    cuda::launch_exact_tables(kernel_model_of<double>(params(), geo()), factors_.get(), reach_.get(), stream());
+  });
+}
+
+// (tile, beam) pairs are counted in 32 bits: a run of scans that could pass
+// 2^32 of them goes in several launches, each continuing the grid (a failure
+// after the first leaves the grid lost).
+void CudaExactRenderer::apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
+  ensure_tables();
+  const uint64_t max_beams = cuda_host::exact_beams_per_launch(params().table_size());
+  for (size_t a = first; a < last;) {
+    size_t b = a + 1;
+    while (b < last && scans.beam_offset[b + 1] - scans.beam_offset[a] <= max_beams) ++b;
+    apply_launch(scans, a, b, st);
+    a = b;
+  }
+  end_update();
+}
+
+void CudaExactRenderer::apply_launch(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
+  const auto t_prep = std::chrono::steady_clock::now();
+  const uint64_t pair_bound = place_beams(scans, first, last, st);
+  st->prep_s += cuda_host::seconds_since(t_prep);
+  if (beams_ == 0) return;
+  launch_apply(pair_bound, st);
+}
+
+// Places the beams of scans [first, last) with the oracle's code, on every
+// core, straight into the pinned staging buffer; returns the bound on their
+// (tile, beam) pairs.
+uint64_t CudaExactRenderer::place_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
+  const BeamLayout layout = lay_out_beams(scans, geo(), 0, first, last);
+  beams_ = layout.used();
+  scans_ = layout.starts.size();
+  st->beams_used += beams_;
+  st->beams_skipped += layout.skipped;
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream()));  // staging is free (every call ends idle)
+  reserve(staging_beams_, std::max<uint64_t>(beams_, 1));
+  reserve(staging_starts_, std::max<size_t>(scans_, 1));
+  PlacedBeam *beams = staging_beams_.get();
+  place_laid_out_beams(scans, geo(), params(), layout, 0, beams);
+  for (size_t s = 0; s < scans_; ++s) staging_starts_[s] = {layout.starts[s].x1, layout.starts[s].y1};
+  return cuda_host::exact_pair_bound(beams, beams_, layout.starts, params().table_size());
+}
+
+size_t CudaExactRenderer::num_tiles() const {
+  return static_cast<size_t>((geo().size_x + cuda::kTile - 1) / cuda::kTile) *
+         ((geo().size_y + cuda::kTile - 1) / cuda::kTile);
+}
+
+void CudaExactRenderer::reserve_scratch(uint64_t pair_bound, size_t tiles) {
+  const size_t nb = beams_, ns = scans_;
+  reserve(beams_dev_, nb);
+  reserve(starts_, ns);
+  reserve(lines_, nb);
+  reserve(counts_, nb + 1);
+  reserve(offsets_, nb + 1);
+  for (auto *b : {&tile_begin_, &tile_end_, &order_, &order_keys_, &order_keys_out_, &order_ids_}) reserve(*b, tiles);
+  reserve(scan_tmp_, std::max<size_t>(cuda::exact_scan_temp_bytes(nb), 1));
+  reserve(order_tmp_, std::max<size_t>(cuda::exact_order_temp_bytes(tiles), 1));
+  reserve(updates_, 2);
+  reserve(staging_counters_, 2);
+  const size_t pairs = std::max<size_t>(pair_bound, 1);
+  if (pairs > pair_tile_.size())
+    cuda_host::check_fits(4 * (cuda_host::grown_size(pair_tile_.size(), pairs) - pair_tile_.size()) * sizeof(uint32_t),
+                          "exact mode (tile lists)");
+  for (auto *b : {&pair_tile_, &pair_beam_, &sorted_tile_, &sorted_beam_}) reserve(*b, pairs);
+  reserve(sort_tmp_, std::max<size_t>(cuda::exact_sort_temp_bytes(pairs), 1));
+}
+
+// The (tile, beam) pairs of the uploaded beams, sorted by tile in (scan,
+// beam) order, each tile's slice, and the order to run the tiles in.
+void CudaExactRenderer::launch_tile_lists(const cuda::KernelModel<double> &m, uint64_t pair_bound, size_t tiles,
+                                          cudaStream_t s, cuda_host::StageTimer &timer) {
+  const size_t nb = beams_;
+  VG_CUDA_CHECK(cudaMemsetAsync(updates_.get(), 0, 2 * sizeof(unsigned long long), s));
+  VG_CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, (nb + 1) * sizeof(uint32_t), s));
+  cuda::launch_exact_lines(m, beams_dev_.get(), starts_.get(), nb, lines_.get(), counts_.get(), s);
+  timer.mark("lines");
+  cuda::exact_scan(counts_.get(), offsets_.get(), nb, scan_tmp_.get(), scan_tmp_.size(), s);
+  timer.mark("scan");
+  cuda::launch_exact_pairs(m, lines_.get(), offsets_.get(), nb, pair_bound, pair_tile_.get(), pair_beam_.get(),
+                           updates_.get() + 1, s);
+  timer.mark("pairs");
+  // kNoTile's low tile_bits bits must not name a tile: 2^tile_bits > tiles.
+  int tile_bits = 1;
+  while ((size_t(1) << tile_bits) <= tiles) ++tile_bits;
+  if (pair_bound)
+    cuda::exact_sort(pair_tile_.get(), sorted_tile_.get(), pair_beam_.get(), sorted_beam_.get(), pair_bound,
+                     tile_bits, sort_tmp_.get(), sort_tmp_.size(), s);
+  timer.mark("sort");
+  cuda::launch_exact_tile_ranges(sorted_tile_.get(), pair_bound, tile_begin_.get(), tile_end_.get(), tiles, s);
+  cuda::exact_tile_order(tile_begin_.get(), tile_end_.get(), tiles, order_.get(), order_keys_.get(),
+                         order_keys_out_.get(), order_ids_.get(), order_tmp_.get(), order_tmp_.size(), s);
+  timer.mark("tile order");
+}
+
+// Allocates every scratch buffer first; the grid changes only in the tiles
+// kernel.
+void CudaExactRenderer::launch_apply(uint64_t pair_bound, MapStats *st) {
+  const cuda::KernelModel<double> m = kernel_model_of<double>(params(), geo());
+  const size_t tiles = num_tiles();
+  reserve_scratch(pair_bound, tiles);
+  PhaseEvents &ev = events();
+  cudaStream_t s = stream();
+  ev.start.record(s);
+  VG_CUDA_CHECK(cudaMemcpyAsync(beams_dev_.get(), staging_beams_.get(), beams_ * sizeof(PlacedBeam),
+                                cudaMemcpyHostToDevice, s));
+  VG_CUDA_CHECK(cudaMemcpyAsync(starts_.get(), staging_starts_.get(), scans_ * sizeof(cuda::StartCell),
+                                cudaMemcpyHostToDevice, s));
+  ev.uploaded.record(s);
+  cuda_host::StageTimer timer(s);
+  timer.mark("start");
+  launch_tile_lists(m, pair_bound, tiles, s, timer);
+  begin_update();
+  cuda::launch_exact_tiles(m, lines_.get(), sorted_beam_.get(), order_.get(), tile_begin_.get(), tile_end_.get(),
+                           use_tables_ ? factors_.get() : nullptr, use_tables_ ? reach_.get() : nullptr,
+                           grid_.get(), updates_.get(), s);
+  timer.mark("tiles");
+  ev.mapped.record(s);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), updates_.get(), 2 * sizeof(unsigned long long),
+                                cudaMemcpyDeviceToHost, s));
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));  // the call's result is complete
+  if (staging_counters_[1] != 0)
+    throw Error(ErrorCode::Internal, "cuda exact mode: more (tile, beam) pairs than the host's bound (a bug)");
+  timer.report();
+  if (std::getenv("VASCO_CUDA_PROFILE")) report_tile_lists(pair_bound, tiles);
+  st->cell_updates += staging_counters_[0];
+  ev.add_times(st);
+}
+
+// Profiling only (VASCO_CUDA_PROFILE): the pairs and the longest tile
+// lists, which bound the tile kernel (a tile's list runs in order).
+void CudaExactRenderer::report_tile_lists(uint64_t pair_bound, size_t tiles) {
+  std::vector<uint32_t> begin(tiles), end(tiles);
+  VG_CUDA_CHECK(cudaMemcpy(begin.data(), tile_begin_.get(), tiles * 4, cudaMemcpyDeviceToHost));
+  VG_CUDA_CHECK(cudaMemcpy(end.data(), tile_end_.get(), tiles * 4, cudaMemcpyDeviceToHost));
+  uint64_t pairs = 0;
+  std::vector<uint32_t> len(tiles);
+  for (size_t t = 0; t < tiles; ++t) pairs += len[t] = end[t] - begin[t];
+  std::sort(len.begin(), len.end(), std::greater<uint32_t>());
+  std::fprintf(stderr, "  [cuda] beams %llu, pairs %llu (bound %llu), tiles %zu, longest lists %u %u %u %u\n",
+               static_cast<unsigned long long>(beams_), static_cast<unsigned long long>(pairs),
+               static_cast<unsigned long long>(pair_bound), tiles, len.size() > 0 ? len[0] : 0,
+               len.size() > 1 ? len[1] : 0, len.size() > 2 ? len[2] : 0, len.size() > 3 ? len[3] : 0);
+}
+
+}  // namespace vasco

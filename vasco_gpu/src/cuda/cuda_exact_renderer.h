@@ -1,0 +1,58 @@
+// cuda_exact_renderer.h — CUDA exact mode, bit-identical to cpu_double: the
+// beams are placed on the host with the oracle's code (DESIGN §2.2) and sent
+// at 16 bytes a beam, listed per kTile x kTile tile in (scan, beam) order,
+// and applied by a thread per cell with the oracle's double arithmetic.
+#ifndef VASCO_GPU_SRC_CUDA_EXACT_RENDERER_H
+#define VASCO_GPU_SRC_CUDA_EXACT_RENDERER_H
+
+#include "cuda_renderer.h"
+#include "table_cache.h"
+
+namespace vasco {
+
+class CudaExactRenderer final : public CudaRenderer {
+ public:
+  CudaExactRenderer(const BackendOptions &options, cudaStream_t stream) : CudaRenderer(options, stream, true) {}
+  std::string name() const override { return "cuda_exact"; }
+
+ private:
+  void reserve_grid(const GridGeometry &geo) override;
+  void clear_grid() override;
+  void apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) override;
+  cuda::GridCells cells() const override;
+  void ensure_tables();
+  void apply_launch(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
+  uint64_t place_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
+  size_t num_tiles() const;
+  void reserve_scratch(uint64_t pair_bound, size_t tiles);
+  void launch_tile_lists(const cuda::KernelModel<double> &m, uint64_t pair_bound, size_t tiles, cudaStream_t s,
+                         cuda_host::StageTimer &timer);
+  void launch_apply(uint64_t pair_bound, MapStats *st);
+  void report_tile_lists(uint64_t pair_bound, size_t tiles);
+
+  cuda::DeviceBuffer<float> grid_;  // probabilities, -1 unknown
+  // The distance and odds-factor tables (they replace a sqrt and two
+  // divisions per update), when small enough.
+  bool use_tables_ = false;
+  cuda_host::TableCache tables_key_;
+  cuda::DeviceBuffer<double2> factors_;  // (free, occupied) odds factors
+  cuda::DeviceBuffer<int> reach_;
+  // One launch's beams (placed by place_beams into staging_beams_) and the
+  // tile lists' scratch.
+  uint64_t beams_ = 0;
+  size_t scans_ = 0;
+  cuda::DeviceBuffer<PlacedBeam> beams_dev_;
+  cuda::DeviceBuffer<cuda::StartCell> starts_;
+  cuda::DeviceBuffer<cuda::LineRec> lines_;
+  cuda::DeviceBuffer<uint32_t> counts_, offsets_, tile_begin_, tile_end_, order_, order_keys_, order_keys_out_,
+      order_ids_, pair_tile_, pair_beam_, sorted_tile_, sorted_beam_;
+  cuda::DeviceBuffer<unsigned char> scan_tmp_, order_tmp_, sort_tmp_;
+  cuda::DeviceBuffer<unsigned long long> updates_;
+  cuda::PinnedBuffer<PlacedBeam> staging_beams_;
+  cuda::PinnedBuffer<cuda::StartCell> staging_starts_;
+  cuda::PinnedBuffer<unsigned long long> staging_counters_;
+};
+
+}  // namespace vasco
+
+#endif  // VASCO_GPU_SRC_CUDA_EXACT_RENDERER_H

@@ -1,0 +1,120 @@
+#include "cuda_float_renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "vasco_gpu/oracle.h"
+
+namespace vasco {
+
+using cuda_host::reserve;
+
+void CudaFloatRenderer::reserve_grid(const GridGeometry &geo) { grow_grid(sums_, geo.num_cells()); }
+
+void CudaFloatRenderer::clear_grid() {
+  cuda::launch_float_clear(sums_.get(), geo().num_cells(), stream());
+  beams_ = 0;
+}
+
+// Refuses a grid whose beams could carry a cell's fixed-point sum past
+// kFixedLimit (egrid_kernels.h): a cell takes one update per beam at most,
+// of at most `step` log-odds. vasco's defaults allow 2 x 10^7 beams, far
+// beyond any log.
+void CudaFloatRenderer::check_capacity(uint64_t beams) const {
+  auto logit = [](double p) { return std::log(p / (1 - p)); };
+  const MapperParams &p = params();
+  const double step = std::max(std::fabs(logit(p.p_occ) - logit(p.p_prior)),
+                               std::fabs(logit(p.p_emp) - logit(p.p_prior)));
+  if (static_cast<double>(beams) * step > cuda::kFixedLimit)
+    throw Error(ErrorCode::TooLarge, "cuda float mode: " + std::to_string(beams) +
+                                         " beams could push a cell's log-odds past the fixed-point range (+-2^22); "
+                                         "use the exact mode or a CPU backend for this log");
+}
+
+cuda::GridCells CudaFloatRenderer::cells() const {
+  cuda::GridCells c;
+  c.sums = sums_.get();
+  c.logodds_prior = kernel_model_of<float>(params(), geo()).logodds_prior;
+  return c;
+}
+
+// The increment tables for the current parameters (built when they change),
+// or null when they would be too large.
+const int2 *CudaFloatRenderer::tables() {
+  const int T = params().table_size();
+  if (T <= 0 || T > cuda::kMaxFloatTable || cuda_host::tables_disabled()) return nullptr;
+  increments_key_.ensure(params(), [&] {
+    reserve(increments_, static_cast<size_t>(T) * static_cast<size_t>(T));
+    cuda::launch_float_tables(kernel_model_of<float>(params(), geo()), increments_.get(), stream());
+  });
+  return increments_.get();
+}
+
+// Checks, allocates and uploads first; the sums change only in launch_map.
+void CudaFloatRenderer::apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
+  const auto t_prep = std::chrono::steady_clock::now();
+  if (scans.beam_offset[last] > UINT32_MAX)
+    throw Error(ErrorCode::TooLarge, "cuda float mode: more than 2^32 beams stored");
+  const uint64_t beams = scans.beam_offset[last] - scans.beam_offset[first];
+  check_capacity(beams_ + beams);
+  const int2 *increments = tables();
+  ranges_.upload(scans, last, stream());
+  stage_scan_records(scans, first, last);
+  reserve(scan_records_, last - first);
+  reserve(counters_, 3);
+  reserve(staging_counters_, 3);
+  st->prep_s += cuda_host::seconds_since(t_prep);
+  begin_update();
+  launch_map(increments, last - first, st);
+  ranges_.commit();
+  beams_ += beams;
+  end_update();
+}
+
+// The records of scans [first, last) into pinned staging, placed with scan
+// 0 fixing the start pose.
+void CudaFloatRenderer::stage_scan_records(const ScanBatch &scans, size_t first, size_t last) {
+  oracle::GridFrame frame;
+  frame.size_x = geo().size_x;
+  frame.size_y = geo().size_y;
+  frame.resolution = geo().resolution;
+  frame.theta_offset = geo().theta_offset;
+  oracle::scan_start(frame, scans.x[0], scans.y[0], scans.theta[0]);
+  reserve(staging_scans_, last - first);
+  for (size_t s = first; s < last; ++s) {
+    const oracle::ScanStart p = oracle::scan_start(frame, scans.x[s], scans.y[s], scans.theta[s]);
+    cuda::FloatScan &f = staging_scans_[s - first];
+    f.lx = static_cast<float>(p.lx);
+    f.ly = static_cast<float>(p.ly);
+    f.theta = static_cast<float>(p.theta);
+    f.x1 = p.x1;
+    f.y1 = p.y1;
+    f.first = static_cast<float>(scans.first_angle[s]);
+    f.step = static_cast<float>(scans.angle_step[s]);
+    f.beam_begin = static_cast<uint32_t>(scans.beam_offset[s]);
+    f.beam_count = scans.beams_in(s);
+  }
+}
+
+void CudaFloatRenderer::launch_map(const int2 *increments, size_t n, MapStats *st) {
+  PhaseEvents &ev = events();
+  cudaStream_t s = stream();
+  ev.start.record(s);
+  VG_CUDA_CHECK(cudaMemcpyAsync(scan_records_.get(), staging_scans_.get(), n * sizeof(cuda::FloatScan),
+                                cudaMemcpyHostToDevice, s));
+  VG_CUDA_CHECK(cudaMemsetAsync(counters_.get(), 0, 3 * sizeof(unsigned long long), s));
+  ev.uploaded.record(s);
+  cuda::launch_float_map(kernel_model_of<float>(params(), geo()), increments, scan_records_.get(),
+                         static_cast<int>(n), ranges_.get(), sums_.get(), counters_.get(), s);
+  ev.mapped.record(s);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), counters_.get(), 3 * sizeof(unsigned long long),
+                                cudaMemcpyDeviceToHost, s));
+  VG_CUDA_CHECK(cudaStreamSynchronize(s));  // the call's result is complete
+  st->beams_used += staging_counters_[0];
+  st->beams_skipped += staging_counters_[1];
+  st->cell_updates += staging_counters_[2];
+  ev.add_times(st);
+}
+
+}  // namespace vasco

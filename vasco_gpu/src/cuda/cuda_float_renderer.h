@@ -1,0 +1,43 @@
+// cuda_float_renderer.h — CUDA float mode: every scan of an apply in one
+// launch, a warp per beam, a thread per cell, log-odds summed in 64-bit fixed
+// point with integer atomics (egrid_kernels.h). The ranges stay on the
+// device between calls: an insert sends its scans' ranges once and a
+// 32-byte record per scan, a render the records only.
+#ifndef VASCO_GPU_SRC_CUDA_FLOAT_RENDERER_H
+#define VASCO_GPU_SRC_CUDA_FLOAT_RENDERER_H
+
+#include "cuda_renderer.h"
+#include "device_ranges.h"
+#include "table_cache.h"
+
+namespace vasco {
+
+class CudaFloatRenderer final : public CudaRenderer {
+ public:
+  CudaFloatRenderer(const BackendOptions &options, cudaStream_t stream) : CudaRenderer(options, stream, false) {}
+  std::string name() const override { return "cuda_float"; }
+  void check_capacity(uint64_t beams) const override;
+
+ private:
+  void reserve_grid(const GridGeometry &geo) override;
+  void clear_grid() override;
+  void apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) override;
+  cuda::GridCells cells() const override;
+  const int2 *tables();
+  void stage_scan_records(const ScanBatch &scans, size_t first, size_t last);
+  void launch_map(const int2 *tables, size_t num_scans, MapStats *st);
+
+  cuda::DeviceBuffer<unsigned long long> sums_;  // fixed-point log-odds sums
+  uint64_t beams_ = 0;                            // applied since the reset
+  cuda::DeviceBuffer<int2> increments_;           // launch_float_tables', when small enough
+  cuda_host::TableCache increments_key_;
+  cuda_host::DeviceRanges ranges_;
+  cuda::DeviceBuffer<cuda::FloatScan> scan_records_;
+  cuda::DeviceBuffer<unsigned long long> counters_;
+  cuda::PinnedBuffer<cuda::FloatScan> staging_scans_;
+  cuda::PinnedBuffer<unsigned long long> staging_counters_;
+};
+
+}  // namespace vasco
+
+#endif  // VASCO_GPU_SRC_CUDA_FLOAT_RENDERER_H
