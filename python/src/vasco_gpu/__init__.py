@@ -16,20 +16,29 @@ The mapping session of the C++ library (``vasco::Mapper``) with NumPy arrays in 
 Arrays: ``Map.cells`` is a float32 view of shape (size_x, size_y) indexed ``cells[x, y]`` as
 CARMEN stores maps (-1 unknown, else the occupancy probability); ``Map.image`` is the same
 memory as a picture (``cells.T[::-1]``, row 0 at the top). ``Scans`` arrays are views too;
-``poses`` properties are new (n, 3) arrays. Errors in files raise :class:`FileError` with
-``.file`` and ``.line``; bad arguments ValueError or TypeError; a backend that cannot run
-here RuntimeError.
+``poses`` properties are new (n, 3) arrays (``Scans.beam_offsets`` is read-only). Errors
+in files raise :class:`FileError` with ``.file`` and ``.line``; other errors of the engine
+one class per kind (:class:`UsageError`, :class:`BadInputError`, ... in ``_errors``), each
+also the built-in exception of its kind: bad arguments ValueError (or TypeError), a backend
+that cannot run here RuntimeError.
 """
 
 from __future__ import annotations
 
 import os
-import re
-from pathlib import Path
 
-import numpy as np
-
-from ._errors import FileError
+from ._errors import (
+    BadInputError,
+    Error,
+    FileError,
+    InternalError,
+    IoError,
+    NoGpuError,
+    OutOfMemoryError,
+    StateError,
+    TooLargeError,
+    UsageError,
+)
 from ._core import (
     Comparison,
     Frame,
@@ -50,14 +59,23 @@ from . import _core
 __version__: str = _core.__version__
 
 __all__ = [
+    "BadInputError",
     "Comparison",
+    "Error",
     "FileError",
     "Frame",
+    "InternalError",
+    "IoError",
     "Log",
     "Map",
     "Mapper",
+    "NoGpuError",
+    "OutOfMemoryError",
     "Params",
     "Scans",
+    "StateError",
+    "TooLargeError",
+    "UsageError",
     "__version__",
     "backends",
     "compare",
@@ -76,71 +94,13 @@ def read_map(path: str | os.PathLike) -> Map:
     Images hold less than a CARMEN map: a PGM is read the way map_server reads it (trinary:
     occupied 1.0, free 0.0, unknown -1; scale: ``(255 - v) / 255`` with 205 unknown; raw:
     ``v / 100`` with 255 unknown), with the YAML's resolution and origin; a PNG as written by
-    :func:`write_map` (``1 - v / 255``, 128 unknown), without resolution or origin (0).
-    Raises :class:`FileError` naming the file.
+    :func:`write_map` (``1 - v / 255``, 128 unknown), without resolution or origin (0). The
+    format is chosen by the name's extension, in any case (``x.PNG``). Raises
+    :class:`FileError` naming the file.
     """
-    p = os.fspath(path)
-    if p.lower().endswith(".pgm"):
-        return _read_pgm(p)
-    return _core._read_map(p)
+    return _core._read_map(os.fspath(path))
 
 
 def gridmap_sha256(m: Map) -> str:
     """SHA-256 (hex) of a map's CARMEN GRIDMAP payload, as the golden ``SHA256SUMS`` hold it."""
     return m.sha256()
-
-
-def _yaml_path(pgm: str) -> str:
-    head, tail = os.path.split(pgm)
-    dot = tail.rfind(".")
-    return os.path.join(head, (tail[:dot] if dot > 0 else tail) + ".yaml")
-
-
-def _read_pgm(path: str) -> Map:
-    yaml = _yaml_path(path)
-    meta: dict[str, str] = {}
-    try:
-        with open(yaml, encoding="utf-8") as f:
-            for line in f:
-                line = line.split("#", 1)[0].strip()
-                if ":" in line:
-                    k, v = line.split(":", 1)
-                    meta[k.strip()] = v.strip()
-    except OSError as e:
-        raise FileError(f"{yaml}: cannot read the YAML beside the PGM: {e.strerror}", yaml, None,
-                        f"cannot read the YAML beside the PGM: {e.strerror}") from None
-    try:
-        resolution = float(meta["resolution"])
-        origin = tuple(float(v) for v in meta.get("origin", "[0, 0, 0]").strip("[] ").split(","))
-        if len(origin) != 3:
-            raise ValueError("origin needs three numbers")
-        negate = int(meta.get("negate", "0"))
-        occupied = float(meta.get("occupied_thresh", "0.65"))
-        free = float(meta.get("free_thresh", "0.196"))
-        mode = meta.get("mode", "trinary").strip("'\"")
-    except (KeyError, ValueError) as e:
-        raise FileError(f"{yaml}: bad or missing key: {e}", yaml, None, f"bad or missing key: {e}") from None
-    try:
-        data = Path(path).read_bytes()
-    except OSError as e:
-        raise FileError(f"{path}: {e.strerror}", path, None, str(e.strerror)) from None
-    m = re.match(rb"P5(?:\s+|#[^\n]*\n)+(\d+)(?:\s+|#[^\n]*\n)+(\d+)(?:\s+|#[^\n]*\n)+(\d+)\s", data)
-    if not m or int(m.group(3)) != 255:
-        raise FileError(f"{path}: not a binary 8-bit PGM (P5, maxval 255)", path, None,
-                        "not a binary 8-bit PGM (P5, maxval 255)")
-    w, h = int(m.group(1)), int(m.group(2))
-    pixels = np.frombuffer(data, dtype=np.uint8, count=w * h, offset=m.end()) if len(data) >= m.end() + w * h else None
-    if pixels is None:
-        raise FileError(f"{path}: truncated PGM", path, None, "truncated PGM")
-    v = pixels.reshape(h, w).astype(np.float32)
-    if mode == "raw":
-        cells = np.where(pixels.reshape(h, w) == 255, np.float32(-1), v / np.float32(100))
-    else:
-        p = (v if negate else np.float32(255) - v) / np.float32(255)
-        unknown = pixels.reshape(h, w) == 205
-        if mode == "scale":
-            cells = np.where(unknown, np.float32(-1), p)
-        else:
-            cells = np.where(p > occupied, np.float32(1), np.where(p < free, np.float32(0), np.float32(-1)))
-    # Image rows (row 0 at the top) -> x-major cells[x, y].
-    return Map(np.ascontiguousarray(cells[::-1].T, dtype=np.float32), resolution, origin)

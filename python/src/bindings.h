@@ -1,0 +1,36 @@
+// bindings.h — the parts of the module vasco_gpu._core, one per class or
+// group of functions (each in its own file), and what they share.
+#ifndef VASCO_PY_BINDINGS_H
+#define VASCO_PY_BINDINGS_H
+
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+
+#include "vasco_gpu/scan_batch.h"
+
+namespace vasco_py {
+
+namespace nb = nanobind;
+
+void bind_errors(nb::module_ &m);   // C++ error codes -> vasco_gpu._errors classes
+void bind_module(nb::module_ &m);   // version, backends, cuda_available
+void bind_params(nb::module_ &m);   // Params
+void bind_frame(nb::module_ &m);    // Frame
+void bind_scans(nb::module_ &m);    // Scans
+void bind_log(nb::module_ &m);      // Log, load_log
+void bind_map(nb::module_ &m);      // Map, _read_map, write_map
+void bind_compare(nb::module_ &m);  // Comparison, compare
+void bind_mapper(nb::module_ &m);   // Mapper
+
+// Throws carmen::Error(BadInput) naming what is wrong when the arrays of
+// `b` disagree (offsets not starting at 0, decreasing, past the ranges;
+// per-scan arrays of different lengths): every batch is checked where it
+// enters the engine, since Python can reach its arrays.
+void check_batch(const vasco::ScanBatch &b);
+
+// The batch's poses as a new (n, 3) float64 array of (x, y, theta).
+nb::ndarray<nb::numpy, double> poses_of(const vasco::ScanBatch &b);
+
+}  // namespace vasco_py
+
+#endif  // VASCO_PY_BINDINGS_H

@@ -1,0 +1,124 @@
+// The class Log and load_log: a CARMEN log read as log2map reads it.
+#include <nanobind/nanobind.h>
+#include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+
+#include <filesystem>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "arrays.h"
+#include "bindings.h"
+#include "param_keys.h"
+#include "vasco_gpu/log_input.h"
+
+namespace vasco_py {
+
+using namespace nb::literals;
+namespace fs = std::filesystem;
+using vasco::LogInput;
+
+namespace {
+
+// Counts by name, only those above zero.
+template <typename Name>
+nb::dict nonzero_counts(const uint64_t *counts, int n, Name name) {
+  nb::dict d;
+  for (int i = 0; i < n; ++i)
+    if (counts[i] > 0) d[name(i)] = counts[i];
+  return d;
+}
+
+nb::dict load_stats_dict(const vasco::LogLoadStats &l) {
+  nb::dict d;
+  const carmen::LogStats &s = l.log;
+  d["lines"] = s.lines;
+  d["laser_messages"] = l.laser_messages;
+  d["scans_used"] = l.scans_used;
+  d["messages"] = nonzero_counts(s.messages.data(), carmen::kNumMessageTypes, [](int t) {
+    return carmen::message_type_name(static_cast<carmen::MessageType>(t));
+  });
+  d["blank_lines"] = s.blank_lines;
+  d["comment_lines"] = s.comment_lines;
+  d["unknown_lines"] = s.unknown_lines;
+  d["bad_lines"] = nonzero_counts(s.bad_lines.data(), carmen::kNumBadLineClasses, [](int b) {
+    return carmen::bad_line_name(static_cast<carmen::BadLine>(b));
+  });
+  d["nan_ranges"] = s.nan_ranges;
+  d["inf_ranges"] = s.inf_ranges;
+  d["negative_ranges"] = s.negative_ranges;
+  return d;
+}
+
+LogInput load_log(const fs::path &path, std::optional<fs::path> param_file, const std::string &robot,
+                  std::optional<nb::dict> overrides, bool lenient) {
+  vasco::LogInputOptions o;
+  o.log = path.string();
+  if (param_file) o.param_file = param_file->string();
+  o.robot = robot;
+  o.lenient = lenient;
+  if (overrides) {
+    for (auto [k, v] : *overrides) {
+      std::string name = nb::cast<std::string>(k);
+      check_param(name, v);
+      if (name.rfind("vasco_", 0) != 0) name = "vasco_" + name;
+      o.overrides[name] = nb::cast<std::string>(nb::str(v));
+    }
+  }
+  nb::gil_scoped_release release;
+  return vasco::load_log_input(o);
+}
+
+constexpr const char *kLogDoc =
+    "A CARMEN log read by load_log: the selected scans, the effective parameters\n"
+    "(keywords > ini > the log's PARAM lines > defaults), the PROTOCOL frame and\n"
+    "what the reader counted.";
+
+constexpr const char *kLoadLogDoc =
+    "Reads a CARMEN log (.log, .clf, gzipped if the name ends in .gz) as log2map does.\n\n"
+    "Every FLASER and ROBOTLASER1 line is a scan; ``param_file`` is a carmen.ini (``robot`` its\n"
+    "section), ``overrides`` keys as in Params (they win over the ini, which wins over the log's\n"
+    "PARAM lines). Strict by default: a bad line raises FileError with ``.file`` and ``.line``;\n"
+    "``lenient=True`` skips bad lines and counts them in ``Log.stats['bad_lines']``. The GIL is\n"
+    "released while the log is read.";
+
+}  // namespace
+
+void bind_log(nb::module_ &m) {
+  nb::class_<LogInput>(m, "Log", kLogDoc)
+      .def_prop_ro(
+          "scans", [](LogInput &in) -> vasco::ScanBatch & { return in.batch; }, nb::rv_policy::reference_internal,
+          "The selected scans (FLASER and ROBOTLASER1 lines, in log order); its arrays are views.")
+      .def_prop_ro(
+          "params", [](const LogInput &in) { return in.params; }, "The effective parameters (a copy).")
+      .def_prop_ro(
+          "frame", [](const LogInput &in) { return in.geo; },
+          "The PROTOCOL frame of the selected scans (a copy): what Mapper uses by default.")
+      .def_prop_ro(
+          "poses", [](const LogInput &in) { return poses_of(in.batch); }, nb::rv_policy::reference,
+          "(n, 3) float64 laser poses (x, y, theta): a new array.")
+      .def_prop_ro(
+          "ranges", [](nb::handle_t<LogInput> self) { return view1(nb::cast<LogInput &>(self).batch.range, self); },
+          nb::rv_policy::reference, "All ranges, float32 (a view; see Scans).")
+      .def_ro("warnings", &LogInput::warnings, "Unknown vasco_* keys and the like.")
+      .def_prop_ro(
+          "stats", [](const LogInput &in) { return load_stats_dict(in.load); },
+          "What the reader counted: lines, messages by type, bad lines by class (lenient mode), odd\n"
+          "ranges, scans used.")
+      .def("__len__", [](const LogInput &in) { return in.batch.num_scans(); })
+      .def("__repr__", [](const LogInput &in) {
+        return nb::str("Log({} scans, {} beams)").format(in.batch.num_scans(), in.batch.num_beams());
+      });
+
+  m.def("load_log", &load_log, "path"_a, "param_file"_a = nb::none(), "robot"_a = "", "overrides"_a = nb::none(),
+        "lenient"_a = false,
+        nb::sig("def load_log(path: str | os.PathLike, param_file: str | os.PathLike | None = None, "
+                "robot: str = '', overrides: dict[str, float | int] | None = None, lenient: bool = False) -> Log"),
+        kLoadLogDoc);
+}
+
+}  // namespace vasco_py

@@ -1,0 +1,164 @@
+// The class Map and the functions that read and write map files.
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/pair.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/tuple.h>
+
+#include <climits>
+#include <filesystem>
+#include <string>
+#include <tuple>
+
+#include "arrays.h"
+#include "bindings.h"
+#include "carmen_compat/error.h"
+#include "map_files.h"
+#include "vasco_gpu/map_digest.h"
+
+namespace vasco_py {
+
+using namespace nb::literals;
+namespace fs = std::filesystem;
+using Origin = std::tuple<double, double, double>;
+
+namespace {
+
+constexpr const char *kMapDoc =
+    "A finished occupancy map (or one read from a file).\n\n"
+    "``cells`` is a writable 2-D float32 NumPy view of the map's memory, shape (size_x,\n"
+    "size_y), x-major as CARMEN stores it: ``cells[x, y]`` is the cell x columns right of and y\n"
+    "rows above the lower-left corner; -1 is unknown, else the occupancy probability.\n"
+    "``image`` is the same memory seen as a picture (``cells.T[::-1]``: row 0 at the top, +y up),\n"
+    "also a view. ``origin`` is the world pose (x, y, theta) of the lower-left corner of cell\n"
+    "(0, 0), as CARMEN's OFFSET chunk and map_server's YAML give it.";
+
+constexpr const char *kWriteMapDoc =
+    "Writes a map, the format chosen by the name: ``.map`` / ``.map.gz`` (CARMEN, with an OFFSET\n"
+    "chunk when the map has an origin), ``.pgm`` (ROS map_server image plus a ``.yaml`` beside it;\n"
+    "``mode`` trinary, scale or raw) or ``.png`` (grey: white free, black occupied, mid grey\n"
+    "unknown). Atomic: a failure leaves no file behind. Raises FileError naming the file, and\n"
+    "BadInputError (a ValueError) for a map read_map would refuse: a cell that is not -1 or a\n"
+    "probability (NaN among them), or, for .map and .pgm, a resolution that is not positive.";
+
+// A side of a map: CARMEN stores it as an int.
+int map_side(size_t n, const char *axis) {
+  if (n > static_cast<size_t>(INT_MAX))
+    throw carmen::Error(carmen::ErrorCode::TooLarge, std::string("Map: ") + axis + " of " + std::to_string(n) +
+                                                         " cells; a map has at most " + std::to_string(INT_MAX));
+  return static_cast<int>(n);
+}
+
+// Checked before the cells are converted: a broadcast array of a huge shape
+// costs nothing until it is made contiguous.
+void check_map_shape(nb::handle cells) {
+  static nb::handle shape_of = nb::object(nb::module_::import_("numpy").attr("shape")).release();
+  nb::tuple shape = nb::cast<nb::tuple>(shape_of(cells));
+  if (shape.size() != 2) return;  // as_array says what is wrong
+  map_side(nb::cast<size_t>(shape[0]), "size_x");
+  map_side(nb::cast<size_t>(shape[1]), "size_y");
+}
+
+void init_map(Map *self, nb::handle cells, double resolution, Origin origin) {
+  check_map_shape(cells);
+  auto a = as_array<float>(cells, "float32", "cells", 2);
+  Map mp;
+  mp.grid.size_x = map_side(a.shape(0), "size_x");
+  mp.grid.size_y = map_side(a.shape(1), "size_y");
+  mp.grid.resolution = resolution;
+  mp.grid.cells.assign(a.data(), a.data() + a.size());
+  mp.origin = {std::get<0>(origin), std::get<1>(origin), std::get<2>(origin)};
+  mp.has_origin = true;
+  new (self) Map(std::move(mp));
+}
+
+Array2<float> cells_view(nb::handle_t<Map> self) {
+  Map &mp = nb::cast<Map &>(self);
+  return Array2<float>(mp.grid.cells.data(), {static_cast<size_t>(mp.grid.size_x), static_cast<size_t>(mp.grid.size_y)},
+                       self);
+}
+
+Array2<float> image_view(nb::handle_t<Map> self) {
+  Map &mp = nb::cast<Map &>(self);
+  const int64_t sy = mp.grid.size_y;
+  float *last_row = mp.grid.cells.empty() ? nullptr : mp.grid.cells.data() + (sy - 1);
+  return Array2<float>(last_row, {static_cast<size_t>(mp.grid.size_y), static_cast<size_t>(mp.grid.size_x)}, self,
+                       {-1, sy});
+}
+
+void bind_map_cells(nb::class_<Map> &cls) {
+  cls.def("__init__", &init_map, "cells"_a, "resolution"_a, "origin"_a = std::make_tuple(0.0, 0.0, 0.0),
+          nb::sig("def __init__(self, cells: numpy.typing.ArrayLike, resolution: float, "
+                  "origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None"),
+          "A map from x-major cells (size_x, size_y), copied into the map.")
+      .def_prop_ro("cells", &cells_view, nb::rv_policy::reference,
+                   nb::sig("def cells(self) -> numpy.typing.NDArray[numpy.float32]"),
+                   "(size_x, size_y) float32, x-major (cells[x, y]); a view of the map's memory.")
+      .def_prop_ro("image", &image_view, nb::rv_policy::reference,
+                   nb::sig("def image(self) -> numpy.typing.NDArray[numpy.float32]"),
+                   "(size_y, size_x) float32 view with row 0 at the top (``cells.T[::-1]``), for plotting.");
+}
+
+void bind_map_properties(nb::class_<Map> &cls) {
+  cls.def_prop_ro("size_x", [](const Map &mp) { return mp.grid.size_x; })
+      .def_prop_ro("size_y", [](const Map &mp) { return mp.grid.size_y; })
+      .def_prop_ro("shape", [](const Map &mp) { return std::make_tuple(mp.grid.size_x, mp.grid.size_y); })
+      .def_prop_rw(
+          "resolution", [](const Map &mp) { return mp.grid.resolution; },
+          [](Map &mp, double r) { mp.grid.resolution = r; }, "Metres per cell.")
+      .def_prop_rw(
+          "origin", [](const Map &mp) { return std::make_tuple(mp.origin.x, mp.origin.y, mp.origin.theta); },
+          [](Map &mp, Origin o) {
+            mp.origin = {std::get<0>(o), std::get<1>(o), std::get<2>(o)};
+            mp.has_origin = true;
+          },
+          "World pose (x, y, theta) of the lower-left corner of cell (0, 0); (0, 0, 0) when unknown.")
+      .def_prop_ro("has_origin", [](const Map &mp) { return mp.has_origin; },
+                   "False for a CARMEN map without an OFFSET chunk and for PNG images.")
+      .def_prop_ro("downsample", [](const Map &mp) { return mp.downsample; },
+                   "The block size finish used (1 for maps read from files).")
+      .def_prop_ro("offset_cells", [](const Map &mp) { return std::make_pair(mp.min_x, mp.min_y); },
+                   "finish's crop offset (min_x, min_y), in downsampled cells.")
+      .def(
+          "sha256",
+          [](const Map &mp) {
+            return vasco::gridmap_payload_sha256(mp.grid.size_x, mp.grid.size_y, mp.grid.resolution, mp.grid.cells);
+          },
+          "SHA-256 of the map's CARMEN GRIDMAP payload (what the golden SHA256SUMS hold).")
+      .def("__repr__", [](const Map &mp) {
+        return nb::str("Map(size_x={}, size_y={}, resolution={}, origin=({}, {}, {}))")
+            .format(mp.grid.size_x, mp.grid.size_y, mp.grid.resolution, mp.origin.x, mp.origin.y, mp.origin.theta);
+      });
+}
+
+void bind_map_files(nb::module_ &m) {
+  m.def(
+      "_read_map",
+      [](const fs::path &path) {
+        nb::gil_scoped_release release;
+        return read_map(path.string());
+      },
+      "path"_a, nb::sig("def _read_map(path: str | os.PathLike) -> Map"),
+      "Reads a map in the format its name says (.map, .map.gz, .pgm with its .yaml, .png).");
+  m.def(
+      "write_map",
+      [](const fs::path &path, const Map &mp, const std::string &mode, const std::string &description) {
+        nb::gil_scoped_release release;
+        write_map(path.string(), mp, mode, description);
+      },
+      "path"_a, "map"_a, "mode"_a = "trinary", "description"_a = "",
+      nb::sig("def write_map(path: str | os.PathLike, map: Map, mode: str = 'trinary', description: str = '') -> None"),
+      kWriteMapDoc);
+}
+
+}  // namespace
+
+void bind_map(nb::module_ &m) {
+  nb::class_<Map> cls(m, "Map", kMapDoc);
+  bind_map_cells(cls);
+  bind_map_properties(cls);
+  bind_map_files(m);
+}
+
+}  // namespace vasco_py

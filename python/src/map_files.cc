@@ -1,0 +1,88 @@
+#include "map_files.h"
+
+#include <cmath>
+#include <ctime>
+#include <sstream>
+
+#include "carmen_compat/error.h"
+#include "carmen_compat/map_format.h"
+#include "vasco_gpu/version.h"
+
+namespace vasco_py {
+
+Map map_from_finished(vasco::FinishedMap &&f, const vasco::GridGeometry &geo) {
+  Map m;
+  m.grid.size_x = f.size_x;
+  m.grid.size_y = f.size_y;
+  m.grid.resolution = f.resolution;
+  m.grid.cells = std::move(f.cells);
+  m.downsample = f.downsample;
+  m.min_x = f.min_x;
+  m.min_y = f.min_y;
+  // As log2map writes it: theta_offset is the first scan's heading, so the
+  // grid axes are the world axes.
+  m.origin.x = geo.world_x(static_cast<double>(f.min_x) * f.downsample);
+  m.origin.y = geo.world_y(static_cast<double>(f.min_y) * f.downsample);
+  m.origin.theta = 0;
+  m.has_origin = true;
+  return m;
+}
+
+Map read_map(const std::string &path) {
+  carmen::MapRead r = carmen::read_map(path);
+  Map m;
+  m.grid = std::move(r.grid);
+  if (r.origin) {
+    m.origin = *r.origin;
+    m.has_origin = true;
+  }
+  return m;
+}
+
+void check_cells(const Map &m, const std::string &what) {
+  const std::vector<float> &c = m.grid.cells;
+  for (size_t i = 0; i < c.size(); ++i) {
+    if (carmen::valid_cell_value(c[i])) continue;
+    const size_t sy = static_cast<size_t>(m.grid.size_y > 0 ? m.grid.size_y : 1);
+    std::ostringstream os;
+    os << what << ": cell (" << i / sy << ", " << i % sy << ") is " << c[i]
+       << ": a cell is -1 (unknown) or a probability in [0, 1]";
+    throw carmen::Error(carmen::ErrorCode::BadInput, os.str());
+  }
+}
+
+namespace {
+
+// A .map stores the resolution as a float, a .pgm's YAML as text; both
+// readers refuse one that is not positive and finite.
+void check_resolution(const std::string &path, double resolution) {
+  const float stored = static_cast<float>(resolution);
+  if (std::isfinite(stored) && stored > 0) return;
+  std::ostringstream os;
+  os << path << ": resolution " << resolution << ": must be a positive number of metres per cell";
+  throw carmen::Error(carmen::ErrorCode::BadInput, os.str());
+}
+
+carmen::MapToWrite to_write(const Map &m, const std::string &pgm_mode, const std::string &description) {
+  carmen::MapToWrite w;
+  w.grid = m.grid;
+  if (m.has_origin) w.origin = m.origin;
+  w.source = "vasco_gpu";
+  w.creator_origin = "python";
+  w.description = description.empty() ? "vasco_gpu " + std::string(vasco::version()) : description;
+  w.time = static_cast<int64_t>(std::time(nullptr));
+  if (!carmen::parse_pgm_mode(pgm_mode, &w.pgm_mode))
+    throw carmen::Error(carmen::ErrorCode::Usage, "write_map: mode '" + pgm_mode + "': expected trinary, scale or raw");
+  return w;
+}
+
+}  // namespace
+
+void write_map(const std::string &path, const Map &m, const std::string &pgm_mode, const std::string &description) {
+  const carmen::MapFormatEntry &format = carmen::map_format_of(path);
+  if (format.format != carmen::MapFormat::Png) check_resolution(path, m.grid.resolution);
+  check_cells(m, path);
+  carmen::write_map(path, to_write(m, pgm_mode, description));
+}
+
+}  // namespace vasco_py

@@ -1,0 +1,281 @@
+// The class Mapper: one mapping session (vasco::Mapper).
+//
+// Threads and the GIL. Calls that map (insert, render, finish) run through
+// run_interruptible: on a worker thread, the GIL released, Ctrl-C seen while
+// they run. Calls on one Mapper are serialised by the session lock, which is
+// only ever taken with the GIL released, so a thread waiting for it never
+// stops the others. What len, frame, last_stats, renders and repr report
+// comes from a snapshot published after every call, read under a lock that
+// is held only to copy it: they answer at once, even during an insert.
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/tuple.h>
+
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "arrays.h"
+#include "bindings.h"
+#include "carmen_compat/error.h"
+#include "interruptible.h"
+#include "map_files.h"
+#include "vasco_gpu/backend.h"
+#include "vasco_gpu/mapper.hpp"
+
+namespace vasco_py {
+
+using namespace nb::literals;
+using carmen::Error;
+using carmen::ErrorCode;
+
+namespace {
+
+static_assert(sizeof(vasco::Pose) == 3 * sizeof(double), "Pose must be three packed doubles");
+
+// cpu_threads' threads: as many as log2map's --threads accepts. Each is kept
+// for the life of the process, so a larger number is refused, not capped
+// silently.
+constexpr int kMaxThreads = 1024;
+
+// What the state properties report, as of the end of the last call.
+struct Snapshot {
+  size_t num_scans = 0;
+  vasco::GridGeometry frame;
+  vasco::MapStats stats;
+  size_t renders = 0;
+};
+
+struct Session {
+  std::unique_ptr<vasco::Mapper> mapper;
+  std::mutex lock;  // serialises calls on mapper; taken only with the GIL released
+  std::mutex snapshot_lock;  // held only to copy `snapshot`
+  Snapshot snapshot;
+  std::string backend;
+  vasco::MapperParams params;
+
+  // Publishes the mapper's state; call with `lock` held.
+  void publish() {
+    Snapshot s{mapper->num_scans(), mapper->frame(), mapper->last_stats(), mapper->renders()};
+    std::lock_guard<std::mutex> g(snapshot_lock);
+    snapshot = s;
+  }
+  Snapshot state() {
+    std::lock_guard<std::mutex> g(snapshot_lock);
+    return snapshot;
+  }
+  // Runs fn(mapper) under the session lock and publishes the state after
+  // it, failed or not. Without the GIL.
+  template <typename Fn>
+  auto locked(Fn &&fn) -> decltype(fn(*mapper)) {
+    std::lock_guard<std::mutex> g(lock);
+    struct Publish {
+      Session *s;
+      ~Publish() { s->publish(); }
+    } publish_after{this};
+    return fn(*mapper);
+  }
+};
+
+vasco::CudaMode cuda_mode_of(const std::string &mode) {
+  if (mode == "float") return vasco::CudaMode::Float;
+  if (mode == "exact") return vasco::CudaMode::Exact;
+  throw Error(ErrorCode::Usage, "cuda_mode '" + mode + "': expected 'float' or 'exact'");
+}
+
+vasco::BackendOptions backend_options(const std::string &backend, const std::optional<std::string> &cuda_mode,
+                                      int threads, int cuda_device, uint64_t max_memory_bytes, std::string *name) {
+  vasco::BackendOptions o;
+  if (cuda_mode) o.cuda_mode = cuda_mode_of(*cuda_mode);
+  if (threads < 0 || threads > kMaxThreads)
+    throw Error(ErrorCode::Usage, "threads " + std::to_string(threads) + ": must be 0 (all cores) to " +
+                                      std::to_string(kMaxThreads));
+  o.threads = threads;
+  o.cuda_device = cuda_device;
+  o.max_memory_bytes = max_memory_bytes;
+  const vasco::CudaMode asked = o.cuda_mode;
+  *name = vasco::resolve_backend_name(backend, &o);
+  if (cuda_mode && o.cuda_mode != asked)
+    throw Error(ErrorCode::Usage, "backend '" + backend + "' contradicts cuda_mode='" + *cuda_mode + "'");
+  return o;
+}
+
+nb::dict stats_dict(const vasco::MapStats &s) {
+  nb::dict d;
+  d["scans"] = s.scans;
+  d["beams_used"] = s.beams_used;
+  d["beams_skipped"] = s.beams_skipped;
+  d["cell_updates"] = s.cell_updates;
+  d["prep_s"] = s.prep_s;
+  d["upload_s"] = s.upload_s;
+  d["map_s"] = s.map_s;
+  d["download_s"] = s.download_s;
+  return d;
+}
+
+std::vector<vasco::Pose> poses_from(nb::handle obj) {
+  auto a = as_array<double>(obj, "float64", "poses", 2);
+  if (a.shape(1) != 3) throw Error(ErrorCode::BadInput, "poses: expected shape (n, 3) (x, y, theta per scan)");
+  std::vector<vasco::Pose> p(a.shape(0));
+  const double *d = a.data();
+  for (size_t s = 0; s < p.size(); ++s) p[s] = {d[3 * s], d[3 * s + 1], d[3 * s + 2]};
+  return p;
+}
+
+void init_mapper(Session *self, std::optional<vasco::MapperParams> params, const std::string &backend,
+                 std::optional<std::string> cuda_mode, int threads, std::optional<vasco::GridGeometry> frame,
+                 int cuda_device, uint64_t max_memory_bytes) {
+  std::string name;
+  const vasco::BackendOptions o = backend_options(backend, cuda_mode, threads, cuda_device, max_memory_bytes, &name);
+  const vasco::MapperParams p = params ? *params : vasco::MapperParams();
+  std::unique_ptr<vasco::Mapper> mp;
+  {
+    nb::gil_scoped_release release;
+    p.validate();
+    mp = frame ? std::make_unique<vasco::Mapper>(p, *frame, name, o) : std::make_unique<vasco::Mapper>(p, name, o);
+  }
+  auto *s = new (self) Session();
+  s->backend = mp->backend_name();
+  s->params = mp->params();
+  s->mapper = std::move(mp);
+  s->publish();
+}
+
+void insert(Session &s, const vasco::ScanBatch &scans) {
+  run_interruptible([&] {
+    check_batch(scans);
+    s.locked([&](vasco::Mapper &m) { m.insert(scans); });
+  });
+}
+
+void render(Session &s, nb::handle poses) {
+  const std::vector<vasco::Pose> p = poses_from(poses);
+  run_interruptible([&] { s.locked([&](vasco::Mapper &m) { m.render(p); }); });
+}
+
+Map finish(Session &s, std::optional<int> downsample, std::optional<int> border) {
+  const int ds = downsample ? *downsample : static_cast<int>(s.params.downsample);
+  const int b = border ? *border : static_cast<int>(s.params.border);
+  return run_interruptible([&] {
+    return s.locked([&](vasco::Mapper &m) { return map_from_finished(m.finish(ds, b), m.frame()); });
+  });
+}
+
+nb::ndarray<nb::numpy, float> read(Session &s, std::optional<std::tuple<int, int, int, int>> window) {
+  std::vector<float> v;
+  vasco::GridWindow gw;
+  {
+    nb::gil_scoped_release release;
+    s.locked([&](vasco::Mapper &m) {
+      gw = window ? vasco::GridWindow{std::get<0>(*window), std::get<1>(*window), std::get<2>(*window),
+                                      std::get<3>(*window)}
+                  : vasco::GridWindow{0, 0, m.frame().size_x, m.frame().size_y};
+      v = m.read(gw);
+    });
+  }
+  return owned(std::move(v), {static_cast<size_t>(gw.width), static_cast<size_t>(gw.height)});
+}
+
+nb::ndarray<nb::numpy, double> poses(Session &s) {
+  std::vector<vasco::Pose> p;
+  {
+    nb::gil_scoped_release release;
+    p = s.locked([](vasco::Mapper &m) { return m.poses(); });
+  }
+  std::vector<double> flat(3 * p.size());
+  for (size_t i = 0; i < p.size(); ++i) {
+    flat[3 * i] = p[i].x;
+    flat[3 * i + 1] = p[i].y;
+    flat[3 * i + 2] = p[i].theta;
+  }
+  return owned(std::move(flat), {p.size(), 3});
+}
+
+constexpr const char *kMapperDoc =
+    "A mapping session (DESIGN section 7): scans stored once (on the GPU for ``cuda``), poses\n"
+    "replaceable as a whole, the evidence grid kept between calls.\n\n"
+    "    mapper = vasco_gpu.Mapper(params, backend='cuda', cuda_mode='exact')\n"
+    "    mapper.insert(log.scans)          # new scans continue the grid\n"
+    "    mapper.render(new_poses)          # a loop closure: every pose moved, recomputed\n"
+    "    m = mapper.finish()               # CARMEN's finish -> Map\n\n"
+    "Backends: cpu_double (CARMEN's routine, bit-identical), cpu_threads (the same bytes on every\n"
+    "core), cpu_float (single precision), cuda (cuda_mode 'float', the default, or 'exact':\n"
+    "CARMEN's bytes), auto (cuda when a GPU is usable, else cpu_threads); 'cuda_exact' and\n"
+    "'cuda_float' name the CUDA modes too. The GIL is released while the session maps; calls on\n"
+    "one Mapper from several threads are serialised, and len, frame, last_stats, renders and\n"
+    "repr answer at once even while another thread maps (as of the end of the last call).\n\n"
+    "Ctrl-C during insert, render or finish runs Python's handler at once; a call cannot stop\n"
+    "half-way, so KeyboardInterrupt is raised when the call has finished: the session then holds\n"
+    "what the call did (the scans inserted, the poses rendered), or, if the call failed, what it\n"
+    "held before.";
+
+constexpr const char *kMapperInitDoc =
+    "A session with ``params`` (vasco's defaults when None) on ``backend``.\n\n"
+    "cuda_mode: 'float' (default) or 'exact'. threads: cpu_threads' threads (0: all cores; at\n"
+    "most 1024, as log2map's --threads). frame: a fixed Frame (cells outside it are skipped, as\n"
+    "CARMEN does) instead of the PROTOCOL frame, which grows as scans arrive. max_memory_bytes:\n"
+    "host memory the session may use (0: no limit). Raises ValueError for bad parameters or an\n"
+    "unknown backend, RuntimeError when the backend cannot run here (e.g. cuda without a GPU).";
+
+void bind_mapper_constructor(nb::class_<Session> &cls) {
+  cls.def("__init__", &init_mapper, "params"_a = nb::none(), "backend"_a = "cpu_double", "cuda_mode"_a = nb::none(),
+          "threads"_a = 0, "frame"_a = nb::none(), "cuda_device"_a = 0,
+          "max_memory_bytes"_a = vasco::kDefaultMaxMemoryBytes, kMapperInitDoc);
+}
+
+void bind_mapper_mapping(nb::class_<Session> &cls) {
+  cls.def("insert", &insert, "scans"_a,
+          "Stores ``scans`` after those stored and applies them to the grid (exact backends: the bytes\n"
+          "of mapping everything at once). Raises BadInputError (a ValueError) for a batch whose\n"
+          "arrays disagree, RuntimeError when the frame would be too large or the session would\n"
+          "exceed max_memory_bytes (nothing is stored then).")
+      .def("render", &render, "poses"_a, nb::sig("def render(self, poses: numpy.typing.ArrayLike) -> None"),
+           "New poses for every stored scan, an (n, 3) float64 array of (x, y, theta), and the grid\n"
+           "recomputed from scratch with them (only the poses travel to the GPU).")
+      .def("finish", &finish, "downsample"_a = nb::none(), "border"_a = nb::none(),
+           "CARMEN's finish of the current grid (block means, crop to the known area plus ``border``),\n"
+           "on the GPU for cuda; ``downsample``/``border`` default to the params'. Returns a Map whose\n"
+           "cells are moved, not copied, out of the session.");
+}
+
+void bind_mapper_arrays(nb::class_<Session> &cls) {
+  cls.def("read", &read, "window"_a = nb::none(),
+          nb::sig("def read(self, window: tuple[int, int, int, int] | None = None) -> "
+                  "numpy.typing.NDArray[numpy.float32]"),
+          "The full-resolution grid, or the window (x0, y0, width, height) of it, as a (width, height)\n"
+          "float32 array, x-major (a new array that owns the cells C++ returned; no further copy).")
+      .def_prop_ro("poses", &poses, nb::rv_policy::reference, "The stored scans' poses, (n, 3) float64 (a new array).");
+}
+
+void bind_mapper_state(nb::class_<Session> &cls) {
+  cls.def("__len__", [](Session &s) { return s.state().num_scans; })
+      .def_prop_ro("num_scans", [](Session &s) { return s.state().num_scans; }, "Scans stored.")
+      .def_prop_ro("frame", [](Session &s) { return s.state().frame; }, "The current frame (a copy).")
+      .def_prop_ro("params", [](Session &s) { return s.params; }, "The session's parameters (a copy).")
+      .def_prop_ro("backend", [](Session &s) { return s.backend; },
+                   "The backend's name (cpu_double, cpu_threads, cpu_float, cuda_float, cuda_exact).")
+      .def_prop_ro("last_stats", [](Session &s) { return stats_dict(s.state().stats); },
+                   "Counts and phase times of the last insert or render.")
+      .def_prop_ro("renders", [](Session &s) { return s.state().renders; },
+                   "Full renders since construction (each render(), each growth, the first insert).")
+      .def("__repr__", [](Session &s) {
+        return nb::str("Mapper(backend='{}', {} scans)").format(s.backend, s.state().num_scans);
+      });
+}
+
+}  // namespace
+
+void bind_mapper(nb::module_ &m) {
+  nb::class_<Session> cls(m, "Mapper", kMapperDoc);
+  bind_mapper_constructor(cls);
+  bind_mapper_mapping(cls);
+  bind_mapper_arrays(cls);
+  bind_mapper_state(cls);
+}
+
+}  // namespace vasco_py

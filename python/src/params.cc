@@ -1,0 +1,120 @@
+// The class Params: the mapper's parameters with carmen.ini's keys as
+// keywords and attributes.
+#include <nanobind/nanobind.h>
+#include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+
+#include <filesystem>
+#include <string>
+
+#include "bindings.h"
+#include "carmen_compat/ini_file.h"
+#include "param_keys.h"
+#include "vasco_gpu/params.h"
+
+namespace vasco_py {
+
+using namespace nb::literals;
+namespace fs = std::filesystem;
+using vasco::MapperParams;
+
+namespace {
+
+std::string params_doc() {
+  return "The mapper's parameters: carmen.ini's ``vasco_*`` keys without the prefix.\n\n"
+         "``Params(p_occ=0.9, resolution=0.05)`` (the ``vasco_`` prefix is accepted\n"
+         "too: ``Params(vasco_p_occ=0.9)``) starts from vasco's defaults and is\n"
+         "validated; an unknown keyword is a TypeError, a value out of range a\n"
+         "ValueError naming the key. Attributes may be changed afterwards; the Mapper\n"
+         "validates them again.\n\n" +
+         param_keys_doc();
+}
+
+std::string params_repr(const MapperParams &p) {
+  std::string s = "Params(";
+  bool first = true;
+  for (auto [k, v] : params_dict(p)) {
+    s += (first ? "" : ", ") + nb::cast<std::string>(nb::str(k)) + "=" + nb::cast<std::string>(nb::repr(v));
+    first = false;
+  }
+  return s + ")";
+}
+
+MapperParams params_from_ini(const fs::path &path, const std::string &robot, nb::kwargs overrides) {
+  carmen::ParamFile pf = carmen::ParamFile::load(path.string(), robot);
+  for (auto [k, v] : overrides) {
+    std::string name = nb::cast<std::string>(k);
+    check_param(name, v);
+    if (name.rfind("vasco_", 0) != 0) name = "vasco_" + name;
+    pf.set_override(name, nb::cast<std::string>(nb::str(v)));
+  }
+  return MapperParams::from_params(pf, nullptr);
+}
+
+// Params' constructors (keywords, from_ini) and keys().
+void bind_params_constructors(nb::class_<MapperParams> &cls) {
+  cls.def(
+         "__init__",
+         [](MapperParams *self, nb::kwargs kwargs) {
+           MapperParams p;
+           for (auto [k, v] : kwargs) set_param(p, nb::cast<std::string>(k), v);
+           p.validate();
+           new (self) MapperParams(p);
+         },
+         nb::sig("def __init__(self, **params: float | int) -> None"),
+         "Parameters from keywords (ini key names, with or without ``vasco_``); the rest keep vasco's\n"
+         "defaults. Validated.")
+      .def_static("from_ini", &params_from_ini, "path"_a, "robot"_a = "", "overrides"_a,
+                  nb::sig("def from_ini(path: str | os.PathLike, robot: str = '', **overrides: float | int) -> Params"),
+                  "Parameters from a carmen.ini (sections [*], [expert] and the robot's, as CARMEN's param_daemon\n"
+                  "reads them), keywords overriding the file. Errors raise FileError naming FILE:LINE.")
+      .def_static(
+          "keys", []() { return vasco::mapper_param_keys(); },
+          "The ini keys the mapper understands (vasco_resolution, ...).");
+}
+
+// Params' methods: validate, to_dict, repr, equality and copies.
+void bind_params_methods(nb::class_<MapperParams> &cls) {
+  cls.def("validate", &MapperParams::validate, "Raises ValueError naming the key when a value is out of range.")
+      .def("to_dict", &params_dict, "The parameters as a dict (keys without ``vasco_``).")
+      .def("__repr__", &params_repr)
+      .def(
+          "__eq__",
+          [](const MapperParams &a, nb::handle b) -> nb::object {
+            if (!nb::isinstance<MapperParams>(b)) return nb::borrow(Py_NotImplemented);
+            return nb::bool_(params_dict(a).equal(params_dict(nb::cast<const MapperParams &>(b))));
+          },
+          nb::sig("def __eq__(self, other: object) -> bool"))
+      .def("__copy__", [](const MapperParams &p) { return p; })
+      .def("__deepcopy__", [](const MapperParams &p, nb::handle) { return p; }, "memo"_a);
+}
+
+// Params' attributes, one per ini key.
+void bind_params_attributes(nb::class_<MapperParams> &cls) {
+  cls.def_rw("resolution", &MapperParams::resolution, "vasco_resolution: cell size in metres.")
+      .def_rw("p_prior", &MapperParams::p_prior, "vasco_p_prior: prior occupancy.")
+      .def_rw("p_occ", &MapperParams::p_occ, "vasco_p_occ: evidence of a hit.")
+      .def_rw("p_emp", &MapperParams::p_emp, "vasco_p_emp: evidence of a free cell.")
+      .def_rw("range_sure", &MapperParams::range_sure, "vasco_range_sure: full-confidence range (m).")
+      .def_rw("range_max", &MapperParams::range_max, "vasco_range_max: evidence ends here (m).")
+      .def_rw("wall_size", &MapperParams::wall_size, "vasco_wall_size: thickness marked occupied behind a hit (m).")
+      .def_rw("downsample", &MapperParams::downsample, "vasco_downsample: finish's block size.")
+      .def_rw("border", &MapperParams::border, "vasco_border: cells kept around the known area.")
+      .def_rw("first_scan", &MapperParams::first_scan, "vasco_first_scan: first laser message used by load_log.")
+      .def_rw("num_scans", &MapperParams::num_scans, "vasco_num_scans: laser messages used by load_log (-1: all).");
+}
+
+}  // namespace
+
+void bind_params(nb::module_ &m) {
+  // The docstring outlives the class: nanobind keeps the pointer it is given.
+  static const std::string doc = params_doc();
+  nb::class_<MapperParams> cls(m, "Params", doc.c_str());
+  bind_params_constructors(cls);
+  bind_params_methods(cls);
+  bind_params_attributes(cls);
+  cls.attr("__hash__") = nb::none();  // mutable, compared by value
+}
+
+}  // namespace vasco_py
