@@ -26,6 +26,7 @@
 #include <cstring>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -38,6 +39,7 @@
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/parallel.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/renderer.h"
 #include "vasco_gpu/scan_batch.h"
 #if defined(VASCO_HAVE_CUDA)
 #include "paper_backend.h"
@@ -107,19 +109,19 @@ void record(Phases *ph, const vasco::MapStats &st, bool gpu, double t0, double t
   ph->stats = st;
 }
 
-// One timed run of a backend alone (the paper's kernels, which only map whole
-// batches): map, finish, write.
-void run_once(vasco::Backend &backend, const vasco::ScanBatch &batch, const vasco::MapperParams &p,
+// One timed run of a GPU map alone (the paper's kernels, which only map whole
+// batches, and ours for comparison): `map` fills the grid, then finish, write.
+void run_once(const std::function<std::vector<float>(vasco::MapStats *)> &map, const vasco::MapperParams &p,
               const vasco::GridGeometry &geo, Phases *ph) {
   const double t0 = now_s();
   vasco::MapStats st;
-  std::vector<float> cells = backend.map(batch, p, geo, &st);
+  std::vector<float> cells = map(&st);
   const double t1 = now_s();
   const vasco::FinishedMap fin = vasco::finish_grid(cells.data(), geo.size_x, geo.size_y, geo.resolution,
                                                     static_cast<int>(p.downsample), static_cast<int>(p.border));
   const double t2 = now_s();
   write_and_discard(fin);
-  record(ph, st, backend.name().rfind("cuda", 0) == 0, t0, t1, t2, now_s());
+  record(ph, st, true, t0, t1, t2, now_s());
 }
 
 // One timed run through a mapping session, as log2map maps a log: a fresh
@@ -320,11 +322,19 @@ void bench_ablation(Bench *b, const Dataset &ds, const ParamSet &ps, const vasco
       {"  + all scans fused into one launch", int(PaperVariant::Fused)},
       {"ours: warp per beam, block per scan, one launch", -1}};
   for (const auto &v : variants) {
-    auto backend = v.second < 0 ? vasco::make_backend("cuda", vasco::BackendOptions{})
-                                : vasco::make_paper_backend(static_cast<PaperVariant>(v.second));
+    std::function<std::vector<float>(vasco::MapStats *)> map;
+    std::shared_ptr<vasco::Renderer> ours;
+    std::shared_ptr<vasco::Backend> paper;
+    if (v.second < 0) {
+      ours = vasco::make_renderer("cuda");
+      map = [&](vasco::MapStats *st) { return vasco::render_grid(*ours, batch, ps.params, geo, st); };
+    } else {
+      paper = vasco::make_paper_backend(static_cast<PaperVariant>(v.second));
+      map = [&](vasco::MapStats *st) { return paper->map(batch, ps.params, geo, st); };
+    }
     Phases ph, warm;
-    run_once(*backend, batch, ps.params, geo, &warm);
-    for (int r = 0; r < b->opt.runs; ++r) run_once(*backend, batch, ps.params, geo, &ph);
+    run_once(map, ps.params, geo, &warm);
+    for (int r = 0; r < b->opt.runs; ++r) run_once(map, ps.params, geo, &ph);
     b->ablation_rows[ds.name + " / " + ps.name].push_back({v.first, median(ph.map)});
   }
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/renderer.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/oracle.h"
 #include "vasco_gpu/params.h"
@@ -60,12 +61,12 @@ int main(int argc, char **argv) {
   const auto batch = vasco::load_scans(std::string(VASCO_SOURCE_DIR) + "/logs/fr079-complete.gfs.log.gz",
                                        p, carmen::LogReaderOptions{}, &ls);
   const auto geo = vasco::size_grid(batch, p);
-  auto lib = vasco::make_cpu_double_backend();
+  auto lib = vasco::make_renderer("cpu_double");
   std::vector<double> t_lib, t_o2;
   bool equal = true;
   for (int r = 0; r < runs + 1; ++r) {
     auto t0 = std::chrono::steady_clock::now();
-    const auto a = lib->map(batch, p, geo, nullptr);
+    const auto a = vasco::render_grid(*lib, batch, p, geo);
     auto t1 = std::chrono::steady_clock::now();
     const auto b = plain_loop(batch, p, geo);
     auto t2 = std::chrono::steady_clock::now();

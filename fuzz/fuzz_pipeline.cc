@@ -7,6 +7,7 @@
 
 #include "fuzz_support.h"
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/renderer.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/mapper.hpp"
 
@@ -29,10 +30,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     batch.add_scan(b.in(-15, 15), b.in(-15, 15), b.in(-7, 7), b.in(-3.2, 0), b.in(0, 0.2), r.data(), n, s + 1);
   }
   const vasco::GridGeometry geo = vasco::size_grid(batch, p);
-  const std::vector<float> ref = vasco::make_cpu_double_backend()->map(batch, p, geo, nullptr);
+  const std::vector<float> ref = vasco::render_grid(*vasco::make_renderer("cpu_double"), batch, p, geo);
   vasco::BackendOptions three;
   three.threads = 3;
-  const std::vector<float> thr = vasco::make_backend("cpu_threads", three)->map(batch, p, geo, nullptr);
+  const std::vector<float> thr = vasco::render_grid(*vasco::make_renderer("cpu_threads", three), batch, p, geo);
   if (std::memcmp(ref.data(), thr.data(), ref.size() * sizeof(float)) != 0) std::abort();
   vasco::Mapper m(p, "cpu_threads", three);
   const size_t half = batch.num_scans() / 2;

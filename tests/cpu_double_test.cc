@@ -12,6 +12,7 @@
 #include "test_seed.h"
 #include "test_support.h"
 #include "vasco_gpu/oracle.h"
+#include "vasco_gpu/renderer.h"
 
 namespace vasco {
 namespace {
@@ -53,18 +54,19 @@ std::vector<float> reference_map(const ScanBatch &batch, const MapperParams &par
 void check_against_reference(const ScanBatch &batch, const MapperParams &params, const GridGeometry &geo) {
   MapStats ref_stats, st;
   const std::vector<float> ref = reference_map(batch, params, geo, &ref_stats);
-  auto backend = make_cpu_double_backend();
-  const std::vector<float> got = backend->map(batch, params, geo, &st);
+  auto renderer = make_renderer("cpu_double");
+  const std::vector<float> got = render_grid(*renderer, batch, params, geo, &st);
   testing_support::expect_bit_identical(ref, got, geo, "cpu_double");
   EXPECT_EQ(ref_stats.beams_used, st.beams_used);
   EXPECT_EQ(ref_stats.beams_skipped, st.beams_skipped);
   EXPECT_EQ(ref_stats.cell_updates, st.cell_updates);
 
-  std::vector<float> parts(geo.num_cells(), egrid::kUnknown);
   const size_t n = batch.num_scans(), a = n / 3, b = 2 * n / 3;
-  backend->apply(batch, 0, a, params, geo, parts.data(), nullptr);
-  backend->apply(batch, a, b, params, geo, parts.data(), nullptr);
-  backend->apply(batch, b, n, params, geo, parts.data(), nullptr);
+  renderer->reset(geo, params);
+  renderer->apply(batch, 0, a, nullptr);
+  renderer->apply(batch, a, b, nullptr);
+  renderer->apply(batch, b, n, nullptr);
+  const std::vector<float> parts = renderer->read(GridWindow{0, 0, geo.size_x, geo.size_y});
   testing_support::expect_bit_identical(ref, parts, geo, "cpu_double in three calls");
 }
 

@@ -39,14 +39,16 @@ void expect_same_counts(const MapStats &ref, const MapStats &got) {
 void check_threads(const ScanBatch &batch, const MapperParams &params, const GridGeometry &geo,
                    const std::vector<float> &ref, const MapStats &ref_stats, int threads) {
   SCOPED_TRACE(std::to_string(threads) + " threads");
-  auto backend = make_cpu_threads_backend(threads);
-  EXPECT_EQ(backend->name(), "cpu_threads");
+  BackendOptions options;
+  options.threads = threads;
+  auto renderer = make_renderer("cpu_threads", options);
+  EXPECT_EQ(renderer->name(), "cpu_threads");
   MapStats st;
-  const std::vector<float> got = backend->map(batch, params, geo, &st);
+  const std::vector<float> got = render_grid(*renderer, batch, params, geo, &st);
   expect_bit_identical(ref, got, geo);
   expect_same_counts(ref_stats, st);
   EXPECT_GE(st.map_s, st.prep_s);
-  const CpuThreadsLoad *load = cpu_threads_load(*backend);
+  const CpuThreadsLoad *load = cpu_threads_load(*renderer);
   ASSERT_NE(load, nullptr);
   EXPECT_EQ(load->threads, threads);
   uint64_t sum = 0;
@@ -67,7 +69,7 @@ const Reference &reference(const std::string &name) {
   if (it == cache.end()) {
     Reference r;
     r.log = load_log(bundled_log(name), MapperParams{});
-    r.grid = make_cpu_double_backend()->map(r.log.batch, MapperParams{}, r.log.geo, &r.stats);
+    r.grid = render_grid(*make_renderer("cpu_double"), r.log.batch, MapperParams{}, r.log.geo, &r.stats);
     it = cache.emplace(name, std::move(r)).first;
   }
   return it->second;
@@ -119,7 +121,7 @@ TEST(CpuThreads, RandomScansWithOddRangesMatchTheOracle) {
       geo.size_y = std::max(1, geo.size_y / 3);
     }
     MapStats rs;
-    const auto ref = make_cpu_double_backend()->map(batch, params, geo, &rs);
+    const auto ref = render_grid(*make_renderer("cpu_double"), batch, params, geo, &rs);
     for (int threads : {1, 2, 3, 16}) check_threads(batch, params, geo, ref, rs, threads);
   }
 }
@@ -136,35 +138,35 @@ TEST(CpuThreads, UnevenAndTinyInputsMatchTheOracle) {
     ScanBatch batch = random_batch(rng, 60, 0.5);
     const GridGeometry geo = size_grid(batch, params);
     MapStats rs;
-    const auto ref = make_cpu_double_backend()->map(batch, params, geo, &rs);
+    const auto ref = render_grid(*make_renderer("cpu_double"), batch, params, geo, &rs);
     for (int threads : {2, 7, 16}) check_threads(batch, params, geo, ref, rs, threads);
     GridGeometry narrow = geo;
     narrow.size_x = 3;
-    const auto ref_narrow = make_cpu_double_backend()->map(batch, params, narrow, &rs);
+    const auto ref_narrow = render_grid(*make_renderer("cpu_double"), batch, params, narrow, &rs);
     for (int threads : {2, 16}) check_threads(batch, params, narrow, ref_narrow, rs, threads);
   }
   {
     const ScanBatch batch = random_batch(rng, 1, 0);
     const GridGeometry geo = size_grid(batch, params);
     MapStats rs;
-    const auto ref = make_cpu_double_backend()->map(batch, params, geo, &rs);
+    const auto ref = render_grid(*make_renderer("cpu_double"), batch, params, geo, &rs);
     for (int threads : {1, 4}) check_threads(batch, params, geo, ref, rs, threads);
   }
 }
 
 TEST(CpuThreads, AllCoresByDefault) {
-  auto backend = make_cpu_threads_backend(0);
+  auto renderer = make_renderer("cpu_threads");
   ScanBatch batch;
   const float r[3] = {1.0f, 2.0f, 3.0f};
   batch.add_scan(0, 0, 0, -0.1, 0.1, r, 3, 1);
   MapperParams params;
   const GridGeometry geo = size_grid(batch, params);
   MapStats st;
-  backend->map(batch, params, geo, &st);
-  const CpuThreadsLoad *load = cpu_threads_load(*backend);
+  render_grid(*renderer, batch, params, geo, &st);
+  const CpuThreadsLoad *load = cpu_threads_load(*renderer);
   ASSERT_NE(load, nullptr);
   EXPECT_EQ(load->threads, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
-  EXPECT_EQ(cpu_threads_load(*make_cpu_double_backend()), nullptr);
+  EXPECT_EQ(cpu_threads_load(*make_renderer("cpu_double")), nullptr);
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include "test_seed.h"
 #include "test_support.h"
 #include "vasco_gpu/compare.h"
+#include "vasco_gpu/error.h"
+#include "vasco_gpu/renderer.h"
 #if defined(VASCO_HAVE_CUDA)
 #include "vasco_gpu/cuda_backend.h"
 #endif
@@ -35,10 +37,12 @@ bool gpu_available(std::string *why) {
     if (!gpu_available(&why_)) GTEST_SKIP() << "no usable GPU: " << why_;   \
   } while (0)
 
-std::unique_ptr<Backend> cuda_backend(CudaMode mode) {
+// A one-shot map of `backend` (CUDA mode `mode`), as a session renders it.
+std::vector<float> map_on(const std::string &backend, const ScanBatch &batch, const MapperParams &params,
+                          const GridGeometry &geo, MapStats *stats, CudaMode mode = CudaMode::Float) {
   BackendOptions o;
   o.cuda_mode = mode;
-  return make_backend("cuda", o);
+  return render_grid(*make_renderer(backend, o), batch, params, geo, stats);
 }
 
 void expect_bit_identical(const std::vector<float> &ref, const std::vector<float> &got,
@@ -49,14 +53,17 @@ void expect_bit_identical(const std::vector<float> &ref, const std::vector<float
 TEST(CudaBackend, WithoutAGpuCudaIsAClearError) {
   std::string why;
   if (gpu_available(&why)) GTEST_SKIP() << "a GPU is present: this checks the no-GPU error";
-  try {
-    make_backend("cuda", BackendOptions{});
-    FAIL() << "expected an error";
-  } catch (const std::runtime_error &e) {
-    EXPECT_NE(std::string(e.what()).find("--backend cuda"), std::string::npos) << e.what();
+  for (const char *name : {"cuda", "cuda_exact", "cuda_float"}) {
+    try {
+      make_renderer(name, BackendOptions{});
+      ADD_FAILURE() << "expected an error for " << name;
+    } catch (const Error &e) {
+      EXPECT_EQ(e.code(), ErrorCode::NoGpu) << e.what();
+      EXPECT_NE(std::string(e.what()).find("backend cuda"), std::string::npos) << e.what();
+    }
   }
   // auto falls back to cpu_threads (the oracle's bytes, on every core).
-  EXPECT_EQ(make_backend("auto", BackendOptions{})->name(), "cpu_threads");
+  EXPECT_EQ(make_renderer("auto", BackendOptions{})->name(), "cpu_threads");
 }
 
 class CudaGolden : public ::testing::TestWithParam<const char *> {};
@@ -67,8 +74,8 @@ TEST_P(CudaGolden, ExactModeIsBitIdenticalToTheOracle) {
   const MapperParams params;
   const LoadedLog log = load_log(bundled_log(GetParam()), params);
   MapStats ref_stats, gpu_stats;
-  const auto ref = make_cpu_double_backend()->map(log.batch, params, log.geo, &ref_stats);
-  const auto got = cuda_backend(CudaMode::Exact)->map(log.batch, params, log.geo, &gpu_stats);
+  const auto ref = map_on("cpu_double", log.batch, params, log.geo, &ref_stats);
+  const auto got = map_on("cuda", log.batch, params, log.geo, &gpu_stats, CudaMode::Exact);
   expect_bit_identical(ref, got, log.geo);
   EXPECT_EQ(gpu_stats.cell_updates, ref_stats.cell_updates);
   EXPECT_EQ(gpu_stats.beams_used, ref_stats.beams_used);
@@ -94,8 +101,8 @@ TEST_P(CudaGolden, FloatModeAgreesWithTheOracle) {
   const MapperParams params;
   const LoadedLog log = load_log(bundled_log(GetParam()), params);
   MapStats ref_stats, gpu_stats;
-  const auto ref = make_cpu_double_backend()->map(log.batch, params, log.geo, &ref_stats);
-  const auto got = cuda_backend(CudaMode::Float)->map(log.batch, params, log.geo, &gpu_stats);
+  const auto ref = map_on("cpu_double", log.batch, params, log.geo, &ref_stats);
+  const auto got = map_on("cuda", log.batch, params, log.geo, &gpu_stats, CudaMode::Float);
   const Agreement a = compare_maps(ref, got);
   std::printf("%s", a.table(std::string("cuda float vs cpu_double, ") + GetParam()).c_str());
   EXPECT_EQ(gpu_stats.beams_used, ref_stats.beams_used);
@@ -121,11 +128,11 @@ TEST(CudaNoLostUpdates, EveryBeamOfAScanUpdatesTheSharedCell) {
   batch.add_scan(1.0, 2.0, 0.3, -M_PI, 2 * M_PI / 720, r.data(), 720, 2);
   const GridGeometry geo = size_grid(batch, params);
   MapStats ref_stats;
-  const auto ref = make_cpu_double_backend()->map(batch, params, geo, &ref_stats);
-  const auto exact = cuda_backend(CudaMode::Exact)->map(batch, params, geo, nullptr);
+  const auto ref = map_on("cpu_double", batch, params, geo, &ref_stats);
+  const auto exact = map_on("cuda", batch, params, geo, nullptr, CudaMode::Exact);
   expect_bit_identical(ref, exact, geo);
   MapStats fs;
-  const auto flt = cuda_backend(CudaMode::Float)->map(batch, params, geo, &fs);
+  const auto flt = map_on("cuda", batch, params, geo, &fs, CudaMode::Float);
   EXPECT_EQ(fs.cell_updates, ref_stats.cell_updates);
   const size_t start = size_t(geo.size_x / 2) * geo.size_y + geo.size_y / 2;
   ASSERT_NE(ref[start], -1.0f);
@@ -149,7 +156,7 @@ TEST(CudaBackend, AMapTooLargeForTheGpuIsAClearError) {
   geo.size_x = geo.size_y = 200000;  // 4e10 cells: 160 GB of floats
   for (CudaMode mode : {CudaMode::Float, CudaMode::Exact}) {
     try {
-      cuda_backend(mode)->map(batch, params, geo, nullptr);
+      map_on("cuda", batch, params, geo, nullptr, mode);
       ADD_FAILURE() << "expected an error";
     } catch (const std::runtime_error &e) {
       EXPECT_NE(std::string(e.what()).find("does not fit in GPU memory"), std::string::npos) << e.what();
@@ -168,8 +175,8 @@ TEST(CudaExact, RandomScansWithOddRangesMatchTheOracle) {
   const ScanBatch batch = testing_support::random_batch(rng, 150, 8);
   const GridGeometry geo = size_grid(batch, params);
   MapStats rs, gs;
-  const auto ref = make_cpu_double_backend()->map(batch, params, geo, &rs);
-  const auto got = cuda_backend(CudaMode::Exact)->map(batch, params, geo, &gs);
+  const auto ref = map_on("cpu_double", batch, params, geo, &rs);
+  const auto got = map_on("cuda", batch, params, geo, &gs, CudaMode::Exact);
   SCOPED_TRACE("random seed " + std::to_string(seed));
   expect_bit_identical(ref, got, geo);
   EXPECT_EQ(rs.cell_updates, gs.cell_updates);

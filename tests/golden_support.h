@@ -28,6 +28,7 @@
 #include "vasco_gpu/log_input.h"
 #include "vasco_gpu/map_digest.h"
 #include "vasco_gpu/mapper.hpp"
+#include "vasco_gpu/renderer.h"
 #if defined(VASCO_HAVE_CUDA)
 #include "vasco_gpu/cuda_backend.h"
 #endif
@@ -144,8 +145,8 @@ struct Path {
 
 inline Path backend_path(const std::string &name, const std::string &backend, BackendOptions opt = {}) {
   return Path{name, [backend, opt](const LogInput &in) {
-                auto b = make_backend(backend, opt);
-                return finish(b->map(in.batch, in.params, in.geo, nullptr), in);
+                auto r = make_renderer(backend, opt);
+                return finish(render_grid(*r, in.batch, in.params, in.geo), in);
               }};
 }
 

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "carmen_compat/error.h"
 #include "carmen_compat/ini_file.h"
 
@@ -108,6 +110,83 @@ TEST(MapperParams, UnknownVascoKeysAreWarnedButCarmensOwnAreNot) {
   ASSERT_EQ(w.size(), 1u);
   EXPECT_NE(w[0].find("test.ini:2"), std::string::npos) << w[0];
   EXPECT_NE(w[0].find("vasco_p_ocupied"), std::string::npos) << w[0];
+}
+
+// The table's defaults are the struct's initializers (two places that must
+// agree: MapperParams{} is read here, not the table).
+TEST(ParamTable, DefaultsAreTheStructsAndEveryDefaultIsValid) {
+  const MapperParams p;
+  ASSERT_EQ(param_table().size(), mapper_param_keys().size());
+  for (const ParamSpec &s : param_table()) {
+    SCOPED_TRACE(s.key);
+    EXPECT_EQ(s.get(p), s.default_value);
+    EXPECT_TRUE(s.valid(s.default_value));
+    EXPECT_EQ(std::string("vasco_") + s.name, s.key);
+    EXPECT_EQ(find_param(s.key), &s);
+    EXPECT_EQ(find_param(s.name), &s);
+  }
+  EXPECT_EQ(find_param("vasco_p_ocupied"), nullptr);
+  EXPECT_EQ(find_param("max_prob"), nullptr);
+}
+
+TEST(ParamTable, SetWritesTheMember) {
+  MapperParams p;
+  find_param("p_occ")->set(p, 0.75);
+  find_param("vasco_border")->set(p, 7);
+  EXPECT_EQ(p.p_occ, 0.75);
+  EXPECT_EQ(p.border, 7);
+}
+
+// validate() names the key in the error itself (no caller parses the message).
+void expect_param_error(const MapperParams &p, const std::string &key) {
+  try {
+    p.validate();
+    ADD_FAILURE() << "expected an error for " << key;
+  } catch (const ParamError &e) {
+    EXPECT_EQ(e.key(), key) << e.what();
+    EXPECT_EQ(e.code(), carmen::ErrorCode::Usage);
+    EXPECT_EQ(std::string(e.what()).rfind(key, 0), 0u) << e.what();
+  }
+}
+
+TEST(ParamTable, ValidateThrowsAParamErrorCarryingTheKey) {
+  MapperParams p;
+  p.p_emp = 1.0;
+  expect_param_error(p, "vasco_p_emp");
+  p = MapperParams{};
+  p.wall_size = NAN;
+  expect_param_error(p, "vasco_wall_size");
+  p = MapperParams{};
+  p.range_sure = 11;
+  expect_param_error(p, "vasco_range_sure");
+  p = MapperParams{};
+  p.resolution = 0.0001;  // 1e5 cells of range: the joint rule
+  expect_param_error(p, "vasco_range_max");
+  p = MapperParams{};
+  p.num_scans = 0;
+  expect_param_error(p, "vasco_num_scans");
+  p.num_scans = -1;
+  EXPECT_NO_THROW(p.validate());
+  p.first_scan = -1;
+  expect_param_error(p, "vasco_first_scan");
+}
+
+TEST(ParamTable, IniErrorsAreFileErrorsOfBadInputAndOverridesAreUsage) {
+  try {
+    from_text("[*]\nvasco_p_occ 1.5\n");
+    FAIL();
+  } catch (const carmen::FileError &e) {
+    EXPECT_EQ(e.code(), carmen::ErrorCode::BadInput);
+    EXPECT_EQ(e.line(), 2);
+  }
+  carmen::ParamFile f = carmen::ParamFile::parse("[*]\n", "test.ini");
+  f.set_override("vasco_border", "-3");
+  try {
+    MapperParams::from_params(f, nullptr);
+    FAIL();
+  } catch (const carmen::Error &e) {
+    EXPECT_EQ(e.code(), carmen::ErrorCode::Usage) << e.what();
+  }
 }
 
 }  // namespace

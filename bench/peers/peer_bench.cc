@@ -30,6 +30,7 @@
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/parallel.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/renderer.h"
 #include "vasco_gpu/scan_batch.h"
 
 #if defined(VASCO_HAVE_MRPT)
@@ -134,18 +135,23 @@ CellCounts count_ours(const std::vector<float> &cells) {
   return c;
 }
 
-// One of our backends: Backend::map on a fresh grid (its allocation included, as every CPU row of
-// mapping_bench). `counts`, when set, gets the cells of the last run's map.
-Row run_ours(const Job &job, const std::string &label, vasco::Backend &backend, CellCounts *counts) {
+// One of our backends: a renderer's reset (every cell unknown again) and apply, as a session renders.
+// `counts`, when set, gets the cells of the last run's map.
+Row run_ours(const Job &job, const std::string &label, const std::string &backend, int threads,
+             CellCounts *counts) {
   Row row = make_row(job, label);
   vasco::MapStats stats;
   std::vector<float> cells;
+  vasco::BackendOptions options;
+  options.threads = threads;
+  auto renderer = vasco::make_renderer(backend, options);
   row.map_s = timed_median(job.runs, [&] {
     stats = vasco::MapStats{};
     const double t0 = now_s();
-    std::vector<float> out = backend.map(job.batch, job.p, job.geo, &stats);
+    renderer->reset(job.geo, job.p);
+    renderer->apply(job.batch, 0, job.batch.num_scans(), &stats);
     const double t = now_s() - t0;
-    cells = std::move(out);  // the previous map is freed here, outside the timing
+    if (counts != nullptr) cells = renderer->read(vasco::GridWindow{0, 0, job.geo.size_x, job.geo.size_y});
     return t;
   });
   row.beams = stats.beams_used;
@@ -398,10 +404,9 @@ void bench_param_set(Bench *b, const Dataset &ds, const ParamSet &ps) {
                job.batch.num_scans(), job.geo.size_x, job.geo.size_y);
   CellCounts ours;
   std::fprintf(stderr, "  cpu_double, cpu_threads, cpu_float ...\n");
-  b->rows.push_back(run_ours(job, "cpu_double", *vasco::make_cpu_double_backend(), &ours));
-  b->rows.push_back(run_ours(job, "cpu_threads (" + std::to_string(b->threads) + ")",
-                             *vasco::make_cpu_threads_backend(b->threads), nullptr));
-  b->rows.push_back(run_ours(job, "cpu_float", *vasco::make_cpu_float_backend(), nullptr));
+  b->rows.push_back(run_ours(job, "cpu_double", "cpu_double", 1, &ours));
+  b->rows.push_back(run_ours(job, "cpu_threads (" + std::to_string(b->threads) + ")", "cpu_threads", b->threads, nullptr));
+  b->rows.push_back(run_ours(job, "cpu_float", "cpu_float", 1, nullptr));
   bench_peers(b, job, ours);
 }
 

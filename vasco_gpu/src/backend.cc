@@ -1,10 +1,11 @@
+// The backend registry: one row per backend, read by make_renderer, the
+// session APIs' name resolution, egrid.h and the tools' --backend help.
 #include "vasco_gpu/backend.h"
 
-#include <algorithm>
+#include <sstream>
 
-#include <stdexcept>
-
-#include "vasco_gpu/cpu_threads_backend.h"
+#include "host_renderer.h"
+#include "vasco_gpu/error.h"
 #include "vasco_gpu/renderer.h"
 
 #if defined(VASCO_HAVE_CUDA)
@@ -14,91 +15,155 @@
 namespace vasco {
 namespace {
 
-// A renderer whose grid lives in host memory and whose backend applies
-// scans to it in place: every CPU backend (CUDA sessions have their own
-// renderer, cuda_renderer.cc).
-class HostRenderer : public Renderer {
+#if defined(VASCO_HAVE_CUDA)
+constexpr bool kCudaCompiled = true;
+#else
+constexpr bool kCudaCompiled = false;
+#endif
+
+std::unique_ptr<Renderer> cpu_double(const BackendOptions &) { return make_cpu_double_renderer(); }
+std::unique_ptr<Renderer> cpu_threads(const BackendOptions &o) { return make_cpu_threads_renderer(o.threads); }
+std::unique_ptr<Renderer> cpu_float(const BackendOptions &) { return make_cpu_float_renderer(); }
+
+// Why cuda cannot run here; empty when it can.
+std::string cuda_unusable_reason(const BackendOptions &o) {
+#if defined(VASCO_HAVE_CUDA)
+  std::string why;
+  return cuda_usable(o.cuda_device, &why) ? std::string() : "no usable GPU: " + why;
+#else
+  (void)o;
+  return "this build has no CUDA backend (configured without nvcc)";
+#endif
+}
+
+std::unique_ptr<Renderer> cuda(const BackendOptions &o) {
+  const std::string why = cuda_unusable_reason(o);
+  if (!why.empty()) throw Error(ErrorCode::NoGpu, "backend cuda: " + why);
+#if defined(VASCO_HAVE_CUDA)
+  return make_cuda_renderer(o);
+#else
+  return nullptr;  // not reached: no CUDA build has a usable GPU
+#endif
+}
+
+// cuda when a GPU is usable, else cpu_threads: cpu_double's bytes on every core.
+std::unique_ptr<Renderer> automatic(const BackendOptions &o) {
+  return cuda_unusable_reason(o).empty() ? cuda(o) : cpu_threads(o);
+}
+
+}  // namespace
+
+const std::vector<BackendInfo> &backend_registry() {
+  static const std::vector<BackendInfo> rows = {
+      {"cpu_double", {}, Exactness::Exact, false, true,
+       "CARMEN's arithmetic to the letter, one core: bit-identical to CARMEN", cpu_double},
+      {"cpu_threads", {}, Exactness::Exact, false, true,
+       "cpu_double's bytes on all cores (--threads)", cpu_threads},
+      {"cpu_float", {}, Exactness::Float, false, true,
+       "single precision on one core, fast; measured against CARMEN's maps", cpu_float},
+      {"cuda", {{"cuda_float", CudaMode::Float}, {"cuda_exact", CudaMode::Exact}}, Exactness::ByCudaMode, true,
+       kCudaCompiled, "the GPU: float mode (fastest) or exact mode (bit-identical to cpu_double)", cuda},
+      {"auto", {}, Exactness::ByCudaMode, false, true,
+       "cuda when a GPU is usable, else cpu_threads", automatic},
+  };
+  return rows;
+}
+
+const BackendInfo *find_backend(const std::string &name) {
+  for (const BackendInfo &b : backend_registry()) {
+    if (name == b.name) return &b;
+    for (const BackendAlias &a : b.aliases)
+      if (name == a.name) return &b;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> compiled_backends() {
+  std::vector<std::string> names;
+  for (const BackendInfo &b : backend_registry())
+    if (b.compiled) names.push_back(b.name);
+  return names;
+}
+
+std::string resolve_backend_name(const std::string &name, BackendOptions *options) {
+  const BackendInfo *b = find_backend(name);
+  if (b == nullptr) {
+    std::string known;
+    for (const std::string &n : backend_names()) known += " " + n;
+    throw Error(ErrorCode::Usage, "unknown backend '" + carmen::printable(name) + "' (known:" + known + ")");
+  }
+  for (const BackendAlias &a : b->aliases)
+    if (name == a.name && options != nullptr) options->cuda_mode = a.cuda_mode;
+  return b->name;
+}
+
+std::vector<std::string> backend_names() {
+  std::vector<std::string> names;
+  for (const BackendInfo &b : backend_registry()) {
+    names.push_back(b.name);
+    for (const BackendAlias &a : b.aliases) names.push_back(a.name);
+  }
+  return names;
+}
+
+std::string backend_help() {
+  std::ostringstream s;
+  for (const BackendInfo &b : backend_registry()) {
+    if (!b.compiled) continue;
+    s << b.name << ": " << b.summary << "\n";
+  }
+  return s.str();
+}
+
+std::unique_ptr<Renderer> make_renderer(const std::string &backend, const BackendOptions &options) {
+  BackendOptions o = options;
+  const std::string name = resolve_backend_name(backend, &o);
+  return find_backend(name)->make(o);
+}
+
+std::vector<float> render_grid(Renderer &renderer, const ScanBatch &scans, const MapperParams &params,
+                               const GridGeometry &geo, MapStats *stats) {
+  renderer.reset(geo, params);
+  renderer.apply(scans, 0, scans.num_scans(), stats);
+  return renderer.read(GridWindow{0, 0, geo.size_x, geo.size_y});
+}
+
+// ---------------------------------------------------------------------------
+// The legacy Backend interface over a CPU renderer's update: the caller's
+// cells are updated in place, nothing is copied.
+// ---------------------------------------------------------------------------
+namespace {
+
+class LegacyBackend : public Backend {
  public:
-  explicit HostRenderer(std::unique_ptr<Backend> backend) : backend_(std::move(backend)) {}
-  std::string name() const override { return backend_->name(); }
-  RendererTraits traits() const override { return {backend_->name() != "cpu_float", false}; }
-
-  void reset(const GridGeometry &geo, const MapperParams &params) override {
-    geo_ = geo;
-    params_ = params;
-    cells_.assign(geo.num_cells(), -1.0f);  // keeps the allocation when the size does not grow
-  }
-
-  void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) override {
-    backend_->apply(scans, first, last, params_, geo_, cells_.data(), stats);
-  }
-
-  FinishedMap finish(int downsample, int border) override {
-    return finish_grid(cells_.data(), geo_.size_x, geo_.size_y, geo_.resolution, downsample, border);
-  }
-
-  std::vector<float> read(const GridWindow &w) override {
-    std::vector<float> out(static_cast<size_t>(w.width) * static_cast<size_t>(w.height));
-    for (int x = 0; x < w.width; ++x) {
-      const float *col = cells_.data() + static_cast<size_t>(w.x0 + x) * geo_.size_y + w.y0;
-      std::copy(col, col + w.height, out.begin() + static_cast<size_t>(x) * w.height);
-    }
-    return out;
+  explicit LegacyBackend(std::unique_ptr<HostGridRenderer> r) : renderer_(std::move(r)) {}
+  std::string name() const override { return renderer_->name(); }
+  void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+             const GridGeometry &geo, float *cells, MapStats *stats) override {
+    renderer_->apply_to(batch, first, last, params, geo, cells, stats);
   }
 
  private:
-  std::unique_ptr<Backend> backend_;
-  GridGeometry geo_;
-  MapperParams params_;
-  std::vector<float> cells_;
+  std::unique_ptr<HostGridRenderer> renderer_;
 };
 
 }  // namespace
 
-
-std::vector<std::string> compiled_backends() {
-  std::vector<std::string> names = {"cpu_double", "cpu_threads", "cpu_float"};
-#if defined(VASCO_HAVE_CUDA)
-  names.push_back("cuda");
-#endif
-  return names;
-}
-
 std::unique_ptr<Backend> make_backend(const std::string &name, const BackendOptions &options) {
-  if (name == "cpu_double") return make_cpu_double_backend();
-  if (name == "cpu_threads") return make_cpu_threads_backend(options.threads);
-  if (name == "cpu_float") return make_cpu_float_backend();
-  if (name == "cuda" || name == "auto") {
-#if defined(VASCO_HAVE_CUDA)
-    std::string why;
-    if (cuda_usable(options.cuda_device, &why)) return make_cuda_backend(options);
-    if (name == "cuda") throw std::runtime_error("--backend cuda: no usable GPU: " + why);
-#else
-    if (name == "cuda")
-      throw std::runtime_error("--backend cuda: this build has no CUDA backend (configured without nvcc)");
-#endif
-    // No GPU: cpu_threads, which gives cpu_double's bytes on every core.
-    return make_cpu_threads_backend(options.threads);
+  std::unique_ptr<Renderer> r = make_renderer(name, options);
+  if (auto *host = dynamic_cast<HostGridRenderer *>(r.get())) {
+    r.release();
+    return std::make_unique<LegacyBackend>(std::unique_ptr<HostGridRenderer>(host));
   }
-  throw std::invalid_argument("unknown backend '" + name + "'");
+  throw Error(ErrorCode::Usage, "backend " + name + " has no whole-grid Backend interface: use make_renderer");
 }
 
-std::string resolve_backend_name(const std::string &name, BackendOptions *options) {
-  if (name == "cuda_exact" || name == "cuda_float") {
-    options->cuda_mode = name == "cuda_exact" ? CudaMode::Exact : CudaMode::Float;
-    return "cuda";
-  }
-  return name;
+std::unique_ptr<Backend> make_cpu_double_backend() {
+  return std::make_unique<LegacyBackend>(make_cpu_double_renderer());
 }
 
-std::unique_ptr<Renderer> make_renderer(const std::string &backend, const BackendOptions &options) {
-#if defined(VASCO_HAVE_CUDA)
-  std::string why;
-  if ((backend == "cuda" || backend == "auto") &&
-      cuda_usable(options.cuda_device, &why))
-    return make_cuda_renderer(options);
-#endif
-  return std::make_unique<HostRenderer>(make_backend(backend, options));
+std::unique_ptr<Backend> make_cpu_float_backend() {
+  return std::make_unique<LegacyBackend>(make_cpu_float_renderer());
 }
 
 }  // namespace vasco

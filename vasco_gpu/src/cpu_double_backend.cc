@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "beam_updates.h"
-#include "vasco_gpu/backend.h"
+#include "host_renderer.h"
 #include "vasco_gpu/oracle.h"
 
 namespace vasco {
@@ -48,12 +48,12 @@ struct Tables {
       : distances(p.table_size(), p.resolution), evidence(p.sensor_model(), p.resolution, p.table_size()) {}
 };
 
-class CpuDoubleBackend : public Backend {
+class CpuDoubleRenderer : public HostGridRenderer {
  public:
-  std::string name() const override { return "cpu_double"; }
+  CpuDoubleRenderer() : HostGridRenderer("cpu_double", true) {}
 
-  void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
-             const GridGeometry &geo, float *cells, MapStats *stats) override {
+  void apply_to(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+                const GridGeometry &geo, float *cells, MapStats *stats) override {
     const auto t0 = std::chrono::steady_clock::now();
     oracle::GridFrame frame;
     frame.size_x = geo.size_x;
@@ -112,6 +112,6 @@ class CpuDoubleBackend : public Backend {
 
 }  // namespace
 
-std::unique_ptr<Backend> make_cpu_double_backend() { return std::make_unique<CpuDoubleBackend>(); }
+std::unique_ptr<HostGridRenderer> make_cpu_double_renderer() { return std::make_unique<CpuDoubleRenderer>(); }
 
 }  // namespace vasco

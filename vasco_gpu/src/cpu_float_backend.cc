@@ -32,7 +32,7 @@
 #include <cstring>
 
 #include "beam_updates.h"
-#include "vasco_gpu/backend.h"
+#include "host_renderer.h"
 #include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/egrid_math.h"
 
@@ -257,12 +257,12 @@ uint64_t add_walked_beam(const EvidenceTable &ev, int x1, int y1, int x2, int y2
   return updates;
 }
 
-class CpuFloatBackend : public Backend {
+class CpuFloatRenderer : public HostGridRenderer {
  public:
-  std::string name() const override { return "cpu_float"; }
+  CpuFloatRenderer() : HostGridRenderer("cpu_float", false) {}
 
-  void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
-             const GridGeometry &geo, float *cells, MapStats *stats) override {
+  void apply_to(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+                const GridGeometry &geo, float *cells, MapStats *stats) override {
     const auto t0 = std::chrono::steady_clock::now();
     MapStats st;
     last = std::min(last, batch.num_scans());
@@ -329,6 +329,6 @@ class CpuFloatBackend : public Backend {
 
 }  // namespace
 
-std::unique_ptr<Backend> make_cpu_float_backend() { return std::make_unique<CpuFloatBackend>(); }
+std::unique_ptr<HostGridRenderer> make_cpu_float_renderer() { return std::make_unique<CpuFloatRenderer>(); }
 
 }  // namespace vasco

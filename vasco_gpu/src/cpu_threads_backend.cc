@@ -53,6 +53,7 @@
 #include <optional>
 
 #include "beam_updates.h"
+#include "host_renderer.h"
 #include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/oracle.h"
 #include "vasco_gpu/parallel.h"
@@ -298,17 +299,15 @@ void run_stripes(const Context &ctx, const Beam *beams, const std::vector<oracle
   });
 }
 
-class CpuThreadsBackend : public Backend {
+class CpuThreadsRenderer : public HostGridRenderer {
  public:
-  explicit CpuThreadsBackend(int threads)
-      : threads_(threads > 0 ? threads : hardware_threads()) {}
-
-  std::string name() const override { return "cpu_threads"; }
+  explicit CpuThreadsRenderer(int threads)
+      : HostGridRenderer("cpu_threads", true), threads_(threads > 0 ? threads : hardware_threads()) {}
 
   const CpuThreadsLoad *load() const { return has_load_ ? &load_ : nullptr; }
 
-  void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
-             const GridGeometry &geo, float *cells, MapStats *stats) override {
+  void apply_to(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+                const GridGeometry &geo, float *cells, MapStats *stats) override {
     const auto t0 = Clock::now();
     const int nt = threads_;
     const size_t ns = last > first ? last - first : 0;
@@ -331,7 +330,7 @@ class CpuThreadsBackend : public Backend {
     if (size_x <= 0 || size_y <= 0 || nb == 0 || T <= 0) {
       st.prep_s = seconds_since(t0);
       st.map_s = st.prep_s;
-      finish(stats, st, std::move(load));
+      keep_load(stats, st, std::move(load));
       return;
     }
 
@@ -353,11 +352,11 @@ class CpuThreadsBackend : public Backend {
     load.stripes_s = seconds_since(t_stripes);
     for (uint64_t n : load.thread_updates) st.cell_updates += n;
     st.map_s = seconds_since(t0);
-    finish(stats, st, std::move(load));
+    keep_load(stats, st, std::move(load));
   }
 
  private:
-  void finish(MapStats *stats, const MapStats &st, CpuThreadsLoad &&load) {
+  void keep_load(MapStats *stats, const MapStats &st, CpuThreadsLoad &&load) {
     if (stats != nullptr) *stats = st;
     load_ = std::move(load);
     has_load_ = true;
@@ -372,13 +371,13 @@ class CpuThreadsBackend : public Backend {
 
 }  // namespace
 
-std::unique_ptr<Backend> make_cpu_threads_backend(int threads) {
-  return std::make_unique<CpuThreadsBackend>(threads);
+std::unique_ptr<HostGridRenderer> make_cpu_threads_renderer(int threads) {
+  return std::make_unique<CpuThreadsRenderer>(threads);
 }
 
-const CpuThreadsLoad *cpu_threads_load(const Backend &backend) {
-  const auto *b = dynamic_cast<const CpuThreadsBackend *>(&backend);
-  return b != nullptr ? b->load() : nullptr;
+const CpuThreadsLoad *cpu_threads_load(const Renderer &renderer) {
+  const auto *r = dynamic_cast<const CpuThreadsRenderer *>(&renderer);
+  return r != nullptr ? r->load() : nullptr;
 }
 
 }  // namespace vasco

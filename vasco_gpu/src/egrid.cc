@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/oracle.h"
@@ -43,9 +44,14 @@ std::string &chosen_backend() {
   return b;
 }
 
-bool known_backend(const std::string &b) {
-  return b == "cpu_double" || b == "cpu_threads" || b == "cpu_float" || b == "cuda" || b == "cuda_exact" ||
-         b == "auto";
+// A name of the backend registry, as a string that lives as long as the
+// program (what vasco_egrid_grid_backend returns); null for an unknown name.
+const char *registry_name(const std::string &b) {
+  const vasco::BackendInfo *info = vasco::find_backend(b);
+  if (info == nullptr) return nullptr;
+  for (const vasco::BackendAlias &a : info->aliases)
+    if (b == a.name) return a.name;
+  return info->name;
 }
 
 // The backend for a grid initialised now: the call's, else the environment's.
@@ -359,20 +365,16 @@ void carmen_mapper_free_evidence_grid(evidence_grid *grid) {
 }
 
 int vasco_egrid_set_backend(const char *backend) {
-  if (backend == nullptr || (*backend != '\0' && !known_backend(backend))) return -1;
+  if (backend == nullptr || (*backend != '\0' && registry_name(backend) == nullptr)) return -1;
   std::lock_guard<std::mutex> lock(sessions_mutex);
   chosen_backend() = backend;
   return 0;
 }
 
 const char *vasco_egrid_grid_backend(const evidence_grid *grid) {
-  static const char *const names[] = {"cpu_double", "cpu_threads", "cpu_float", "cuda_float", "cuda_exact"};
   const Session *s = session_of(grid);
-  if (s == nullptr) return names[0];
-  const std::string b = s->mapper->backend_name();
-  for (const char *n : names)
-    if (b == n) return n;
-  return names[0];
+  const char *name = s != nullptr ? registry_name(s->mapper->backend_name()) : nullptr;
+  return name != nullptr ? name : "cpu_double";
 }
 
 }  // extern "C"

@@ -59,8 +59,10 @@ void carmen_mapper_finish_evidence_grid(evidence_grid *grid, int downsample, int
 void carmen_mapper_free_evidence_grid(evidence_grid *grid);
 
 /* vasco_gpu extension: the backend that grids initialised from now on run on
- * ("cpu_double", the default; "cpu_threads"; "cpu_float"; "cuda" (float
- * mode); "cuda_exact"; "auto"). Without a call (or after one with ""), the
+ * ("cpu_double", the default; "cpu_threads"; "cpu_float"; "cuda" or
+ * "cuda_float" (float mode); "cuda_exact"; "auto": the names of the backend
+ * registry, vasco_gpu/backend.h). Every name vasco_egrid_grid_backend
+ * returns is accepted here. Without a call (or after one with ""), the
  * environment variable VASCO_GPU_BACKEND chooses. Returns 0, or -1 for an
  * unknown name.
  *

@@ -1,5 +1,6 @@
-// backend.h — the interface every mapping backend implements, and the
-// factory that picks one by name.
+// backend.h — the mapping backends: their options, their statistics, and the
+// one registry of their names (backend_registry()) that make_renderer
+// (renderer.h), the session APIs, egrid.h and the tools' --backend all read.
 #ifndef VASCO_GPU_BACKEND_H
 #define VASCO_GPU_BACKEND_H
 
@@ -41,6 +42,58 @@ struct BackendOptions {
   uint64_t max_memory_bytes = kDefaultMaxMemoryBytes;  // host memory a Mapper may use (0: no limit)
 };
 
+class Renderer;
+
+// Another name of a backend that also chooses its CUDA mode (cuda_exact, cuda_float).
+struct BackendAlias {
+  const char *name;
+  CudaMode cuda_mode;
+};
+
+// Whether a backend's grid is CARMEN's bytes.
+enum class Exactness { Exact, Float, ByCudaMode };
+
+// One row of the registry: everything the APIs and the tools say about a backend.
+struct BackendInfo {
+  const char *name;                   // what make_renderer takes: cpu_double, ..., auto
+  std::vector<BackendAlias> aliases;  // names that also set BackendOptions::cuda_mode
+  Exactness exactness;
+  bool grid_on_device;
+  bool compiled;        // false: named but not in this build (cuda without nvcc)
+  const char *summary;  // one line, for --backend's help and the docs
+  // Creates the renderer; throws Error(NoGpu) when the backend cannot run here.
+  std::unique_ptr<Renderer> (*make)(const BackendOptions &options);
+};
+
+// Every backend, compiled in or not, in the order the help lists them.
+const std::vector<BackendInfo> &backend_registry();
+
+// The row of a backend name or alias; null when there is none.
+const BackendInfo *find_backend(const std::string &name_or_alias);
+
+// The names make_renderer accepts in this build, "auto" included (it always
+// runs: cuda when a GPU is usable, else cpu_threads).
+std::vector<std::string> compiled_backends();
+
+// The session APIs' names (C API, egrid.h, Python): a name or an alias.
+// Returns the registry's name; an alias sets options->cuda_mode. Throws
+// Error(Usage) for a name that is neither.
+std::string resolve_backend_name(const std::string &name, BackendOptions *options);
+
+// Every name and alias resolve_backend_name accepts, compiled in or not. A
+// session reports its backend (Renderer::name()) as one of them: a CPU name,
+// cuda_float or cuda_exact.
+std::vector<std::string> backend_names();
+
+// The help text of a --backend option: one "name: summary" line per
+// compiled backend.
+std::string backend_help();
+
+// ---------------------------------------------------------------------------
+// Legacy whole-grid interface, kept source-compatible while its last callers
+// move to make_renderer (renderer.h): it applies scans to cells the caller
+// owns. New code drives a Renderer.
+// ---------------------------------------------------------------------------
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -48,12 +101,10 @@ class Backend {
   // Applies scans [first, last) of `batch`, in order, to `cells` (x-major,
   // cells[x * size_y + y], a grid of geometry `geo`), which holds the result
   // of scans [0, first): all unknown (-1) when first == 0. Scan 0 of the
-  // batch fixes CARMEN's start pose whatever `first` is, so for the exact
-  // backends applying 0..k in several calls gives the bytes of one call.
+  // batch fixes CARMEN's start pose whatever `first` is.
   virtual void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
                      const GridGeometry &geo, float *cells, MapStats *stats) = 0;
-  // Applies every scan of `batch` to a fresh evidence grid of geometry `geo`
-  // (all cells unknown) and returns it.
+  // Applies every scan of `batch` to a fresh evidence grid of geometry `geo`.
   virtual std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
                                  const GridGeometry &geo, MapStats *stats) {
     std::vector<float> cells(geo.num_cells(), -1.0f);
@@ -62,21 +113,9 @@ class Backend {
   }
 };
 
-// Backend names accepted by make_backend: cpu_double, cpu_threads, cpu_float,
-// cuda (if compiled in) and auto (cuda when a GPU is usable, else
-// cpu_threads: the oracle's bytes on every core).
-std::vector<std::string> compiled_backends();
-
-// Creates a backend; throws std::invalid_argument for an unknown name and
-// std::runtime_error for `cuda` without a usable GPU (the message says why).
+// A CPU backend of the registry (cpu_double, cpu_threads, cpu_float, or auto
+// without a GPU) as a legacy Backend; throws as make_renderer does.
 std::unique_ptr<Backend> make_backend(const std::string &name, const BackendOptions &options = {});
-
-// A backend name as the session APIs take it (C API, egrid.h): besides
-// make_backend's names, "cuda_exact" and "cuda_float" (what Backend::name()
-// reports) select the CUDA mode. Returns the make_backend name; sets
-// options->cuda_mode for the two aliases.
-std::string resolve_backend_name(const std::string &name, BackendOptions *options);
-
 std::unique_ptr<Backend> make_cpu_double_backend();
 std::unique_ptr<Backend> make_cpu_float_backend();
 

@@ -8,14 +8,14 @@
 #include <memory>
 #include <vector>
 
-#include "vasco_gpu/backend.h"
+#include "vasco_gpu/renderer.h"
 
 namespace vasco {
 
-// threads <= 0: hardware_threads() (parallel.h: the cores this process may use). name() is "cpu_threads".
-std::unique_ptr<Backend> make_cpu_threads_backend(int threads);
+// The renderer is make_renderer("cpu_threads", options): options.threads <= 0
+// means hardware_threads() (parallel.h: the cores this process may use).
 
-// How the last map() call of a cpu_threads backend split its work: the grid
+// How the last apply() of a cpu_threads renderer split its work: the grid
 // is cut into stripes of x columns, each updated by one thread at a time.
 struct CpuThreadsLoad {
   int threads = 0;
@@ -28,9 +28,9 @@ struct CpuThreadsLoad {
   double stripes_s = 0;                   // wall time of the stripe phase
 };
 
-// The load report of `backend`'s last map() call; null when `backend` is not a
-// cpu_threads backend or has not mapped yet.
-const CpuThreadsLoad *cpu_threads_load(const Backend &backend);
+// The load report of `renderer`'s last apply(); null when `renderer` is not a
+// cpu_threads renderer or has not applied scans yet.
+const CpuThreadsLoad *cpu_threads_load(const Renderer &renderer);
 
 }  // namespace vasco
 

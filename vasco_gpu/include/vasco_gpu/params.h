@@ -7,6 +7,7 @@
 #include <tuple>
 #include <vector>
 
+#include "carmen_compat/error.h"
 #include "vasco_gpu/egrid_math.h"
 
 namespace carmen {
@@ -16,7 +17,8 @@ class ParamFile;
 namespace vasco {
 
 struct MapperParams {
-  // vasco's defaults (vegrid.c).
+  // vasco's defaults (vegrid.c); param_table() lists the same values, and
+  // params_test checks that the two agree.
   double resolution = 0.025;  // vasco_resolution, m per cell
   double p_prior = 0.5;       // vasco_p_prior
   double p_occ = 0.55;        // vasco_p_occ
@@ -35,9 +37,9 @@ struct MapperParams {
   // vasco_* keys are appended to `warnings` (typos).
   static MapperParams from_params(const carmen::ParamFile &params, std::vector<std::string> *warnings);
 
-  // Checks the ranges (probabilities strictly between 0 and 1, resolution > 0,
-  // 0 <= range_sure <= range_max, downsample >= 1, border >= 0, ...); throws
-  // std::invalid_argument naming the key.
+  // Checks every value against param_table()'s bounds and the two rules
+  // that join keys (0 <= range_sure <= range_max, range_max / resolution at
+  // most 32767 cells); throws ParamError naming the key.
   void validate() const;
 
   // The sensor model's parameters, in the precision of the update.
@@ -57,6 +59,44 @@ struct MapperParams {
   // Number of distance-table entries per axis: (int)(range_max / resolution).
   int table_size() const;
 };
+
+// A parameter value out of its range: code Usage, and the key (vasco_p_occ)
+// that is wrong. from_params turns it into a FileError at the key's line.
+class ParamError : public carmen::Error {
+ public:
+  ParamError(std::string key, const std::string &message)
+      : carmen::Error(carmen::ErrorCode::Usage, message), key_(std::move(key)) {}
+  const std::string &key() const { return key_; }
+
+ private:
+  std::string key_;
+};
+
+// One vasco_* parameter: the one place its key, member, default, bounds and
+// meaning are written. Exactly one of `real` and `whole` is set.
+struct ParamSpec {
+  const char *key;   // carmen.ini key: vasco_resolution
+  const char *name;  // the member's and the keyword's name: resolution
+  double MapperParams::*real;
+  long MapperParams::*whole;
+  double default_value;  // vasco's default (num_scans: -1, all)
+  double lo, hi;         // bounds of a valid value
+  bool lo_open, hi_open; // whether lo, hi themselves are outside
+  bool minus_one_ok;     // -1 is valid too (num_scans: all)
+  const char *rule;      // the bounds in words, for the error message
+  const char *meaning;   // what it is, with its unit (README's parameter table)
+
+  bool integer() const { return whole != nullptr; }
+  double get(const MapperParams &p) const { return integer() ? static_cast<double>(p.*whole) : p.*real; }
+  void set(MapperParams &p, double v) const;
+  bool valid(double v) const;
+};
+
+// Every parameter, in the README's order.
+const std::vector<ParamSpec> &param_table();
+
+// The row of a key (vasco_p_occ) or a name (p_occ); null when there is none.
+const ParamSpec *find_param(const std::string &key_or_name);
 
 // The names of all keys MapperParams understands (vasco_resolution, ...).
 const std::vector<std::string> &mapper_param_keys();

@@ -60,9 +60,17 @@ class Renderer {
   virtual RendererTraits traits() const = 0;
 };
 
-// The renderer of a backend name (cpu_double, cpu_threads, cpu_float, cuda,
-// auto); throws as make_backend does.
+// The renderer of a backend name or alias (backend_registry(): cpu_double,
+// cpu_threads, cpu_float, cuda, auto; cuda_exact and cuda_float set the CUDA
+// mode). Throws Error(Usage) for an unknown name and Error(NoGpu) for cuda
+// when this build has no CUDA backend or no GPU is usable (the message says
+// why); auto falls back to cpu_threads.
 std::unique_ptr<Renderer> make_renderer(const std::string &backend, const BackendOptions &options = {});
+
+// Every scan of `scans` on a fresh grid of `geo`: reset, apply, and the whole
+// full-resolution grid read back (x-major). What a one-shot map is.
+std::vector<float> render_grid(Renderer &renderer, const ScanBatch &scans, const MapperParams &params,
+                               const GridGeometry &geo, MapStats *stats = nullptr);
 
 }  // namespace vasco
 

@@ -1,0 +1,49 @@
+// host_renderer.h — the base of every CPU backend: a Renderer whose grid is
+// a vector of cells in host memory, which the backend updates in place.
+// Internal to the library (the backends' sources and the registry).
+#ifndef VASCO_GPU_SRC_HOST_RENDERER_H
+#define VASCO_GPU_SRC_HOST_RENDERER_H
+
+#include <string>
+#include <vector>
+
+#include "vasco_gpu/backend.h"
+#include "vasco_gpu/renderer.h"
+
+namespace vasco {
+
+class HostGridRenderer : public Renderer {
+ public:
+  HostGridRenderer(std::string name, bool exact) : name_(std::move(name)), exact_(exact) {}
+
+  std::string name() const override { return name_; }
+  RendererTraits traits() const override { return {exact_, false}; }
+
+  void reset(const GridGeometry &geo, const MapperParams &params) override;
+  void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) override;
+  FinishedMap finish(int downsample, int border) override;
+  std::vector<float> read(const GridWindow &window) override;
+
+  // The backend's update: applies scans [first, last) of `scans` to `cells`
+  // (x-major, a grid of `geo`), which hold the result of scans [0, first);
+  // scan 0 fixes CARMEN's start pose. The grid may be the caller's (the
+  // legacy Backend interface) rather than this renderer's own.
+  virtual void apply_to(const ScanBatch &scans, size_t first, size_t last, const MapperParams &params,
+                        const GridGeometry &geo, float *cells, MapStats *stats) = 0;
+
+ private:
+  std::string name_;
+  bool exact_;
+  GridGeometry geo_;
+  MapperParams params_;
+  std::vector<float> cells_;
+};
+
+// The CPU backends, each in its own source file.
+std::unique_ptr<HostGridRenderer> make_cpu_double_renderer();
+std::unique_ptr<HostGridRenderer> make_cpu_float_renderer();
+std::unique_ptr<HostGridRenderer> make_cpu_threads_renderer(int threads);
+
+}  // namespace vasco
+
+#endif  // VASCO_GPU_SRC_HOST_RENDERER_H
