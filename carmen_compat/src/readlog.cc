@@ -2,7 +2,9 @@
 // two share one implementation of every message format.
 #include "carmen/readlog.h"
 
+#include <atomic>
 #include <climits>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -165,6 +167,95 @@ bool check_args(const void *string, const void *msg) {
   return true;
 }
 
+// The largest index carmen_logfile_index_messages builds (readlog.h).
+std::atomic<int> g_max_messages{CARMEN_LOGFILE_MAX_MESSAGES};
+
+// Message offsets, kept in a malloc()ed array that grows by half again (it
+// becomes the index's array: no copy at the end). One slot more than the
+// count, for the length.
+struct Offsets {
+  off_t *at = nullptr;
+  std::size_t count = 0, capacity = 0;
+  ~Offsets() { std::free(at); }
+  // Room for one more offset after the last.
+  bool room() {
+    if (count < capacity) return true;
+    const std::size_t grown = capacity < 1024 ? 1024 : capacity + capacity / 2;
+    void *p = std::realloc(at, sizeof(off_t) * grown);
+    if (p == nullptr) return false;
+    at = static_cast<off_t *>(p);
+    capacity = grown;
+    return true;
+  }
+  bool push(off_t offset) {
+    if (!room()) return false;
+    at[count++] = offset;
+    return true;
+  }
+};
+
+// As CARMEN: index what could be read, and say what is wrong. A last
+// message cut by the damage is dropped (it would be half a line).
+void note_damage(carmen_FILE *infile, Offsets &offsets, bool after_newline, off_t &total) {
+  const std::string what = infile->compressed ? "corrupt or truncated gzip stream" : "read error";
+  if (!after_newline && offsets.count > 0) total = offsets.at[--offsets.count];
+  set_error(what + " after " + std::to_string(offsets.count) + " messages: the rest of the log is lost");
+  std::fprintf(stderr, "carmen_logfile_index_messages: %s\n", g_last_error.c_str());
+  if (infile->compressed) gzclearerr(infile->comp_fp);
+  else std::clearerr(infile->fp);
+}
+
+// Finds where every message starts (every byte after a '\n' but '\r', as
+// CARMEN), stopping with an error at more than g_max_messages; the length of
+// the stream goes in the slot after the last.
+bool find_messages(carmen_FILE *infile, Offsets &offsets) {
+  const std::size_t limit = static_cast<std::size_t>(g_max_messages.load());
+  std::vector<char> chunk(std::size_t(1) << 20);
+  off_t total = 0;
+  bool after_newline = true;  // the first byte starts a message
+  for (;;) {
+    const std::size_t n = carmen_fread(chunk.data(), 1, chunk.size(), infile);
+    for (std::size_t i = 0; i < n; ++i) {
+      const char c = chunk[i];
+      if (after_newline && c != '\r') {
+        if (offsets.count == limit) {
+          set_error("more than " + std::to_string(limit) +
+                    " messages: over the index's limit (carmen_logfile_set_max_messages raises it)");
+          return false;
+        }
+        if (!offsets.push(total + static_cast<off_t>(i))) {
+          set_error("out of memory");
+          return false;
+        }
+      }
+      after_newline = c == '\n';
+    }
+    total += static_cast<off_t>(n);
+    if (n < chunk.size()) break;
+  }
+  if (carmen_ferror(infile)) note_damage(infile, offsets, after_newline, total);
+  if (!offsets.room()) {  // for the length
+    set_error("out of memory");
+    return false;
+  }
+  offsets.at[offsets.count] = total;
+  return true;
+}
+
+// The index over `offsets`, which hands over its array; NULL when out of memory.
+carmen_logfile_index_t *make_index(Offsets &offsets) {
+  auto *index = static_cast<carmen_logfile_index_t *>(std::calloc(1, sizeof(carmen_logfile_index_t)));
+  if (index == nullptr) {
+    set_error("out of memory");
+    return nullptr;
+  }
+  index->num_messages = static_cast<int>(offsets.count);
+  index->current_position = 0;
+  index->offset = offsets.at;
+  offsets.at = nullptr;
+  return index;
+}
+
 }  // namespace
 
 extern "C" {
@@ -303,56 +394,20 @@ carmen_logfile_index_p carmen_logfile_index_messages(carmen_FILE *infile) {
     set_error("cannot rewind the log");
     return nullptr;
   }
-  std::vector<off_t> offsets;
-  std::vector<char> chunk(std::size_t(1) << 20);
-  off_t total = 0;
-  bool after_newline = true;  // the first byte starts a message
-  for (;;) {
-    const std::size_t n = carmen_fread(chunk.data(), 1, chunk.size(), infile);
-    for (std::size_t i = 0; i < n; ++i) {
-      const char c = chunk[i];
-      if (after_newline && c != '\r') offsets.push_back(total + static_cast<off_t>(i));
-      after_newline = c == '\n';
-    }
-    total += static_cast<off_t>(n);
-    if (n < chunk.size()) break;
-  }
-  if (carmen_ferror(infile)) {
-    // As CARMEN: index what could be read, and say what is wrong. A last
-    // message cut by the damage is dropped (it would be half a line).
-    const std::string what = infile->compressed ? "corrupt or truncated gzip stream" : "read error";
-    if (!after_newline && !offsets.empty()) {
-      total = offsets.back();
-      offsets.pop_back();
-    }
-    set_error(what + " after " + std::to_string(offsets.size()) + " messages: the rest of the log is lost");
-    std::fprintf(stderr, "carmen_logfile_index_messages: %s\n", g_last_error.c_str());
-    if (infile->compressed) gzclearerr(infile->comp_fp);
-    else std::clearerr(infile->fp);
-  }
-  if (offsets.size() >= static_cast<std::size_t>(INT_MAX)) {
-    set_error("too many messages");
-    return nullptr;
-  }
-  auto *index = static_cast<carmen_logfile_index_t *>(std::calloc(1, sizeof(carmen_logfile_index_t)));
-  off_t *off = static_cast<off_t *>(std::malloc(sizeof(off_t) * (offsets.size() + 1)));
-  if (index == nullptr || off == nullptr) {
-    std::free(index);
-    std::free(off);
-    set_error("out of memory");
-    return nullptr;
-  }
-  if (!offsets.empty()) std::memcpy(off, offsets.data(), sizeof(off_t) * offsets.size());
-  off[offsets.size()] = total;
-  index->num_messages = static_cast<int>(offsets.size());
-  index->current_position = 0;
-  index->offset = off;
-  if (carmen_fseek(infile, 0, SEEK_SET) != 0) {
+  Offsets offsets;
+  if (!find_messages(infile, offsets)) return nullptr;
+  carmen_logfile_index_t *index = make_index(offsets);
+  if (index && carmen_fseek(infile, 0, SEEK_SET) != 0) {
     carmen_logfile_free_index(&index);
     set_error("cannot rewind the log");
-    return nullptr;
   }
   return index;
+}
+
+int carmen_logfile_set_max_messages(int max_messages) {
+  const int before = g_max_messages;
+  if (max_messages > 0) g_max_messages = max_messages;
+  return before;
 }
 
 void carmen_logfile_free_index(carmen_logfile_index_p *pindex) {

@@ -51,8 +51,15 @@ typedef struct {
  * truncated gzip stream it indexes, as CARMEN does, the messages read before
  * the damage (a message cut by it is dropped) and reports the damage on
  * stderr and in carmen_readlog_last_error(). NULL for a NULL file, a file
- * that cannot be rewound, or more than INT_MAX messages. */
+ * that cannot be rewound, or more messages than the limit (below; the index
+ * takes 8 bytes a message), reading stopping there. */
 carmen_logfile_index_p carmen_logfile_index_messages(carmen_FILE *infile);
+/* Not in CARMEN: the most messages carmen_logfile_index_messages indexes
+ * (by default CARMEN_LOGFILE_MAX_MESSAGES, 16777216: an index of 128 MiB; a
+ * file of nothing but newlines would otherwise make one of 8 bytes per byte).
+ * Sets it for the process when max_messages > 0; returns the limit before. */
+#define CARMEN_LOGFILE_MAX_MESSAGES 16777216
+int carmen_logfile_set_max_messages(int max_messages);
 /* Frees the index and sets *pindex to NULL. */
 void carmen_logfile_free_index(carmen_logfile_index_p *pindex);
 /* 1 when every message has been read. */
