@@ -1,5 +1,6 @@
 // The mapconvert tool, run as a program.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -120,6 +121,27 @@ TEST_F(MapConvert, BadInputExitsOneNamingTheFile) {
   const ToolRun nogrid = mapconvert({dir.file("nogrid.map"), dir.file("x.pgm")});
   EXPECT_EQ(nogrid.status, 1);
   EXPECT_TRUE(contains(nogrid.output, "GRIDMAP")) << nogrid.output;
+}
+
+// The output must not be the input (by device and inode, however spelled,
+// a .pgm's .yaml included), nor a FIFO: refused before anything is written.
+TEST_F(MapConvert, AnOutputThatIsTheInputOrSpecialIsRefused) {
+  TempDir dir;
+  const std::string in = dir.file("m.map");
+  maptest::write_bytes(in, read_bytes(map_fixture("freiburg.map")));
+  const std::string bytes = read_bytes(in);
+  const ToolRun same = mapconvert({in, dir.path() + "/./m.map"});
+  EXPECT_EQ(same.status, 2) << same.output;
+  EXPECT_TRUE(contains(same.output, "is the input")) << same.output;
+  ASSERT_EQ(::rename(in.c_str(), dir.file("m.yaml").c_str()), 0);
+  const ToolRun yaml = mapconvert({dir.file("m.yaml"), dir.file("m.pgm")});  // m.pgm writes m.yaml
+  EXPECT_EQ(yaml.status, 2) << yaml.output;
+  EXPECT_EQ(read_bytes(dir.file("m.yaml")), bytes);
+  ASSERT_EQ(::mkfifo(dir.file("p.png").c_str(), 0600), 0);
+  const ToolRun fifo = mapconvert({dir.file("m.yaml"), dir.file("p.png")});
+  EXPECT_EQ(fifo.status, 1) << fifo.output;
+  EXPECT_TRUE(contains(fifo.output, "is a FIFO")) << fifo.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"m.yaml", "p.png"}));
 }
 
 }  // namespace

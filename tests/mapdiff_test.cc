@@ -1,6 +1,7 @@
 // The mapdiff tool, run as a program, and the grid comparison behind it.
 #include <gtest/gtest.h>
 #include <png.h>
+#include <sys/stat.h>
 
 #include <cstring>
 #include <optional>
@@ -117,12 +118,52 @@ TEST_F(MapDiff, IdenticalMaps) {
   const ToolRun quiet = mapdiff({"--quiet", a_, dir_.file("b.map.gz")});
   EXPECT_EQ(quiet.status, 0);
   EXPECT_EQ(quiet.output, "identical\n");
-  // The OFFSET chunk is not part of the GRIDMAP: a moved origin alone is noted, not judged.
+  // A map without an OFFSET chunk says nothing about where it lies: still identical.
   write_grid(dir_.file("moved.map"), base_grid(), GlobalOffset{1, 2, 0});
   const ToolRun moved = mapdiff({a_, dir_.file("moved.map")});
   EXPECT_EQ(moved.status, 0) << moved.output;
   EXPECT_TRUE(contains(moved.output, "offset x 1 y 2 theta 0\n")) << moved.output;
   EXPECT_TRUE(contains(moved.output, "note: the OFFSET chunks differ\n")) << moved.output;
+}
+
+// The same GRIDMAP 1.9e8 m away is another map, unless --no-offset.
+TEST_F(MapDiff, IdenticalGridsWithOtherOffsetsDiffer) {
+  write_grid(dir_.file("here.map"), base_grid(), GlobalOffset{0, 0, 0});
+  write_grid(dir_.file("there.map"), base_grid(), GlobalOffset{1.9e8, 0, 0});
+  const ToolRun r = mapdiff({dir_.file("here.map"), dir_.file("there.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "verdict: different: identical GRIDMAPs at other places")) << r.output;
+  EXPECT_EQ(mapdiff({"--tolerance", "0.5", dir_.file("here.map"), dir_.file("there.map")}).status, 1);
+  const ToolRun ignored = mapdiff({"--no-offset", dir_.file("here.map"), dir_.file("there.map")});
+  EXPECT_EQ(ignored.status, 0) << ignored.output;
+  EXPECT_TRUE(contains(ignored.output, "verdict: identical\n")) << ignored.output;
+}
+
+// --png must name a new or regular file that is neither input: an empty
+// name, an input spelled another way, a FIFO and a link to a device are
+// refused before anything is written, and left as they were.
+TEST_F(MapDiff, PngTargetsThatMustNotBeReplacedAreRefused) {
+  const std::string a_bytes = maptest::read_bytes(a_);
+  ASSERT_EQ(::mkfifo(dir_.file("pipe.png").c_str(), 0600), 0);
+  ASSERT_EQ(::symlink("/dev/null", dir_.file("null.png").c_str()), 0);
+  const std::vector<std::string> before = dir_.entries();
+  const ToolRun empty = mapdiff({"--png", "", a_, a_});
+  EXPECT_EQ(empty.status, 2);
+  EXPECT_TRUE(contains(empty.output, "--png needs a file name")) << empty.output;
+  const ToolRun input = mapdiff({"--png", dir_.path() + "/./a.map", a_, a_});
+  EXPECT_EQ(input.status, 2);
+  EXPECT_TRUE(contains(input.output, "is the input")) << input.output;
+  const ToolRun fifo = mapdiff({"--png", dir_.file("pipe.png"), a_, a_});
+  EXPECT_EQ(fifo.status, 2);
+  EXPECT_TRUE(contains(fifo.output, "is a FIFO")) << fifo.output;
+  const ToolRun dev = mapdiff({"--png", dir_.file("null.png"), a_, a_});
+  EXPECT_EQ(dev.status, 2);
+  EXPECT_TRUE(contains(dev.output, "is a character device")) << dev.output;
+  EXPECT_EQ(maptest::read_bytes(a_), a_bytes);
+  EXPECT_EQ(dir_.entries(), before);
+  struct stat st;
+  ASSERT_EQ(::lstat(dir_.file("null.png").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISLNK(st.st_mode));
 }
 
 TEST_F(MapDiff, OneCellChanged) {

@@ -17,6 +17,8 @@
 #include "carmen_compat/error.h"
 #include "carmen_compat/image_io.h"
 #include "carmen_compat/map_file.h"
+#include "carmen_compat/map_format.h"
+#include "cli_support.h"
 
 namespace {
 
@@ -41,18 +43,14 @@ int usage_error(const std::string &msg) {
   return 2;
 }
 
-bool ends_with(const std::string &s, const char *suffix) {
-  const size_t n = std::strlen(suffix);
-  return s.size() >= n && s.compare(s.size() - n, n, suffix) == 0;
-}
-
 enum class OutKind { None, Map, Pgm, Png };
 
+// By the map-format table's rule (file_names.h: the extension, any case).
 OutKind kind_of(const std::string &path) {
-  if (ends_with(path, ".map") || ends_with(path, ".map.gz")) return OutKind::Map;
-  if (ends_with(path, ".pgm")) return OutKind::Pgm;
-  if (ends_with(path, ".png")) return OutKind::Png;
-  return OutKind::None;
+  const carmen::MapFormatEntry *f = carmen::find_map_format(path);
+  if (f == nullptr) return OutKind::None;
+  if (f->format == carmen::MapFormat::PgmYaml) return OutKind::Pgm;
+  return f->format == carmen::MapFormat::Png ? OutKind::Png : OutKind::Map;
 }
 
 std::string quoted(const std::string &s) { return "\"" + s + "\""; }
@@ -202,6 +200,9 @@ int main(int argc, char **argv) {
   OutKind kind = OutKind::None;
   if (const int rc = check_args(a, &kind)) return rc;
   try {
+    // The output (and a .pgm's .yaml) is checked before the map is read: it
+    // must be replaceable and must not be the input.
+    if (!a.info) cli::check_outputs({a.files[0]}, carmen::map_output_files(a.files[1]));
     const carmen::MapFile m = carmen::read_map_file(a.files[0]);
     if (a.info) {
       print_info(a.files[0], m);
@@ -209,8 +210,9 @@ int main(int argc, char **argv) {
       convert(a.files[0], m, a.files[1], kind, a.mode);
     }
     return 0;
-  } catch (const carmen::FileError &e) {
+  } catch (const carmen::Error &e) {  // names the file itself
     std::fprintf(stderr, "mapconvert: %s\n", e.what());
+    return cli::exit_status(e);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "mapconvert: %s: %s\n", a.files[0].c_str(), e.what());
   }

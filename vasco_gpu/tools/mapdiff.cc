@@ -7,8 +7,6 @@
 // Exit 0 same (or within tolerance), 1 different, 2 usage error or a file
 // that cannot be read (or the --png picture cannot be written). A regression
 // suite can then tell "the map changed" (1) from "the check broke" (2).
-#include <png.h>
-
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cmath>
@@ -23,7 +21,9 @@
 
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
+#include "carmen_compat/image_io.h"
 #include "carmen_compat/map_file.h"
+#include "cli_support.h"
 #include "vasco_gpu/compare.h"
 #include "vasco_gpu/map_digest.h"
 #include "vasco_gpu/version.h"
@@ -37,6 +37,7 @@ struct Options {
   long long max_status_differs = 0;
   double min_class_agreement = 1.0;
   bool quiet = false, json = false, no_offset = false;
+  bool png_given = false;    // --png was given (an empty name is refused, not ignored)
   bool tolerant = false;     // a tolerance option was given: judge by the limits
   bool class_limit = false;  // --min-class-agreement was given
 };
@@ -164,11 +165,27 @@ std::vector<std::string> tolerance_failures(const vasco::GridComparison &c, cons
   return f;
 }
 
+// Identical GRIDMAPs placed apart in the world are different maps, unless
+// told to ignore the OFFSET chunks (a map without one says nothing).
+bool offsets_conflict(const Input &a, const Input &b, const Options &o) {
+  return !o.no_offset && a.offset && b.offset && !same_offset(a.offset, b.offset);
+}
+
+std::string offset_text(const std::optional<carmen::GlobalOffset> &o) {
+  if (!o) return "none";
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "x %.9g y %.9g theta %.9g", o->x, o->y, o->theta);
+  return buf;
+}
+
 Verdict judge(const Input &a, const Input &b, bool identical, const Alignment &al,
               const vasco::GridComparison &c, const Options &o) {
   if (!al.compared)
     return {1, "different: resolution " + fmt("%.9g", a.grid.resolution) + " m vs " +
                    fmt("%.9g", b.grid.resolution) + " m (cells not compared)"};
+  if (identical && offsets_conflict(a, b, o))
+    return {1, "different: identical GRIDMAPs at other places: OFFSET " + offset_text(a.offset) + " vs " +
+                   offset_text(b.offset) + " (--no-offset ignores it)"};
   if (identical) return {0, "identical"};
   if (!o.tolerant) return {1, "different: " + summary(c)};
   const std::vector<std::string> f = tolerance_failures(c, o);
@@ -182,12 +199,6 @@ Verdict judge(const Input &a, const Input &b, bool identical, const Alignment &a
 // Text report
 // ---------------------------------------------------------------------------
 
-std::string offset_text(const std::optional<carmen::GlobalOffset> &o) {
-  if (!o) return "none";
-  char buf[128];
-  std::snprintf(buf, sizeof buf, "x %.9g y %.9g theta %.9g", o->x, o->y, o->theta);
-  return buf;
-}
 
 void print_input(const char *label, const Input &in) {
   std::printf("%s: %s\n   size %d x %d cells, resolution %.9g m, offset %s\n   GRIDMAP sha256 %s\n", label,
@@ -246,22 +257,7 @@ void print_text(const Input &a, const Input &b, bool identical, const Alignment 
 // JSON report
 // ---------------------------------------------------------------------------
 
-std::string json_string(const std::string &s) {
-  std::string out = "\"";
-  for (unsigned char ch : s) {
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += char(ch);
-    } else if (ch < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", ch);
-      out += buf;
-    } else {
-      out += char(ch);
-    }
-  }
-  return out + "\"";
-}
+using cli::json_string;
 
 // JSON has no NaN or infinity.
 std::string json_number(double v, const char *format = "%.17g") {
@@ -322,27 +318,6 @@ void print_json(const Input &a, const Input &b, bool identical, const Alignment 
 // The picture
 // ---------------------------------------------------------------------------
 
-// The project's write_png is greyscale only; this is its RGB twin, atomic in
-// the same way (temp file beside the target, renamed over it; removed on any
-// failure, so a failed run leaves nothing behind).
-void write_rgb_png(const std::string &path, int width, int height, const std::vector<uint8_t> &rgb) {
-  carmen::AtomicOutput out(path);
-  FILE *f = out.take_stdio();
-  png_image image;
-  std::memset(&image, 0, sizeof image);
-  image.version = PNG_IMAGE_VERSION;
-  image.width = static_cast<png_uint_32>(width);
-  image.height = static_cast<png_uint_32>(height);
-  image.format = PNG_FORMAT_RGB;
-  const int ok = png_image_write_to_stdio(&image, f, 0, rgb.data(), static_cast<png_int_32>(3 * width), nullptr);
-  const std::string message = ok ? std::string() : std::string(image.message);
-  png_image_free(&image);
-  const bool closed = std::fclose(f) == 0;
-  if (!ok) throw carmen::FileError(path, "PNG write failed: " + message);
-  if (!closed) throw carmen::FileError(path, std::string("write failed: ") + std::strerror(errno));
-  out.commit();
-}
-
 // Writes the picture of the overlap; false (and a note) when there is none.
 bool write_picture(const std::string &path, const Input &a, const Input &b, const Alignment &al,
                    const vasco::GridComparison &c) {
@@ -351,7 +326,7 @@ bool write_picture(const std::string &path, const Input &a, const Input &b, cons
     std::fprintf(stderr, "mapdiff: %s: not written: %s\n", path.c_str(), why);
     return false;
   }
-  write_rgb_png(path, c.width, c.height, vasco::difference_image_rgb(a.grid, b.grid, c));
+  carmen::write_rgb_png(path, c.width, c.height, vasco::difference_image_rgb(a.grid, b.grid, c));
   return true;
 }
 
@@ -365,7 +340,8 @@ const char kFooter[] =
     "cells apart, B is laid on A by it; otherwise at cell (0, 0). Only the overlap\n"
     "is compared; cells outside it count as differing.\n"
     "Same: without tolerance options, equal size and resolution and bit-identical\n"
-    "cells. With any of --tolerance, --max-status-differs, --min-class-agreement:\n"
+    "cells, and equal OFFSET chunks where both maps have one (unless --no-offset).\n"
+    "With any of --tolerance, --max-status-differs, --min-class-agreement:\n"
     "within every limit (an unset --tolerance or --max-status-differs is 0).\n"
     "PNG: the overlap, y up; A in grey (white free, black occupied, grey unknown);\n"
     "red B higher, blue B lower (pale |dp| <= 1e-6 .. full |dp| >= 1, log scale);\n"
@@ -389,7 +365,8 @@ void add_options(CLI::App &app, Options &o) {
                  "e.g. 0.999 (default: not checked)")
       ->type_name("FRAC")->check(CLI::Range(0.0, 1.0));
   app.add_option("--png", o.png, "write a picture of the differences")->type_name("FILE");
-  app.add_flag("--no-offset", o.no_offset, "ignore OFFSET chunks: align at cell (0, 0)");
+  app.add_flag("--no-offset", o.no_offset,
+               "ignore OFFSET chunks: align at cell (0, 0), and identical GRIDMAPs are identical wherever they lie");
   app.add_flag("--quiet,-q", o.quiet, "print the verdict line only");
   app.add_flag("--json", o.json, "print the report as one JSON object (not with --quiet)");
   app.footer(kFooter);
@@ -410,8 +387,9 @@ int parse(int argc, char **argv, Options &o) {
     std::fprintf(stderr, "mapdiff: --quiet and --json exclude each other\nRun 'mapdiff --help' for usage.\n");
     return 2;
   }
-  if (!o.png.empty() && (o.png == o.a || o.png == o.b)) {
-    std::fprintf(stderr, "mapdiff: --png %s would overwrite an input map\n", o.png.c_str());
+  o.png_given = app.count("--png") > 0;
+  if (o.png_given && o.png.empty()) {
+    std::fprintf(stderr, "mapdiff: --png needs a file name\nRun 'mapdiff --help' for usage.\n");
     return 2;
   }
   o.class_limit = app.count("--min-class-agreement") > 0;
@@ -420,7 +398,9 @@ int parse(int argc, char **argv, Options &o) {
 }
 
 int run(const Options &o) {
-  // Both maps are read before anything is written: a bad input leaves no picture.
+  // The picture's file is checked, and both maps read, before anything is
+  // written: a bad input or target leaves no picture.
+  if (o.png_given) cli::check_outputs({o.a, o.b}, {o.png});
   const Input a = load(o.a);
   const Input b = load(o.b);
   const bool identical = identical_grids(a.grid, b.grid);
