@@ -1,22 +1,97 @@
 // vasco::Mapper on the GPU: the CUDA renderer keeps grid, ranges and scratch
 // on the device. Exact mode: inserts in pieces and renders with new poses
 // equal cpu_double bit for bit; both modes: the finish on the device equals
-// CARMEN's finish of the grid read back. Skips without a GPU.
+// CARMEN's finish of the grid read back, a refused insert or render changes
+// nothing, a renderer given a stream works on it and leaves it alive. Skips
+// without a GPU.
 #include <gtest/gtest.h>
 
+#include <climits>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <random>
+
+#if defined(VASCO_HAVE_CUDA)
+#include <cuda_runtime.h>
+#endif
 
 #include "golden_support.h"
 #include "test_seed.h"
 #include "test_support.h"
+#include "vasco_gpu/error.h"
 #include "vasco_gpu/mapper.hpp"
 
 namespace vasco {
 namespace {
 
 using testing_support::bundled_log;
+
+#if defined(VASCO_HAVE_CUDA)
+// Takes all but `leave` bytes of the GPU's free memory while it lives, so
+// that a grown frame cannot fit.
+class GpuMemoryHog {
+ public:
+  explicit GpuMemoryHog(size_t leave) {
+    size_t free_b = 0, total_b = 0;
+    if (cudaMemGetInfo(&free_b, &total_b) != cudaSuccess || free_b <= leave) return;
+    if (cudaMalloc(&ptr_, free_b - leave) != cudaSuccess) {
+      ptr_ = nullptr;
+      cudaGetLastError();  // clear it: the renderer's next call must not see it
+    }
+  }
+  ~GpuMemoryHog() {
+    if (ptr_ != nullptr) cudaFree(ptr_);
+  }
+  GpuMemoryHog(const GpuMemoryHog &) = delete;
+  GpuMemoryHog &operator=(const GpuMemoryHog &) = delete;
+  bool holding() const { return ptr_ != nullptr; }
+
+ private:
+  void *ptr_ = nullptr;
+};
+#endif
+
+// What a session shows of itself: the scans, frame, poses, grid and finished map.
+struct SessionView {
+  size_t scans = 0;
+  GridGeometry frame;
+  std::vector<Pose> poses;
+  std::vector<float> grid;
+  std::string finished;
+};
+
+SessionView view_of(const Mapper &m) {
+  return {m.num_scans(), m.frame(), m.poses(), m.read(), golden::digest(m.finish(4, 20))};
+}
+
+void expect_same_session(const SessionView &before, const Mapper &m, const std::string &what) {
+  SCOPED_TRACE(what);
+  const SessionView now = view_of(m);
+  EXPECT_EQ(now.scans, before.scans);
+  EXPECT_EQ(now.frame.size_x, before.frame.size_x);
+  EXPECT_EQ(now.frame.size_y, before.frame.size_y);
+  EXPECT_EQ(now.frame.x0, before.frame.x0);
+  EXPECT_EQ(now.frame.y0, before.frame.y0);
+  ASSERT_EQ(now.poses.size(), before.poses.size());
+  for (size_t i = 0; i < now.poses.size(); ++i) {
+    EXPECT_EQ(now.poses[i].x, before.poses[i].x) << "pose " << i;
+    EXPECT_EQ(now.poses[i].y, before.poses[i].y) << "pose " << i;
+    EXPECT_EQ(now.poses[i].theta, before.poses[i].theta) << "pose " << i;
+  }
+  EXPECT_EQ(now.finished, before.finished);
+  testing_support::expect_bit_identical(before.grid, now.grid, before.frame, what);
+}
+
+// `call` must throw vasco::Error with `code`.
+void expect_error(ErrorCode code, const std::function<void()> &call, const std::string &what) {
+  try {
+    call();
+    ADD_FAILURE() << what << " was accepted";
+  } catch (const Error &e) {
+    EXPECT_EQ(e.code(), code) << what << ": " << e.what();
+  }
+}
 
 class MapperCuda : public ::testing::Test {
  protected:
@@ -155,13 +230,104 @@ TEST_F(MapperCuda, FloatRefusesBeamsPastItsFixedPointRangeAndChangesNothing) {
   try {
     m.insert(many);
     FAIL() << "inserting " << many.num_beams() << " beams of evidence 0.999999 was accepted";
-  } catch (const std::runtime_error &e) {
+  } catch (const Error &e) {
+    EXPECT_EQ(e.code(), ErrorCode::TooLarge) << e.what();
     EXPECT_NE(std::string(e.what()).find("fixed-point range"), std::string::npos) << e.what();
   }
   EXPECT_EQ(m.poses().size(), poses.size());
   testing_support::expect_bit_identical(before, m.read(), m.frame(), "after the refused insert");
   m.render(poses);  // still renders
   testing_support::expect_bit_identical(before, m.read(), m.frame(), "after a render");
+}
+
+// A frame grown beyond the GPU's free memory is refused by the renderer's
+// reset before it changes anything: the session keeps its scans, frame,
+// poses, grid and finished map, in both modes and for insert and render
+// alike, and its later inserts give the bytes of a session that never saw
+// the refused calls.
+TEST_F(MapperCuda, RefusedGrowthChangesNothingInEitherMode) {
+#if defined(VASCO_HAVE_CUDA)
+  for (CudaMode md : {CudaMode::Float, CudaMode::Exact}) {
+    SCOPED_TRACE(md == CudaMode::Float ? "float" : "exact");
+    Mapper m(params_, "cuda", mode(md));
+    m.insert(scans_.select(0, 100));
+    const SessionView before = view_of(m);
+    // 150 m away in x and y: a frame of about 12,800^2 cells (650 MB exact,
+    // 1.3 GB float), more than the 512 MiB left free.
+    ScanBatch far;
+    far.add_scan(scans_.x[0] + 150, scans_.y[0] + 150, scans_.theta[0], scans_.first_angle[0],
+                 scans_.angle_step[0], scans_.ranges_of(0), scans_.beams_in(0), 1);
+    std::vector<Pose> moved = m.poses();
+    moved.back().x += 150;
+    moved.back().y += 150;
+    {
+      GpuMemoryHog hog(size_t(512) << 20);
+      ASSERT_TRUE(hog.holding());
+      expect_error(ErrorCode::OutOfMemory, [&] { m.insert(far); }, "an insert needing a grown frame");
+      expect_same_session(before, m, "after the refused insert");
+      expect_error(ErrorCode::OutOfMemory, [&] { m.render(moved); }, "a render needing a grown frame");
+      expect_same_session(before, m, "after the refused render");
+    }
+    m.insert(scans_.select(100, 100));
+    Mapper clean(params_, "cuda", mode(md));
+    clean.insert(scans_.select(0, 100));
+    clean.insert(scans_.select(100, 100));
+    expect_same_session(view_of(clean), m, "later inserts");
+  }
+#endif
+}
+
+// A border beyond the grid keeps every block (CARMEN's int arithmetic would
+// overflow near INT_MAX): the same map as the host's finish with a border
+// that just clamps to the grid.
+TEST_F(MapperCuda, FinishWithAHugeBorderKeepsTheWholeGrid) {
+  for (CudaMode md : {CudaMode::Float, CudaMode::Exact}) {
+    Mapper m(params_, "cuda", mode(md));
+    m.insert(scans_.select(0, 100));
+    const std::vector<float> grid = m.read();
+    const GridGeometry &g = m.frame();
+    const FinishedMap host = finish_grid(grid.data(), g.size_x, g.size_y, g.resolution, 4, g.size_x + g.size_y);
+    ASSERT_EQ(host.min_x, 0);
+    ASSERT_EQ(host.size_x, g.size_x / 4 - 1);
+    for (int border : {g.size_x + g.size_y, 1 << 30, INT_MAX - 1, INT_MAX}) {
+      const FinishedMap dev = m.finish(4, border);
+      EXPECT_EQ(dev.min_x, 0) << border;
+      EXPECT_EQ(dev.min_y, 0) << border;
+      EXPECT_EQ(golden::digest(dev), golden::digest(host)) << m.backend_name() << " border " << border;
+    }
+  }
+}
+
+// nvblox's injected streams: a renderer given a stream maps on it (the same
+// bytes as one with its own) and leaves it alive; before its first reset it
+// has no grid to read (a State error, not a read of nothing).
+TEST_F(MapperCuda, RendererOnTheCallersStreamLeavesItAlive) {
+#if defined(VASCO_HAVE_CUDA)
+  const GridGeometry geo = size_grid(scans_, params_);
+  for (CudaMode md : {CudaMode::Float, CudaMode::Exact}) {
+    cudaStream_t stream = nullptr;
+    ASSERT_EQ(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking), cudaSuccess);
+    std::vector<float> on_theirs, on_own;
+    {
+      std::unique_ptr<Renderer> theirs = make_cuda_renderer(mode(md), stream);
+      expect_error(ErrorCode::State, [&] { theirs->read(GridWindow{0, 0, 1, 1}); }, "a read before any reset");
+      theirs->reset(geo, params_);
+      theirs->apply(scans_, 0, scans_.num_scans(), nullptr);
+      on_theirs = theirs->read(GridWindow{0, 0, geo.size_x, geo.size_y});
+    }
+    std::unique_ptr<Renderer> own = make_cuda_renderer(mode(md));
+    own->reset(geo, params_);
+    own->apply(scans_, 0, scans_.num_scans(), nullptr);
+    on_own = own->read(GridWindow{0, 0, geo.size_x, geo.size_y});
+    testing_support::expect_bit_identical(on_own, on_theirs, geo, "the caller's stream");
+    void *probe = nullptr;
+    ASSERT_EQ(cudaMalloc(&probe, 64), cudaSuccess);
+    EXPECT_EQ(cudaMemsetAsync(probe, 0, 64, stream), cudaSuccess) << "the renderer destroyed the caller's stream";
+    EXPECT_EQ(cudaStreamSynchronize(stream), cudaSuccess);
+    cudaFree(probe);
+    cudaStreamDestroy(stream);
+  }
+#endif
 }
 
 }  // namespace
