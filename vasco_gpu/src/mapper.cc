@@ -40,6 +40,16 @@ void check_poses(const std::vector<Pose> &poses) {
       throw Error(ErrorCode::BadInput, "Mapper::render: pose " + std::to_string(s) + " is not finite");
 }
 
+// A renderer keeps per-thread scratch: a count far beyond any machine's cores
+// would exhaust memory inside an insert, so it is refused up front.
+constexpr int kMaxThreads = 4096;
+
+void check_threads(int threads) {
+  if (threads < 0 || threads > kMaxThreads)
+    throw Error(ErrorCode::Usage, "Mapper: threads = " + std::to_string(threads) + " is outside 0 (all cores) .. " +
+                                      std::to_string(kMaxThreads));
+}
+
 // One axis of a grown PROTOCOL frame: as wide as needed, and at least half
 // as wide again as now (sizes are 2 * half + 2), in 64 bits.
 int64_t grown_size(int need, int current) {
@@ -59,11 +69,12 @@ double memory_need(const GridGeometry &geo, uint64_t beams, bool grid_on_device)
 }  // namespace
 
 Mapper::Mapper(const MapperParams &params, const std::string &backend, const BackendOptions &options)
-    : Mapper(params, make_renderer(backend, options), options) {}
+    : Mapper(params, (check_threads(options.threads), make_renderer(backend, options)), options) {}
 
 Mapper::Mapper(const MapperParams &params, std::unique_ptr<Renderer> renderer, const BackendOptions &options)
     : params_(params), options_(options), renderer_(std::move(renderer)) {
   if (!renderer_) throw Error(ErrorCode::Usage, "Mapper: no renderer");
+  check_threads(options.threads);
   params_.validate();
 }
 

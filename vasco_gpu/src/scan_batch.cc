@@ -55,7 +55,7 @@ void ScanBatch::validate() const {
   check_length("angle_step", angle_step.size(), n);
   check_length("line", line.size(), n);
   if (beam_offset.size() != n + 1)
-    bad_scan(std::min(beam_offset.size(), n), "beam_offset has " + std::to_string(beam_offset.size()) +
+    bad_scan(beam_offset.empty() ? 0 : std::min(beam_offset.size() - 1, n), "beam_offset has " + std::to_string(beam_offset.size()) +
                                                   " entries for " + std::to_string(n) + " scans (needs n + 1)");
   if (beam_offset[0] != 0) bad_scan(0, "beam_offset[0] is " + std::to_string(beam_offset[0]) + ", not 0");
   for (size_t s = 0; s < n; ++s) {

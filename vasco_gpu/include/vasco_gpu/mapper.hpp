@@ -63,7 +63,8 @@ namespace vasco {
 class Mapper {
  public:
   // PROTOCOL frame. Throws for bad parameters or an unknown backend, and when
-  // the backend cannot run here (the registry's errors).
+  // the backend cannot run here (the registry's errors); Error(Usage) for
+  // options.threads outside 0 (all cores) .. 4096.
   Mapper(const MapperParams &params, const std::string &backend = "cpu_double",
          const BackendOptions &options = {});
   // Fixed frame: `frame.size_x`, `size_y`, `resolution` (must equal
