@@ -15,6 +15,7 @@
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/log_reader.h"
+#include "temp_dir.h"
 
 namespace {
 
@@ -83,27 +84,6 @@ class PipedStdin {
  private:
   int saved_ = -1;
   std::thread writer_;
-};
-
-// A temporary directory for FIFOs and files, removed at the end.
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/log_reader_input_test_XXXXXX";
-    if (const char *d = mkdtemp(tmpl)) path_ = d;
-  }
-  ~TempDir() {
-    for (const auto &f : files_) std::remove(f.c_str());
-    rmdir(path_.c_str());
-  }
-  std::string file(const std::string &name) {
-    files_.push_back(path_ + "/" + name);
-    return files_.back();
-  }
-
- private:
-  std::string path_;
-  std::vector<std::string> files_;
 };
 
 TEST(LogReaderInput, DashReadsStandardInput) {

@@ -1,6 +1,7 @@
 // Tests of the streaming CARMEN log reader (carmen_compat/log_reader.h).
 #include "test_seed.h"
 #include "carmen_compat/log_reader.h"
+#include "temp_dir.h"
 
 #include <dirent.h>
 #include <gtest/gtest.h>
@@ -43,28 +44,6 @@ bool is_dir(const std::string &p) {
   struct stat st;
   return stat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
 }
-
-// A temporary directory removed (with its files) at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/log_reader_test_XXXXXX";
-    const char *d = mkdtemp(tmpl);
-    if (d) path_ = d;
-  }
-  ~TempDir() {
-    for (const auto &f : files_) std::remove(f.c_str());
-    if (!path_.empty()) rmdir(path_.c_str());
-  }
-  std::string file(const std::string &name) {
-    files_.push_back(path_ + "/" + name);
-    return files_.back();
-  }
-
- private:
-  std::string path_;
-  std::vector<std::string> files_;
-};
 
 std::string read_file(const std::string &path) {
   std::ifstream in(path, std::ios::binary);
