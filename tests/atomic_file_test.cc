@@ -22,6 +22,7 @@
 
 #include "carmen_compat/error.h"
 #include "map_test_support.h"
+#include "sticky_dir.h"
 
 namespace {
 
@@ -406,10 +407,8 @@ TEST(MapCheckReplaceable, AMountPointIsRefused) {
 TEST(MapCheckReplaceable, AnotherUsersFileInAStickyDirectoryIsRefused) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root to make a file of another user";
   TempDir dir;
-  ASSERT_EQ(::chmod(dir.path().c_str(), 0755), 0);
-  const std::string sticky = dir.file("tmp");
-  ASSERT_EQ(::mkdir(sticky.c_str(), 0777), 0);
-  ASSERT_EQ(::chmod(sticky.c_str(), 01777), 0);
+  const std::string sticky = maptest::make_sticky_directory(dir);
+  ASSERT_FALSE(sticky.empty());
   write_text(sticky + "/theirs.png", "root's");
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);

@@ -14,6 +14,7 @@
 
 #include "carmen_compat/map_file.h"
 #include "map_test_support.h"
+#include "sticky_dir.h"
 #include "tool_support.h"
 #include "test_support.h"
 
@@ -277,15 +278,6 @@ TEST(Log2Map, SmallDefectsGiveClearErrors) {
   EXPECT_TRUE(dir.entries().empty());
 }
 
-TEST(Log2Map, JsonToAFullStdoutFails) {
-  TempDir dir;
-  const std::string cmd = tooltest::quote(std::string(VASCO_BIN_DIR) + "/log2map") + " --json --quiet " +
-                          tooltest::quote(kIntel) + " " + tooltest::quote(dir.file("a.map")) +
-                          " > /dev/full 2>/dev/null";
-  const int st = std::system(cmd.c_str());
-  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << st;
-}
-
 // A hostile file's escape sequences reach the terminal escaped.
 TEST(Log2Map, EscapeCodesFromAFileAreNotEchoedRaw) {
   TempDir dir;
@@ -361,10 +353,8 @@ TEST(Log2Map, SpecialFilesAreNeverReplaced) {
 TEST(Log2Map, AnotherUsersFileInAStickyDirectoryTouchesNoOutput) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root to make a file of another user";
   TempDir dir;
-  ASSERT_EQ(::chmod(dir.path().c_str(), 0755), 0);
-  const std::string sticky = dir.file("tmp");
-  ASSERT_EQ(::mkdir(sticky.c_str(), 0777), 0);
-  ASSERT_EQ(::chmod(sticky.c_str(), 01777), 0);
+  const std::string sticky = maptest::make_sticky_directory(dir);
+  ASSERT_FALSE(sticky.empty());
   write_text(dir, "tmp/theirs.png", "root's");
   write_text(dir, "tmp/mine.map", "old map");
   ASSERT_EQ(::chown((sticky + "/mine.map").c_str(), 65534, 65534), 0);
@@ -398,27 +388,32 @@ TEST(Log2Map, MaxMemoryOutOfRangeIsAUsageError) {
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"a.map"}));
 }
 
+// Runs log2map --json on intel into dir/a.map with standard output as
+// `redirect` says; its exit status, and its stderr in *err.
+int log2map_json_to(const TempDir &dir, const std::string &redirect, std::string *err) {
+  const std::string cmd = tooltest::quote(std::string(VASCO_BIN_DIR) + "/log2map") + " --json --quiet " +
+                          tooltest::quote(kIntel) + " " + tooltest::quote(dir.file("a.map")) + " " + redirect +
+                          " 2>" + tooltest::quote(dir.file("err.txt"));
+  const int st = std::system(cmd.c_str());
+  *err = read_all(dir.file("err.txt"));
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
 // --json with standard output closed: refused before the maps are made.
 TEST(Log2Map, JsonToAClosedStdoutFailsBeforeAnyWork) {
   TempDir dir;
-  const std::string cmd = tooltest::quote(std::string(VASCO_BIN_DIR) + "/log2map") + " --json --quiet " +
-                          tooltest::quote(kIntel) + " " + tooltest::quote(dir.file("a.map")) + " >&- 2>" +
-                          tooltest::quote(dir.file("err.txt"));
-  const int st = std::system(cmd.c_str());
-  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << st;
-  EXPECT_TRUE(contains(read_all(dir.file("err.txt")), "standard output is closed")) << read_all(dir.file("err.txt"));
+  std::string err;
+  EXPECT_EQ(log2map_json_to(dir, ">&-", &err), 1);
+  EXPECT_TRUE(contains(err, "standard output is closed")) << err;
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"err.txt"}));
 }
 
 // A full stdout is seen only once the maps are written: the message says so.
 TEST(Log2Map, JsonToAFullStdoutSaysTheMapsWereWritten) {
   TempDir dir;
-  const std::string cmd = tooltest::quote(std::string(VASCO_BIN_DIR) + "/log2map") + " --json --quiet " +
-                          tooltest::quote(kIntel) + " " + tooltest::quote(dir.file("a.map")) + " >/dev/full 2>" +
-                          tooltest::quote(dir.file("err.txt"));
-  const int st = std::system(cmd.c_str());
-  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 1) << st;
-  EXPECT_TRUE(contains(read_all(dir.file("err.txt")), "the maps were written")) << read_all(dir.file("err.txt"));
+  std::string err;
+  EXPECT_EQ(log2map_json_to(dir, ">/dev/full", &err), 1);
+  EXPECT_TRUE(contains(err, "the maps were written")) << err;
 }
 
 }  // namespace
