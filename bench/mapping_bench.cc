@@ -109,6 +109,7 @@ void record(Phases *ph, const vasco::MapStats &st, bool gpu, double t0, double t
   ph->stats = st;
 }
 
+#if defined(VASCO_HAVE_CUDA)
 // One timed run of a GPU map alone (the paper's kernels, which only map whole
 // batches, and ours for comparison): `map` fills the grid, then finish, write.
 void run_once(const std::function<std::vector<float>(vasco::MapStats *)> &map, const vasco::MapperParams &p,
@@ -123,6 +124,7 @@ void run_once(const std::function<std::vector<float>(vasco::MapStats *)> &map, c
   write_and_discard(fin);
   record(ph, st, true, t0, t1, t2, now_s());
 }
+#endif
 
 // One timed run through a mapping session, as log2map maps a log: a fresh
 // session, every scan inserted, finish (on the GPU for cuda), write.
