@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "golden_support.h"
+#include "vasco_gpu/timing.h"
 
 namespace {
 
@@ -75,10 +76,6 @@ std::vector<golden::Path> select_paths(const Options &opt, std::vector<golden::P
   if (opt.paths.empty())
     for (const auto &n : float_names) floats->push_back(all.at(n));
   return exact;
-}
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
 // Runs one case; returns the number of exact paths that differed.

@@ -35,6 +35,7 @@
 #include "host_renderer.h"
 #include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/log_odds.h"
 
 namespace vasco {
 namespace {
@@ -51,9 +52,6 @@ bool untouched(double v) {
   std::memcpy(&bits, &v, sizeof bits);
   return bits == kUntouchedBits;
 }
-
-// A probability's log-odds; +-inf at exactly 1 and 0 (the oracle's pinned cells).
-double logit(double p) { return std::log(p / (1.0 - p)); }
 
 // The evidence of an update: log-odds increments logit(p) - logit(prior) of
 // a free and of an occupied cell, by the cell's offsets (i, j) from the

@@ -57,15 +57,12 @@
 #include "vasco_gpu/beam_placement.h"
 #include "vasco_gpu/oracle.h"
 #include "vasco_gpu/parallel.h"
+#include "vasco_gpu/timing.h"
 
 namespace vasco {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // Stripes per thread: enough slack for the dynamic hand-out to even out the
 // estimate's errors, few enough that a beam rarely spans many stripes.
