@@ -1,9 +1,13 @@
 /* The mapping session from C (vasco_gpu/mapper.h), as a C program would use
- * it: inserts one at a time equal one insert of everything, a render with
+ * it: inserts one at a time equal one insert of everything in the frame
+ * they grew to (and, rendered again, in the PROTOCOL frame), a render with
  * moved poses equals a fresh session fed the moved scans, a fixed frame equals
  * CARMEN's own egrid.h call by call, and each error gives its code and a
- * message. Exit 0 when every check passes. */
+ * message chosen by the error's kind, and one handle survives two threads.
+ * Exit 0 when every check passes. */
+#include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -81,7 +85,17 @@ static void incremental_and_render(const vasco_mapper_params *p) {
                               steps + s) == VASCO_OK, "insert %d: %s", s, vasco_last_error(one_by_one));
   CHECK(vasco_mapper_insert(at_once, NUM_SCANS, poses, counts, ranges, firsts, steps) == VASCO_OK, "insert");
   CHECK(vasco_mapper_num_scans(one_by_one) == NUM_SCANS, "scan count");
-  expect_same_grid(one_by_one, at_once, "one by one vs at once");
+  /* The frame grew with a margin: the same bytes as everything at once in it. */
+  int gx, gy;
+  CHECK(vasco_mapper_grid_size(one_by_one, &gx, &gy) == VASCO_OK, "grid size");
+  vasco_mapper *in_its_frame = NULL;
+  CHECK(vasco_mapper_create_fixed(p, "cpu_double", gx, gy, poses[2], &in_its_frame) == VASCO_OK, "create_fixed");
+  CHECK(vasco_mapper_insert(in_its_frame, NUM_SCANS, poses, counts, ranges, firsts, steps) == VASCO_OK, "insert");
+  expect_same_grid(one_by_one, in_its_frame, "one by one vs at once in the grown frame");
+  vasco_mapper_destroy(in_its_frame);
+  /* Rendered again with its own poses: the PROTOCOL frame, as one insert of everything. */
+  CHECK(vasco_mapper_render(one_by_one, NUM_SCANS, poses) == VASCO_OK, "render: %s", vasco_last_error(one_by_one));
+  expect_same_grid(one_by_one, at_once, "one by one, rendered again, vs at once");
 
   /* A loop closure: every pose moved. */
   double moved[NUM_SCANS * 3];
@@ -150,6 +164,66 @@ static void errors(const vasco_mapper_params *p) {
   CHECK(vasco_mapper_insert(m, 1, far, counts, ranges, firsts, steps) == VASCO_ERR_TOO_LARGE, "far scan");
   CHECK(vasco_mapper_num_scans(m) == NUM_SCANS, "a failed insert stored a scan");
   CHECK(vasco_mapper_insert(m, 1, NULL, counts, ranges, firsts, steps) == VASCO_ERR_INVALID_ARGUMENT, "NULL");
+  double bad_pose[3] = {0, NAN, 0};
+  CHECK(vasco_mapper_insert(m, 1, bad_pose, counts, ranges, firsts, steps) == VASCO_ERR_INVALID_ARGUMENT, "NaN pose");
+  CHECK(strstr(vasco_last_error(m), "scan 0") != NULL, "message: %s", vasco_last_error(m));
+  double moved[NUM_SCANS * 3];
+  memcpy(moved, poses, sizeof moved);
+  moved[3 * 7 + 2] = INFINITY;
+  CHECK(vasco_mapper_render(m, NUM_SCANS, moved) == VASCO_ERR_INVALID_ARGUMENT, "inf heading");
+  CHECK(strstr(vasco_last_error(m), "pose 7") != NULL, "message: %s", vasco_last_error(m));
+  CHECK(vasco_mapper_read(m, 0, 0, 0, 5, NULL) == VASCO_OK, "a 0-wide window: %s", vasco_last_error(m));
+  CHECK(vasco_mapper_read(m, 3, 3, 5, 0, out) == VASCO_OK, "a 0-high window: %s", vasco_last_error(m));
+  CHECK(vasco_mapper_finish(m, 4, INT_MAX, &map) == VASCO_OK, "border INT_MAX: %s", vasco_last_error(m));
+  CHECK(vasco_mapper_num_scans(m) == NUM_SCANS, "the failed calls stored a scan");
+  vasco_mapper_destroy(m);
+}
+
+/* The memory budget: over it is VASCO_ERR_OUT_OF_MEMORY (not INTERNAL), and
+ * a budget the session already exceeds is refused, keeping the old one. */
+static void memory_budget(const vasco_mapper_params *p) {
+  vasco_mapper *m = create(p);
+  CHECK(vasco_mapper_insert(m, NUM_SCANS, poses, counts, ranges, firsts, steps) == VASCO_OK, "insert");
+  CHECK(vasco_mapper_set_max_memory(m, 1024) == VASCO_ERR_OUT_OF_MEMORY, "a budget below the session's need");
+  CHECK(vasco_mapper_set_max_memory(m, 64ull << 20) == VASCO_OK, "64 MiB: %s", vasco_last_error(m));
+  double far[3] = {2000, 0, 0}; /* 2 km out: a grid of about 500 MiB */
+  CHECK(vasco_mapper_insert(m, 1, far, counts, ranges, firsts, steps) == VASCO_ERR_OUT_OF_MEMORY, "over budget");
+  CHECK(strstr(vasco_last_error(m), "budget") != NULL, "message: %s", vasco_last_error(m));
+  CHECK(vasco_mapper_num_scans(m) == NUM_SCANS, "a refused insert stored a scan");
+  CHECK(vasco_mapper_set_max_memory(m, 0) == VASCO_OK, "no budget");
+  CHECK(vasco_mapper_insert(m, 1, far, counts, ranges, firsts, steps) == VASCO_OK, "no budget: %s", vasco_last_error(m));
+  CHECK(vasco_mapper_set_max_memory(NULL, 0) == VASCO_ERR_INVALID_ARGUMENT, "NULL handle");
+  vasco_mapper_destroy(m);
+}
+
+/* Two threads on one handle: inserts, reads, finishes and counts interleave
+ * under the handle's lock (run under ASan/TSan: no use after free). */
+enum { ROUNDS = 30 };
+static void *hammer(void *arg) {
+  vasco_mapper *m = arg;
+  float out[16];
+  vasco_map map;
+  int sx, sy;
+  for (int i = 0; i < ROUNDS; ++i) {
+    const int s = i % NUM_SCANS;
+    CHECK(vasco_mapper_insert(m, 1, poses + 3 * s, counts + s, ranges + s * NUM_BEAMS, firsts + s, steps + s) ==
+              VASCO_OK, "threaded insert: %s", vasco_last_error(m));
+    CHECK(vasco_mapper_grid_size(m, &sx, &sy) == VASCO_OK, "threaded size");
+    CHECK(vasco_mapper_read(m, sx / 2, sy / 2, 4, 4, out) == VASCO_OK, "threaded read");
+    CHECK(vasco_mapper_finish(m, 2, 5, &map) == VASCO_OK, "threaded finish");
+    (void)vasco_mapper_num_scans(m);
+  }
+  return NULL;
+}
+
+static void two_threads_one_handle(const vasco_mapper_params *p) {
+  vasco_mapper *m = create(p);
+  pthread_t a, b;
+  CHECK(pthread_create(&a, NULL, hammer, m) == 0, "thread a");
+  CHECK(pthread_create(&b, NULL, hammer, m) == 0, "thread b");
+  pthread_join(a, NULL);
+  pthread_join(b, NULL);
+  CHECK(vasco_mapper_num_scans(m) == 2 * ROUNDS, "%zu scans after two threads", vasco_mapper_num_scans(m));
   vasco_mapper_destroy(m);
 }
 
@@ -161,6 +235,8 @@ int main(void) {
   incremental_and_render(&p);
   fixed_frame_equals_egrid(&p);
   errors(&p);
+  memory_budget(&p);
+  two_threads_one_handle(&p);
   if (failures) {
     fprintf(stderr, "mapper_c_api_test: %d checks failed\n", failures);
     return 1;
