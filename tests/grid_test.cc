@@ -3,7 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <climits>
 #include <cmath>
+
+#include "vasco_gpu/error.h"
+#include "vasco_gpu/oracle.h"
 
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"
@@ -57,8 +61,28 @@ TEST(FinishGrid, DownsampleOneKeepsValues) {
 
 TEST(FinishGrid, RejectsBadArguments) {
   auto c = unknown(4, 4);
-  EXPECT_THROW(finish_grid(c.data(), 4, 4, 0.1, 0, 1), std::invalid_argument);
-  EXPECT_THROW(finish_grid(c.data(), 4, 4, 0.1, 2, -1), std::invalid_argument);
+  EXPECT_THROW(finish_grid(c.data(), 4, 4, 0.1, 0, 1), Error);
+  EXPECT_THROW(finish_grid(c.data(), 4, 4, 0.1, 2, -1), Error);
+}
+
+TEST(FinishGrid, HugeBordersCropToTheGridWithoutOverflow) {
+  // 10 x 6 cells, ds 2 -> 5 x 3 blocks, one known cell. Any border at least
+  // the grid's clamps every bound: blocks 0 .. n - 1, size n - 1 (the
+  // missing +1), whatever CARMEN's int arithmetic would have wrapped to.
+  auto c = unknown(10, 6);
+  c[4 * 6 + 2] = 0.7f;
+  for (int border : {5, 1000, INT_MAX / 2, INT_MAX - 1, INT_MAX}) {
+    const FinishedMap m = finish_grid(c.data(), 10, 6, 0.1, 2, border);
+    EXPECT_EQ(m.min_x, 0) << border;
+    EXPECT_EQ(m.min_y, 0) << border;
+    EXPECT_EQ(m.size_x, 4) << border;
+    EXPECT_EQ(m.size_y, 2) << border;
+    EXPECT_EQ(m.cells[2 * 2 + 1], 0.7f) << border;
+  }
+  // Nothing known and a huge border: the same whole-grid crop, all unknown.
+  const FinishedMap none = finish_grid(unknown(10, 6).data(), 10, 6, 0.1, 2, INT_MAX);
+  EXPECT_EQ(none.size_x, 4);
+  EXPECT_EQ(none.size_y, 2);
 }
 
 TEST(SizeGrid, TwiceTheExtentPlusReachPlusTwo) {
@@ -87,14 +111,37 @@ TEST(SizeGrid, AbsurdExtentIsAClearErrorNotAnAllocation) {
   try {
     size_grid(b, p);
     FAIL() << "expected an error";
-  } catch (const std::runtime_error &e) {
+  } catch (const Error &e) {
+    EXPECT_EQ(e.code(), ErrorCode::TooLarge);
     EXPECT_NE(std::string(e.what()).find("too large"), std::string::npos) << e.what();
   }
 }
 
 TEST(SizeGrid, EmptyBatchIsAnError) {
   ScanBatch b;
-  EXPECT_THROW(size_grid(b, MapperParams{}), std::runtime_error);
+  EXPECT_THROW(size_grid(b, MapperParams{}), Error);
+}
+
+TEST(StartFrame, RecordsScanZerosPoseAsCarmensFirstUpdate) {
+  ScanBatch b;
+  float r = 1.0f;
+  b.add_scan(1.5, -2.0, 0.4, 0, 0, &r, 1, 1);
+  b.add_scan(3.0, 1.0, 0.1, 0, 0, &r, 1, 2);
+  GridGeometry g;
+  g.size_x = 40;
+  g.size_y = 30;
+  g.resolution = 0.25;
+  g.theta_offset = 0.4;
+  const oracle::GridFrame f = start_frame(g, b);
+  EXPECT_EQ(f.size_x, 40);
+  EXPECT_EQ(f.size_y, 30);
+  EXPECT_EQ(f.resolution, 0.25);
+  EXPECT_EQ(f.theta_offset, 0.4);
+  EXPECT_FALSE(f.first);
+  EXPECT_EQ(f.start_x, 1.5 / 0.25);
+  EXPECT_EQ(f.start_y, -2.0 / 0.25);
+  EXPECT_EQ(f.start_theta, 0.4);
+  EXPECT_TRUE(start_frame(g, ScanBatch{}).first);
 }
 
 }  // namespace
