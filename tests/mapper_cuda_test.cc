@@ -122,7 +122,8 @@ TEST_F(MapperCuda, ExactInsertsInPiecesEqualCpuDouble) {
     m.insert(scans_.select(static_cast<long>(a), static_cast<long>(n)));
     a += n;
   }
-  const GridGeometry geo = size_grid(scans_, params_);
+  // Growth leaves a margin: the reference is a fresh map in the session's frame.
+  const GridGeometry geo = m.frame();
   const auto ref = make_cpu_double_backend()->map(scans_, params_, geo, nullptr);
   testing_support::expect_bit_identical(ref, m.read(), geo, "cuda exact session");
 }
@@ -191,9 +192,13 @@ TEST_F(MapperCuda, FloatSessionIsTheSameBytesWhateverTheRunAndTheInserts) {
     again.render(again.poses());
     testing_support::expect_bit_identical(first, again.read(), geo, "float re-render " + std::to_string(run));
   }
+  // Inserts that grow the frame leave a margin: one insert into a fixed frame
+  // of the grown size is the reference.
   Mapper pieces(params_, "cuda", mode(CudaMode::Float));
   for (size_t a = 0; a < scans_.num_scans(); a += 50) pieces.insert(scans_.select(static_cast<long>(a), 50));
-  testing_support::expect_bit_identical(first, pieces.read(), geo, "float inserts of 50 scans");
+  Mapper whole(params_, pieces.frame(), "cuda", mode(CudaMode::Float));
+  whole.insert(scans_);
+  testing_support::expect_bit_identical(whole.read(), pieces.read(), pieces.frame(), "float inserts of 50 scans");
 }
 
 // Both modes look updates up in per-(i, j) tables when the table is small
@@ -273,6 +278,38 @@ TEST_F(MapperCuda, RefusedGrowthChangesNothingInEitherMode) {
     clean.insert(scans_.select(0, 100));
     clean.insert(scans_.select(100, 100));
     expect_same_session(view_of(clean), m, "later inserts");
+  }
+#endif
+}
+
+// The renderer itself, without a session's rollback: a reset refused for
+// GPU memory keeps the old frame and grid (read, finish and a further apply
+// see them), in both modes.
+TEST_F(MapperCuda, RefusedResetKeepsTheRenderersGrid) {
+#if defined(VASCO_HAVE_CUDA)
+  const GridGeometry geo = size_grid(scans_.select(0, 100), params_);
+  GridGeometry huge = geo;
+  huge.size_x = huge.size_y = 16384;  // 1 GiB exact, 2 GiB float
+  const GridWindow all{0, 0, geo.size_x, geo.size_y};
+  for (CudaMode md : {CudaMode::Float, CudaMode::Exact}) {
+    std::unique_ptr<Renderer> r = make_cuda_renderer(mode(md));
+    r->reset(geo, params_);
+    r->apply(scans_, 0, 100, nullptr);
+    const std::vector<float> before = r->read(all);
+    const std::string finished = golden::digest(r->finish(4, 20));
+    {
+      GpuMemoryHog hog(size_t(512) << 20);
+      ASSERT_TRUE(hog.holding());
+      expect_error(ErrorCode::OutOfMemory, [&] { r->reset(huge, params_); }, r->name() + ": a reset past the GPU");
+      testing_support::expect_bit_identical(before, r->read(all), geo, r->name() + " after the refused reset");
+      EXPECT_EQ(golden::digest(r->finish(4, 20)), finished) << r->name();
+    }
+    r->apply(scans_, 100, 200, nullptr);
+    std::unique_ptr<Renderer> clean = make_cuda_renderer(mode(md));
+    clean->reset(geo, params_);
+    clean->apply(scans_, 0, 100, nullptr);
+    clean->apply(scans_, 100, 200, nullptr);
+    testing_support::expect_bit_identical(clean->read(all), r->read(all), geo, r->name() + " applied on after it");
   }
 #endif
 }
