@@ -22,12 +22,6 @@ void bind_map(nb::module_ &m);      // Map, _read_map, write_map
 void bind_compare(nb::module_ &m);  // Comparison, compare
 void bind_mapper(nb::module_ &m);   // Mapper
 
-// Throws carmen::Error(BadInput) naming what is wrong when the arrays of
-// `b` disagree (offsets not starting at 0, decreasing, past the ranges;
-// per-scan arrays of different lengths): every batch is checked where it
-// enters the engine, since Python can reach its arrays.
-void check_batch(const vasco::ScanBatch &b);
-
 // The batch's poses as a new (n, 3) float64 array of (x, y, theta).
 nb::ndarray<nb::numpy, double> poses_of(const vasco::ScanBatch &b);
 

@@ -42,13 +42,18 @@ bool cuda_available(std::string *why) {
 #endif
 }
 
-// backends()'s docstring names what it returns in this build.
+// backends()'s docstring: what it returns in this build, and what each is,
+// from the backend registry.
 std::string backends_doc() {
   std::string names;
   for (const std::string &n : vasco::compiled_backends()) names += (names.empty() ? "" : ", ") + n;
-  return "The backends compiled into this build: " + names +
-         ".\n\nMapper(backend=...) accepts these names and also 'auto' (cuda when a GPU is usable,\n"
-         "else cpu_threads), which is a choice among them, not a backend of its own.";
+  std::string doc = "The backends compiled into this build: " + names + ".\n\nEach is a Mapper(backend=...) name:\n";
+  for (const vasco::BackendInfo &b : vasco::backend_registry()) {
+    if (!b.compiled) continue;
+    doc += std::string("\n  ") + b.name + ": " + b.summary;
+    for (const vasco::BackendAlias &a : b.aliases) doc += std::string(" (also '") + a.name + "')";
+  }
+  return doc;
 }
 
 }  // namespace

@@ -1,6 +1,5 @@
-// param_keys.h — the mapper's parameters by ini key, for Python's keywords.
-// Library logic carried by the bindings until vasco's parameter table
-// (params.h) exists; then these read it and this file goes.
+// param_keys.h — Python keywords and attributes of the mapper's parameters,
+// read from vasco's parameter table (params.h: param_table()).
 #ifndef VASCO_PY_PARAM_KEYS_H
 #define VASCO_PY_PARAM_KEYS_H
 
@@ -15,23 +14,15 @@ namespace vasco_py {
 
 namespace nb = nanobind;
 
-struct ParamKey {
-  const char *name;  // without vasco_
-  double vasco::MapperParams::*d;
-  long vasco::MapperParams::*l;
-  const char *unit;  // " m" or ""
-};
-
-// The key `name` names (with or without "vasco_"), or nullptr.
-const ParamKey *find_key(std::string name);
-// Sets the key `name` of `p` from a Python number; TypeError for an unknown
-// key, a bool, a non-number or a fraction for a whole-number key.
+// Sets the parameter `name` (with or without "vasco_") of `p` from a Python
+// number; TypeError for an unknown key, a bool, a non-number or a fraction
+// for a whole-number key. Bounds are validate()'s.
 void set_param(vasco::MapperParams &p, const std::string &name, nb::handle value);
 // Raises as set_param does when `name` = `value` would be refused.
 void check_param(const std::string &name, nb::handle value);
 // The parameters as a dict, keys without "vasco_", in the table's order.
 nb::dict params_dict(const vasco::MapperParams &p);
-// "Keys (default): resolution (0.025 m), ...": the defaults as the table has them.
+// One line per key: "name: meaning; default D; RULE".
 std::string param_keys_doc();
 
 }  // namespace vasco_py

@@ -5,6 +5,7 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <deque>
 #include <filesystem>
 #include <string>
 
@@ -90,19 +91,14 @@ void bind_params_methods(nb::class_<MapperParams> &cls) {
       .def("__deepcopy__", [](const MapperParams &p, nb::handle) { return p; }, "memo"_a);
 }
 
-// Params' attributes, one per ini key.
+// Params' attributes, one per row of the parameter table.
 void bind_params_attributes(nb::class_<MapperParams> &cls) {
-  cls.def_rw("resolution", &MapperParams::resolution, "vasco_resolution: cell size in metres.")
-      .def_rw("p_prior", &MapperParams::p_prior, "vasco_p_prior: prior occupancy.")
-      .def_rw("p_occ", &MapperParams::p_occ, "vasco_p_occ: evidence of a hit.")
-      .def_rw("p_emp", &MapperParams::p_emp, "vasco_p_emp: evidence of a free cell.")
-      .def_rw("range_sure", &MapperParams::range_sure, "vasco_range_sure: full-confidence range (m).")
-      .def_rw("range_max", &MapperParams::range_max, "vasco_range_max: evidence ends here (m).")
-      .def_rw("wall_size", &MapperParams::wall_size, "vasco_wall_size: thickness marked occupied behind a hit (m).")
-      .def_rw("downsample", &MapperParams::downsample, "vasco_downsample: finish's block size.")
-      .def_rw("border", &MapperParams::border, "vasco_border: cells kept around the known area.")
-      .def_rw("first_scan", &MapperParams::first_scan, "vasco_first_scan: first laser message used by load_log.")
-      .def_rw("num_scans", &MapperParams::num_scans, "vasco_num_scans: laser messages used by load_log (-1: all).");
+  static std::deque<std::string> docs;  // nanobind keeps the pointers it is given
+  for (const vasco::ParamSpec &k : vasco::param_table()) {
+    docs.push_back(std::string(k.key) + ": " + k.meaning + ".");
+    if (k.integer()) cls.def_rw(k.name, k.whole, docs.back().c_str());
+    else cls.def_rw(k.name, k.real, docs.back().c_str());
+  }
 }
 
 }  // namespace

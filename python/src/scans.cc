@@ -2,8 +2,8 @@
 // views of their memory. The arrays that say where each scan's beams lie
 // (beam_offsets) are read-only views, so Python cannot make a batch whose
 // offsets point outside its ranges; every batch is still checked where it
-// enters the engine (check_batch), as a batch filled by other means might
-// disagree.
+// enters the engine (ScanBatch::validate: select, ranges_of, beam_counts,
+// and the Mapper's insert), as a batch filled by other means might disagree.
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 
@@ -27,40 +27,6 @@ using carmen::ErrorCode;
 using vasco::ScanBatch;
 
 namespace {
-
-[[noreturn]] void bad_batch(const std::string &what) { throw Error(ErrorCode::BadInput, "Scans: " + what); }
-
-void check_lengths(const ScanBatch &b) {
-  const size_t n = b.num_scans();
-  const struct {
-    const char *name;
-    size_t size;
-  } columns[] = {{"y", b.y.size()},
-                 {"theta", b.theta.size()},
-                 {"first_angle", b.first_angle.size()},
-                 {"angle_step", b.angle_step.size()},
-                 {"lines", b.line.size()}};
-  for (const auto &c : columns)
-    if (c.size != n) bad_batch(std::string(c.name) + " has " + std::to_string(c.size) + " entries for " +
-                               std::to_string(n) + " scans");
-  if (b.beam_offset.size() != n + 1)
-    bad_batch("beam_offsets has " + std::to_string(b.beam_offset.size()) + " entries for " + std::to_string(n) +
-              " scans (needs one more)");
-}
-
-void check_offsets(const ScanBatch &b) {
-  if (b.beam_offset[0] != 0) bad_batch("beam_offsets[0] is " + std::to_string(b.beam_offset[0]) + ", not 0");
-  for (size_t s = 0; s < b.num_scans(); ++s) {
-    const uint64_t lo = b.beam_offset[s], hi = b.beam_offset[s + 1];
-    if (hi < lo) bad_batch("beam_offsets decrease at scan " + std::to_string(s));
-    if (hi - lo > static_cast<uint64_t>(carmen::kMaxCount))
-      bad_batch("scan " + std::to_string(s) + " has " + std::to_string(hi - lo) + " beams (at most " +
-                std::to_string(carmen::kMaxCount) + ")");
-  }
-  if (b.beam_offset.back() != b.num_beams())
-    bad_batch("beam_offsets end at " + std::to_string(b.beam_offset.back()) + ", but there are " +
-              std::to_string(b.num_beams()) + " ranges");
-}
 
 // beam_counts as whole numbers in [0, kMaxCount]: a fraction (181.7) is an
 // error, not truncated.
@@ -122,13 +88,8 @@ Array1<float> ranges_of(nb::handle_t<ScanBatch> self, long s) {
   ScanBatch &b = nb::cast<ScanBatch &>(self);
   if (s < 0) s += static_cast<long>(b.num_scans());
   if (s < 0 || static_cast<size_t>(s) >= b.num_scans()) throw nb::index_error("scan index out of range");
-  check_batch(b);
-  return Array1<float>(b.range.data() + b.beam_offset[s], {static_cast<size_t>(b.beams_in(s))}, self);
-}
-
-ScanBatch select(const ScanBatch &b, long first, long count) {
-  check_batch(b);
-  return b.select(first, count);
+  float *first = const_cast<float *>(b.checked_ranges_of(static_cast<size_t>(s)));
+  return Array1<float>(first, {static_cast<size_t>(b.beams_in(s))}, self);
 }
 
 constexpr const char *kScansDoc =
@@ -186,14 +147,14 @@ void bind_scans_methods(nb::class_<ScanBatch> &cls) {
       .def_prop_ro(
           "beam_counts",
           [](const ScanBatch &b) {
-            check_batch(b);
+            b.validate();
             std::vector<int64_t> c(b.num_scans());
             for (size_t s = 0; s < c.size(); ++s) c[s] = b.beams_in(s);
             return owned(std::move(c), {c.size()});
           },
           nb::rv_policy::reference, "Beams per scan (int64): a new array.")
       .def("ranges_of", &ranges_of, "s"_a, nb::rv_policy::reference, "The ranges of scan s (a view).")
-      .def("select", &select, "first"_a, "count"_a = -1,
+      .def("select", [](const ScanBatch &b, long first, long count) { return b.select(first, count); }, "first"_a, "count"_a = -1,
            "Scans [first, first + count) as new Scans (count -1: to the end), clipped to the batch.")
       .def("__repr__", [](const ScanBatch &b) {
         return nb::str("Scans({} scans, {} beams)").format(b.num_scans(), b.num_beams());
@@ -201,11 +162,6 @@ void bind_scans_methods(nb::class_<ScanBatch> &cls) {
 }
 
 }  // namespace
-
-void check_batch(const ScanBatch &b) {
-  check_lengths(b);
-  check_offsets(b);
-}
 
 nb::ndarray<nb::numpy, double> poses_of(const ScanBatch &b) {
   const size_t n = b.num_scans();

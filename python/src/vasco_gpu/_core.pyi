@@ -14,8 +14,14 @@ has_cuda: bool
 
 def backends() -> list[str]:
     """
-    The backend names this build knows: cpu_double, cpu_threads, cpu_float, cuda (when built with
-    CUDA) and auto.
+    The backends compiled into this build: cpu_double, cpu_threads, cpu_float, auto.
+
+    Each is a Mapper(backend=...) name:
+
+      cpu_double: CARMEN's arithmetic to the letter, one core: bit-identical to CARMEN
+      cpu_threads: cpu_double's bytes on all cores (--threads)
+      cpu_float: single precision on one core, fast; measured against CARMEN's maps
+      auto: cuda when a GPU is usable, else cpu_threads
     """
 
 def cuda_available() -> tuple[bool, str]:
@@ -36,9 +42,19 @@ class Params:
     ValueError naming the key. Attributes may be changed afterwards; the Mapper
     validates them again.
 
-    Keys (default): resolution (0.025 m), p_prior (0.5), p_occ (0.55), p_emp
-    (0.45), range_sure (5.0 m), range_max (10.0 m), wall_size (0.2 m), downsample
-    (4), border (20), first_scan (0), num_scans (-1: all).
+    Keys:
+
+      resolution: cell size (m); default 0.025; must be between 1e-6 and 1e6 m per cell.
+      p_prior: prior occupancy; default 0.5; must be strictly between 0 and 1.
+      p_occ: evidence of a hit; default 0.55; must be strictly between 0 and 1.
+      p_emp: evidence of a free cell; default 0.45; must be strictly between 0 and 1.
+      range_sure: full-confidence range (m); default 5; must satisfy 0 <= range_sure <= range_max.
+      range_max: evidence ends here (m); default 10; must be > 0 and at most 100000 m (with 0 no cell is ever updated).
+      wall_size: thickness marked occupied behind a hit (m); default 0.2; must be a finite number >= 0.
+      downsample: finish: block size; default 4; must be between 1 and 1000000.
+      border: finish: cells kept around the known area; default 20; must be between 0 and 1000000.
+      first_scan: first laser message used; default 0; must be >= 0.
+      num_scans: number of laser messages used; default -1 (all); must be >= 1 (or -1 for all).
     """
 
     def __init__(self, **params: float | int) -> None:
@@ -74,7 +90,7 @@ class Params:
 
     @property
     def resolution(self) -> float:
-        """vasco_resolution: cell size in metres."""
+        """vasco_resolution: cell size (m)."""
 
     @resolution.setter
     def resolution(self, arg: float, /) -> None: ...
@@ -123,28 +139,28 @@ class Params:
 
     @property
     def downsample(self) -> int:
-        """vasco_downsample: finish's block size."""
+        """vasco_downsample: finish: block size."""
 
     @downsample.setter
     def downsample(self, arg: int, /) -> None: ...
 
     @property
     def border(self) -> int:
-        """vasco_border: cells kept around the known area."""
+        """vasco_border: finish: cells kept around the known area."""
 
     @border.setter
     def border(self, arg: int, /) -> None: ...
 
     @property
     def first_scan(self) -> int:
-        """vasco_first_scan: first laser message used by load_log."""
+        """vasco_first_scan: first laser message used."""
 
     @first_scan.setter
     def first_scan(self, arg: int, /) -> None: ...
 
     @property
     def num_scans(self) -> int:
-        """vasco_num_scans: laser messages used by load_log (-1: all)."""
+        """vasco_num_scans: number of laser messages used."""
 
     @num_scans.setter
     def num_scans(self, arg: int, /) -> None: ...
@@ -212,16 +228,17 @@ class Scans:
     geometry (first_angle relative to theta, angle_step) per scan, ranges as float32, all scans'
     beams concatenated.
 
-    ``ranges``, ``x``, ``y``, ``theta``, ``first_angle``, ``angle_step``, ``beam_offsets`` and
-    ``lines`` are writable NumPy views of the object's memory (they keep it alive); ``poses``
-    and ``beam_counts`` are new arrays.
+    ``ranges``, ``x``, ``y``, ``theta``, ``first_angle``, ``angle_step`` and ``lines`` are writable
+    NumPy views of the object's memory (they keep it alive); ``beam_offsets`` is a read-only view
+    (which beams are whose must stay consistent with the ranges); ``poses`` and ``beam_counts``
+    are new arrays.
     """
 
     def __init__(self, poses: numpy.typing.ArrayLike, ranges: numpy.typing.ArrayLike, beam_counts: numpy.typing.ArrayLike, first_angle: float | numpy.typing.ArrayLike, angle_step: float | numpy.typing.ArrayLike) -> None:
         """
-        Scans from arrays (copied): poses (n, 3), ranges (sum of beam_counts,), beam_counts (n,),
-        first_angle and angle_step a number or one value per scan (radians; CARMEN's 181-beam SICK:
-        first_angle=-pi/2, angle_step=pi/180).
+        Scans from arrays (copied): poses (n, 3), ranges (sum of beam_counts,), beam_counts (n,) whole
+        numbers, first_angle and angle_step a number or one value per scan (radians; CARMEN's 181-beam
+        SICK: first_angle=-pi/2, angle_step=pi/180).
         """
 
     def __len__(self) -> int: ...
@@ -254,14 +271,14 @@ class Scans:
         """Angle added after every beam, per scan (a view)."""
 
     @property
-    def beam_offsets(self) -> Annotated[NDArray[numpy.uint64], dict(shape=(None,), order='C')]:
-        """
-        Scan s owns ranges[beam_offsets[s]:beam_offsets[s + 1]] (uint64, n + 1 entries, a view).
-        """
-
-    @property
     def lines(self) -> Annotated[NDArray[numpy.int64], dict(shape=(None,), order='C')]:
         """Line of each scan in its log (a view)."""
+
+    @property
+    def beam_offsets(self) -> Annotated[NDArray[numpy.uint64], dict(shape=(None,), order='C', writable=False)]:
+        """
+        Scan s owns ranges[beam_offsets[s]:beam_offsets[s + 1]] (uint64, n + 1 entries, a read-only view).
+        """
 
     @property
     def poses(self) -> NDArray[numpy.float64]:
@@ -414,7 +431,9 @@ def write_map(path: str | os.PathLike, map: Map, mode: str = 'trinary', descript
     Writes a map, the format chosen by the name: ``.map`` / ``.map.gz`` (CARMEN, with an OFFSET
     chunk when the map has an origin), ``.pgm`` (ROS map_server image plus a ``.yaml`` beside it;
     ``mode`` trinary, scale or raw) or ``.png`` (grey: white free, black occupied, mid grey
-    unknown). Atomic: a failure leaves no file behind. Raises FileError naming the file.
+    unknown). Atomic: a failure leaves no file behind. Raises FileError naming the file, and
+    BadInputError (a ValueError) for a map read_map would refuse: a cell that is not -1 or a
+    probability (NaN among them), or, for .map and .pgm, a resolution that is not positive.
     """
 
 class Comparison:
@@ -514,7 +533,8 @@ def compare(a: Map, b: Map, align: bool = True, top: int = 0) -> Comparison:
     Compares map B with map A (the reference): DESIGN section 4's table (class agreement,
     known/unknown differences, |dp| > 0.1, max |dp|, bit-identical cells). Maps whose origins
     are a whole number of cells apart are aligned by them (``align=False``: cell (0, 0) on cell
-    (0, 0)). ``top``: how many of the largest differences to keep in ``.largest``.
+    (0, 0)). ``top``: how many of the largest differences to keep in ``.largest``. A map holding a
+    cell that is not -1 or a probability (NaN among them) raises BadInputError (a ValueError).
     """
 
 class Mapper:
@@ -531,25 +551,32 @@ class Mapper:
     core), cpu_float (single precision), cuda (cuda_mode 'float', the default, or 'exact':
     CARMEN's bytes), auto (cuda when a GPU is usable, else cpu_threads); 'cuda_exact' and
     'cuda_float' name the CUDA modes too. The GIL is released while the session maps; calls on
-    one Mapper from several threads are serialised.
+    one Mapper from several threads are serialised, and len, frame, last_stats, renders and
+    repr answer at once even while another thread maps (as of the end of the last call).
+
+    Ctrl-C during insert, render or finish runs Python's handler at once; a call cannot stop
+    half-way, so KeyboardInterrupt is raised when the call has finished: the session then holds
+    what the call did (the scans inserted, the poses rendered), or, if the call failed, what it
+    held before.
     """
 
     def __init__(self, params: Params | None = None, backend: str = 'cpu_double', cuda_mode: str | None = None, threads: int = 0, frame: Frame | None = None, cuda_device: int = 0, max_memory_bytes: int = 2147483648) -> None:
         """
         A session with ``params`` (vasco's defaults when None) on ``backend``.
 
-        cuda_mode: 'float' (default) or 'exact'. threads: cpu_threads' threads (0: all cores).
-        frame: a fixed Frame (cells outside it are skipped, as CARMEN does) instead of the PROTOCOL
-        frame, which grows as scans arrive. max_memory_bytes: host memory the session may use (0: no
-        limit). Raises ValueError for bad parameters or an unknown backend, RuntimeError when the
-        backend cannot run here (e.g. cuda without a GPU).
+        cuda_mode: 'float' (default) or 'exact'. threads: cpu_threads' threads (0: all cores; at
+        most 1024, as log2map's --threads). frame: a fixed Frame (cells outside it are skipped, as
+        CARMEN does) instead of the PROTOCOL frame, which grows as scans arrive. max_memory_bytes:
+        host memory the session may use (0: no limit). Raises ValueError for bad parameters or an
+        unknown backend, RuntimeError when the backend cannot run here (e.g. cuda without a GPU).
         """
 
     def insert(self, scans: Scans) -> None:
         """
         Stores ``scans`` after those stored and applies them to the grid (exact backends: the bytes
-        of mapping everything at once). Raises RuntimeError when the frame would be too large or the
-        session would exceed max_memory_bytes (nothing is stored then).
+        of mapping everything at once). Raises BadInputError (a ValueError) for a batch whose
+        arrays disagree, RuntimeError when the frame would be too large or the session would
+        exceed max_memory_bytes (nothing is stored then).
         """
 
     def render(self, poses: numpy.typing.ArrayLike) -> None:
