@@ -1,6 +1,6 @@
 /* The mapping session from C (vasco_gpu/mapper.h), as a C program would use
- * it: inserts one at a time equal one insert of everything in the frame
- * they grew to (and, rendered again, in the PROTOCOL frame), a render with
+ * it: inserts one at a time equal one insert of everything (the frame grew
+ * with a margin that read and finish do not show), a render with
  * moved poses equals a fresh session fed the moved scans, a fixed frame equals
  * CARMEN's own egrid.h call by call, and each error gives its code and a
  * message chosen by the error's kind, and one handle survives two threads.
@@ -85,13 +85,14 @@ static void incremental_and_render(const vasco_mapper_params *p) {
                               steps + s) == VASCO_OK, "insert %d: %s", s, vasco_last_error(one_by_one));
   CHECK(vasco_mapper_insert(at_once, NUM_SCANS, poses, counts, ranges, firsts, steps) == VASCO_OK, "insert");
   CHECK(vasco_mapper_num_scans(one_by_one) == NUM_SCANS, "scan count");
-  /* The frame grew with a margin: the same bytes as everything at once in it. */
+  /* The grid grew with a margin; the frame read shows is the PROTOCOL frame. */
   int gx, gy;
   CHECK(vasco_mapper_grid_size(one_by_one, &gx, &gy) == VASCO_OK, "grid size");
   vasco_mapper *in_its_frame = NULL;
   CHECK(vasco_mapper_create_fixed(p, "cpu_double", gx, gy, poses[2], &in_its_frame) == VASCO_OK, "create_fixed");
   CHECK(vasco_mapper_insert(in_its_frame, NUM_SCANS, poses, counts, ranges, firsts, steps) == VASCO_OK, "insert");
-  expect_same_grid(one_by_one, in_its_frame, "one by one vs at once in the grown frame");
+  expect_same_grid(one_by_one, in_its_frame, "one by one vs a fixed frame of its size");
+  expect_same_grid(one_by_one, at_once, "one by one vs at once");
   vasco_mapper_destroy(in_its_frame);
   /* Rendered again with its own poses: the PROTOCOL frame, as one insert of everything. */
   CHECK(vasco_mapper_render(one_by_one, NUM_SCANS, poses) == VASCO_OK, "render: %s", vasco_last_error(one_by_one));

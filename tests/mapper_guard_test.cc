@@ -2,7 +2,7 @@
 // disagree, non-finite poses and headings are refused naming the scan; a
 // renderer that fails mid-call leaves the session as it was (scans, poses,
 // frame, grid); finish takes any border; live insertion grows the frame
-// geometrically, and the grid still equals a fresh render in frame().
+// geometrically, and read() and finish() still equal a fresh render in frame().
 #include <gtest/gtest.h>
 
 #include <climits>
@@ -294,8 +294,7 @@ TEST(MapperGuard, FinishTakesAnyBorderWithoutOverflow) {
   EXPECT_EQ(code_of([&] { Mapper(small_params()).finish(); }), ErrorCode::State);
 }
 
-// The grid after every insert of a robot driving straight out equals a fresh
-// render of the stored scans in frame().
+// A robot driving straight out, one scan per insert.
 void drive_out(Mapper &m, size_t n, double step) {
   for (size_t s = 0; s < n; ++s) m.insert(drive(1, step, s));
 }
@@ -311,9 +310,11 @@ TEST(MapperGuard, DrivingOutCostsLogarithmicallyManyRenders) {
     EXPECT_LE(m.renders(), 7u) << backend;
     const std::vector<float> want = fresh(m.scans(), m.params(), m.frame());
     expect_bit_identical(want, m.read(), m.frame(), backend);
-    const GridGeometry protocol = size_grid(m.scans(), m.params());
-    EXPECT_GE(m.frame().size_x, protocol.size_x);
-    EXPECT_GE(m.frame().size_y, protocol.size_y);
+    const GridGeometry protocol = size_grid(m.scans(), m.params());  // frame() is it, margin unseen
+    EXPECT_EQ(m.frame().size_x, protocol.size_x);
+    EXPECT_EQ(m.frame().size_y, protocol.size_y);
+    const FinishedMap f = m.finish(2, 7);
+    EXPECT_EQ(f.cells, finish_grid(want.data(), protocol.size_x, protocol.size_y, protocol.resolution, 2, 7).cells);
   }
   Mapper longer(small_params());
   drive_out(longer, 400, 0.1);

@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "vasco_gpu/egrid_math.h"
 #include "vasco_gpu/error.h"
 
 namespace vasco {
@@ -50,6 +51,18 @@ void check_threads(int threads) {
                                       std::to_string(kMaxThreads));
 }
 
+// Whether every used beam of `scans` ends a safe number of cells from its
+// start: then the end cell never wraps CARMEN's 32-bit ints and a scan maps
+// to the same cells, shifted, in a larger grid. A -inf or huge negative range
+// ends at INT_MIN, and CARMEN's wrapping x2 - x1 then depends on the start
+// cell's absolute index: such sessions grow without a margin.
+bool beams_shift_invariant(const ScanBatch &scans, const MapperParams &params) {
+  const double limit = static_cast<double>(1 << 29) * params.resolution;
+  for (float r : scans.range)
+    if (egrid::is_beam_used(r) && !(std::fabs(static_cast<double>(r) + params.wall_size) < limit)) return false;
+  return true;
+}
+
 // One axis of a grown PROTOCOL frame: as wide as needed, and at least half
 // as wide again as now (sizes are 2 * half + 2), in 64 bits.
 int64_t grown_size(int need, int current) {
@@ -83,7 +96,7 @@ Mapper::Mapper(const MapperParams &params, const GridGeometry &frame, const std:
     : Mapper(params, backend, options) {
   check_fixed_frame(frame, params);
   fixed_frame_ = true;
-  geo_ = frame;
+  geo_ = grid_ = frame;
 }
 
 GridGeometry Mapper::frame_for(const PoseExtent &extent, const ScanBatch &scans) const {
@@ -97,7 +110,7 @@ GridGeometry Mapper::frame_for(const PoseExtent &extent, const ScanBatch &scans)
 // The frame an insert grows to: `need` widened by the margin where it fits
 // the size limit and the memory budget, else `need` itself.
 GridGeometry Mapper::grown_frame(const GridGeometry &need, uint64_t beams) const {
-  const int64_t sx = grown_size(need.size_x, geo_.size_x), sy = grown_size(need.size_y, geo_.size_y);
+  const int64_t sx = grown_size(need.size_x, grid_.size_x), sy = grown_size(need.size_y, grid_.size_y);
   if (sx >= INT32_MAX || sy >= INT32_MAX || static_cast<uint64_t>(sx) * static_cast<uint64_t>(sy) > kMaxGridCells)
     return need;
   GridGeometry g = need;
@@ -126,7 +139,7 @@ void Mapper::set_max_memory_bytes(uint64_t bytes) {
   const uint64_t old = options_.max_memory_bytes;
   options_.max_memory_bytes = bytes;
   try {
-    if (scans_.num_scans() > 0) check_memory(geo_, scans_.num_beams());
+    if (scans_.num_scans() > 0) check_memory(grid_, scans_.num_beams());
   } catch (...) {
     options_.max_memory_bytes = old;
     throw;
@@ -142,7 +155,7 @@ void Mapper::check_grid_usable(const char *what) const {
 }
 
 void Mapper::rerender() {
-  renderer_->reset(geo_, params_);
+  renderer_->reset(grid_, params_);
   renderer_->apply(scans_, 0, scans_.num_scans(), &stats_);
   ++renders_;
 }
@@ -150,7 +163,9 @@ void Mapper::rerender() {
 // Puts back what `saved` holds (scans_ already truncated to saved.scans) and
 // renders the grid again; a render that fails too leaves the grid marked lost.
 void Mapper::restore(const Saved &saved) noexcept {
+  shift_invariant_ = saved.shift_invariant;
   geo_ = saved.geo;
+  grid_ = saved.grid;
   extent_ = saved.extent;
   grid_lost_ = false;
   if (saved.scans > 0) {
@@ -167,20 +182,26 @@ Mapper::InsertPlan Mapper::plan_insert(const ScanBatch &scans) const {
   const size_t before = scans_.num_scans();
   const uint64_t beams = scans_.num_beams() + scans.num_beams();
   InsertPlan plan;
+  plan.shift_invariant = shift_invariant_ && beams_shift_invariant(scans, params_);
   plan.extent = extent_;
   for (size_t s = 0; s < scans.num_scans(); ++s) plan.extent.add_pose(scans.x[s], scans.y[s], scans.theta[s], s);
-  const GridGeometry need = frame_for(plan.extent, scans);
-  const bool fits = before > 0 && need.size_x <= geo_.size_x && need.size_y <= geo_.size_y;
-  plan.geo = fits || fixed_frame_ ? (before > 0 ? geo_ : need) : (before > 0 ? grown_frame(need, beams) : need);
+  plan.geo = frame_for(plan.extent, scans);
+  const bool fits = before > 0 && plan.geo.size_x <= grid_.size_x && plan.geo.size_y <= grid_.size_y;
+  if (before == 0)
+    plan.grid = plan.geo;  // the first insert: the PROTOCOL frame itself
+  else
+    plan.grid = fits ? grid_ : !plan.shift_invariant ? plan.geo : grown_frame(plan.geo, beams);
   plan.full_render = before == 0 || grid_lost_ || !fits;
-  check_memory(plan.geo, beams);
+  check_memory(plan.grid, beams);
   renderer_->check_capacity(beams);
   return plan;
 }
 
 void Mapper::apply_insert(const InsertPlan &plan, size_t before) {
   extent_ = plan.extent;
+  shift_invariant_ = plan.shift_invariant;
   geo_ = plan.geo;
+  grid_ = plan.grid;
   stats_ = MapStats{};
   if (plan.full_render)
     rerender();
@@ -242,7 +263,7 @@ void Mapper::render(const std::vector<Pose> &poses) {
   };
   swap_poses();
   extent_ = extent;
-  geo_ = geo;
+  geo_ = grid_ = geo;
   stats_ = MapStats{};
   try {
     rerender();
@@ -258,13 +279,18 @@ FinishedMap Mapper::finish(int downsample, int border) const {
   check_grid_usable("Mapper::finish");
   if (downsample < 1) throw Error(ErrorCode::Usage, "Mapper::finish: downsample must be at least 1");
   if (border < 0) throw Error(ErrorCode::Usage, "Mapper::finish: border must not be negative");
-  return renderer_->finish(downsample, border);
+  if (grid_.size_x == geo_.size_x && grid_.size_y == geo_.size_y) return renderer_->finish(downsample, border);
+  // A grown grid: CARMEN's finish of the frame()'s window of it.
+  const std::vector<float> cells = read();
+  return finish_grid(cells.data(), geo_.size_x, geo_.size_y, geo_.resolution, downsample, border);
 }
 
 std::vector<float> Mapper::read(const GridWindow &window) const {
   check_grid_usable("Mapper::read");
   check_window(window, geo_);
-  return renderer_->read(window);
+  // frame() lies centred in the grid: the same first scan, whole cells of margin.
+  const int dx = (grid_.size_x - geo_.size_x) / 2, dy = (grid_.size_y - geo_.size_y) / 2;
+  return renderer_->read(GridWindow{window.x0 + dx, window.y0 + dy, window.width, window.height});
 }
 
 std::vector<float> Mapper::read() const { return read(GridWindow{0, 0, geo_.size_x, geo_.size_y}); }
