@@ -34,10 +34,10 @@
 #include "bench_support.h"
 #include "carmen_compat/map_file.h"
 #include "vasco_gpu/backend.h"
-#include "vasco_gpu/cpu_threads_backend.h"
+#include "vasco_gpu/internal/cpu_threads_backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/mapper.hpp"
-#include "vasco_gpu/parallel.h"
+#include "vasco_gpu/internal/parallel.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/renderer.h"
 #include "vasco_gpu/scan_batch.h"
@@ -326,12 +326,12 @@ void bench_ablation(Bench *b, const Dataset &ds, const ParamSet &ps, const vasco
   for (const auto &v : variants) {
     std::function<std::vector<float>(vasco::MapStats *)> map;
     std::shared_ptr<vasco::Renderer> ours;
-    std::shared_ptr<vasco::Backend> paper;
+    std::shared_ptr<vasco::PaperMapper> paper;
     if (v.second < 0) {
       ours = vasco::make_renderer("cuda");
       map = [&](vasco::MapStats *st) { return vasco::render_grid(*ours, batch, ps.params, geo, st); };
     } else {
-      paper = vasco::make_paper_backend(static_cast<PaperVariant>(v.second));
+      paper = vasco::make_paper_mapper(static_cast<PaperVariant>(v.second));
       map = [&](vasco::MapStats *st) { return paper->map(batch, ps.params, geo, st); };
     }
     Phases ph, warm;

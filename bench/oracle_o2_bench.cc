@@ -16,7 +16,8 @@
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/renderer.h"
 #include "vasco_gpu/grid.h"
-#include "vasco_gpu/oracle.h"
+#include "vasco_gpu/internal/oracle.h"
+#include "vasco_gpu/internal/sensor_params.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"
 
@@ -36,7 +37,7 @@ std::vector<float> plain_loop(const vasco::ScanBatch &b, const vasco::MapperPara
   frame.size_y = geo.size_y;
   frame.resolution = geo.resolution;
   frame.theta_offset = geo.theta_offset;
-  const vasco::egrid::SensorModel<double> model = p.sensor_model();
+  const vasco::egrid::SensorModel<double> model = vasco::sensor_model_of(p);
   const int t = p.table_size();
   std::vector<double> table(static_cast<size_t>(t) * t);
   std::vector<const double *> rows(t);

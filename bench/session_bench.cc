@@ -24,9 +24,9 @@
 #include <thread>
 #include <vector>
 
-#include "vasco_gpu/log_input.h"
+#include "vasco_gpu/internal/log_input.h"
 #include "vasco_gpu/mapper.hpp"
-#include "vasco_gpu/parallel.h"
+#include "vasco_gpu/internal/parallel.h"
 #if defined(VASCO_HAVE_CUDA)
 #include "vasco_gpu/cuda_backend.h"
 #endif

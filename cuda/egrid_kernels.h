@@ -11,9 +11,9 @@
 #include <cstdint>
 #include <string>
 
-#include "vasco_gpu/egrid_math.h"
-#include "vasco_gpu/finish_math.h"
-#include "vasco_gpu/placed_beam.h"
+#include "vasco_gpu/internal/egrid_math.h"
+#include "vasco_gpu/internal/finish_math.h"
+#include "vasco_gpu/internal/placed_beam.h"
 
 namespace vasco {
 namespace cuda {

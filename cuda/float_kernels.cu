@@ -23,7 +23,7 @@
 
 #include "cuda_check.h"
 #include "egrid_kernels.h"
-#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
 namespace cuda {

@@ -6,7 +6,7 @@
 #define VASCO_CUDA_LINE_REC_CUH
 
 #include "egrid_kernels.h"
-#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
 namespace cuda {

@@ -14,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       const carmen::ParamFile pf = carmen::ParamFile::parse(text, "fuzz.ini", robot);
       std::vector<std::string> warnings;
       vasco::MapperParams::from_params(pf, &warnings);
-    } catch (const carmen::FileError &) {
+    } catch (const carmen::Error &) {  // a ParamError or a FileError: refused input
     } catch (const std::invalid_argument &) {
     }
   }

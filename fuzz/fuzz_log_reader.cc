@@ -14,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       try {
         carmen::LogStats stats;
         carmen::read_log(in.path(), opt, &stats);
-      } catch (const carmen::FileError &) {
+      } catch (const carmen::Error &) {
       }
     }
   }

@@ -10,11 +10,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     opt.max_kept_bytes = 64 << 20;  // the budget, small enough for the fuzzer's memory limit
     try {
       carmen::read_map_file(in.path(), opt);
-    } catch (const carmen::FileError &) {
+    } catch (const carmen::Error &) {
     }
     try {
       carmen::list_map_chunks(in.path());
-    } catch (const carmen::FileError &) {
+    } catch (const carmen::Error &) {
     }
     carmen::is_map_file(in.path());
   }

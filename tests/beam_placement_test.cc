@@ -10,8 +10,8 @@
 
 #include "test_seed.h"
 #include "test_support.h"
-#include "vasco_gpu/beam_placement.h"
-#include "vasco_gpu/oracle.h"
+#include "vasco_gpu/internal/beam_placement.h"
+#include "vasco_gpu/internal/oracle.h"
 
 namespace vasco {
 namespace {

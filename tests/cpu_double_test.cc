@@ -1,5 +1,5 @@
 // The cpu_double backend against the oracle's reference loop
-// (oracle::update_scan, what egrid.cc runs for CARMEN's C API): the backend
+// (oracle::update_scan, what carmen_egrid_api.cc runs for CARMEN's C API): the backend
 // takes a faster path for ordinary beams (cpu_double_backend.cc), which must
 // give the same grid bytes and counts wherever it is taken or left.
 #include <gtest/gtest.h>
@@ -11,15 +11,16 @@
 
 #include "test_seed.h"
 #include "test_support.h"
-#include "vasco_gpu/oracle.h"
+#include "vasco_gpu/internal/oracle.h"
 #include "vasco_gpu/renderer.h"
+#include "vasco_gpu/internal/sensor_params.h"
 
 namespace vasco {
 namespace {
 
 using testing_support::random_batch;
 
-// oracle::update_scan over scans [0, n), as egrid.cc drives it.
+// oracle::update_scan over scans [0, n), as carmen_egrid_api.cc drives it.
 std::vector<float> reference_map(const ScanBatch &batch, const MapperParams &params, const GridGeometry &geo,
                                  MapStats *stats) {
   std::vector<float> cells(geo.num_cells(), egrid::kUnknown);
@@ -38,7 +39,7 @@ std::vector<float> reference_map(const ScanBatch &batch, const MapperParams &par
   }
   *stats = MapStats{};
   for (size_t s = 0; s < batch.num_scans(); ++s) {
-    const auto c = oracle::update_scan(cells.data(), frame, params.sensor_model(), params.wall_size, T,
+    const auto c = oracle::update_scan(cells.data(), frame, sensor_model_of(params), params.wall_size, T,
                                        rows.empty() ? nullptr : rows.data(), batch.x[s], batch.y[s],
                                        batch.theta[s], batch.beams_in(s), batch.ranges_of(s),
                                        oracle::SteppedAngles{batch.first_angle[s], batch.angle_step[s]});

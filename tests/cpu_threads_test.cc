@@ -12,7 +12,7 @@
 
 #include "test_seed.h"
 #include "test_support.h"
-#include "vasco_gpu/cpu_threads_backend.h"
+#include "vasco_gpu/internal/cpu_threads_backend.h"
 
 namespace vasco {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "test_seed.h"
 #include "test_support.h"
-#include "vasco_gpu/compare.h"
+#include "carmen_compat/map_compare.h"
 #include "vasco_gpu/error.h"
 #include "vasco_gpu/renderer.h"
 #if defined(VASCO_HAVE_CUDA)
@@ -103,7 +103,7 @@ TEST_P(CudaGolden, FloatModeAgreesWithTheOracle) {
   MapStats ref_stats, gpu_stats;
   const auto ref = map_on("cpu_double", log.batch, params, log.geo, &ref_stats);
   const auto got = map_on("cuda", log.batch, params, log.geo, &gpu_stats, CudaMode::Float);
-  const Agreement a = compare_maps(ref, got);
+  const carmen::Agreement a = carmen::compare_maps(ref, got);
   std::printf("%s", a.table(std::string("cuda float vs cpu_double, ") + GetParam()).c_str());
   EXPECT_EQ(gpu_stats.beams_used, ref_stats.beams_used);
   EXPECT_GT(a.class_agreement(), 0.999);
@@ -139,7 +139,7 @@ TEST(CudaNoLostUpdates, EveryBeamOfAScanUpdatesTheSharedCell) {
   // 1440 free updates of logit(0.499) = -0.004 each: p = 1/(1+e^5.76) = 0.0031.
   // One lost update moves p by 0.4 %; float rounding of the sum is below 1e-4.
   EXPECT_NEAR(flt[start], ref[start], 1e-5 + 1e-4 * ref[start]);
-  const Agreement a = compare_maps(ref, flt);
+  const carmen::Agreement a = carmen::compare_maps(ref, flt);
   EXPECT_EQ(a.status_differs, 0u);
   EXPECT_LT(a.max_abs_diff, 1e-4);
 }

@@ -1,7 +1,7 @@
 // Tests of the shared per-cell math (egrid_math.h): the same functions the
 // CUDA kernels run.
 #include "test_seed.h"
-#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/internal/egrid_math.h"
 
 #include <gtest/gtest.h>
 

@@ -65,7 +65,7 @@ inline void expect_float_within_bounds(const Case &c, const Path &path) {
   const FinishedMap ref = backend_path("cpu_double", "cpu_double").run(in);
   ASSERT_EQ(digest(ref), c.sha256) << "cpu_double is not CARMEN's map: no reference for " << path.name;
   const FinishedMap got = path.run(in);
-  const Agreement a = compare_finished(ref, got);
+  const carmen::Agreement a = compare_finished(ref, got);
   std::printf("%s", a.table(path.name + " vs CARMEN's " + c.name).c_str());
   uint64_t known = 0;
   for (float v : ref.cells) known += v != -1.0f;

@@ -4,11 +4,14 @@
 //   golden_check [--golden DIR] [--data DIR] [--paths LIST] [--case SUBSTRING]
 //
 // Exact paths (cpu_double, cpu_threads/1, /2, /7, egrid_c_api, a mapping
-// session fed the scans in pieces (mapper/cpu_threads), egrid.h on a
+// session fed the scans in pieces then rendered again with its poses
+// (mapper/cpu_threads), egrid.h on a
 // cpu_threads session, and cuda_exact, mapper/cuda and egrid_c_api/cuda_exact
 // in exact mode when a GPU is usable) must give CARMEN's GRIDMAP payload
 // digest.
-// Float paths (cpu_float, cuda_float) are reported against the golden map with
+// Float paths (cpu_float, cuda_float) and the session fed in pieces as it is
+// (mapper-grown/..., whose grown grid may round a boundary cell the other
+// way: mapper.hpp) are reported against the golden map with
 // the DESIGN §4 table; the golden cells are those of cpu_double once its
 // digest has matched CARMEN's. Exit 0 when every exact path matched every
 // case, 1 when one did not, 2 on a usage error, 77 when DIR holds no goldens.
@@ -19,7 +22,7 @@
 #include <vector>
 
 #include "golden_support.h"
-#include "vasco_gpu/timing.h"
+#include "vasco_gpu/internal/timing.h"
 
 namespace {
 
@@ -48,12 +51,13 @@ std::vector<golden::Path> select_paths(const Options &opt, std::vector<golden::P
   const bool gpu = golden::cuda_available(&why);
   if (!gpu) std::printf("CUDA paths skipped: %s\n", why.c_str());
   std::map<std::string, golden::Path> all;
-  std::vector<std::string> exact_names, float_names = {"cpu_float"};
+  std::vector<std::string> exact_names, float_names = {"cpu_float", "mapper-grown/cpu_threads"};
   for (auto &p : golden::exact_cpu_paths()) {
     exact_names.push_back(p.name);
     all.emplace(p.name, p);
   }
   all.emplace("cpu_float", golden::backend_path("cpu_float", "cpu_float"));
+  all.emplace("mapper-grown/cpu_threads", golden::mapper_grown_path("cpu_threads"));
   if (gpu) {
     exact_names.push_back("cuda_exact");
     float_names.push_back("cuda_float");
@@ -63,6 +67,8 @@ std::vector<golden::Path> select_paths(const Options &opt, std::vector<golden::P
     exact.cuda_mode = CudaMode::Exact;
     exact_names.push_back("mapper/cuda");
     all.emplace("mapper/cuda", golden::mapper_path("cuda", exact));
+    float_names.push_back("mapper-grown/cuda");
+    all.emplace("mapper-grown/cuda", golden::mapper_grown_path("cuda", exact));
     exact_names.push_back("egrid_c_api/cuda_exact");
     all.emplace("egrid_c_api/cuda_exact", golden::egrid_path("cuda_exact"));
   }
@@ -70,7 +76,7 @@ std::vector<golden::Path> select_paths(const Options &opt, std::vector<golden::P
   const std::vector<std::string> wanted = opt.paths.empty() ? exact_names : opt.paths;
   for (const auto &n : wanted) {
     if (!all.count(n)) throw std::invalid_argument("unknown or unavailable path '" + n + "'");
-    const bool is_float = n == "cpu_float" || n == "cuda_float";
+    const bool is_float = n == "cpu_float" || n == "cuda_float" || n.rfind("mapper-grown/", 0) == 0;
     (is_float ? *floats : exact).push_back(all.at(n));
   }
   if (opt.paths.empty())
@@ -107,7 +113,7 @@ int run_case(const golden::Case &c, const std::string &log, const std::string &i
                   c.name.c_str(), p.name.c_str());
       continue;
     }
-    const Agreement a = golden::compare_finished(reference, p.run(in));
+    const carmen::Agreement a = golden::compare_finished(reference, p.run(in));
     std::printf("%-9s %-52s %-13s max|dp| %.3g, |dp|>0.1 %llu, status differs %llu, class %.4f%%\n",
                 "float", c.name.c_str(), p.name.c_str(), a.max_abs_diff,
                 (unsigned long long)a.large_diffs, (unsigned long long)a.status_differs,
@@ -165,7 +171,8 @@ int main(int argc, char **argv) {
       std::fprintf(stderr,
                    "usage: golden_check [--golden DIR] [--data DIR] [--paths a,b,...] [--case SUBSTRING]\n"
                    "paths: cpu_double cpu_threads/1 cpu_threads/2 cpu_threads/7 egrid_c_api mapper/cpu_threads "
-                   "egrid_c_api/cpu_threads cuda_exact mapper/cuda egrid_c_api/cuda_exact cpu_float cuda_float\n");
+                   "egrid_c_api/cpu_threads cuda_exact mapper/cuda egrid_c_api/cuda_exact cpu_float cuda_float "
+                   "mapper-grown/cpu_threads mapper-grown/cuda\n");
       return 2;
     }
   }

@@ -23,10 +23,10 @@
 #include "carmen/egrid.h"
 #include "carmen_compat/map_file.h"
 #include "vasco_gpu/backend.h"
-#include "vasco_gpu/compare.h"
+#include "carmen_compat/map_compare.h"
 #include "vasco_gpu/grid.h"
-#include "vasco_gpu/log_input.h"
-#include "vasco_gpu/map_digest.h"
+#include "vasco_gpu/internal/log_input.h"
+#include "carmen_compat/map_digest.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/renderer.h"
 #if defined(VASCO_HAVE_CUDA)
@@ -91,7 +91,7 @@ inline FinishedMap finish(const std::vector<float> &cells, const LogInput &in) {
 }
 
 inline std::string digest(const FinishedMap &m) {
-  return gridmap_payload_sha256(m.size_x, m.size_y, m.resolution, m.cells);
+  return carmen::gridmap_payload_sha256(m.size_x, m.size_y, m.resolution, m.cells);
 }
 
 // The golden PROTOCOL's steps through CARMEN's C API (egrid.h): initialize
@@ -174,15 +174,30 @@ inline bool cuda_available(std::string *why) {
 
 // A mapping session fed the case's scans in pieces of 97 (vasco::Mapper):
 // incremental inserts, frame growth and the renderer's finish.
+// A session fed the scans in pieces of 97: its grid grows with a margin, so
+// scans rendered into a grid of another size may round a cell position on
+// a cell boundary the other way (mapper.hpp: the reservation). As it is: a
+// path reported against CARMEN's map (golden_check's mapper-grown/...).
+inline Mapper session_in_pieces(const LogInput &in, const std::string &backend, const BackendOptions &opt) {
+  Mapper m(in.params, backend, opt);
+  for (size_t a = 0; a < in.batch.num_scans(); a += 97) m.insert(in.batch.select(static_cast<long>(a), 97));
+  if (m.frame().size_x != in.geo.size_x || m.frame().size_y != in.geo.size_y)
+    throw std::runtime_error("the session's frame is not the PROTOCOL frame");
+  return m;
+}
+
+inline Path mapper_grown_path(const std::string &backend, BackendOptions opt = {}) {
+  return Path{"mapper-grown/" + backend,
+              [backend, opt](const LogInput &in) { return session_in_pieces(in, backend, opt).finish(); }};
+}
+
+// The same session, then render(poses()): rendered again in frame() itself,
+// what a SLAM pipeline does after moving poses — CARMEN's bytes.
 inline Path mapper_path(const std::string &backend, BackendOptions opt = {}) {
   return Path{"mapper/" + backend, [backend, opt](const LogInput &in) {
-                Mapper m(in.params, backend, opt);
-                for (size_t a = 0; a < in.batch.num_scans(); a += 97)
-                  m.insert(in.batch.select(static_cast<long>(a), 97));
-                FinishedMap f = m.finish();
-                if (m.frame().size_x != in.geo.size_x || m.frame().size_y != in.geo.size_y)
-                  throw std::runtime_error("the session's frame is not the PROTOCOL frame");
-                return f;
+                Mapper m = session_in_pieces(in, backend, opt);
+                m.render(m.poses());
+                return m.finish();
               }};
 }
 
@@ -217,10 +232,10 @@ inline void to_union_box(const FinishedMap &a, const FinishedMap &b, std::vector
   place(b, ub);
 }
 
-inline Agreement compare_finished(const FinishedMap &ref, const FinishedMap &test) {
+inline carmen::Agreement compare_finished(const FinishedMap &ref, const FinishedMap &test) {
   std::vector<float> ur, ut;
   to_union_box(ref, test, &ur, &ut);
-  return compare_maps(ur, ut);
+  return carmen::compare_maps(ur, ut);
 }
 
 

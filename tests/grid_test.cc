@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "vasco_gpu/error.h"
-#include "vasco_gpu/oracle.h"
+#include "vasco_gpu/internal/oracle.h"
 
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"

@@ -68,7 +68,7 @@ TEST(Log2Map, WritesEveryFormatAndTheMapIsTheOraclesFinishedGrid) {
   // The GRIDMAP equals finish(cpu_double) computed here, in process.
   const vasco::MapperParams params;
   const auto log = vasco::testing_support::load_log(kIntel, params);
-  const auto cells = vasco::make_cpu_double_backend()->map(log.batch, params, log.geo, nullptr);
+  const auto cells = vasco::render_grid(*vasco::make_renderer("cpu_double"), log.batch, params, log.geo);
   const auto fin = vasco::finish_grid(cells.data(), log.geo.size_x, log.geo.size_y, log.geo.resolution,
                                       4, 20);
   for (const char *name : {"m.map.gz", "plain.map"}) {
@@ -257,6 +257,42 @@ TEST(Log2Map, AGridBeyondTheMemoryBudgetIsRefusedNamingTheLog) {
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"far.log"}));
 }
 
+
+// --max-memory bounds what is read too: a log of long scans is refused at
+// the scan that passes the budget, naming the log's line, not loaded first
+// (3000 scans of 100000 beams reached 2.8 GB with --max-memory 100).
+TEST(Log2Map, TheMemoryBudgetIsCountedWhileTheLogIsRead) {
+  TempDir dir;
+  std::string scan = "FLASER 20000";
+  for (int i = 0; i < 20000; ++i) scan += " 1.5";
+  scan += " 0 0 0 0 0 0 1 t 0\n";
+  std::string text;
+  for (int i = 0; i < 40; ++i) text += scan;  // 80 KB of ranges a scan: 3.2 MB in all
+  const std::string log = write_text(dir, "long.log", text);
+  const ToolRun r = log2map({"--backend", "cpu_double", "--max-memory", "1", log, dir.file("out.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, log + ":1")) << r.output;  // a line of the log, "long.log:1N: ..."
+  EXPECT_TRUE(contains(r.output, "(1.07 MiB), more than the memory budget of 1048576 bytes (1 MiB); raise it with "
+                                 "--max-memory"))
+      << r.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"long.log"}));
+}
+
+// A log whose every beam CARMEN skips (50 m or more, +inf, NaN, 1e308 as a
+// float) maps nothing: the error names the log and says why (it said
+// "gridmap size 0 x 0 is not positive", naming no file); nothing is written.
+TEST(Log2Map, ALogWhoseEveryBeamIsSkippedSaysWhy) {
+  TempDir dir;
+  const std::string log = write_text(dir, "far.log",
+                                     "FLASER 3 50.0 1e308 nan 0 0 0 0 0 0 1 t 0\n"
+                                     "FLASER 3 60 inf 75.5 0.5 0 0 0.5 0 0 2 t 0\n");
+  const ToolRun r = log2map({"--backend", "cpu_double", log, dir.file("out.map"), dir.file("out.png")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, log + ": no beam updated any cell: every one of the 6 ranges of the 2 scans"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "50 m or more, NaN or +inf")) << r.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"far.log"}));
+}
 
 // The small defects of the reliability audit, each with its reproduction.
 TEST(Log2Map, SmallDefectsGiveClearErrors) {

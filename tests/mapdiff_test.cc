@@ -11,7 +11,7 @@
 #include "carmen_compat/map_file.h"
 #include "map_test_support.h"
 #include "tool_support.h"
-#include "vasco_gpu/compare.h"
+#include "carmen_compat/map_compare.h"
 
 namespace {
 
@@ -390,8 +390,8 @@ TEST(CompareGrids, AgreesWithCompareMapsAtNoShift) {
   GridMap a = base_grid(), b = base_grid();
   b.at(3, 2) = 0.625f;
   b.at(1, 1) = carmen::kUnknownCell;
-  const vasco::Agreement m = vasco::compare_maps(a.cells, b.cells);
-  const vasco::GridComparison g = vasco::compare_grids(a, b, 0, 0, 10);
+  const carmen::Agreement m = carmen::compare_maps(a.cells, b.cells);
+  const carmen::GridComparison g = carmen::compare_grids(a, b, 0, 0, 10);
   EXPECT_EQ(g.agreement.cells, m.cells);
   EXPECT_EQ(g.agreement.identical, m.identical);
   EXPECT_EQ(g.agreement.status_differs, m.status_differs);
@@ -408,7 +408,7 @@ TEST(CompareGrids, AgreesWithCompareMapsAtNoShift) {
 
 TEST(CompareGrids, NoOverlap) {
   const GridMap a = base_grid();
-  const vasco::GridComparison g = vasco::compare_grids(a, a, 6, 0, 10);
+  const carmen::GridComparison g = carmen::compare_grids(a, a, 6, 0, 10);
   EXPECT_EQ(g.width, 0);
   EXPECT_EQ(g.height, 0);
   EXPECT_EQ(g.outside, 48u);
@@ -419,12 +419,12 @@ TEST(CompareGrids, NoOverlap) {
 TEST(CompareGrids, OffsetShift) {
   int64_t sx = 0, sy = 0;
   std::string why;
-  EXPECT_TRUE(vasco::offset_shift({1.0, 2.0, 0}, {1.5, 1.0, 0}, 0.25, &sx, &sy, &why));
+  EXPECT_TRUE(carmen::offset_shift({1.0, 2.0, 0}, {1.5, 1.0, 0}, 0.25, &sx, &sy, &why));
   EXPECT_EQ(sx, 2);
   EXPECT_EQ(sy, -4);
-  EXPECT_FALSE(vasco::offset_shift({0, 0, 0}, {0.1, 0, 0}, 0.25, &sx, &sy, &why));
+  EXPECT_FALSE(carmen::offset_shift({0, 0, 0}, {0.1, 0, 0}, 0.25, &sx, &sy, &why));
   EXPECT_TRUE(contains(why, "whole number")) << why;
-  EXPECT_FALSE(vasco::offset_shift({0, 0, 0.5}, {0, 0, 0.5}, 0.25, &sx, &sy, &why));
+  EXPECT_FALSE(carmen::offset_shift({0, 0, 0.5}, {0, 0, 0.5}, 0.25, &sx, &sy, &why));
   EXPECT_TRUE(contains(why, "theta")) << why;
 }
 

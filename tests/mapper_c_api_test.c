@@ -1,4 +1,4 @@
-/* The mapping session from C (vasco_gpu/mapper.h), as a C program would use
+/* The mapping session from C (vasco_gpu/mapper_c.h), as a C program would use
  * it: inserts one at a time equal one insert of everything (the frame grew
  * with a margin that read and finish do not show), a render with
  * moved poses equals a fresh session fed the moved scans, a fixed frame equals
@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "carmen/egrid.h"
-#include "vasco_gpu/mapper.h"
+#include "vasco_gpu/mapper_c.h"
 
 #define NUM_SCANS 60
 #define NUM_BEAMS 181

@@ -124,7 +124,7 @@ TEST_F(MapperCuda, ExactInsertsInPiecesEqualCpuDouble) {
   }
   // Growth leaves a margin: the reference is a fresh map in the session's frame.
   const GridGeometry geo = m.frame();
-  const auto ref = make_cpu_double_backend()->map(scans_, params_, geo, nullptr);
+  const auto ref = render_grid(*make_renderer("cpu_double"), scans_, params_, geo);
   testing_support::expect_bit_identical(ref, m.read(), geo, "cuda exact session");
 }
 
@@ -148,7 +148,7 @@ TEST_F(MapperCuda, ExactRenderWithMovedPosesEqualsCpuDouble) {
     moved.theta[i] = poses[i].theta;
   }
   const GridGeometry geo = size_grid(moved, params_);
-  const auto ref = make_cpu_double_backend()->map(moved, params_, geo, nullptr);
+  const auto ref = render_grid(*make_renderer("cpu_double"), moved, params_, geo);
   testing_support::expect_bit_identical(ref, m.read(), geo, "cuda exact render");
   const FinishedMap host = finish_grid(ref.data(), geo.size_x, geo.size_y, geo.resolution, 4, 20);
   EXPECT_EQ(golden::digest(m.finish(4, 20)), golden::digest(host));

@@ -130,53 +130,52 @@ void expect_unchanged(const Mapper &m, const ScanBatch &stored, const std::vecto
   expect_bit_identical(fresh(stored, m.params(), geo), m.read(), geo, "a fresh render of the stored scans");
 }
 
-TEST(MapperGuard, FailedApplyInTheSameFrameLeavesTheSessionAsItWas) {
+// A failing session that has mapped 10 scans, and what it held then.
+struct Started {
   Session s = failing_session();
-  const ScanBatch first = drive(10, 0.05);
-  s.mapper->insert(first);
-  const std::vector<float> grid = s.mapper->read();
-  const GridGeometry geo = s.mapper->frame();
-  s.renderer->fail_apply_at = s.renderer->applies;  // the next apply: scans 10..11, same frame
-  EXPECT_THROW(s.mapper->insert(drive(2, 0.05, 10)), std::bad_alloc);
-  expect_unchanged(*s.mapper, first, grid, geo);
-  const FinishedMap before = fresh_finish(first, geo);
-  EXPECT_EQ(s.mapper->finish(1, 5).cells, before.cells);
+  ScanBatch first = drive(10, 0.05);
+  std::vector<float> grid;
+  GridGeometry geo;
+  Started() {
+    s.mapper->insert(first);
+    grid = s.mapper->read();
+    geo = s.mapper->frame();
+  }
+  void expect_unchanged() const { vasco::expect_unchanged(*s.mapper, first, grid, geo); }
+};
+
+TEST(MapperGuard, FailedApplyInTheSameFrameLeavesTheSessionAsItWas) {
+  Started t;
+  t.s.renderer->fail_apply_at = t.s.renderer->applies;  // the next apply: scans 10..11, same frame
+  EXPECT_THROW(t.s.mapper->insert(drive(2, 0.05, 10)), std::bad_alloc);
+  t.expect_unchanged();
+  EXPECT_EQ(t.s.mapper->finish(1, 5).cells, fresh_finish(t.first, t.geo).cells);
 }
 
 TEST(MapperGuard, FailedGrowthRenderLeavesTheSessionAsItWas) {
-  Session s = failing_session();
-  const ScanBatch first = drive(10, 0.05);
-  s.mapper->insert(first);
-  const std::vector<float> grid = s.mapper->read();
-  const GridGeometry geo = s.mapper->frame();
-  s.renderer->fail_reset_at = s.renderer->resets;  // the growth's reset
-  EXPECT_THROW(s.mapper->insert(drive(1, 0.05, 400)), std::bad_alloc);  // 20 m out: grows
-  expect_unchanged(*s.mapper, first, grid, geo);
+  Started t;
+  t.s.renderer->fail_reset_at = t.s.renderer->resets;  // the growth's reset
+  EXPECT_THROW(t.s.mapper->insert(drive(1, 0.05, 400)), std::bad_alloc);  // 20 m out: grows
+  t.expect_unchanged();
 }
 
 TEST(MapperGuard, FailedRenderKeepsTheOldPoses) {
-  Session s = failing_session();
-  const ScanBatch first = drive(10, 0.05);
-  s.mapper->insert(first);
-  const std::vector<float> grid = s.mapper->read();
-  const GridGeometry geo = s.mapper->frame();
-  std::vector<Pose> moved = s.mapper->poses();
+  Started t;
+  std::vector<Pose> moved = t.s.mapper->poses();
   for (Pose &p : moved) p.x += 3.0;
-  s.renderer->fail_apply_at = s.renderer->applies;
-  EXPECT_THROW(s.mapper->render(moved), std::bad_alloc);
-  expect_unchanged(*s.mapper, first, grid, geo);
+  t.s.renderer->fail_apply_at = t.s.renderer->applies;
+  EXPECT_THROW(t.s.mapper->render(moved), std::bad_alloc);
+  t.expect_unchanged();
 }
 
 TEST(MapperGuard, ALostGridIsRefusedUntilRenderedAgain) {
-  Session s = failing_session();
-  const ScanBatch first = drive(10, 0.05);
-  s.mapper->insert(first);
-  s.renderer->fail_apply_at = s.renderer->applies;
-  s.renderer->fail_every_after = true;  // the restoring render fails too
-  EXPECT_THROW(s.mapper->insert(drive(2, 0.05, 10)), std::bad_alloc);
-  EXPECT_EQ(s.mapper->num_scans(), 10u);
-  EXPECT_EQ(code_of([&] { s.mapper->finish(); }), ErrorCode::State);
-  EXPECT_EQ(code_of([&] { s.mapper->read(); }), ErrorCode::State);
+  Started t;
+  t.s.renderer->fail_apply_at = t.s.renderer->applies;
+  t.s.renderer->fail_every_after = true;  // the restoring render fails too
+  EXPECT_THROW(t.s.mapper->insert(drive(2, 0.05, 10)), std::bad_alloc);
+  EXPECT_EQ(t.s.mapper->num_scans(), 10u);
+  EXPECT_EQ(code_of([&] { t.s.mapper->finish(); }), ErrorCode::State);
+  EXPECT_EQ(code_of([&] { t.s.mapper->read(); }), ErrorCode::State);
 }
 
 TEST(MapperGuard, RenderAfterALostGridRestoresIt) {
@@ -197,11 +196,11 @@ TEST(MapperGuard, AHugeThreadCountIsRefusedBeforeAnyInsert) {
   // 2^31 - 1 threads used to fail inside an insert after the session changed
   // (and make per-thread scratch of 16 GiB first).
   BackendOptions o;
-  for (int threads : {INT_MAX, 4097, -1}) {
+  for (int threads : {INT_MAX, kMaxThreads + 1, -1}) {
     o.threads = threads;
     EXPECT_EQ(code_of([&] { Mapper m(small_params(), "cpu_threads", o); }), ErrorCode::Usage) << threads;
   }
-  o.threads = 4096;
+  o.threads = kMaxThreads;
   Mapper m(small_params(), "cpu_threads", o);
   EXPECT_EQ(m.backend_name(), "cpu_threads");
 }
@@ -221,6 +220,40 @@ TEST(MapperGuard, OverTheMemoryBudgetIsOutOfMemoryAndChangesNothing) {
   m.set_max_memory_bytes(0);
   m.insert(drive(1, 1000.0, 2));
   EXPECT_EQ(m.num_scans(), 6u);
+}
+
+// The MiB figures of a refusal, as the message gives them.
+double mib_after(const std::string &m, const std::string &before) {
+  const size_t at = m.find(before);
+  return at == std::string::npos ? -1 : std::stod(m.substr(at + before.size()));
+}
+
+// A refusal always reads as a need above the budget (it said "needs about 2
+// MiB ... more than the budget of 2 MiB"), and names how to raise it only
+// where the caller said how.
+TEST(MapperGuard, AMemoryRefusalReadsAsMoreThanTheBudget) {
+  for (uint64_t budget : {uint64_t(2) << 20, uint64_t(3) << 20, (uint64_t(5) << 20) / 2}) {
+    BackendOptions o;
+    o.max_memory_bytes = budget;
+    int refused = 0;
+    for (double step = 1.0; step < 400.0; step *= 1.005) {  // grids of growing size around the budget
+      Mapper m(small_params(), "cpu_double", o);
+      const std::string msg = message_of([&] { m.insert(drive(2, step)); });
+      if (msg.empty()) continue;
+      ++refused;
+      const double need = mib_after(msg, "needs about "), said = mib_after(msg, "the budget of ");
+      ASSERT_GT(need, 0) << msg;
+      EXPECT_GT(need, said) << msg;
+      EXPECT_LE(said * (1 << 20), static_cast<double>(budget)) << msg;
+      EXPECT_EQ(msg.find("raise it"), std::string::npos) << msg;
+    }
+    EXPECT_GT(refused, 3) << budget;
+  }
+  BackendOptions o;
+  o.max_memory_bytes = 1 << 20;
+  o.budget_hint = "--max-memory MiB";
+  Mapper m(small_params(), "cpu_double", o);
+  EXPECT_NE(message_of([&] { m.insert(drive(2, 200.0)); }).find("raise it (--max-memory MiB)"), std::string::npos);
 }
 
 // A batch of three scans, broken by `breakit`, must be refused naming `scan`

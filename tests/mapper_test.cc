@@ -18,6 +18,7 @@
 #include "test_seed.h"
 #include "test_support.h"
 #include "vasco_gpu/error.h"
+#include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
 namespace {
@@ -117,7 +118,7 @@ TEST_P(MapperExact, RenderWithNewPosesEqualsAFreshMapOfALogCarryingThem) {
   const LogInput in = load_log_input(in_opt);
   ASSERT_EQ(in.geo.size_x, m.frame().size_x);
   ASSERT_EQ(in.geo.size_y, m.frame().size_y);
-  const FinishedMap fresh = golden::finish(make_cpu_double_backend()->map(in.batch, in.params, in.geo, nullptr), in);
+  const FinishedMap fresh = golden::finish(render_grid(*make_renderer("cpu_double"), in.batch, in.params, in.geo), in);
   EXPECT_EQ(golden::digest(m.finish()), golden::digest(fresh));
 }
 
@@ -181,7 +182,7 @@ TEST(MapperSession, CpuFloatInsertsAreRepeatableAndNearItsOneShot) {
   };
   const std::vector<float> inserted = session();
   testing_support::expect_bit_identical(inserted, session(), frame, "cpu_float, the same inserts again");
-  const auto one_shot = make_cpu_float_backend()->map(f.scans, f.params, frame, nullptr);
+  const auto one_shot = render_grid(*make_renderer("cpu_float"), f.scans, f.params, frame);
   ASSERT_EQ(one_shot.size(), inserted.size());
   size_t known = 0, compared = 0, beyond = 0;
   for (size_t c = 0; c < one_shot.size(); ++c) {

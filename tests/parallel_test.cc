@@ -8,7 +8,7 @@
 #include <thread>
 #include <vector>
 
-#include "vasco_gpu/parallel.h"
+#include "vasco_gpu/internal/parallel.h"
 
 namespace vasco {
 namespace {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/renderer.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"
@@ -32,11 +33,6 @@ inline LoadedLog load_log(const std::string &path, const MapperParams &params) {
   l.batch = load_scans(path, params, carmen::LogReaderOptions{}, &stats);
   l.geo = size_grid(l.batch, params);
   return l;
-}
-
-inline std::vector<float> run_backend(Backend &backend, const LoadedLog &log,
-                                      const MapperParams &params, MapStats *stats = nullptr) {
-  return backend.map(log.batch, params, log.geo, stats);
 }
 
 // Random scans with odd ranges: NaN, +-inf, negative, >= 50, 49.99.

@@ -10,7 +10,7 @@
 #include "cuda_check.h"
 #include "cuda_host_support.h"
 #include "egrid_kernels.h"
-#include "vasco_gpu/beam_placement.h"
+#include "vasco_gpu/internal/beam_placement.h"
 #include "vasco_gpu/cuda_backend.h"
 
 namespace vasco {
@@ -24,9 +24,7 @@ using cuda::Stream;
 using cuda_host::check_fits;
 using cuda_host::StageTimer;
 
-double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-class PaperBackend : public Backend {
+class PaperBackend : public PaperMapper {
  public:
   PaperBackend(cuda::PaperVariant v, int device) : variant_(v), device_(device) {
     VG_CUDA_CHECK(cudaSetDevice(device));
@@ -43,11 +41,6 @@ class PaperBackend : public Backend {
     st.scans = batch.num_scans();
     if (stats != nullptr) *stats = st;
     return grid;
-  }
-
-  void apply(const ScanBatch &, size_t, size_t, const MapperParams &, const GridGeometry &, float *,
-             MapStats *) override {
-    throw std::logic_error("the paper's kernels map whole batches only");
   }
 
  private:
@@ -73,7 +66,7 @@ class PaperBackend : public Backend {
       h_scans[s] = f;
     }
     const cuda::KernelModel<float> m = kernel_model_of<float>(params, geo);
-    st->prep_s = seconds(t_prep);
+    st->prep_s = seconds_since(t_prep);
 
     const size_t cells = geo.num_cells(), nbeams = batch.num_beams();
     if (nbeams > UINT32_MAX) throw std::runtime_error("the paper's kernels: more than 2^32 beams");
@@ -125,7 +118,7 @@ class PaperBackend : public Backend {
 
 }  // namespace
 
-std::unique_ptr<Backend> make_paper_backend(cuda::PaperVariant variant, int cuda_device) {
+std::unique_ptr<PaperMapper> make_paper_mapper(cuda::PaperVariant variant, int cuda_device) {
   std::string why;
   if (!cuda_usable(cuda_device, &why)) throw std::runtime_error("no usable GPU: " + why);
   return std::make_unique<PaperBackend>(variant, cuda_device);

@@ -16,7 +16,7 @@
 
 #include "cuda_check.h"
 #include "paper_kernels.h"
-#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
 namespace cuda {

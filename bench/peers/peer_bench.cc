@@ -25,10 +25,10 @@
 
 #include "../bench_support.h"
 #include "vasco_gpu/backend.h"
-#include "vasco_gpu/cpu_threads_backend.h"
-#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/internal/cpu_threads_backend.h"
+#include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/grid.h"
-#include "vasco_gpu/parallel.h"
+#include "vasco_gpu/internal/parallel.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/renderer.h"
 #include "vasco_gpu/scan_batch.h"

@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "carmen_compat/file_names.h"
+
 namespace {
 
-bool ends_with_gz(const char *name) {
-  const size_t n = std::strlen(name);
-  return n >= 3 && std::strcmp(name + n - 3, ".gz") == 0;
-}
+// By name, case and all, as CARMEN's carmen_fopen decides.
+bool ends_with_gz(const char *name) { return carmen::ends_with(name, ".gz"); }
 
 }  // namespace
 

@@ -58,10 +58,17 @@ constexpr uint64_t kNoBinary = UINT64_MAX;
 constexpr std::size_t kMaxLineCap = std::size_t(1) << 30;  // largest max_line_length honoured
 
 // "104857600 bytes (100 MiB)".
+// "1120896 bytes (1.07 MiB)": whole MiB as such, else rounded up to 0.01 MiB,
+// so that a need just over a whole budget never reads as the budget itself.
 std::string bytes_text(uint64_t n) {
   std::string s = std::to_string(n) + " bytes";
-  if (n >= (uint64_t(1) << 20)) s += " (" + std::to_string(n >> 20) + " MiB)";
-  return s;
+  if (n < (uint64_t(1) << 20)) return s;
+  if (n % (uint64_t(1) << 20) == 0) return s + " (" + std::to_string(n >> 20) + " MiB)";
+  const uint64_t mib = uint64_t(1) << 20;
+  const uint64_t hundredths = n / mib * 100 + ((n % mib) * 100 + mib - 1) / mib;  // no wrap for any n
+  char frac[8];
+  std::snprintf(frac, sizeof frac, "%02d", static_cast<int>(hundredths % 100));
+  return s + " (" + std::to_string(hundredths / 100) + "." + frac + " MiB)";
 }
 
 // The bytes a caller keeps of a message it keeps (see LogReaderOptions::memory_budget).

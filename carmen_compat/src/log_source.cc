@@ -12,16 +12,12 @@
 #include <exception>
 
 #include "carmen_compat/error.h"
+#include "carmen_compat/file_names.h"
 #include "gzip_stream.h"
 
 namespace carmen {
 
 namespace {
-
-bool ends_with(const std::string &s, const char *suffix) {
-  const std::size_t n = std::strlen(suffix);
-  return s.size() >= n && s.compare(s.size() - n, n, suffix) == 0;
-}
 
 std::string errno_text(const char *what) { return std::string(what) + ": " + std::strerror(errno); }
 

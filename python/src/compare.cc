@@ -11,12 +11,12 @@
 
 #include "bindings.h"
 #include "map_files.h"
-#include "vasco_gpu/compare.h"
+#include "carmen_compat/map_compare.h"
 
 namespace vasco_py {
 
 using namespace nb::literals;
-using vasco::GridComparison;
+using carmen::GridComparison;
 
 namespace {
 
@@ -29,7 +29,7 @@ constexpr const char *kCompareDoc =
 
 // Every count of a comparison as a dict (Comparison.to_dict).
 nb::dict comparison_dict(const GridComparison &c) {
-  const vasco::Agreement &a = c.agreement;
+  const carmen::Agreement &a = c.agreement;
   nb::dict d;
   d["cells"] = a.cells;
   d["both_known"] = a.both_known;
@@ -101,7 +101,7 @@ void bind_comparison_methods(nb::class_<GridComparison> &cls) {
       .def("to_dict", &comparison_dict, "Every count as a dict.")
       .def("__str__", [](const GridComparison &c) { return c.agreement.table("B against A"); })
       .def("__repr__", [](const GridComparison &c) {
-        const vasco::Agreement &a = c.agreement;
+        const carmen::Agreement &a = c.agreement;
         return nb::str("Comparison(cells={}, class_agreement={:.6f}, status_differs={}, large_diffs={}, "
                        "max_abs_diff={}, identical={}, outside={})")
             .format(a.cells, a.class_agreement(), a.status_differs, a.large_diffs, a.max_abs_diff, a.identical,
@@ -116,9 +116,9 @@ GridComparison compare(const Map &a, const Map &b, bool align, size_t top) {
   int64_t sx = 0, sy = 0;
   if (align && a.has_origin && b.has_origin) {
     std::string why;
-    if (!vasco::offset_shift(a.origin, b.origin, a.grid.resolution, &sx, &sy, &why)) sx = sy = 0;
+    if (!carmen::offset_shift(a.origin, b.origin, a.grid.resolution, &sx, &sy, &why)) sx = sy = 0;
   }
-  return vasco::compare_grids(a.grid, b.grid, sx, sy, top);
+  return carmen::compare_grids(a.grid, b.grid, sx, sy, top);
 }
 
 }  // namespace

@@ -14,7 +14,7 @@
 #include "arrays.h"
 #include "bindings.h"
 #include "param_keys.h"
-#include "vasco_gpu/log_input.h"
+#include "vasco_gpu/internal/log_input.h"
 
 namespace vasco_py {
 

@@ -15,7 +15,7 @@
 #include "bindings.h"
 #include "carmen_compat/error.h"
 #include "map_files.h"
-#include "vasco_gpu/map_digest.h"
+#include "carmen_compat/map_digest.h"
 
 namespace vasco_py {
 
@@ -123,7 +123,7 @@ void bind_map_properties(nb::class_<Map> &cls) {
       .def(
           "sha256",
           [](const Map &mp) {
-            return vasco::gridmap_payload_sha256(mp.grid.size_x, mp.grid.size_y, mp.grid.resolution, mp.grid.cells);
+            return carmen::gridmap_payload_sha256(mp.grid.size_x, mp.grid.size_y, mp.grid.resolution, mp.grid.cells);
           },
           "SHA-256 of the map's CARMEN GRIDMAP payload (what the golden SHA256SUMS hold).")
       .def("__repr__", [](const Map &mp) {

@@ -6,12 +6,14 @@
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_format.h"
+#include "vasco_gpu/map_output.h"
 #include "vasco_gpu/version.h"
 
 namespace vasco_py {
 
 Map map_from_finished(vasco::FinishedMap &&f, const vasco::GridGeometry &geo) {
   Map m;
+  m.origin = vasco::world_origin(f, geo);  // as log2map writes it
   m.grid.size_x = f.size_x;
   m.grid.size_y = f.size_y;
   m.grid.resolution = f.resolution;
@@ -19,11 +21,6 @@ Map map_from_finished(vasco::FinishedMap &&f, const vasco::GridGeometry &geo) {
   m.downsample = f.downsample;
   m.min_x = f.min_x;
   m.min_y = f.min_y;
-  // As log2map writes it: theta_offset is the first scan's heading, so the
-  // grid axes are the world axes.
-  m.origin.x = geo.world_x(static_cast<double>(f.min_x) * f.downsample);
-  m.origin.y = geo.world_y(static_cast<double>(f.min_y) * f.downsample);
-  m.origin.theta = 0;
   m.has_origin = true;
   return m;
 }

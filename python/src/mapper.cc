@@ -38,10 +38,7 @@ namespace {
 
 static_assert(sizeof(vasco::Pose) == 3 * sizeof(double), "Pose must be three packed doubles");
 
-// cpu_threads' threads: as many as log2map's --threads accepts. Each is kept
-// for the life of the process, so a larger number is refused, not capped
-// silently.
-constexpr int kMaxThreads = 1024;
+using vasco::kMaxThreads;  // as log2map's --threads: refused beyond, not capped
 
 // What the state properties report, as of the end of the last call.
 struct Snapshot {
@@ -98,6 +95,7 @@ vasco::BackendOptions backend_options(const std::string &backend, const std::opt
   o.threads = threads;
   o.cuda_device = cuda_device;
   o.max_memory_bytes = max_memory_bytes;
+  o.budget_hint = "Mapper(max_memory_bytes=...)";
   const vasco::CudaMode asked = o.cuda_mode;
   *name = vasco::resolve_backend_name(backend, &o);
   if (cuda_mode && o.cuda_mode != asked)

@@ -6,7 +6,7 @@
 #include "cuda_check.h"
 #include "line_check.h"
 #include "line_rec.cuh"
-#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
 namespace cuda {

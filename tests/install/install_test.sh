@@ -44,6 +44,16 @@ for name in vasco_gpu egrid map_io readlog; do
   [[ -e "$lib/lib$name.so" ]] || fail "lib$name.so is not installed"
 done
 [[ -f "$prefix/include/carmen/map.h" ]] || fail "carmen/map.h is not installed"
+[[ ! -e "$prefix/include/vasco_gpu/internal" ]] || fail "the internal headers (vasco_gpu/internal/) are installed"
+# Every installed header stands on its own: none reaches a header that is not installed.
+for h in "$prefix"/include/vasco_gpu/*.h* "$prefix"/include/carmen_compat/*.h; do
+  echo "#include \"${h#"$prefix/include/"}\"" | c++ -std=c++17 -fsyntax-only -I"$prefix/include" -x c++ - \
+    || fail "${h#"$prefix/include/"} does not compile on its own"
+done
+for h in "$prefix"/include/carmen/*.h "$prefix"/include/vasco_gpu/mapper_c.h; do
+  echo "#include \"${h#"$prefix/include/"}\"" | cc -std=c99 -fsyntax-only -I"$prefix/include" -x c - \
+    || fail "${h#"$prefix/include/"} does not compile as C on its own"
+done
 
 # 1. pkg-config alone (the client itself uses libm), a C compiler and linker.
 cc -std=c99 -o "$tmp/pc_shared" "$client" $(pkg-config --cflags --libs vasco_gpu) -lm

@@ -128,42 +128,4 @@ std::vector<float> render_grid(Renderer &renderer, const ScanBatch &scans, const
   return renderer.read(GridWindow{0, 0, geo.size_x, geo.size_y});
 }
 
-// ---------------------------------------------------------------------------
-// The legacy Backend interface over a CPU renderer's update: the caller's
-// cells are updated in place, nothing is copied.
-// ---------------------------------------------------------------------------
-namespace {
-
-class LegacyBackend : public Backend {
- public:
-  explicit LegacyBackend(std::unique_ptr<HostGridRenderer> r) : renderer_(std::move(r)) {}
-  std::string name() const override { return renderer_->name(); }
-  void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
-             const GridGeometry &geo, float *cells, MapStats *stats) override {
-    renderer_->apply_to(batch, first, last, params, geo, cells, stats);
-  }
-
- private:
-  std::unique_ptr<HostGridRenderer> renderer_;
-};
-
-}  // namespace
-
-std::unique_ptr<Backend> make_backend(const std::string &name, const BackendOptions &options) {
-  std::unique_ptr<Renderer> r = make_renderer(name, options);
-  if (auto *host = dynamic_cast<HostGridRenderer *>(r.get())) {
-    r.release();
-    return std::make_unique<LegacyBackend>(std::unique_ptr<HostGridRenderer>(host));
-  }
-  throw Error(ErrorCode::Usage, "backend " + name + " has no whole-grid Backend interface: use make_renderer");
-}
-
-std::unique_ptr<Backend> make_cpu_double_backend() {
-  return std::make_unique<LegacyBackend>(make_cpu_double_renderer());
-}
-
-std::unique_ptr<Backend> make_cpu_float_backend() {
-  return std::make_unique<LegacyBackend>(make_cpu_float_renderer());
-}
-
 }  // namespace vasco

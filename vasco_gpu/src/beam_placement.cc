@@ -1,11 +1,11 @@
-#include "vasco_gpu/beam_placement.h"
+#include "vasco_gpu/internal/beam_placement.h"
 
 #include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-#include "vasco_gpu/parallel.h"
+#include "vasco_gpu/internal/parallel.h"
 
 namespace vasco {
 

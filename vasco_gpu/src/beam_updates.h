@@ -20,7 +20,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
 namespace beam_updates {
@@ -73,9 +73,12 @@ struct BeamUpdates {
   explicit BeamUpdates(int table_size);
 };
 
-// Cells [x_lo, x_hi) x [y_lo, y_hi), inside the grid.
+// Cells [x_lo, x_hi) x [y_lo, y_hi), inside the grid (empty: all 0).
 struct Box {
-  int x_lo, x_hi, y_lo, y_hi;
+  int x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;
+  int width() const { return x_hi - x_lo; }
+  int height() const { return y_hi - y_lo; }
+  size_t cells() const { return static_cast<size_t>(width()) * static_cast<size_t>(height()); }
 };
 
 // egrid::first_square_not_below(limit, resolution, n_max), stepping from an

@@ -1,5 +1,5 @@
 // cpu_double: the oracle. DESIGN §2 to the letter: every beam's updates are
-// oracle::trace_beam's (the code CARMEN's C API in egrid.cc runs), applied
+// oracle::trace_beam's (the code CARMEN's C API in carmen_egrid_api.cc runs), applied
 // in (scan, beam) order with the oracle's arithmetic. Ordinary beams take the
 // two-pass form of beam_updates.h (same bytes, about 1.8x faster on fr079:
 // the argument is in beam_updates.cc); degenerate ones (a range of -inf) and an
@@ -12,7 +12,8 @@
 
 #include "beam_updates.h"
 #include "host_renderer.h"
-#include "vasco_gpu/oracle.h"
+#include "vasco_gpu/internal/oracle.h"
+#include "vasco_gpu/internal/sensor_params.h"
 
 namespace vasco {
 namespace {
@@ -45,7 +46,7 @@ struct Tables {
   DistanceTable distances;
   beam_updates::Evidence evidence;
   explicit Tables(const MapperParams &p)
-      : distances(p.table_size(), p.resolution), evidence(p.sensor_model(), p.resolution, p.table_size()) {}
+      : distances(p.table_size(), p.resolution), evidence(sensor_model_of(p), p.resolution, p.table_size()) {}
 };
 
 class CpuDoubleRenderer : public HostGridRenderer {

@@ -33,9 +33,10 @@
 
 #include "beam_updates.h"
 #include "host_renderer.h"
-#include "vasco_gpu/beam_placement.h"
-#include "vasco_gpu/egrid_math.h"
-#include "vasco_gpu/log_odds.h"
+#include "vasco_gpu/internal/beam_placement.h"
+#include "vasco_gpu/internal/egrid_math.h"
+#include "vasco_gpu/internal/log_odds.h"
+#include "vasco_gpu/internal/sensor_params.h"
 
 namespace vasco {
 namespace {
@@ -64,7 +65,7 @@ class EvidenceTable {
   static constexpr int64_t kMaxEntries = int64_t(1) << 21;
 
   explicit EvidenceTable(const MapperParams &params)
-      : model_(params.sensor_model()),
+      : model_(sensor_model_of(params)),
         res_(params.resolution),
         logit_prior_(logit(model_.prior)),
         size_(params.table_size()) {
@@ -121,10 +122,7 @@ class EvidenceTable {
 // min(max(|dx|, |dy|), table_size - 1) steps of its scan's start cell (the
 // walk stops at its end cell and before table_size steps), so the box is the
 // union over scans of the start cell widened by its longest beam's reach.
-struct Box {
-  int x0 = 0, y0 = 0, width = 0, height = 0;
-  size_t cells() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
-};
+using beam_updates::Box;
 
 Box reach_of(const PlacedBeams &placed, int table_size, const GridGeometry &geo) {
   const int64_t t = std::max(table_size - 1, 0);
@@ -147,8 +145,8 @@ Box reach_of(const PlacedBeams &placed, int table_size, const GridGeometry &geo)
   x0 = std::max<int64_t>(x0, 0), y0 = std::max<int64_t>(y0, 0);
   x1 = std::min<int64_t>(x1, geo.size_x - 1), y1 = std::min<int64_t>(y1, geo.size_y - 1);
   if (x0 > x1 || y0 > y1) return b;
-  b.x0 = static_cast<int>(x0), b.y0 = static_cast<int>(y0);
-  b.width = static_cast<int>(x1 - x0 + 1), b.height = static_cast<int>(y1 - y0 + 1);
+  b.x_lo = static_cast<int>(x0), b.y_lo = static_cast<int>(y0);
+  b.x_hi = static_cast<int>(x1 + 1), b.y_hi = static_cast<int>(y1 + 1);
   return b;
 }
 
@@ -174,15 +172,14 @@ struct WalkState {
 
 WalkFrame frame_of(const egrid::LineParams &p, int table_size, const Box &box, WalkState *w) {
   const int minor_inc = p.flipped ? -p.inc : p.inc;
-  const int64_t bx = int64_t(p.x1) - box.x0, by = int64_t(p.y1) - box.y0;
+  const int64_t bx = int64_t(p.x1) - box.x_lo, by = int64_t(p.y1) - box.y_lo;
   WalkFrame f;
-  const ptrdiff_t h = box.height;  // the scratch is [x][y], as the grid
+  const ptrdiff_t h = box.height();  // the scratch is [x][y], as the grid
   f.major_step = p.steep ? p.inc : p.inc * h;
   f.minor_stride = p.steep ? minor_inc * h : minor_inc;
   f.two_a = 2 * static_cast<int64_t>(p.a);
   f.two_b = 2 * static_cast<int64_t>(p.b);
-  beam_updates::steps_in_box(p, std::min(p.major_len, table_size - 1),
-                             {box.x0, box.x0 + box.width, box.y0, box.y0 + box.height}, &f.k_first, &f.k_last);
+  beam_updates::steps_in_box(p, std::min(p.major_len, table_size - 1), box, &f.k_first, &f.k_last);
   // The state at k_first, in closed form.
   const int64_t k = f.k_first;
   const int64_t m = k == 0 ? 0 : egrid::line_minor_offset(p, static_cast<int>(k));
@@ -247,7 +244,7 @@ uint64_t add_walked_beam(const EvidenceTable &ev, int x1, int y1, int x2, int y2
     if (i < 0 || j < 0 || i >= t || j >= t) return false;  // kFarDistance: stops
     const int64_t n = int64_t(i) * i + int64_t(j) * j;
     if (n >= ev.n_stop()) return false;
-    acc[static_cast<size_t>(cx - box.x0) * box.height + static_cast<size_t>(cy - box.y0)] +=
+    acc[static_cast<size_t>(cx - box.x_lo) * box.height() + static_cast<size_t>(cy - box.y_lo)] +=
         ev.increment(n, n < n_free);
     ++updates;
     return true;
@@ -308,10 +305,10 @@ class CpuFloatRenderer : public HostGridRenderer {
   // sum, back to a probability.
   void merge(const EvidenceTable &ev, const Box &box, const GridGeometry &geo, float *cells) const {
     const double lp = ev.logit_prior();
-    for (int x = 0; x < box.width; ++x) {
-      const double *acc = scratch_.data() + static_cast<size_t>(x) * box.height;
-      float *col = cells + static_cast<size_t>(box.x0 + x) * geo.size_y + box.y0;
-      for (int y = 0; y < box.height; ++y) {
+    for (int x = 0; x < box.width(); ++x) {
+      const double *acc = scratch_.data() + static_cast<size_t>(x) * box.height();
+      float *col = cells + static_cast<size_t>(box.x_lo + x) * geo.size_y + box.y_lo;
+      for (int y = 0; y < box.height(); ++y) {
         if (untouched(acc[y])) continue;
         const double before = col[y] == egrid::kUnknown ? lp : logit(col[y]);
         const double odds = std::exp(before + acc[y]);

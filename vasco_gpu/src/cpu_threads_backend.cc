@@ -38,7 +38,7 @@
 //    step 0, stopping at the oracle's stop, in every stripe; each applies only
 //    the updates in its own columns. No monotonicity is needed there.
 //  * Counts: each oracle update is applied in exactly one stripe.
-#include "vasco_gpu/cpu_threads_backend.h"
+#include "vasco_gpu/internal/cpu_threads_backend.h"
 
 #include <algorithm>
 #include <atomic>
@@ -54,10 +54,11 @@
 
 #include "beam_updates.h"
 #include "host_renderer.h"
-#include "vasco_gpu/beam_placement.h"
-#include "vasco_gpu/oracle.h"
-#include "vasco_gpu/parallel.h"
-#include "vasco_gpu/timing.h"
+#include "vasco_gpu/internal/beam_placement.h"
+#include "vasco_gpu/internal/oracle.h"
+#include "vasco_gpu/internal/parallel.h"
+#include "vasco_gpu/internal/timing.h"
+#include "vasco_gpu/internal/sensor_params.h"
 
 namespace vasco {
 namespace {
@@ -335,7 +336,7 @@ class CpuThreadsRenderer : public HostGridRenderer {
     std::unique_ptr<Beam[]> beams(new Beam[nb]);
     const Stripes stripes = cut_stripes(place_all(placed, size_x, size_y, T, nt, beams.get()), size_x, nt);
     if (evidence_key_ != params.table_key()) {  // kept between calls (a session's inserts)
-      evidence_.emplace(params.sensor_model(), params.resolution, T);
+      evidence_.emplace(sensor_model_of(params), params.resolution, T);
       evidence_key_ = params.table_key();
     }
     const Bins bins = bin_beams(beams.get(), nb, stripes, nt);
@@ -343,7 +344,7 @@ class CpuThreadsRenderer : public HostGridRenderer {
 
     // 4. The stripes.
     const auto t_stripes = Clock::now();
-    const egrid::SensorModel<double> model = params.sensor_model();
+    const egrid::SensorModel<double> model = sensor_model_of(params);
     const Context ctx{cells, size_x, size_y, T, geo.resolution, model, &*evidence_};
     run_stripes(ctx, beams.get(), starts, stripes, bins, nt, &load);
     load.stripes_s = seconds_since(t_stripes);

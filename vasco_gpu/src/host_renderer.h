@@ -26,8 +26,7 @@ class HostGridRenderer : public Renderer {
 
   // The backend's update: applies scans [first, last) of `scans` to `cells`
   // (x-major, a grid of `geo`), which hold the result of scans [0, first);
-  // scan 0 fixes CARMEN's start pose. The grid may be the caller's (the
-  // legacy Backend interface) rather than this renderer's own.
+  // scan 0 fixes CARMEN's start pose.
   virtual void apply_to(const ScanBatch &scans, size_t first, size_t last, const MapperParams &params,
                         const GridGeometry &geo, float *cells, MapStats *stats) = 0;
 

@@ -1,4 +1,4 @@
-#include "vasco_gpu/log_input.h"
+#include "vasco_gpu/internal/log_input.h"
 
 #include <stdexcept>
 #include <utility>
@@ -24,6 +24,11 @@ LogInput load_log_input(const LogInputOptions &options) {
   all.num_scans = -1;
   carmen::LogReaderOptions reader;
   reader.strict = !options.lenient;
+  reader.memory_budget = options.memory_budget;
+  reader.budget_option = options.budget_option;
+  reader.budget_types = carmen::message_type_bit(carmen::MessageType::FLASER) |  // what load_scans keeps
+                        carmen::message_type_bit(carmen::MessageType::ROBOTLASER1) |
+                        carmen::message_type_bit(carmen::MessageType::PARAM);
   ScanBatch every = load_scans(options.log, all, reader, &in.load, options.progress);
   for (size_t i = 0; i < in.load.params.size(); ++i)
     params.add_fallback(in.load.params[i].first, in.load.params[i].second, options.log,

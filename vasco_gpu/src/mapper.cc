@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 #include <string>
 #include <utility>
 
-#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/error.h"
 
 namespace vasco {
@@ -43,8 +44,6 @@ void check_poses(const std::vector<Pose> &poses) {
 
 // A renderer keeps per-thread scratch: a count far beyond any machine's cores
 // would exhaust memory inside an insert, so it is refused up front.
-constexpr int kMaxThreads = 4096;
-
 void check_threads(int threads) {
   if (threads < 0 || threads > kMaxThreads)
     throw Error(ErrorCode::Usage, "Mapper: threads = " + std::to_string(threads) + " is outside 0 (all cores) .. " +
@@ -119,6 +118,26 @@ GridGeometry Mapper::grown_frame(const GridGeometry &need, uint64_t beams) const
   return fits_memory(g, beams) ? g : need;
 }
 
+namespace {
+
+// `bytes` in MiB with `decimals` digits, rounded up or down.
+std::string mebibytes(double bytes, bool up, int decimals = 0) {
+  const double scale = std::pow(10.0, decimals), mib = bytes / (1 << 20) * scale;
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(decimals) << (up ? std::ceil(mib) : std::floor(mib)) / scale;
+  return s.str();
+}
+
+// A need above the budget, rounded up with as many decimals as it takes to
+// read as more than `budget` ("2.1 MiB ... more than the budget of 2 MiB").
+std::string need_above(double need, const std::string &budget) {
+  std::string text = mebibytes(need, true);
+  for (int d = 1; d <= 6 && std::stod(text) <= std::stod(budget); ++d) text = mebibytes(need, true, d);
+  return text;
+}
+
+}  // namespace
+
 bool Mapper::fits_memory(const GridGeometry &geo, uint64_t beams) const {
   return options_.max_memory_bytes == 0 ||
          memory_need(geo, beams, renderer_->traits().grid_on_device) <= static_cast<double>(options_.max_memory_bytes);
@@ -127,11 +146,14 @@ bool Mapper::fits_memory(const GridGeometry &geo, uint64_t beams) const {
 void Mapper::check_memory(const GridGeometry &geo, uint64_t beams) const {
   if (fits_memory(geo, beams)) return;
   const double need = memory_need(geo, beams, renderer_->traits().grid_on_device);
+  const uint64_t b = options_.max_memory_bytes;
+  const std::string budget = mebibytes(static_cast<double>(b), false, b % (1 << 20) == 0 ? 0 : 2);
   std::ostringstream m;
-  m << "the map needs about " << static_cast<uint64_t>(need / (1 << 20)) << " MiB of memory (a grid of "
-    << geo.size_x << " x " << geo.size_y << " cells at " << geo.resolution << " m and " << beams
-    << " beams), more than the budget of " << (options_.max_memory_bytes >> 20)
-    << " MiB: raise it (log2map --max-memory MiB), or use a coarser vasco_resolution";
+  m << "the map needs about " << need_above(need, budget) << " MiB of memory (a grid of " << geo.size_x
+    << " x " << geo.size_y << " cells at " << geo.resolution << " m and " << beams
+    << " beams), more than the budget of " << budget << " MiB: ";
+  if (!options_.budget_hint.empty()) m << "raise it (" << options_.budget_hint << "), or ";
+  m << "use a coarser vasco_resolution";
   throw Error(ErrorCode::OutOfMemory, m.str());
 }
 

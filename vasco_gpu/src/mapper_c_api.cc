@@ -1,5 +1,5 @@
-// The C API of the mapping session (vasco_gpu/mapper.h) on vasco::Mapper.
-#include "vasco_gpu/mapper.h"
+// The C API of the mapping session (vasco_gpu/mapper_c.h) on vasco::Mapper.
+#include "vasco_gpu/mapper_c.h"
 
 #include <cstring>
 #include <mutex>
@@ -15,7 +15,7 @@ struct vasco_mapper {
   std::unique_ptr<vasco::Mapper> mapper;
   vasco::FinishedMap finished;  // what the last vasco_mapper_finish returned points into
   std::string error;
-  mutable std::mutex lock;  // one call at a time (mapper.h: Threads)
+  mutable std::mutex lock;  // one call at a time (mapper_c.h: Threads)
 };
 
 namespace {
@@ -84,6 +84,7 @@ vasco_status create(const vasco_mapper_params *params, const char *backend, cons
   }
   *out = nullptr;
   vasco::BackendOptions opt;
+  opt.budget_hint = "vasco_mapper_set_max_memory";
   std::string name;
   // An unknown name is the one failure of resolving it: VASCO_ERR_BACKEND.
   const vasco_status known = guarded(&create_error, [&] {

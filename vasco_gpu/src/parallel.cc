@@ -1,4 +1,4 @@
-#include "vasco_gpu/parallel.h"
+#include "vasco_gpu/internal/parallel.h"
 
 #include <unistd.h>
 

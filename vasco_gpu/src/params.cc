@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "carmen_compat/ini_file.h"
-#include "vasco_gpu/oracle.h"
+#include "vasco_gpu/internal/oracle.h"
 
 namespace vasco {
 namespace {

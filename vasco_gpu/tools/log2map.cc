@@ -27,7 +27,8 @@
 #include "cli_support.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
-#include "vasco_gpu/log_input.h"
+#include "vasco_gpu/internal/egrid_math.h"
+#include "vasco_gpu/internal/log_input.h"
 #include "vasco_gpu/map_output.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/params.h"
@@ -148,6 +149,8 @@ vasco::LogInput read_input(const Options &opt) {
   in.robot = opt.robot;
   in.overrides = opt.overrides;
   in.lenient = opt.lenient;
+  in.memory_budget = opt.max_memory_bytes;  // the scans alone may not pass what the map may use
+  in.budget_option = "--max-memory";
   ProgressBar bar("parse", !opt.quiet && isatty(STDERR_FILENO));
   in.progress = [&](uint64_t done, uint64_t total) { bar.update(done, total); };
   return vasco::load_log_input(in);
@@ -224,11 +227,29 @@ void check_before_work(const Options &opt) {
   if (opt.json) cli::check_stdout_writable("--json");
 }
 
+// Why a log's scans updated no cell, for the error that says so (there is
+// no map to write: finish crops to the known cells).
+std::string why_nothing_was_mapped(const vasco::LogInput &in) {
+  const vasco::ScanBatch &b = in.batch;
+  uint64_t used = 0;
+  for (float r : b.range) used += static_cast<double>(r) < vasco::egrid::kLaserRangeLimit;  // NaN compares false
+  std::ostringstream m;
+  m << "no beam updated any cell: ";
+  if (used == 0) {
+    m << "every one of the " << b.num_beams() << " ranges of the " << b.num_scans()
+      << " scans mapped is " << vasco::egrid::kLaserRangeLimit << " m or more, NaN or +inf (CARMEN uses a beam only below "
+      << vasco::egrid::kLaserRangeLimit << " m)";
+  } else {
+    m << used << " beams were used, but none reached a cell of the grid";
+  }
+  return m.str();
+}
+
 // The mapping session in the PROTOCOL frame, fed every scan at once.
 void make_map(const Options &opt, const vasco::BackendOptions &bopt, RunResult &r) {
   vasco::Mapper mapper(r.input.params, opt.backend, bopt);
   r.backend = mapper.backend_name();
-  if (opt.backend == "auto" && r.backend.rfind("cuda", 0) != 0 && !opt.quiet)
+  if (opt.backend == "auto" && !mapper.backend_traits().grid_on_device && !opt.quiet)
     std::fprintf(stderr, "log2map: --backend auto: %s: using %s\n", no_gpu_reason(bopt).c_str(), r.backend.c_str());
   auto t = Clock::now();
   try {
@@ -244,7 +265,7 @@ void make_map(const Options &opt, const vasco::BackendOptions &bopt, RunResult &
   r.map = mapper.finish();
   r.finish_s = seconds_since(t);
   for (float v : r.map.cells) r.known += v != -1.0f;
-  if (r.known == 0) r.input.warnings.push_back(opt.log + ": no cell was updated: the map is all unknown");
+  if (r.known == 0) throw carmen::FileError(opt.log, why_nothing_was_mapped(r.input));
   r.origin = vasco::world_origin(r.map, r.input.geo);
 }
 
@@ -268,6 +289,7 @@ int run(const Options &opt) {
   bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
   bopt.threads = opt.threads;
   bopt.max_memory_bytes = opt.max_memory_bytes;
+  bopt.budget_hint = "--max-memory MiB";
   std::future<bool> gpu_ready = start_cuda(opt, bopt);
 
   RunResult r;
@@ -299,12 +321,13 @@ int main(int argc, char **argv) {
   app.add_option("OUT", opt.outputs, "output files: .map, .map.gz, .pgm, .png")->required();
   app.add_option("--param-file", opt.param_file, "carmen.ini with vasco_* keys (default: vasco's defaults)");
   app.add_option("--robot", opt.robot, "robot section of the ini to use");
-  app.add_option("--backend", opt.backend,
-                 "cpu_double | cpu_threads | cpu_float | cuda | auto (default: auto = cuda if a GPU "
-                 "is usable, else cpu_threads)")
-      ->check(CLI::IsMember({"cpu_double", "cpu_threads", "cpu_float", "cuda", "auto"}));
-  app.add_option("--threads", opt.threads, "threads of cpu_threads, 1 to 1024 (default: all cores)")
-      ->check(CLI::Range(0, 1024));
+  std::vector<std::string> backends;  // the registry's names; one not compiled in says why when run
+  for (const vasco::BackendInfo &b : vasco::backend_registry()) backends.push_back(b.name);
+  app.add_option("--backend", opt.backend, "the backend (default: auto), one of:\n" + vasco::backend_help())
+      ->check(CLI::IsMember(backends));
+  app.add_option("--threads", opt.threads,
+                 "threads of cpu_threads, 1 to " + std::to_string(vasco::kMaxThreads) + " (default: all cores)")
+      ->check(CLI::Range(0, vasco::kMaxThreads));
   app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
       ->check(CLI::IsMember({"float", "exact"}));
   std::string max_memory;

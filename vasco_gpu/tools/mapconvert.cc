@@ -203,7 +203,11 @@ int main(int argc, char **argv) {
     // The output (and a .pgm's .yaml) is checked before the map is read: it
     // must be replaceable and must not be the input.
     if (!a.info) cli::check_outputs({a.files[0]}, carmen::map_output_files(a.files[1]));
-    const carmen::MapFile m = carmen::read_map_file(a.files[0]);
+    // --info lists named GRIDMAP chunks without parsing them: a file of
+    // thousands of them costs their headers, not their cells.
+    carmen::MapReadOptions read;
+    if (a.info) read.named_chunks = carmen::NamedChunkReading::Index;
+    const carmen::MapFile m = carmen::read_map_file(a.files[0], read);
     if (a.info) {
       print_info(a.files[0], m);
     } else {

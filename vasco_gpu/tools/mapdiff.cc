@@ -24,8 +24,8 @@
 #include "carmen_compat/image_io.h"
 #include "carmen_compat/map_file.h"
 #include "cli_support.h"
-#include "vasco_gpu/compare.h"
-#include "vasco_gpu/map_digest.h"
+#include "carmen_compat/map_compare.h"
+#include "carmen_compat/map_digest.h"
 #include "vasco_gpu/version.h"
 
 namespace {
@@ -46,7 +46,7 @@ struct Input {
   std::string path;
   carmen::GridMap grid;
   std::optional<carmen::GlobalOffset> offset;
-  std::string sha256;  // of the GRIDMAP payload (vasco/map_digest.h): what goldens are published with
+  std::string sha256;  // of the GRIDMAP payload (carmen_compat/map_digest.h): what goldens are published with
 };
 
 // Where B lies on A and why; `compared` is false when the resolutions differ.
@@ -78,7 +78,7 @@ Input load(const std::string &path) {
   }
   if (!m.gridmap) throw carmen::FileError(path, "has no GRIDMAP chunk: nothing to compare");
   Input in{path, std::move(*m.gridmap), m.offset, {}};
-  in.sha256 = vasco::gridmap_payload_sha256(in.grid.size_x, in.grid.size_y, in.grid.resolution, in.grid.cells);
+  in.sha256 = carmen::gridmap_payload_sha256(in.grid.size_x, in.grid.size_y, in.grid.resolution, in.grid.cells);
   return in;
 }
 
@@ -116,7 +116,7 @@ Alignment align(const Input &a, const Input &b, bool identical, bool no_offset) 
     al.how = std::string("at cell (0, 0) (no OFFSET chunk in ") + missing + ")";
   } else {
     std::string why;
-    if (vasco::offset_shift(*a.offset, *b.offset, a.grid.resolution, &al.shift_x, &al.shift_y, &why)) {
+    if (carmen::offset_shift(*a.offset, *b.offset, a.grid.resolution, &al.shift_x, &al.shift_y, &why)) {
       al.how = "by OFFSET: B's cell (0, 0) is A's cell (" + std::to_string(al.shift_x) + ", " +
                std::to_string(al.shift_y) + ")";
     } else {
@@ -136,8 +136,8 @@ std::string fmt(const char *format, double v) {
   return buf;
 }
 
-std::string summary(const vasco::GridComparison &c) {
-  const vasco::Agreement &g = c.agreement;
+std::string summary(const carmen::GridComparison &c) {
+  const carmen::Agreement &g = c.agreement;
   const uint64_t n = c.differing_cells();
   return std::to_string(n) + (n == 1 ? " cell differs" : " cells differ") + " (max |dp| " + fmt("%.9g", g.max_abs_diff) +
          ", known/unknown differs " + std::to_string(g.status_differs) + ", outside the overlap " +
@@ -150,9 +150,9 @@ std::string summary(const vasco::GridComparison &c) {
 // asked for: every class disagreement is a status change or a value change,
 // which the other two limits already bound, so a default of 1.0 would make
 // `--max-status-differs 5` fail on the very changes it allows.
-std::vector<std::string> tolerance_failures(const vasco::GridComparison &c, const Options &o) {
+std::vector<std::string> tolerance_failures(const carmen::GridComparison &c, const Options &o) {
   std::vector<std::string> f;
-  const vasco::Agreement &g = c.agreement;
+  const carmen::Agreement &g = c.agreement;
   if (!(g.max_abs_diff <= o.tolerance))
     f.push_back("max |dp| " + fmt("%.9g", g.max_abs_diff) + " > " + fmt("%.9g", o.tolerance));
   const unsigned long long status = g.status_differs + c.outside;
@@ -179,7 +179,7 @@ std::string offset_text(const std::optional<carmen::GlobalOffset> &o) {
 }
 
 Verdict judge(const Input &a, const Input &b, bool identical, const Alignment &al,
-              const vasco::GridComparison &c, const Options &o) {
+              const carmen::GridComparison &c, const Options &o) {
   if (!al.compared)
     return {1, "different: resolution " + fmt("%.9g", a.grid.resolution) + " m vs " +
                    fmt("%.9g", b.grid.resolution) + " m (cells not compared)"};
@@ -206,7 +206,7 @@ void print_input(const char *label, const Input &in) {
               in.sha256.c_str());
 }
 
-void print_cell(const vasco::CellDifference &d, const vasco::GridComparison &c) {
+void print_cell(const carmen::CellDifference &d, const carmen::GridComparison &c) {
   std::printf("  (%d, %d)  A %.9g  B %.9g", d.x, d.y, d.a, d.b);
   if (d.a != -1.0f && d.b != -1.0f) std::printf("  dp %+.9g", double(d.b) - double(d.a));
   if (c.shift_x != 0 || c.shift_y != 0)
@@ -214,8 +214,8 @@ void print_cell(const vasco::CellDifference &d, const vasco::GridComparison &c) 
   std::printf("\n");
 }
 
-void print_differences(const vasco::GridComparison &c) {
-  const vasco::Agreement &g = c.agreement;
+void print_differences(const carmen::GridComparison &c) {
+  const carmen::Agreement &g = c.agreement;
   const uint64_t known_differ = g.cells - g.identical - g.status_differs;  // both -1: equal bits
   if (!c.largest.empty()) {
     std::printf("largest |dp| (known in both; %zu of %llu cells that differ):\n", c.largest.size(),
@@ -229,7 +229,7 @@ void print_differences(const vasco::GridComparison &c) {
   }
 }
 
-void print_comparison(const vasco::GridComparison &c) {
+void print_comparison(const carmen::GridComparison &c) {
   if (c.width == 0) {
     std::printf("compared: nothing (the grids do not overlap); outside the overlap %llu cells (%llu known)\n",
                 (unsigned long long)c.outside, (unsigned long long)c.outside_known);
@@ -243,7 +243,7 @@ void print_comparison(const vasco::GridComparison &c) {
 }
 
 void print_text(const Input &a, const Input &b, bool identical, const Alignment &al,
-                const vasco::GridComparison &c, const Verdict &v) {
+                const carmen::GridComparison &c, const Verdict &v) {
   print_input("A", a);
   print_input("B", b);
   std::printf("identical: %s (GRIDMAP size, resolution and cells bit for bit)\n", identical ? "yes" : "no");
@@ -278,7 +278,7 @@ std::string json_input(const Input &in) {
   return j.str();
 }
 
-std::string json_cells(const std::vector<vasco::CellDifference> &cells) {
+std::string json_cells(const std::vector<carmen::CellDifference> &cells) {
   std::string s = "[";
   for (size_t i = 0; i < cells.size(); ++i) {
     const auto &d = cells[i];
@@ -288,8 +288,8 @@ std::string json_cells(const std::vector<vasco::CellDifference> &cells) {
   return s + "]";
 }
 
-std::string json_comparison(const vasco::GridComparison &c) {
-  const vasco::Agreement &g = c.agreement;
+std::string json_comparison(const carmen::GridComparison &c) {
+  const carmen::Agreement &g = c.agreement;
   std::ostringstream j;
   j << "{\"shift_x\":" << c.shift_x << ",\"shift_y\":" << c.shift_y << ",\"x0\":" << c.x0 << ",\"y0\":" << c.y0
     << ",\"width\":" << c.width << ",\"height\":" << c.height << ",\"outside\":" << c.outside
@@ -305,7 +305,7 @@ std::string json_comparison(const vasco::GridComparison &c) {
 }
 
 void print_json(const Input &a, const Input &b, bool identical, const Alignment &al,
-                const vasco::GridComparison &c, const Verdict &v) {
+                const carmen::GridComparison &c, const Verdict &v) {
   std::printf("{\"a\":%s,\"b\":%s,\"identical\":%s,\"offsets_equal\":%s,\"alignment\":%s,"
               "\"comparison\":%s,\"verdict\":%s,\"exit\":%d}\n",
               json_input(a).c_str(), json_input(b).c_str(), identical ? "true" : "false",
@@ -320,13 +320,13 @@ void print_json(const Input &a, const Input &b, bool identical, const Alignment 
 
 // Writes the picture of the overlap; false (and a note) when there is none.
 bool write_picture(const std::string &path, const Input &a, const Input &b, const Alignment &al,
-                   const vasco::GridComparison &c) {
+                   const carmen::GridComparison &c) {
   const char *why = !al.compared ? "the resolutions differ" : c.width == 0 ? "the grids do not overlap" : nullptr;
   if (why != nullptr) {
     std::fprintf(stderr, "mapdiff: %s: not written: %s\n", path.c_str(), why);
     return false;
   }
-  carmen::write_rgb_png(path, c.width, c.height, vasco::difference_image_rgb(a.grid, b.grid, c));
+  carmen::write_rgb_png(path, c.width, c.height, carmen::difference_image_rgb(a.grid, b.grid, c));
   return true;
 }
 
@@ -405,8 +405,8 @@ int run(const Options &o) {
   const Input b = load(o.b);
   const bool identical = identical_grids(a.grid, b.grid);
   const Alignment al = align(a, b, identical, o.no_offset);
-  vasco::GridComparison c;
-  if (al.compared) c = vasco::compare_grids(a.grid, b.grid, al.shift_x, al.shift_y, size_t(o.top));
+  carmen::GridComparison c;
+  if (al.compared) c = carmen::compare_grids(a.grid, b.grid, al.shift_x, al.shift_y, size_t(o.top));
   const Verdict v = judge(a, b, identical, al, c, o);
   const bool pictured = !o.png.empty() && write_picture(o.png, a, b, al, c);
   if (o.json) {

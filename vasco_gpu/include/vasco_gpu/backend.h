@@ -35,11 +35,20 @@ enum class CudaMode { Float, Exact };
 // allocated.
 constexpr uint64_t kDefaultMaxMemoryBytes = uint64_t(2) << 30;
 
+// The most threads a session's cpu_threads may use (BackendOptions::threads,
+// log2map --threads, Python's threads): each keeps scratch for the life of
+// the renderer, so a count far beyond any machine's cores is refused, not
+// capped silently.
+constexpr int kMaxThreads = 1024;
+
 struct BackendOptions {
   CudaMode cuda_mode = CudaMode::Float;
-  int threads = 0;   // cpu_threads: 0 = all cores
+  int threads = 0;   // cpu_threads: 0 = all cores, at most kMaxThreads
   int cuda_device = 0;
   uint64_t max_memory_bytes = kDefaultMaxMemoryBytes;  // host memory a Mapper may use (0: no limit)
+  // How the caller raises max_memory_bytes, as a refusal names it ("log2map
+  // --max-memory MiB", "vasco_mapper_set_max_memory"); empty: not named.
+  std::string budget_hint;
 };
 
 class Renderer;
@@ -88,36 +97,6 @@ std::vector<std::string> backend_names();
 // The help text of a --backend option: one "name: summary" line per
 // compiled backend.
 std::string backend_help();
-
-// ---------------------------------------------------------------------------
-// Legacy whole-grid interface, kept source-compatible while its last callers
-// move to make_renderer (renderer.h): it applies scans to cells the caller
-// owns. New code drives a Renderer.
-// ---------------------------------------------------------------------------
-class Backend {
- public:
-  virtual ~Backend() = default;
-  virtual std::string name() const = 0;
-  // Applies scans [first, last) of `batch`, in order, to `cells` (x-major,
-  // cells[x * size_y + y], a grid of geometry `geo`), which holds the result
-  // of scans [0, first): all unknown (-1) when first == 0. Scan 0 of the
-  // batch fixes CARMEN's start pose whatever `first` is.
-  virtual void apply(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
-                     const GridGeometry &geo, float *cells, MapStats *stats) = 0;
-  // Applies every scan of `batch` to a fresh evidence grid of geometry `geo`.
-  virtual std::vector<float> map(const ScanBatch &batch, const MapperParams &params,
-                                 const GridGeometry &geo, MapStats *stats) {
-    std::vector<float> cells(geo.num_cells(), -1.0f);
-    apply(batch, 0, batch.num_scans(), params, geo, cells.data(), stats);
-    return cells;
-  }
-};
-
-// A CPU backend of the registry (cpu_double, cpu_threads, cpu_float, or auto
-// without a GPU) as a legacy Backend; throws as make_renderer does.
-std::unique_ptr<Backend> make_backend(const std::string &name, const BackendOptions &options = {});
-std::unique_ptr<Backend> make_cpu_double_backend();
-std::unique_ptr<Backend> make_cpu_float_backend();
 
 }  // namespace vasco
 

@@ -12,7 +12,7 @@ namespace vasco {
 struct MapperParams;
 struct ScanBatch;
 namespace oracle {
-struct GridFrame;  // vasco_gpu/oracle.h
+struct GridFrame;  // vasco_gpu/internal/oracle.h
 }
 
 // Where the evidence grid lies: its size and the first scan's pose, which

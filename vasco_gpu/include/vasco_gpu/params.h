@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "carmen_compat/error.h"
-#include "vasco_gpu/egrid_math.h"
 
 namespace carmen {
 class ParamFile;
@@ -41,13 +40,6 @@ struct MapperParams {
   // that join keys (0 <= range_sure <= range_max, range_max / resolution at
   // most 32767 cells); throws ParamError naming the key.
   void validate() const;
-
-  // The sensor model's parameters, in the precision of the update.
-  template <class Real = double>
-  egrid::SensorModel<Real> sensor_model() const {
-    return {static_cast<Real>(p_prior), static_cast<Real>(p_occ), static_cast<Real>(p_emp),
-            static_cast<Real>(range_sure), static_cast<Real>(range_max)};
-  }
 
   // What the backends' per-(i, j) distance and evidence tables depend on:
   // a table built for one key serves every grid with the same key.

@@ -11,7 +11,7 @@
 #include <functional>
 
 #include "exact_pair_bound.h"
-#include "vasco_gpu/beam_placement.h"
+#include "vasco_gpu/internal/beam_placement.h"
 
 namespace vasco {
 
@@ -59,7 +59,7 @@ void CudaExactRenderer::apply_scans(const ScanBatch &scans, size_t first, size_t
 void CudaExactRenderer::apply_launch(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
   const auto t_prep = std::chrono::steady_clock::now();
   const uint64_t pair_bound = place_beams(scans, first, last, st);
-  st->prep_s += cuda_host::seconds_since(t_prep);
+  st->prep_s += seconds_since(t_prep);
   if (beams_ == 0) return;
   launch_apply(pair_bound, st);
 }

@@ -4,7 +4,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "vasco_gpu/oracle.h"
+#include "vasco_gpu/internal/log_odds.h"
+#include "vasco_gpu/internal/oracle.h"
 
 namespace vasco {
 
@@ -22,7 +23,6 @@ void CudaFloatRenderer::clear_grid() {
 // of at most `step` log-odds. vasco's defaults allow 2 x 10^7 beams, far
 // beyond any log.
 void CudaFloatRenderer::check_capacity(uint64_t beams) const {
-  auto logit = [](double p) { return std::log(p / (1 - p)); };
   const MapperParams &p = params();
   const double step = std::max(std::fabs(logit(p.p_occ) - logit(p.p_prior)),
                                std::fabs(logit(p.p_emp) - logit(p.p_prior)));
@@ -64,7 +64,7 @@ void CudaFloatRenderer::apply_scans(const ScanBatch &scans, size_t first, size_t
   reserve(scan_records_, last - first);
   reserve(counters_, 3);
   reserve(staging_counters_, 3);
-  st->prep_s += cuda_host::seconds_since(t_prep);
+  st->prep_s += seconds_since(t_prep);
   begin_update();
   launch_map(increments, last - first, st);
   ranges_.commit();

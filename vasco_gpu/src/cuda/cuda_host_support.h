@@ -21,6 +21,8 @@
 #include "vasco_gpu/error.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/internal/sensor_params.h"
+#include "vasco_gpu/internal/timing.h"
 
 namespace vasco {
 namespace cuda_host {
@@ -42,10 +44,6 @@ inline void check_fits(size_t bytes, const char *what) {
     throw Error(ErrorCode::OutOfMemory, std::string("the map does not fit in GPU memory: ") + what + " needs " +
                                             mib(bytes) + ", " + mib(free_b) + " free of " + mib(total_b) +
                                             " (use a coarser vasco_resolution or a CPU backend)");
-}
-
-inline double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // VASCO_CUDA_NO_TABLES=1 computes every update in full, as grids too large
@@ -106,7 +104,7 @@ void reserve_checked(cuda::DeviceBuffer<T> &b, size_t n, const char *what) {
 template <class Real>
 cuda::KernelModel<Real> kernel_model_of(const MapperParams &p, const GridGeometry &geo) {
   cuda::KernelModel<Real> m{};
-  m.sensor = p.sensor_model<Real>();
+  m.sensor = sensor_model_of<Real>(p);
   m.resolution = static_cast<Real>(p.resolution);
   m.wall = static_cast<Real>(p.wall_size);
   m.table_size = p.table_size();

@@ -4,7 +4,7 @@
 #include <cstdlib>
 
 #include "egrid_kernels.h"
-#include "vasco_gpu/parallel.h"
+#include "vasco_gpu/internal/parallel.h"
 
 namespace vasco {
 namespace cuda_host {

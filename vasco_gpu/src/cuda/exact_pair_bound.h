@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "vasco_gpu/oracle.h"
-#include "vasco_gpu/placed_beam.h"
+#include "vasco_gpu/internal/oracle.h"
+#include "vasco_gpu/internal/placed_beam.h"
 
 namespace vasco {
 namespace cuda_host {

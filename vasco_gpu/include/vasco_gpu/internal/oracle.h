@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "vasco_gpu/egrid_math.h"
+#include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
 namespace oracle {

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "vasco_gpu/grid.h"
-#include "vasco_gpu/oracle.h"
+#include "vasco_gpu/internal/oracle.h"
 #include "vasco_gpu/params.h"
-#include "vasco_gpu/placed_beam.h"
+#include "vasco_gpu/internal/placed_beam.h"
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco {

@@ -28,6 +28,12 @@ struct LogInputOptions {
   std::map<std::string, std::string> overrides;  // vasco_KEY -> value (command line)
   bool lenient = false;                          // skip bad lines instead of stopping
   std::function<void(uint64_t, uint64_t)> progress;  // (bytes read, file size)
+  // Bytes the scans and PARAM lines kept from the log may take (0: no limit),
+  // counted while the log is read: the message that passes it is refused
+  // (FileError naming the line, ErrorCode::OutOfMemory) before the rest is
+  // read. budget_option: how the user raises it, as the error names it.
+  uint64_t memory_budget = 0;
+  std::string budget_option = "--max-memory";
 };
 
 struct LogInput {

@@ -17,7 +17,7 @@
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/mapper.hpp"
-#include "vasco_gpu/oracle.h"
+#include "vasco_gpu/internal/oracle.h"
 
 namespace {
 
