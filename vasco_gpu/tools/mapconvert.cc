@@ -43,14 +43,16 @@ int usage_error(const std::string &msg) {
   return 2;
 }
 
-enum class OutKind { None, Map, Pgm, Png };
+// A CARMEN map is copied whole (every chunk); any other format of the
+// map-format table gets the grid and its origin through the table's writer.
+enum class OutKind { None, Map, Pgm, Grid };
 
 // By the map-format table's rule (file_names.h: the extension, any case).
 OutKind kind_of(const std::string &path) {
   const carmen::MapFormatEntry *f = carmen::find_map_format(path);
   if (f == nullptr) return OutKind::None;
-  if (f->format == carmen::MapFormat::PgmYaml) return OutKind::Pgm;
-  return f->format == carmen::MapFormat::Png ? OutKind::Png : OutKind::Map;
+  if (f->format == carmen::MapFormat::CarmenMap || f->format == carmen::MapFormat::CarmenMapGz) return OutKind::Map;
+  return f->format == carmen::MapFormat::PgmYaml ? OutKind::Pgm : OutKind::Grid;
 }
 
 std::string quoted(const std::string &s) { return "\"" + s + "\""; }
@@ -181,11 +183,11 @@ void convert(const std::string &in, const carmen::MapFile &m, const std::string 
     return;
   }
   if (!m.gridmap) throw carmen::FileError(in, "has no GRIDMAP chunk: there is no image to make");
-  if (kind == OutKind::Pgm) {
-    carmen::write_pgm_with_yaml(out, *m.gridmap, m.offset.value_or(carmen::GlobalOffset{}), mode);
-  } else {
-    carmen::write_png(out, *m.gridmap);
-  }
+  carmen::MapToWrite w;
+  w.grid = *m.gridmap;
+  w.origin = m.offset;
+  w.pgm_mode = mode;
+  carmen::write_map(out, w);
 }
 
 }  // namespace
