@@ -5,8 +5,10 @@
 #include <cstdint>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "vasco_gpu/error.h"
+#include "vasco_gpu/internal/finish_math.h"
 #include "vasco_gpu/internal/oracle.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/scan_batch.h"
@@ -72,76 +74,28 @@ GridGeometry size_grid(const PoseExtent &e, const ScanBatch &batch, const Mapper
   return g;
 }
 
-namespace {
-
-// The downsampled blocks and CARMEN's crop bounds (64-bit: min starts at
-// n - border - 1 and max at border, both widened by known blocks).
-struct Blocks {
-  int nx = 0, ny = 0;
-  std::vector<float> cells;  // x-major, -1 unknown
-  int64_t min_x = 0, max_x = 0, min_y = 0, max_y = 0;
-};
-
-// The mean of block (bx, by)'s known cells, summed in double; false when
-// none is known.
-bool block_mean(const float *cells, int size_y, int bx, int by, int ds, float *mean) {
-  double sum = 0;
-  int count = 0;
-  for (int i = bx * ds; i < (bx + 1) * ds; ++i) {
-    const float *col = cells + static_cast<size_t>(i) * size_y;
-    for (int j = by * ds; j < (by + 1) * ds; ++j) {
-      if (col[j] != -1.0f) {
-        sum += col[j];
-        ++count;
-      }
-    }
-  }
-  *mean = count > 0 ? static_cast<float>(sum / static_cast<double>(count)) : -1.0f;
-  return count > 0;
-}
-
-Blocks downsample_blocks(const float *cells, int size_x, int size_y, int ds, int64_t border) {
-  Blocks b;
-  b.nx = size_x / ds;
-  b.ny = size_y / ds;
-  b.cells.resize(static_cast<size_t>(b.nx) * b.ny);
-  b.min_x = b.nx - border - 1, b.max_x = border;
-  b.min_y = b.ny - border - 1, b.max_y = border;
-  for (int bx = 0; bx < b.nx; ++bx) {
-    for (int by = 0; by < b.ny; ++by) {
-      float v;
-      if (block_mean(cells, size_y, bx, by, ds, &v)) {
-        b.min_x = std::min<int64_t>(b.min_x, bx), b.max_x = std::max<int64_t>(b.max_x, bx);
-        b.min_y = std::min<int64_t>(b.min_y, by), b.max_y = std::max<int64_t>(b.max_y, by);
-      }
-      b.cells[static_cast<size_t>(bx) * b.ny + by] = v;
-    }
-  }
-  return b;
-}
-
-}  // namespace
-
+// CARMEN's finish (finish_math.h, the same functions the GPU's finish
+// kernels run): block means, the known box, the crop and its cells.
 FinishedMap finish_grid(const float *cells, int size_x, int size_y, double resolution,
                         int downsample, int border) {
-  if (downsample < 1) throw Error(ErrorCode::Usage, "downsample must be at least 1");
-  if (border < 0) throw Error(ErrorCode::Usage, "border must not be negative");
-  const Blocks b = downsample_blocks(cells, size_x, size_y, downsample, border);
-  const int64_t min_x = std::max<int64_t>(b.min_x - border, 0), max_x = std::min<int64_t>(b.max_x + border, b.nx - 1);
-  const int64_t min_y = std::max<int64_t>(b.min_y - border, 0), max_y = std::min<int64_t>(b.max_y + border, b.ny - 1);
-  FinishedMap m;
-  m.downsample = downsample;
-  m.resolution = resolution * downsample;
-  // Inside [0, n - 1] after the clamps: they fit an int.
-  m.min_x = static_cast<int>(std::min<int64_t>(min_x, b.nx));
-  m.min_y = static_cast<int>(std::min<int64_t>(min_y, b.ny));
-  // CARMEN's new size is max - min, without +1: the last row and column go.
-  m.size_x = max_x - min_x > 0 ? static_cast<int>(max_x - min_x) : 0;
-  m.size_y = max_y - min_y > 0 ? static_cast<int>(max_y - min_y) : 0;
-  m.cells.resize(static_cast<size_t>(m.size_x) * m.size_y);
-  for (int x = 0; x < m.size_x; ++x)
-    for (int y = 0; y < m.size_y; ++y)
-      m.cells[static_cast<size_t>(x) * m.size_y + y] = b.cells[static_cast<size_t>(x + m.min_x) * b.ny + (y + m.min_y)];
+  finish::check_arguments(downsample, border);
+  const finish::Blocks blocks = finish::blocks_of(size_x, size_y, downsample);
+  std::vector<float> means(static_cast<size_t>(blocks.count()));
+  finish::KnownBox known;
+  const auto cell_at = [cells](int64_t c) { return cells[c]; };
+  for (int bx = 0; bx < blocks.nx; ++bx) {
+    for (int by = 0; by < blocks.ny; ++by) {
+      const finish::BlockMean m = finish::block_mean(cell_at, size_y, downsample, bx, by);
+      if (m.known) finish::widen(known, bx, by);
+      means[static_cast<size_t>(bx) * blocks.ny + by] = m.value;
+    }
+  }
+  const finish::Crop crop = finish::crop_of(known, blocks, border);
+  FinishedMap m = finish::finished_frame(crop, resolution, downsample);
+  m.cells.resize(static_cast<size_t>(crop.count()));
+  for (int x = 0; x < crop.size_x; ++x)
+    for (int y = 0; y < crop.size_y; ++y)
+      m.cells[static_cast<size_t>(x) * crop.size_y + y] = means[finish::cropped_block(crop, blocks, x, y)];
   return m;
 }
 
