@@ -65,7 +65,7 @@ SessionView view_of(const Mapper &m) {
   return {m.num_scans(), m.frame(), m.poses(), m.read(), golden::digest(m.finish(4, 20))};
 }
 
-void expect_same_session(const SessionView &before, const Mapper &m, const std::string &what) {
+[[maybe_unused]] void expect_same_session(const SessionView &before, const Mapper &m, const std::string &what) {
   SCOPED_TRACE(what);
   const SessionView now = view_of(m);
   EXPECT_EQ(now.scans, before.scans);
@@ -84,7 +84,7 @@ void expect_same_session(const SessionView &before, const Mapper &m, const std::
 }
 
 // `call` must throw vasco::Error with `code`.
-void expect_error(ErrorCode code, const std::function<void()> &call, const std::string &what) {
+[[maybe_unused]] void expect_error(ErrorCode code, const std::function<void()> &call, const std::string &what) {
   try {
     call();
     ADD_FAILURE() << what << " was accepted";

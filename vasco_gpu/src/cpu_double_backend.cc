@@ -14,6 +14,7 @@
 #include "host_renderer.h"
 #include "vasco_gpu/internal/oracle.h"
 #include "vasco_gpu/internal/sensor_params.h"
+#include "vasco_gpu/internal/table_cache.h"
 
 namespace vasco {
 namespace {
@@ -63,10 +64,7 @@ class CpuDoubleRenderer : public HostGridRenderer {
     frame.theta_offset = geo.theta_offset;
     // CARMEN's first update call records the start pose: that is scan 0's.
     if (first > 0 && batch.num_scans() > 0) oracle::scan_start(frame, batch.x[0], batch.y[0], batch.theta[0]);
-    if (key_ != params.table_key()) {
-      tables_.emplace(params);
-      key_ = params.table_key();
-    }
+    tables_key_.ensure(params, [&] { tables_.emplace(params); });
     MapStats st;
     beam_updates::BeamUpdates updates(params.table_size());
     for (size_t s = first; s < last; ++s) {
@@ -108,7 +106,7 @@ class CpuDoubleRenderer : public HostGridRenderer {
   }
 
   std::optional<Tables> tables_;               // kept between calls
-  std::optional<MapperParams::TableKey> key_;  // of tables_
+  TableCache tables_key_;  // of tables_
 };
 
 }  // namespace

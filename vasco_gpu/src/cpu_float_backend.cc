@@ -37,6 +37,7 @@
 #include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/internal/log_odds.h"
 #include "vasco_gpu/internal/sensor_params.h"
+#include "vasco_gpu/internal/table_cache.h"
 
 namespace vasco {
 namespace {
@@ -279,10 +280,7 @@ class CpuFloatRenderer : public HostGridRenderer {
 
  private:
   const EvidenceTable &table_for(const MapperParams &params) {
-    if (!table_ || table_key_ != params.table_key()) {
-      table_ = std::make_unique<EvidenceTable>(params);
-      table_key_ = params.table_key();
-    }
+    table_key_.ensure(params, [&] { table_ = std::make_unique<EvidenceTable>(params); });
     return *table_;
   }
 
@@ -318,7 +316,7 @@ class CpuFloatRenderer : public HostGridRenderer {
   }
 
   std::unique_ptr<EvidenceTable> table_;
-  MapperParams::TableKey table_key_{};
+  TableCache table_key_;  // of table_
   std::vector<double> scratch_;  // the call's sums over its box, [x][y]; kept for its allocation
 };
 

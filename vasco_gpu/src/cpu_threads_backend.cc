@@ -59,6 +59,7 @@
 #include "vasco_gpu/internal/parallel.h"
 #include "vasco_gpu/internal/timing.h"
 #include "vasco_gpu/internal/sensor_params.h"
+#include "vasco_gpu/internal/table_cache.h"
 
 namespace vasco {
 namespace {
@@ -335,10 +336,8 @@ class CpuThreadsRenderer : public HostGridRenderer {
     // 2. Column ranges and the work estimate; 3. stripes and their beams.
     std::unique_ptr<Beam[]> beams(new Beam[nb]);
     const Stripes stripes = cut_stripes(place_all(placed, size_x, size_y, T, nt, beams.get()), size_x, nt);
-    if (evidence_key_ != params.table_key()) {  // kept between calls (a session's inserts)
-      evidence_.emplace(sensor_model_of(params), params.resolution, T);
-      evidence_key_ = params.table_key();
-    }
+    // Kept between calls (a session's inserts).
+    evidence_key_.ensure(params, [&] { evidence_.emplace(sensor_model_of(params), params.resolution, T); });
     const Bins bins = bin_beams(beams.get(), nb, stripes, nt);
     st.prep_s = seconds_since(t0);
 
@@ -362,7 +361,7 @@ class CpuThreadsRenderer : public HostGridRenderer {
 
   int threads_;
   std::optional<beam_updates::Evidence> evidence_;
-  std::optional<MapperParams::TableKey> evidence_key_;  // of evidence_
+  TableCache evidence_key_;  // of evidence_
   CpuThreadsLoad load_;
   bool has_load_ = false;
 };

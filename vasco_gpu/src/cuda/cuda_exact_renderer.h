@@ -6,7 +6,7 @@
 #define VASCO_GPU_SRC_CUDA_EXACT_RENDERER_H
 
 #include "cuda_renderer.h"
-#include "table_cache.h"
+#include "vasco_gpu/internal/table_cache.h"
 
 namespace vasco {
 
@@ -34,7 +34,7 @@ class CudaExactRenderer final : public CudaRenderer {
   // The distance and odds-factor tables (they replace a sqrt and two
   // divisions per update), when small enough.
   bool use_tables_ = false;
-  cuda_host::TableCache tables_key_;
+  TableCache tables_key_;
   cuda::DeviceBuffer<double2> factors_;  // (free, occupied) odds factors
   cuda::DeviceBuffer<int> reach_;
   // One launch's beams (placed by place_beams into staging_beams_) and the

@@ -8,7 +8,7 @@
 
 #include "cuda_renderer.h"
 #include "device_ranges.h"
-#include "table_cache.h"
+#include "vasco_gpu/internal/table_cache.h"
 
 namespace vasco {
 
@@ -30,7 +30,7 @@ class CudaFloatRenderer final : public CudaRenderer {
   cuda::DeviceBuffer<unsigned long long> sums_;  // fixed-point log-odds sums
   uint64_t beams_ = 0;                            // applied since the reset
   cuda::DeviceBuffer<int2> increments_;           // launch_float_tables', when small enough
-  cuda_host::TableCache increments_key_;
+  TableCache increments_key_;
   cuda_host::DeviceRanges ranges_;
   cuda::DeviceBuffer<cuda::FloatScan> scan_records_;
   cuda::DeviceBuffer<unsigned long long> counters_;

@@ -1,8 +1,9 @@
-// table_cache.h — which parameters a renderer's device tables were built
-// for (MapperParams::table_key()), so that they are rebuilt only when the
-// key changes. One cache per table set: CUDA float and exact mode each hold one.
-#ifndef VASCO_GPU_SRC_CUDA_TABLE_CACHE_H
-#define VASCO_GPU_SRC_CUDA_TABLE_CACHE_H
+// table_cache.h — which parameters a renderer's tables were built for
+// (MapperParams::table_key()), so that they are rebuilt only when the key
+// changes. One cache per table set: each CPU backend and each CUDA mode
+// holds one.
+#ifndef VASCO_GPU_INTERNAL_TABLE_CACHE_H
+#define VASCO_GPU_INTERNAL_TABLE_CACHE_H
 
 #include <optional>
 #include <utility>
@@ -10,7 +11,6 @@
 #include "vasco_gpu/params.h"
 
 namespace vasco {
-namespace cuda_host {
 
 class TableCache {
  public:
@@ -30,7 +30,6 @@ class TableCache {
   std::optional<MapperParams::TableKey> key_;
 };
 
-}  // namespace cuda_host
 }  // namespace vasco
 
-#endif  // VASCO_GPU_SRC_CUDA_TABLE_CACHE_H
+#endif  // VASCO_GPU_INTERNAL_TABLE_CACHE_H
