@@ -168,10 +168,15 @@ TEST_F(ManyNamedChunks, MapconvertInfoListsEveryChunkWithoutParsingThem) {
   const std::string tool = std::string(VASCO_BIN_DIR) + "/mapconvert";
   const long info_kib = peak_rss_kib_of({tool, "--info", path()});
   ASSERT_GT(info_kib, 0) << "mapconvert --info failed";
-  EXPECT_LT(info_kib, 48 * 1024) << "mapconvert --info peaked at " << info_kib << " KiB";
   const long convert_kib = peak_rss_kib_of({tool, path(), dir_->file("copy.map")});
   ASSERT_GT(convert_kib, 0) << "mapconvert to .map failed";
-  EXPECT_GT(convert_kib, 100 * 1024) << "converting peaked at only " << convert_kib << " KiB";
+  // Both processes carry the same base (libraries, buffers; under ASan its
+  // shadow and quarantine too): parsing the 125 MiB of named cells must cost
+  // most of them beyond what --info costs.
+  EXPECT_GT(convert_kib - info_kib, 100 * 1024) << "--info " << info_kib << " KiB, converting " << convert_kib;
+#if !defined(__SANITIZE_ADDRESS__)
+  EXPECT_LT(info_kib, 48 * 1024) << "mapconvert --info peaked at " << info_kib << " KiB";
+#endif
   FILE *p = popen(("'" + tool + "' --info '" + path() + "'").c_str(), "r");
   ASSERT_NE(p, nullptr);
   std::string out;
