@@ -33,7 +33,7 @@
 // of a cell boundary (poses on a 1 mm or 1 cm lattice often do) can fall one
 // cell over, and its beams with it. Measured (`make golden`, the session fed
 // in pieces of 97 scans: golden_check's mapper-grown/cpu_threads): 20 of the
-// 27 public golden cases are CARMEN's bytes; in the other 7 up to 0.12% of
+// 27 public golden cases are CARMEN's bytes; in the other 7 up to 0.13% of
 // the cells change class (fr101 raw: 4370 cells, max |dp| 0.17; paper
 // parameters: 0.41). render(poses()) renders in frame() itself, without a
 // margin, and gives CARMEN's bytes again (mapper/cpu_threads: 27 of 27). A fixed frame
