@@ -29,9 +29,11 @@
 // same first scan and heading), read() returns its window and finish()
 // finishes that window, so the margin is never seen. The reservation: in a
 // grown grid a scan's cell position is size/2 + d rounded at the grid's size,
-// not the final frame's, so a scan whose position lies within a rounding step
-// of a cell boundary (poses on a 1 mm or 1 cm lattice often do) can fall one
-// cell over, and its beams with it. Measured (`make golden`, the session fed
+// not the final frame's, so a scan position or a beam end lying within a
+// rounding step of a cell boundary (poses and ranges on a 1 mm or 1 cm
+// lattice often do) can fall one cell over (a scan: with all its beams).
+// Exactly: read() is the frame()'s window of a fresh render in grid_frame().
+// Measured (`make golden`, the session fed
 // in pieces of 97 scans: golden_check's mapper-grown/cpu_threads): 20 of the
 // 27 public golden cases are CARMEN's bytes; in the other 7 up to 0.13% of
 // the cells change class (fr101 raw: 4370 cells, max |dp| 0.17; paper
@@ -114,6 +116,11 @@ class Mapper {
   const ScanBatch &scans() const { return scans_; }
   std::vector<Pose> poses() const;
   const GridGeometry &frame() const { return geo_; }
+  // The renderer's grid: frame() itself, or after growth frame() centred in
+  // whole cells of margin (the same first scan and heading). With an exact
+  // backend read() is the frame()'s window of a fresh render of the stored
+  // scans in this grid, byte for byte.
+  const GridGeometry &grid_frame() const { return grid_; }
   const MapperParams &params() const { return params_; }
   std::string backend_name() const { return renderer_->name(); }
   // What the backend is: exact or not, grid on the GPU or in host memory.
