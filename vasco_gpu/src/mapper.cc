@@ -120,20 +120,26 @@ GridGeometry Mapper::grown_frame(const GridGeometry &need, uint64_t beams) const
 
 namespace {
 
-// `bytes` in MiB with `decimals` digits, rounded up or down.
-std::string mebibytes(double bytes, bool up, int decimals = 0) {
+// `bytes` in MiB rounded up or down to `decimals` digits, as a number and as text.
+double mebibytes_rounded(double bytes, bool up, int decimals) {
   const double scale = std::pow(10.0, decimals), mib = bytes / (1 << 20) * scale;
+  return (up ? std::ceil(mib) : std::floor(mib)) / scale;
+}
+
+std::string mebibytes(double bytes, bool up, int decimals = 0) {
   std::ostringstream s;
-  s << std::fixed << std::setprecision(decimals) << (up ? std::ceil(mib) : std::floor(mib)) / scale;
+  s << std::fixed << std::setprecision(decimals) << mebibytes_rounded(bytes, up, decimals);
   return s.str();
 }
 
-// A need above the budget, rounded up with as many decimals as it takes to
-// read as more than `budget` ("2.1 MiB ... more than the budget of 2 MiB").
-std::string need_above(double need, const std::string &budget) {
-  std::string text = mebibytes(need, true);
-  for (int d = 1; d <= 6 && std::stod(text) <= std::stod(budget); ++d) text = mebibytes(need, true, d);
-  return text;
+// A need above a budget shown with `budget_decimals`, rounded up with as
+// many decimals as it takes to read as more than it ("2.1 MiB ... more than
+// the budget of 2 MiB"). Compared as numbers, not as text.
+std::string need_above(double need, double budget, int budget_decimals) {
+  const double shown_budget = mebibytes_rounded(budget, false, budget_decimals);
+  int d = 0;
+  while (d < 6 && mebibytes_rounded(need, true, d) <= shown_budget) ++d;
+  return mebibytes(need, true, d);
 }
 
 }  // namespace
@@ -147,9 +153,10 @@ void Mapper::check_memory(const GridGeometry &geo, uint64_t beams) const {
   if (fits_memory(geo, beams)) return;
   const double need = memory_need(geo, beams, renderer_->traits().grid_on_device);
   const uint64_t b = options_.max_memory_bytes;
-  const std::string budget = mebibytes(static_cast<double>(b), false, b % (1 << 20) == 0 ? 0 : 2);
+  const int budget_decimals = b % (1 << 20) == 0 ? 0 : 2;
+  const std::string budget = mebibytes(static_cast<double>(b), false, budget_decimals);
   std::ostringstream m;
-  m << "the map needs about " << need_above(need, budget) << " MiB of memory (a grid of " << geo.size_x
+  m << "the map needs about " << need_above(need, static_cast<double>(b), budget_decimals) << " MiB of memory (a grid of " << geo.size_x
     << " x " << geo.size_y << " cells at " << geo.resolution << " m and " << beams
     << " beams), more than the budget of " << budget << " MiB: ";
   if (!options_.budget_hint.empty()) m << "raise it (" << options_.budget_hint << "), or ";

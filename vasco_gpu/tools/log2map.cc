@@ -232,7 +232,7 @@ void check_before_work(const Options &opt) {
 std::string why_nothing_was_mapped(const vasco::LogInput &in) {
   const vasco::ScanBatch &b = in.batch;
   uint64_t used = 0;
-  for (float r : b.range) used += static_cast<double>(r) < vasco::egrid::kLaserRangeLimit;  // NaN compares false
+  for (float r : b.range) used += vasco::egrid::is_beam_used(r);
   std::ostringstream m;
   m << "no beam updated any cell: ";
   if (used == 0) {
