@@ -18,6 +18,7 @@ void bind_params(nb::module_ &m);   // Params
 void bind_frame(nb::module_ &m);    // Frame
 void bind_scans(nb::module_ &m);    // Scans
 void bind_log(nb::module_ &m);      // Log, load_log
+void bind_inputs(nb::module_ &m);   // _log_from_scans, _run_tool (bag2map)
 void bind_map(nb::module_ &m);      // Map, _read_map, write_map
 void bind_compare(nb::module_ &m);  // Comparison, compare
 void bind_mapper(nb::module_ &m);   // Mapper

@@ -13,6 +13,7 @@
 
 #include "arrays.h"
 #include "bindings.h"
+#include "inputs.h"
 #include "param_keys.h"
 #include "vasco_gpu/internal/log_input.h"
 
@@ -55,20 +56,10 @@ nb::dict load_stats_dict(const vasco::LogLoadStats &l) {
 }
 
 LogInput load_log(const fs::path &path, std::optional<fs::path> param_file, const std::string &robot,
-                  std::optional<nb::dict> overrides, bool lenient) {
+                  std::optional<nb::dict> overrides, bool lenient, nb::kwargs kwargs) {
   vasco::LogInputOptions o;
-  o.log = path.string();
-  if (param_file) o.param_file = param_file->string();
-  o.robot = robot;
+  fill_input_options(o, path.string(), param_file, robot, overrides, kwargs);
   o.lenient = lenient;
-  if (overrides) {
-    for (auto [k, v] : *overrides) {
-      std::string name = nb::cast<std::string>(k);
-      check_param(name, v);
-      if (name.rfind("vasco_", 0) != 0) name = "vasco_" + name;
-      o.overrides[name] = nb::cast<std::string>(nb::str(v));
-    }
-  }
   nb::gil_scoped_release release;
   return vasco::load_log_input(o);
 }
@@ -84,7 +75,13 @@ constexpr const char *kLoadLogDoc =
     "section), ``overrides`` keys as in Params (they win over the ini, which wins over the log's\n"
     "PARAM lines). Strict by default: a bad line raises FileError with ``.file`` and ``.line``;\n"
     "``lenient=True`` skips bad lines and counts them in ``Log.stats['bad_lines']``. The GIL is\n"
-    "released while the log is read.";
+    "released while the log is read.\n\n"
+    "Poses from a SLAM back end (log2map --poses): ``poses`` a TUM trajectory, g2o file or CARMEN log;\n"
+    "``pose_format`` 'auto' | 'tum' | 'g2o' | 'carmen'; ``pose_match`` 'auto' | 'order' | 'id' | 'time';\n"
+    "``pose_tolerance`` seconds (0.1); ``pose_ids`` a file of 'id scan' pairs; ``skip_unposed`` leave out\n"
+    "scans without a pose; ``pose_frame`` 'laser' | 'robot'; ``laser_mount`` (x, y, theta) of the laser\n"
+    "on the robot. Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared\n"
+    "frame, ``add`` further logs, each a path or (path, (x, y, theta)).";
 
 }  // namespace
 
@@ -104,6 +101,11 @@ void bind_log(nb::module_ &m) {
       .def_prop_ro(
           "ranges", [](nb::handle_t<LogInput> self) { return view1(nb::cast<LogInput &>(self).batch.range, self); },
           nb::rv_policy::reference, "All ranges, float32 (a view; see Scans).")
+      .def_prop_ro(
+          "stamps", [](const LogInput &in) { return owned(std::vector<double>(in.stamps), {in.stamps.size()}); },
+          nb::rv_policy::reference, "Each selected scan's timestamp in seconds, float64 (a new array; NaN where unknown).")
+      .def_ro("posed_from_file", &LogInput::posed_from_file, "Scans whose pose came from ``poses`` (0 without).")
+      .def_ro("unposed_skipped", &LogInput::unposed_skipped, "Scans left out for want of a pose (``skip_unposed``).")
       .def_ro("warnings", &LogInput::warnings, "Unknown vasco_* keys and the like.")
       .def_prop_ro(
           "stats", [](const LogInput &in) { return load_stats_dict(in.load); },
@@ -115,9 +117,14 @@ void bind_log(nb::module_ &m) {
       });
 
   m.def("load_log", &load_log, "path"_a, "param_file"_a = nb::none(), "robot"_a = "", "overrides"_a = nb::none(),
-        "lenient"_a = false,
+        "lenient"_a = false, "kwargs"_a,
         nb::sig("def load_log(path: str | os.PathLike, param_file: str | os.PathLike | None = None, "
-                "robot: str = '', overrides: dict[str, float | int] | None = None, lenient: bool = False) -> Log"),
+                "robot: str = '', overrides: dict[str, float | int] | None = None, lenient: bool = False, *, "
+                "poses: str | os.PathLike | None = None, pose_format: str = 'auto', pose_match: str = 'auto', "
+                "pose_tolerance: float = 0.1, pose_ids: str | os.PathLike | None = None, skip_unposed: bool = False, "
+                "pose_frame: str = 'laser', laser_mount: tuple[float, float, float] | None = None, "
+                "transform: tuple[float, float, float] | None = None, "
+                "add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float]]] | None = None) -> Log"),
         kLoadLogDoc);
 }
 

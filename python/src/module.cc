@@ -90,6 +90,7 @@ NB_MODULE(_core, m) {
   vasco_py::bind_frame(m);
   vasco_py::bind_scans(m);
   vasco_py::bind_log(m);
+  vasco_py::bind_inputs(m);
   vasco_py::bind_map(m);
   vasco_py::bind_compare(m);
   vasco_py::bind_mapper(m);

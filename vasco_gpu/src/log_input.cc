@@ -1,5 +1,7 @@
 #include "vasco_gpu/internal/log_input.h"
 
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -8,16 +10,173 @@
 
 namespace vasco {
 
-LogInput load_log_input(const LogInputOptions &options) {
-  LogInput in;
+namespace {
+
+bool is_identity(const Pose2 &t) { return t.x == 0 && t.y == 0 && t.theta == 0; }
+
+// The ini and the command line, validated now, before a long log is read.
+carmen::ParamFile command_line_params(const LogInputOptions &options, std::vector<std::string> *warnings) {
   carmen::ParamFile params;
   if (!options.param_file.empty()) params = carmen::ParamFile::load(options.param_file, options.robot);
   for (const auto &kv : options.overrides) params.set_override(kv.first, kv.second);
-  for (const auto &w : params.warnings()) in.warnings.push_back(w.str());
-  // Validates the ini and the command line now, before a long log is read.
+  for (const auto &w : params.warnings()) warnings->push_back(w.str());
   MapperParams::from_params(params, nullptr);
+  return params;
+}
 
-  // Every laser message: the run is selected below, once the log's own
+// The scan named in messages: "intel.log line 812 (scan 403)".
+std::string scan_name(const std::string &source, const ScanBatch &b, size_t s) {
+  std::string n = source;
+  if (s < b.line.size() && b.line[s] > 0) n += " line " + std::to_string(b.line[s]);
+  return n + " (scan " + std::to_string(s) + ")";
+}
+
+// The laser pose of a robot pose from the pose file: by the given mount, or
+// by the scan's own.
+Pose2 laser_pose_of(const Pose2 &robot, const StampedScans &scans, size_t s, const PoseSource &src,
+                    const std::string &source) {
+  if (src.has_mount) return compose(robot, src.mount);
+  if (s < scans.has_mount.size() && scans.has_mount[s]) return compose(robot, scans.mounts[s]);
+  throw carmen::FileError(src.file, "the poses are of the robot, but " + scan_name(source, scans.batch, s) +
+                                        " says nothing of where its laser sits on the robot (a FLASER line): "
+                                        "give the mount with --laser-mount X,Y,THETA",
+                          carmen::ErrorCode::Usage);
+}
+
+// Replaces the scans' poses by the pose file's (DESIGN §3 step 1 gets its
+// poses from elsewhere); scans without one are left out when asked.
+void apply_pose_file(StampedScans &scans, const PoseSource &src, const std::string &source, LogInput *in) {
+  if (src.file.empty()) return;
+  PoseFile file = read_pose_file(src.file, src.format);
+  PoseMatchOptions match = src.match;
+  if (!src.id_map_file.empty()) match.id_map = read_pose_id_map(src.id_map_file);
+  const PoseMatch m = match_poses(file, scans.batch.num_scans(), scans.stamps, source, scans.batch.line, match);
+  ScanBatch &b = scans.batch;
+  for (size_t s = 0; s < b.num_scans(); ++s) {
+    if (!m.matched[s]) continue;
+    const Pose2 p = src.robot_frame ? laser_pose_of(m.pose[s], scans, s, src, source) : m.pose[s];
+    b.x[s] = p.x;
+    b.y[s] = p.y;
+    b.theta[s] = p.theta;
+  }
+  in->posed_from_file = b.num_scans() - m.unmatched;
+  in->unposed_skipped = m.unmatched;
+  if (m.unmatched > 0) scans.keep_only(m.matched);
+}
+
+// A block larger than the grid leaves nothing to finish: say so, naming
+// where the value came from.
+void check_downsample(const LogInput &in, const carmen::ParamFile &params, const std::string &source) {
+  if (in.params.downsample <= in.geo.size_x && in.params.downsample <= in.geo.size_y) return;
+  const std::string m = "vasco_downsample = " + std::to_string(in.params.downsample) + " is larger than the grid (" +
+                        std::to_string(in.geo.size_x) + " x " + std::to_string(in.geo.size_y) +
+                        " cells): the finished map would be empty";
+  const auto where = params.find("vasco_downsample");
+  if (where && where->line > 0) throw carmen::FileError(where->file, where->line, m);
+  throw carmen::FileError(where ? where->file : source, m);
+}
+
+// The steps after reading, the same for logs and bags: poses from a file,
+// the effective parameters, the selected run, the grid.
+LogInput finish_input(StampedScans scans, carmen::ParamFile &params, const LogInputOptions &options,
+                      LogInput in, const char *scan_kind) {
+  apply_pose_file(scans, options.poses, options.log, &in);
+  in.params = MapperParams::from_params(params, &in.warnings);
+  const long laser_messages = in.load.laser_messages;
+  in.stamps = std::move(scans.stamps);
+  in.batch = std::move(scans.batch).select(in.params.first_scan, in.params.num_scans);  // no copy of the ranges
+  {
+    const auto begin = std::min<size_t>(static_cast<size_t>(std::max(in.params.first_scan, 0L)), in.stamps.size());
+    in.stamps.erase(in.stamps.begin(), in.stamps.begin() + static_cast<std::ptrdiff_t>(begin));
+    in.stamps.resize(in.batch.num_scans());
+  }
+  in.load.scans_used = static_cast<long>(in.batch.num_scans());
+  if (in.batch.num_scans() == 0)
+    throw carmen::FileError(
+        options.log, std::string("no ") + scan_kind + " to map" +
+                         std::string(laser_messages > 0 ? " in the selected range (vasco_first_scan " +
+                                                              std::to_string(in.params.first_scan) + " of " +
+                                                              std::to_string(laser_messages) + " laser messages)"
+                                                        : ""));
+  try {
+    in.geo = size_grid(in.batch, in.params);  // the frame a Mapper's first insert of in.batch takes
+  } catch (const carmen::Error &e) {
+    throw carmen::FileError(options.log, e.what(), e.code());
+  }
+  check_downsample(in, params, options.log);
+  return in;
+}
+
+// The counts of a further session's log added to the first's.
+void add_counts(LogLoadStats &to, const LogLoadStats &from) {
+  carmen::LogStats &a = to.log;
+  const carmen::LogStats &b = from.log;
+  for (int t = 0; t < carmen::kNumMessageTypes; ++t) a.messages[t] += b.messages[t];
+  for (int c = 0; c < carmen::kNumBadLineClasses; ++c) a.bad_lines[c] += b.bad_lines[c];
+  a.lines += b.lines;
+  a.blank_lines += b.blank_lines;
+  a.comment_lines += b.comment_lines;
+  a.unknown_lines += b.unknown_lines;
+  a.nan_ranges += b.nan_ranges;
+  a.inf_ranges += b.inf_ranges;
+  a.negative_ranges += b.negative_ranges;
+  a.kept_bytes += b.kept_bytes;
+  to.laser_messages += from.laser_messages;
+}
+
+void check_sessions(const LogInputOptions &options) {
+  if (!options.more_logs.empty() && !options.poses.file.empty())
+    throw carmen::Error(carmen::ErrorCode::Usage,
+                        "a pose file applies to one input: map several sessions with their own poses by "
+                        "writing each session's poses into its log first (log2map --poses, then bag2carmen "
+                        "or the Python API)");
+  auto finite = [](const Pose2 &t) { return std::isfinite(t.x) && std::isfinite(t.y) && std::isfinite(t.theta); };
+  if (!finite(options.transform)) throw carmen::Error(carmen::ErrorCode::Usage, options.log + ": the transform is not finite");
+  for (const SessionInput &s : options.more_logs)
+    if (!finite(s.transform)) throw carmen::Error(carmen::ErrorCode::Usage, s.path + ": the transform is not finite");
+}
+
+}  // namespace
+
+void transform_poses(ScanBatch &batch, const Pose2 &transform) {
+  if (is_identity(transform)) return;
+  for (size_t s = 0; s < batch.num_scans(); ++s) {
+    const Pose2 p = compose(transform, Pose2{batch.x[s], batch.y[s], batch.theta[s]});
+    batch.x[s] = p.x;
+    batch.y[s] = p.y;
+    batch.theta[s] = p.theta;
+  }
+}
+
+void StampedScans::append(StampedScans &&more, const Pose2 &transform) {
+  transform_poses(more.batch, transform);  // the mounts are in the robot's frame: unchanged
+  more.stamps.resize(more.batch.num_scans(), std::numeric_limits<double>::quiet_NaN());
+  more.mounts.resize(more.batch.num_scans());
+  more.has_mount.resize(more.batch.num_scans(), 0);
+  stamps.resize(batch.num_scans(), std::numeric_limits<double>::quiet_NaN());
+  mounts.resize(batch.num_scans());
+  has_mount.resize(batch.num_scans(), 0);
+  batch.append(more.batch);
+  stamps.insert(stamps.end(), more.stamps.begin(), more.stamps.end());
+  mounts.insert(mounts.end(), more.mounts.begin(), more.mounts.end());
+  has_mount.insert(has_mount.end(), more.has_mount.begin(), more.has_mount.end());
+}
+
+void StampedScans::keep_only(const std::vector<uint8_t> &keep) {
+  StampedScans kept;
+  for (size_t s = 0; s < batch.num_scans(); ++s) {
+    if (!keep[s]) continue;
+    kept.batch.add_scan(batch.x[s], batch.y[s], batch.theta[s], batch.first_angle[s], batch.angle_step[s],
+                        batch.ranges_of(s), batch.beams_in(s), batch.line[s]);
+    kept.stamps.push_back(s < stamps.size() ? stamps[s] : std::numeric_limits<double>::quiet_NaN());
+    kept.mounts.push_back(s < mounts.size() ? mounts[s] : Pose2{});
+    kept.has_mount.push_back(s < has_mount.size() ? has_mount[s] : 0);
+  }
+  *this = std::move(kept);
+}
+
+StampedScans read_stamped_scans(const std::string &path, const LogInputOptions &options, LogLoadStats *stats) {
+  // Every laser message: the run is selected later, once the log's own
   // PARAM lines (which may set vasco_first_scan / vasco_num_scans) are known.
   MapperParams all;
   all.first_scan = 0;
@@ -29,38 +188,55 @@ LogInput load_log_input(const LogInputOptions &options) {
   reader.budget_types = carmen::message_type_bit(carmen::MessageType::FLASER) |  // what load_scans keeps
                         carmen::message_type_bit(carmen::MessageType::ROBOTLASER1) |
                         carmen::message_type_bit(carmen::MessageType::PARAM);
-  ScanBatch every = load_scans(options.log, all, reader, &in.load, options.progress);
-  for (size_t i = 0; i < in.load.params.size(); ++i)
-    params.add_fallback(in.load.params[i].first, in.load.params[i].second, options.log,
-                        in.load.param_lines[i]);
-  in.params = MapperParams::from_params(params, &in.warnings);
+  StampedScans out;
+  out.batch = load_scans(path, all, reader, stats, options.progress);
+  out.stamps = stats->stamps;
+  out.mounts.resize(out.batch.num_scans());
+  out.has_mount = stats->robot_pose_known;
+  for (size_t s = 0; s < out.batch.num_scans(); ++s) {
+    if (!out.has_mount[s]) continue;
+    const carmen::Point &r = stats->robot_poses[s];
+    out.mounts[s] = compose(inverse(Pose2{r.x, r.y, r.theta}),
+                            Pose2{out.batch.x[s], out.batch.y[s], out.batch.theta[s]});
+  }
+  return out;
+}
 
-  in.batch = std::move(every).select(in.params.first_scan, in.params.num_scans);  // no copy of the ranges
-  in.load.scans_used = static_cast<long>(in.batch.num_scans());
-  if (in.batch.num_scans() == 0)
-    throw carmen::FileError(
-        options.log, "no FLASER or ROBOTLASER1 scans to map" +
-                         std::string(in.load.laser_messages > 0
-                                         ? " in the selected range (vasco_first_scan " +
-                                               std::to_string(in.params.first_scan) + " of " +
-                                               std::to_string(in.load.laser_messages) + " laser messages)"
-                                         : ""));
-  try {
-    in.geo = size_grid(in.batch, in.params);  // the frame a Mapper's first insert of in.batch takes
-  } catch (const carmen::Error &e) {
-    throw carmen::FileError(options.log, e.what(), e.code());
+LogInput load_log_input(const LogInputOptions &options) {
+  check_sessions(options);
+  LogInput in;
+  carmen::ParamFile params = command_line_params(options, &in.warnings);
+  StampedScans scans = read_stamped_scans(options.log, options, &in.load);
+  transform_poses(scans.batch, options.transform);
+  auto add_params = [&](const LogLoadStats &load, const std::string &path) {
+    for (size_t i = 0; i < load.params.size(); ++i)
+      params.add_fallback(load.params[i].first, load.params[i].second, path, load.param_lines[i]);
+  };
+  add_params(in.load, options.log);
+  for (const SessionInput &more : options.more_logs) {
+    // The budget is for all sessions together: each log gets what is left.
+    LogInputOptions rest = options;
+    if (rest.memory_budget > 0)
+      rest.memory_budget = rest.memory_budget > in.load.log.kept_bytes ? rest.memory_budget - in.load.log.kept_bytes : 1;
+    LogLoadStats load;
+    StampedScans next = read_stamped_scans(more.path, rest, &load);
+    add_params(load, more.path);
+    add_counts(in.load, load);
+    scans.append(std::move(next), more.transform);
   }
-  // A block larger than the grid leaves nothing to finish: say so, naming
-  // where the value came from.
-  if (in.params.downsample > in.geo.size_x || in.params.downsample > in.geo.size_y) {
-    const std::string m = "vasco_downsample = " + std::to_string(in.params.downsample) + " is larger than the grid (" +
-                          std::to_string(in.geo.size_x) + " x " + std::to_string(in.geo.size_y) +
-                          " cells): the finished map would be empty";
-    const auto where = params.find("vasco_downsample");
-    if (where && where->line > 0) throw carmen::FileError(where->file, where->line, m);
-    throw carmen::FileError(where ? where->file : options.log, m);
-  }
-  return in;
+  return finish_input(std::move(scans), params, options, std::move(in), "FLASER or ROBOTLASER1 scans");
+}
+
+LogInput log_input_from_scans(StampedScans scans, const LogInputOptions &options) {
+  if (!options.more_logs.empty())
+    throw carmen::Error(carmen::ErrorCode::Usage, "log_input_from_scans: append further sessions to the scans");
+  check_sessions(options);
+  scans.batch.validate();
+  LogInput in;
+  carmen::ParamFile params = command_line_params(options, &in.warnings);
+  in.load.laser_messages = static_cast<long>(scans.batch.num_scans());
+  transform_poses(scans.batch, options.transform);
+  return finish_input(std::move(scans), params, options, std::move(in), "scans");
 }
 
 }  // namespace vasco

@@ -192,6 +192,9 @@ ScanBatch load_scans(const std::string &log_path, const MapperParams &params,
         batch.add_scan(l.laser_pose.x, l.laser_pose.y, l.laser_pose.theta, l.config.start_angle,
                        l.config.angular_resolution, l.range.data(), static_cast<int>(l.range.size()),
                        msg.line);
+        st.stamps.push_back(l.timestamp);
+        st.robot_poses.push_back(l.robot_pose);
+        st.robot_pose_known.push_back(msg.type == carmen::MessageType::ROBOTLASER1);
         break;
       }
       case carmen::MessageType::PARAM:

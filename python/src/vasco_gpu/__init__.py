@@ -13,6 +13,9 @@ The mapping session of the C++ library (``vasco::Mapper``) with NumPy arrays in 
     m = mapper.finish()                                       # Map: .cells (size_x, size_y), x-major
     vg.write_map("fr079.png", m)
 
+ROS bags (ROS 1 ``.bag``, ROS 2 sqlite3 and MCAP, read with ``rosbags``) give the same ``Log``:
+``vg.load_bag("run.mcap")``; poses from a SLAM back end: ``vg.load_log(path, poses="opt.g2o")``.
+
 Arrays: ``Map.cells`` is a float32 view of shape (size_x, size_y) indexed ``cells[x, y]`` as
 CARMEN stores maps (-1 unknown, else the occupancy probability); ``Map.image`` is the same
 memory as a picture (``cells.T[::-1]``, row 0 at the top). ``Scans`` arrays are views too;
@@ -55,6 +58,7 @@ from ._core import (
     write_map,
 )
 from . import _core
+from ._bags import load_bag
 
 __version__: str = _core.__version__
 
@@ -82,6 +86,7 @@ __all__ = [
     "cuda_available",
     "gridmap_sha256",
     "has_cuda",
+    "load_bag",
     "load_log",
     "read_map",
     "write_map",

@@ -66,6 +66,12 @@ struct LogLoadStats {
   long scans_used = 0;           // after vasco_first_scan / vasco_num_scans
   std::vector<std::pair<std::string, std::string>> params;  // PARAM lines (name, value)
   std::vector<long> param_lines;                            // their line numbers
+  // Per scan kept: its ipc timestamp, and the robot's pose where the line
+  // gives it in the laser pose's frame (ROBOTLASER1; FLASER's odometry
+  // triple is in the odometry frame, so robot_pose_known is 0 there).
+  std::vector<double> stamps;
+  std::vector<carmen::Point> robot_poses;
+  std::vector<uint8_t> robot_pose_known;
 };
 
 // Reads the laser scans of a log by DESIGN §3 step 1: every FLASER and

@@ -17,12 +17,55 @@
 
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/pose_file.h"
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco {
 
+// One more input of a map made from several sessions (several robots or
+// days in one place): its scans follow the first log's, each pose taken into
+// the shared frame by `transform` (the identity when the sessions already
+// share one).
+struct SessionInput {
+  std::string path;
+  Pose2 transform;
+};
+
+// Where the scans' poses come from when not from the inputs themselves: a
+// pose file of a SLAM back end (pose_file.h), matched to the scans of the
+// whole input before vasco_first_scan / vasco_num_scans select.
+struct PoseSource {
+  std::string file;  // empty: the inputs' own laser poses
+  PoseFileFormat format = PoseFileFormat::Auto;
+  PoseMatchOptions match;
+  std::string id_map_file;  // "id scan" pairs for PoseMatching::Id
+  // The poses are of the laser (false) or of the robot (true): a robot pose
+  // is taken to the laser by the mount, given here (has_mount) or read from
+  // each scan (ROBOTLASER1 lines and bags carry one; FLASER lines do not).
+  bool robot_frame = false;
+  bool has_mount = false;
+  Pose2 mount;  // the laser in the robot's frame
+};
+
+// A log's scans with what the pose sources need of each: its timestamp and
+// (where the input says) the laser's mount on the robot. What load_log_input
+// reads from CARMEN logs, and what a bag reader hands over.
+struct StampedScans {
+  ScanBatch batch;
+  std::vector<double> stamps;     // one per scan (NaN where unknown)
+  std::vector<Pose2> mounts;      // one per scan where has_mount[s]
+  std::vector<uint8_t> has_mount;
+  // Appends `more` with every pose taken into the shared frame by `transform`.
+  void append(StampedScans &&more, const Pose2 &transform);
+  // Keeps the scans where keep[s] (what skip_unmatched leaves).
+  void keep_only(const std::vector<uint8_t> &keep);
+};
+
 struct LogInputOptions {
   std::string log;                               // .log, .clf, gzipped if .gz
+  Pose2 transform;                               // of `log` into the shared frame (identity: as read)
+  std::vector<SessionInput> more_logs;           // further sessions mapped into the same grid
+  PoseSource poses;
   std::string param_file;                        // carmen.ini; empty: none
   std::string robot;                             // robot section of the ini
   std::map<std::string, std::string> overrides;  // vasco_KEY -> value (command line)
@@ -39,6 +82,9 @@ struct LogInputOptions {
 struct LogInput {
   MapperParams params;                // validated
   ScanBatch batch;                    // the selected scans, in log order
+  std::vector<double> stamps;         // their timestamps (NaN where unknown)
+  uint64_t posed_from_file = 0;       // scans whose pose came from options.poses
+  uint64_t unposed_skipped = 0;       // scans left out for want of a pose (skip_unmatched)
   LogLoadStats load;                  // counts of the whole log
   GridGeometry geo;                   // DESIGN §3 step 2 (size_grid), from the selected scans: the
                                       // frame a Mapper's first insert of `batch` takes (use the
@@ -49,7 +95,25 @@ struct LogInput {
 // Reads the parameters and the log. Throws carmen::FileError naming the file
 // (and line) for bad input: an unreadable or malformed log or ini, a bad
 // parameter value, no scans in the selected run, poses too far apart.
+// With more_logs, every input is read in turn; their PARAM lines apply in
+// that order, as if the logs were one file, and the frame is that of the
+// combined scans: on an exact backend the map equals that of one log holding
+// every scan in that order.
 LogInput load_log_input(const LogInputOptions &options);
+
+// The same from scans read elsewhere (a ROS bag): the parameters come from
+// options' ini and overrides (a bag has no PARAM lines), options.poses
+// applies, options.log names the source in errors and options.more_logs
+// must be empty (the caller appends further sessions to `scans` itself).
+LogInput log_input_from_scans(StampedScans scans, const LogInputOptions &options);
+
+// Reads a CARMEN log's scans with their stamps and mounts (every laser
+// message; no selection), counting into *stats.
+StampedScans read_stamped_scans(const std::string &path, const LogInputOptions &options, LogLoadStats *stats);
+
+// Every pose of `batch` taken into another frame: compose(transform, pose).
+// The identity leaves every bit as it was.
+void transform_poses(ScanBatch &batch, const Pose2 &transform);
 
 }  // namespace vasco
 

@@ -1,0 +1,360 @@
+// log2map — turns a CARMEN laser log into a map, as CARMEN's evidence grid
+// (vasco/egrid.c) would (DESIGN §3).
+//
+//   log2map [options] LOG OUT [OUT...]
+//
+// Outputs by extension: .map / .map.gz (CARMEN), .pgm (+ .yaml, ROS
+// map_server), .png. Exit 0 ok, 1 bad input or runtime error, 2 usage error.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <future>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/atomic_file.h"
+#include "carmen_compat/error.h"
+#include "carmen_compat/map_format.h"
+#include "cli_support.h"
+#include "log2map_app.h"
+#include "log2map_options.h"
+#include "vasco_gpu/backend.h"
+#include "vasco_gpu/grid.h"
+#include "vasco_gpu/internal/egrid_math.h"
+#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/map_output.h"
+#include "vasco_gpu/mapper.hpp"
+#include "vasco_gpu/params.h"
+#include "vasco_gpu/scan_batch.h"
+#include "vasco_gpu/version.h"
+#if defined(VASCO_HAVE_CUDA)
+#include "vasco_gpu/cuda_backend.h"
+#endif
+
+namespace log2map {
+
+namespace {
+
+using cli::Clock;
+using cli::seconds_since;
+
+// A one-line progress bar on stderr, only when stderr is a terminal.
+class ProgressBar {
+ public:
+  ProgressBar(const char *label, bool enabled) : label_(label), enabled_(enabled) {}
+  ~ProgressBar() { done(); }
+  void update(uint64_t done_units, uint64_t total) {
+    if (!enabled_ || total == 0) return;
+    const int pct = static_cast<int>(100.0 * double(done_units) / double(total));
+    if (pct == last_) return;
+    last_ = pct;
+    const int width = 40, filled = std::min(width, pct * width / 100);
+    std::fprintf(stderr, "\r%-8s [%s%s] %3d%%", label_, std::string(filled, '#').c_str(),
+                 std::string(width - filled, ' ').c_str(), std::min(pct, 100));
+    std::fflush(stderr);
+    shown_ = true;
+  }
+  void done() {
+    if (shown_) std::fprintf(stderr, "\r%*s\r", 60, "");
+    shown_ = false;
+  }
+
+ private:
+  const char *label_;
+  bool enabled_;
+  int last_ = -1;
+  bool shown_ = false;
+};
+
+std::string basename_of(const std::string &path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// Every file the run creates (a .pgm's .yaml too), for the checks made
+// before any work.
+std::vector<std::string> files_written(const std::vector<std::string> &outputs) {
+  std::vector<std::string> files;
+  for (const std::string &out : outputs) {
+    const std::vector<std::string> of_one = carmen::map_output_files(out);
+    files.insert(files.end(), of_one.begin(), of_one.end());
+  }
+  return files;
+}
+
+// What one run produced, for the summary and --json.
+struct RunResult {
+  vasco::LogInput input;
+  vasco::MapStats stats;
+  vasco::FinishedMap map;
+  carmen::GlobalOffset origin;  // of the map's cell (0, 0), in the world
+  std::string backend;
+  uint64_t known = 0;
+  double parse_s = 0, map_total_s = 0, finish_s = 0, write_s = 0, total_s = 0;
+};
+
+// CUDA initialisation costs a few tenths of a second: started on another
+// thread while the log is parsed.
+std::future<bool> start_cuda(const Options &opt, const vasco::BackendOptions &bopt) {
+  std::future<bool> ready;
+#if defined(VASCO_HAVE_CUDA)
+  if (opt.backend == "cuda" || opt.backend == "auto") {
+    ready = std::async(std::launch::async, [dev = bopt.cuda_device] {
+      std::string why;
+      return vasco::cuda_usable(dev, &why);
+    });
+  }
+#else
+  (void)opt;
+  (void)bopt;
+#endif
+  return ready;
+}
+
+// Why the GPU backend is not used, for the --backend auto note.
+std::string no_gpu_reason(const vasco::BackendOptions &bopt) {
+#if defined(VASCO_HAVE_CUDA)
+  std::string why;
+  return vasco::cuda_usable(bopt.cuda_device, &why) ? "GPU usable" : "no usable GPU (" + why + ")";
+#else
+  (void)bopt;
+  return "this build has no CUDA backend";
+#endif
+}
+
+// Parameters (command line > ini > the log's PARAM lines > defaults), the
+// scans (of every session, with poses from --poses when given) and the grid,
+// with a progress bar on a terminal.
+vasco::LogInput read_input(const Options &opt, const ToolSpec &spec) {
+  vasco::LogInputOptions in;
+  in.log = opt.log;
+  in.transform = opt.transform;
+  in.poses = opt.poses;
+  in.param_file = opt.param_file;
+  in.robot = opt.robot;
+  in.overrides = opt.overrides;
+  in.lenient = opt.lenient;
+  in.memory_budget = opt.max_memory_bytes;  // the scans alone may not pass what the map may use
+  in.budget_option = "--max-memory";
+  ProgressBar bar(spec.read ? "read" : "parse", !opt.quiet && isatty(STDERR_FILENO));
+  in.progress = [&](uint64_t done, uint64_t total) { bar.update(done, total); };
+  if (!spec.read) {
+    in.more_logs = opt.more;
+    return vasco::load_log_input(in);
+  }
+  // Another kind of input: the tool's reader makes the scans, the sessions
+  // are appended here, the rest is a log's.
+  // The reader learns of --poses (its inputs' poses are then not needed)
+  // and --laser-mount (the mount of a pose topic's robot) too.
+  std::map<std::string, std::string> values = opt.extra;
+  if (!opt.poses.file.empty()) values["poses"] = opt.poses.file;
+  if (opt.poses.has_mount) values["laser-mount"] = opt.laser_mount_text;
+  vasco::StampedScans scans = spec.read(opt.log, values, in.progress);
+  for (const vasco::SessionInput &more : opt.more) {
+    bar.done();
+    scans.append(spec.read(more.path, values, in.progress), more.transform);
+  }
+  bar.done();
+  return vasco::log_input_from_scans(std::move(scans), in);
+}
+
+// Every output as one transaction: all are written to temporaries first and
+// renamed only when every one is written, so a failure touches no output
+// (an existing file stays as it was) and leaves no temporary.
+void write_outputs(const Options &opt, const RunResult &r) {
+  carmen::MapToWrite map = vasco::map_to_write(r.map, r.input.geo);
+  map.author = opt.tool;
+  map.source = basename_of(opt.log);
+  map.description = "vasco_gpu " + std::string(vasco::version()) + " " + r.backend;
+  map.time = static_cast<int64_t>(std::time(nullptr));
+  carmen::OutputTransaction tx;
+  for (const std::string &out : opt.outputs) carmen::write_map(tx, out, map);
+  tx.commit();
+}
+
+void print_summary(const Options &opt, const RunResult &r) {
+  const auto &ls = r.input.load.log;
+  const vasco::MapStats &ms = r.stats;
+  const vasco::GridGeometry &geo = r.input.geo;
+  std::fprintf(stderr,
+               "%s: %s: %zu scans (of %ld laser messages), %llu beams used, %llu skipped "
+               "(>= 50 m, NaN or inf), %llu cell updates\n",
+               opt.tool.c_str(), opt.log.c_str(), r.input.batch.num_scans(), r.input.load.laser_messages,
+               (unsigned long long)ms.beams_used, (unsigned long long)ms.beams_skipped,
+               (unsigned long long)ms.cell_updates);
+  if (!opt.more.empty())
+    std::fprintf(stderr, "%s: %zu sessions mapped into one grid\n", opt.tool.c_str(), opt.more.size() + 1);
+  if (!opt.poses.file.empty())
+    std::fprintf(stderr, "%s: poses from %s for %llu scans%s\n", opt.tool.c_str(), opt.poses.file.c_str(),
+                 (unsigned long long)r.input.posed_from_file,
+                 r.input.unposed_skipped ? (", " + std::to_string(r.input.unposed_skipped) +
+                                            " scans without a pose left out (--skip-unposed)").c_str()
+                                         : "");
+  if (ls.nan_ranges + ls.inf_ranges + ls.negative_ranges)
+    std::fprintf(stderr, "%s: odd ranges kept as data: %llu NaN, %llu inf, %llu negative\n", opt.tool.c_str(),
+                 (unsigned long long)ls.nan_ranges, (unsigned long long)ls.inf_ranges,
+                 (unsigned long long)ls.negative_ranges);
+  if (ls.total_bad_lines())
+    std::fprintf(stderr, "%s: lenient: skipped %llu bad lines\n%s", opt.tool.c_str(), (unsigned long long)ls.total_bad_lines(),
+                 ls.summary().c_str());
+  std::fprintf(stderr, "%s: grid %d x %d at %g m -> map %d x %d at %g m (%llu known cells)\n", opt.tool.c_str(), geo.size_x,
+               geo.size_y, geo.resolution, r.map.size_x, r.map.size_y, r.map.resolution,
+               (unsigned long long)r.known);
+  std::fprintf(stderr,
+               "%s: backend %s; parse %.3f s, prep %.3f s, upload %.3f s, map %.3f s, "
+               "download %.3f s, finish %.3f s, write %.3f s, total %.3f s\n",
+               opt.tool.c_str(),
+               r.backend.c_str(), r.parse_s, ms.prep_s, ms.upload_s, ms.map_s, ms.download_s, r.finish_s,
+               r.write_s, r.total_s);
+}
+
+void print_json(const Options &opt, const RunResult &r) {
+  const auto &ls = r.input.load.log;
+  const vasco::MapStats &ms = r.stats;
+  const vasco::GridGeometry &geo = r.input.geo;
+  std::ostringstream j;
+  j.precision(9);
+  j << "{\"log\":" << cli::json_string(opt.log) << ",\"backend\":" << cli::json_string(r.backend)
+    << ",\"scans\":" << r.input.batch.num_scans() << ",\"laser_messages\":" << r.input.load.laser_messages
+    << ",\"beams_used\":" << ms.beams_used << ",\"beams_skipped\":" << ms.beams_skipped
+    << ",\"cell_updates\":" << ms.cell_updates << ",\"nan_ranges\":" << ls.nan_ranges
+    << ",\"inf_ranges\":" << ls.inf_ranges << ",\"negative_ranges\":" << ls.negative_ranges
+    << ",\"bad_lines\":" << ls.total_bad_lines() << ",\"sessions\":" << opt.more.size() + 1
+    << ",\"posed_from_file\":" << r.input.posed_from_file << ",\"unposed_skipped\":" << r.input.unposed_skipped << ",\"grid\":[" << geo.size_x << "," << geo.size_y
+    << "],\"map\":[" << r.map.size_x << "," << r.map.size_y << "],\"map_resolution\":" << r.map.resolution
+    << ",\"known_cells\":" << r.known << ",\"origin\":[" << r.origin.x << "," << r.origin.y << "]"
+    << ",\"seconds\":{\"parse\":" << r.parse_s << ",\"prep\":" << ms.prep_s << ",\"upload\":" << ms.upload_s
+    << ",\"map\":" << ms.map_s << ",\"map_total\":" << r.map_total_s << ",\"download\":" << ms.download_s
+    << ",\"finish\":" << r.finish_s << ",\"write\":" << r.write_s << ",\"total\":" << r.total_s
+    << "},\"outputs\":[";
+  for (size_t i = 0; i < opt.outputs.size(); ++i) j << (i ? "," : "") << cli::json_string(opt.outputs[i]);
+  j << "]}\n";
+  std::fputs(j.str().c_str(), stdout);
+}
+
+// Everything refused before the log is read: outputs that cannot or must
+// not be written, and a --json with nowhere to go.
+void check_before_work(const Options &opt) {
+  std::vector<std::string> inputs = {opt.log, opt.param_file, opt.poses.file, opt.poses.id_map_file};
+  for (const vasco::SessionInput &more : opt.more) inputs.push_back(more.path);
+  cli::check_outputs(inputs, files_written(opt.outputs));
+  if (opt.json) cli::check_stdout_writable("--json");
+}
+
+// Why a log's scans updated no cell, for the error that says so (there is
+// no map to write: finish crops to the known cells).
+std::string why_nothing_was_mapped(const vasco::LogInput &in) {
+  const vasco::ScanBatch &b = in.batch;
+  uint64_t used = 0;
+  for (float r : b.range) used += vasco::egrid::is_beam_used(r);
+  std::ostringstream m;
+  m << "no beam updated any cell: ";
+  if (used == 0) {
+    m << "every one of the " << b.num_beams() << " ranges of the " << b.num_scans()
+      << " scans mapped is " << vasco::egrid::kLaserRangeLimit << " m or more, NaN or +inf (CARMEN uses a beam only below "
+      << vasco::egrid::kLaserRangeLimit << " m)";
+  } else {
+    m << used << " beams were used, but none reached a cell of the grid";
+  }
+  return m.str();
+}
+
+// The mapping session in the PROTOCOL frame, fed every scan at once.
+void make_map(const Options &opt, const vasco::BackendOptions &bopt, RunResult &r) {
+  vasco::Mapper mapper(r.input.params, opt.backend, bopt);
+  r.backend = mapper.backend_name();
+  if (opt.backend == "auto" && !mapper.backend_traits().grid_on_device && !opt.quiet)
+    std::fprintf(stderr, "%s: --backend auto: %s: using %s\n", opt.tool.c_str(), no_gpu_reason(bopt).c_str(), r.backend.c_str());
+  auto t = Clock::now();
+  try {
+    mapper.insert(r.input.batch);
+  } catch (const carmen::Error &e) {
+    // Over the memory budget: the log's poses decide the grid, so name it.
+    if (e.code() == carmen::ErrorCode::OutOfMemory) throw carmen::FileError(opt.log, e.what(), e.code());
+    throw;
+  }
+  r.stats = mapper.last_stats();
+  r.map_total_s = seconds_since(t);
+  t = Clock::now();
+  r.map = mapper.finish();
+  r.finish_s = seconds_since(t);
+  for (float v : r.map.cells) r.known += v != -1.0f;
+  if (r.known == 0) throw carmen::FileError(opt.log, why_nothing_was_mapped(r.input));
+  r.origin = vasco::world_origin(r.map, r.input.geo);
+}
+
+// The statistics come after the maps are in place: a failure to print them
+// says so, so that nobody takes the exit status for a missing map.
+void print_report(const Options &opt, const RunResult &r) {
+  for (const auto &w : r.input.warnings)
+    std::fprintf(stderr, "%s: warning: %s\n", opt.tool.c_str(), carmen::printable(w).c_str());
+  if (!opt.quiet) print_summary(opt, r);
+  if (opt.json) print_json(opt, r);
+  if (std::fflush(stdout) != 0 || std::ferror(stdout))
+    throw carmen::Error(carmen::ErrorCode::Io, std::string("the maps were written, but the statistics could not be "
+                                                           "written to standard output: ") + std::strerror(errno));
+}
+
+int run(const Options &opt, const ToolSpec &spec) {
+  const auto t_start = Clock::now();
+  carmen::remove_temporaries_on_signals();
+  check_before_work(opt);
+  vasco::BackendOptions bopt;
+  bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
+  bopt.threads = opt.threads;
+  bopt.max_memory_bytes = opt.max_memory_bytes;
+  bopt.budget_hint = "--max-memory MiB";
+  std::future<bool> gpu_ready = start_cuda(opt, bopt);
+
+  RunResult r;
+  auto t = Clock::now();
+  r.input = read_input(opt, spec);
+  r.parse_s = seconds_since(t);
+  if (gpu_ready.valid()) gpu_ready.wait();
+  make_map(opt, bopt, r);
+  t = Clock::now();
+  write_outputs(opt, r);
+  r.write_s = seconds_since(t);
+  r.total_s = seconds_since(t_start);
+  print_report(opt, r);
+  return 0;
+}
+
+}  // namespace
+
+int run_tool(int argc, const char *const *argv, const ToolSpec &spec) {
+  Options opt;
+  const int parsed = parse_options(argc, argv, spec, &opt);
+  if (parsed >= 0) return parsed;
+  const char *tool = spec.name.c_str();
+  try {
+    return run(opt, spec);
+  } catch (const std::bad_alloc &) {
+    std::fprintf(stderr, "%s: out of memory\n", tool);
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "%s: %s\n", tool, carmen::printable(e.what()).c_str());
+    return cli::exit_status(e);
+  }
+  return 1;
+}
+
+ToolSpec log2map_spec() {
+  ToolSpec spec;
+  spec.name = "log2map";
+  spec.summary =
+      "log2map: builds a CARMEN evidence-grid map (vasco/egrid.c) from a laser log.\n"
+      "Outputs by extension: .map, .map.gz (CARMEN), .pgm (+ .yaml, ROS map_server), .png.";
+  spec.input_name = "LOG";
+  spec.input_help = "CARMEN log (.log, .clf, or gzipped .gz)";
+  return spec;
+}
+
+}  // namespace log2map

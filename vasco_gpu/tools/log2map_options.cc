@@ -1,0 +1,181 @@
+#include "log2map_options.h"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+
+#include "carmen_compat/error.h"
+#include "carmen_compat/map_format.h"
+#include "cli_support.h"
+#include "vasco_gpu/backend.h"
+#include "vasco_gpu/params.h"
+#include "vasco_gpu/version.h"
+
+namespace log2map {
+
+namespace {
+
+using carmen::Error;
+using carmen::ErrorCode;
+
+// One number in the C locale, the whole text.
+bool parse_double(const std::string &text, double *out) {
+  const char *b = text.data(), *e = b + text.size();
+  if (b != e && *b == '+') ++b;
+  const auto r = std::from_chars(b, e, *out);
+  return r.ec == std::errc() && r.ptr == e && b != e;
+}
+
+void add_input_options(CLI::App &app, const ToolSpec &spec, Options &opt) {
+  app.add_option(spec.input_name, opt.log, spec.input_help)->required();
+  app.add_option("OUT", opt.outputs, "output files: .map, .map.gz, .pgm, .png")->required();
+  app.add_option("--param-file", opt.param_file, "carmen.ini with vasco_* keys (default: vasco's defaults)");
+  app.add_option("--robot", opt.robot, "robot section of the ini to use");
+}
+
+void add_backend_options(CLI::App &app, Options &opt) {
+  std::vector<std::string> backends;  // the registry's names; one not compiled in says why when run
+  for (const vasco::BackendInfo &b : vasco::backend_registry()) backends.push_back(b.name);
+  app.add_option("--backend", opt.backend, "the backend (default: auto), one of:\n" + vasco::backend_help())
+      ->check(CLI::IsMember(backends));
+  app.add_option("--threads", opt.threads,
+                 "threads of cpu_threads, 1 to " + std::to_string(vasco::kMaxThreads) + " (default: all cores)")
+      ->check(CLI::Range(0, vasco::kMaxThreads));
+  app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
+      ->check(CLI::IsMember({"float", "exact"}));
+  app.add_flag("--lenient", opt.lenient, "skip bad log lines (and report them) instead of stopping");
+  app.add_flag("--json", opt.json, "print machine-readable statistics on stdout");
+  app.add_flag("--quiet", opt.quiet, "no progress and no summary");
+}
+
+// What --poses and --add take; checked after parsing (raw holds the text).
+struct PoseText {
+  std::string format = "auto", match = "auto", frame = "laser", mount, transform;
+  std::vector<std::string> adds;
+};
+
+void add_pose_options(CLI::App &app, Options &opt, PoseText &raw) {
+  app.add_option("--poses", opt.poses.file,
+                 "replace each scan's laser pose by a SLAM back end's: a TUM trajectory, a g2o file "
+                 "(VERTEX_SE2) or a CARMEN log")
+      ->type_name("FILE");
+  app.add_option("--pose-format", raw.format, "auto (by extension: .g2o, .log/.clf[.gz], else TUM) | tum | g2o | carmen")
+      ->check(CLI::IsMember({"auto", "tum", "g2o", "carmen"}));
+  app.add_option("--pose-match", raw.match,
+                 "auto (time when the file has stamps, else order) | order | id | time")
+      ->check(CLI::IsMember({"auto", "order", "id", "time"}));
+  app.add_option("--pose-ids", opt.poses.id_map_file, "g2o vertex id -> scan index pairs ('id scan' lines) for --pose-match id")
+      ->type_name("FILE");
+  app.add_option("--pose-tolerance", opt.poses.match.tolerance,
+                 "time matching: the poses around a scan's stamp may be this far from it, in s (default 0.1)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--skip-unposed", opt.poses.match.skip_unmatched, "leave out (and count) scans without a pose instead of stopping");
+  app.add_option("--pose-frame", raw.frame, "the poses are of the laser (default) or of the robot")
+      ->check(CLI::IsMember({"laser", "robot"}));
+  app.add_option("--laser-mount", raw.mount,
+                 "the laser in the robot's frame, for --pose-frame robot (default: from each scan)")
+      ->type_name("X,Y,THETA");
+  app.add_option("--transform", raw.transform, "the input into the shared frame of several sessions (default: identity)")
+      ->type_name("X,Y,THETA");
+  app.add_option("--add", raw.adds, "a further session mapped into the same grid, its transform after an '@'")
+      ->type_name("INPUT[@X,Y,THETA]");
+}
+
+void add_param_options(CLI::App &app, std::map<std::string, std::string> &raw) {
+  for (const auto &key : vasco::mapper_param_keys())
+    app.add_option("--" + key, raw[key], "override " + key)->type_name("VALUE");
+}
+
+// Everything checked after parsing that CLI11 cannot: a usage error.
+void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &raw, const std::string &max_memory,
+                    Options &opt) {
+  if (app.count("--max-memory") > 0) opt.max_memory_bytes = cli::parse_mebibytes(max_memory, "--max-memory");
+  for (const auto &out : opt.outputs) carmen::map_format_of(out);  // an unknown extension
+  opt.poses.format = vasco::pose_file_format_from_name(raw.format);
+  opt.poses.match.matching = vasco::pose_matching_from_name(raw.match);
+  opt.poses.robot_frame = raw.frame == "robot";
+  if (!raw.mount.empty()) {
+    opt.poses.mount = parse_pose_triple(raw.mount, "--laser-mount");
+    opt.poses.has_mount = true;
+    opt.laser_mount_text = raw.mount;
+  }
+  if (!raw.transform.empty()) opt.transform = parse_pose_triple(raw.transform, "--transform");
+  for (const std::string &a : raw.adds) opt.more.push_back(parse_session(a));
+  const bool pose_options = app.count("--pose-format") || app.count("--pose-match") || app.count("--pose-ids") ||
+                            app.count("--pose-tolerance") || app.count("--skip-unposed") ||
+                            app.count("--pose-frame") ||
+                            (app.count("--laser-mount") && !spec.read);  // a bag's pose topic needs one too
+  if (pose_options && opt.poses.file.empty())
+    throw Error(ErrorCode::Usage, "the --pose-* options, --skip-unposed and --laser-mount go with --poses FILE");
+}
+
+}  // namespace
+
+vasco::Pose2 parse_pose_triple(const std::string &text, const std::string &option) {
+  double v[3];
+  size_t start = 0;
+  for (int i = 0; i < 3; ++i) {
+    const size_t comma = i < 2 ? text.find(',', start) : text.size();
+    const bool ok = comma != std::string::npos && parse_double(text.substr(start, comma - start), &v[i]) &&
+                    std::isfinite(v[i]) && (i < 2 || text.find(',', start) == std::string::npos);
+    if (!ok)
+      throw Error(ErrorCode::Usage, option + " '" + text + "': expected X,Y,THETA (three finite numbers: m, m, rad)");
+    start = comma + 1;
+  }
+  return vasco::Pose2{v[0], v[1], v[2]};
+}
+
+vasco::SessionInput parse_session(const std::string &text) {
+  vasco::SessionInput s;
+  s.path = text;
+  const size_t at = text.rfind('@');
+  if (at != std::string::npos && std::count(text.begin() + static_cast<std::ptrdiff_t>(at), text.end(), ',') == 2) {
+    s.path = text.substr(0, at);
+    s.transform = parse_pose_triple(text.substr(at + 1), "--add " + text);
+  }
+  if (s.path.empty()) throw Error(ErrorCode::Usage, "--add '" + text + "': no input named");
+  return s;
+}
+
+int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Options *opt) {
+  opt->tool = spec.name;
+  opt->max_memory_bytes = vasco::kDefaultMaxMemoryBytes;
+  CLI::App app{spec.summary};
+  app.set_version_flag("--version", [&spec] {
+    std::string s = spec.name + " (vasco_gpu) " + vasco::version() + "\nbackends compiled in:";
+    for (const auto &b : vasco::compiled_backends()) s += " " + b;
+    return s;
+  });
+  add_input_options(app, spec, *opt);
+  std::map<std::string, std::string> extra;
+  for (const ExtraOption &e : spec.extra_options) app.add_option("--" + e.name, extra[e.name], e.help)->type_name(e.type_name);
+  add_backend_options(app, *opt);
+  std::string max_memory;
+  app.add_option("--max-memory", max_memory, "host memory the map may use, in MiB (default 2048; 0: no limit)")
+      ->type_name("MiB");
+  PoseText raw_poses;
+  add_pose_options(app, *opt, raw_poses);
+  std::map<std::string, std::string> raw;
+  add_param_options(app, raw);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError &e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  for (const auto &kv : raw)
+    if (app.count("--" + kv.first) > 0) opt->overrides[kv.first] = kv.second;
+  for (const auto &kv : extra)
+    if (app.count("--" + kv.first) > 0) opt->extra[kv.first] = kv.second;
+  try {
+    finish_options(app, spec, raw_poses, max_memory, *opt);
+  } catch (const carmen::Error &e) {
+    std::fprintf(stderr, "%s: %s\n", spec.name.c_str(), carmen::printable(e.what()).c_str());
+    return 2;
+  }
+  return -1;
+}
+
+}  // namespace log2map

@@ -1,0 +1,51 @@
+// log2map_options.h — the command line of the log → map tools, parsed once
+// into Options (log2map_options.cc); log2map_app.cc runs them.
+#ifndef VASCO_GPU_TOOLS_LOG2MAP_OPTIONS_H
+#define VASCO_GPU_TOOLS_LOG2MAP_OPTIONS_H
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "log2map_app.h"
+#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pose_file.h"
+
+namespace log2map {
+
+struct Options {
+  std::string tool = "log2map";
+  std::string log;  // the first input
+  std::vector<std::string> outputs;
+  std::string param_file;
+  std::string robot;
+  std::string backend = "auto";
+  std::string cuda_mode = "float";
+  int threads = 0;
+  uint64_t max_memory_bytes = 0;
+  bool lenient = false, json = false, quiet = false;
+  std::map<std::string, std::string> overrides;  // --vasco_KEY VALUE
+  vasco::Pose2 transform;                        // --transform: the first input into the shared frame
+  std::vector<vasco::SessionInput> more;         // --add INPUT[@X,Y,THETA]
+  vasco::PoseSource poses;                       // --poses FILE and its options
+  std::string laser_mount_text;                  // --laser-mount as given
+  std::map<std::string, std::string> extra;      // the tool's own options, as given
+};
+
+// Parses argv into *opt. Returns -1 to go on, else the exit status to
+// return at once: 0 after --help or --version, 2 after a usage error (said
+// on stderr).
+int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Options *opt);
+
+// "X,Y,THETA" (metres, metres, radians; C locale) as a pose. Throws
+// carmen::Error(Usage) naming `option`.
+vasco::Pose2 parse_pose_triple(const std::string &text, const std::string &option);
+
+// "--add PATH[@X,Y,THETA]": the path, and the transform when one follows the
+// last '@' (a path may hold an '@' of its own when no transform follows).
+vasco::SessionInput parse_session(const std::string &text);
+
+}  // namespace log2map
+
+#endif  // VASCO_GPU_TOOLS_LOG2MAP_OPTIONS_H
