@@ -1,0 +1,229 @@
+// log2map with poses from elsewhere (--poses: g2o, CARMEN log, TUM) and with
+// several sessions in one grid (--add), run as a program. The expected maps
+// are log2map's own on logs this test writes with the poses in them: the
+// route a user without these options would take.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/map_file.h"
+#include "map_test_support.h"
+#include "tool_support.h"
+
+namespace {
+
+using maptest::TempDir;
+using tooltest::contains;
+using tooltest::ToolRun;
+
+ToolRun log2map(const std::vector<std::string> &args) { return tooltest::run_tool("log2map", args, true); }
+
+const std::string kIntel = std::string(VASCO_LOGS_DIR) + "/intel.gfs.log.gz";
+
+std::string g17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+// A FLASER line split into tokens; the laser pose follows the ranges.
+struct Flaser {
+  std::vector<std::string> tok;
+  size_t pose_at() const { return 2 + std::stoul(tok[1]); }
+  double get(int k) const { return std::stod(tok[pose_at() + k]); }
+  void set(int k, double v) { tok[pose_at() + k] = g17(v); }
+  double stamp() const { return std::stod(tok[pose_at() + 6]); }
+  std::string text() const {
+    std::string s;
+    for (size_t i = 0; i < tok.size(); ++i) s += (i ? " " : "") + tok[i];
+    return s + "\n";
+  }
+};
+
+std::vector<Flaser> intel_scans() {
+  std::istringstream in(maptest::gunzip_file(kIntel));
+  std::vector<Flaser> out;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("FLASER ", 0) != 0) continue;
+    Flaser f;
+    std::istringstream ls(line);
+    for (std::string t; ls >> t;) f.tok.push_back(t);
+    out.push_back(f);
+  }
+  return out;
+}
+
+std::string log_text(const std::vector<Flaser> &scans, size_t begin, size_t end) {
+  std::string s;
+  for (size_t i = begin; i < end; ++i) s += scans[i].text();
+  return s;
+}
+
+// What a back end might do after a loop closure: every pose moved a little,
+// more towards the end.
+std::vector<Flaser> perturbed(std::vector<Flaser> scans) {
+  for (size_t i = 0; i < scans.size(); ++i) {
+    const double u = double(i) / double(scans.size());
+    scans[i].set(0, scans[i].get(0) + 0.05 * u * std::sin(0.1 * double(i)));
+    scans[i].set(1, scans[i].get(1) - 0.04 * u);
+    scans[i].set(2, scans[i].get(2) + 0.01 * u);
+  }
+  return scans;
+}
+
+std::vector<float> gridmap_of(const std::string &path) {
+  const carmen::MapFile mf = carmen::read_map_file(path);
+  EXPECT_TRUE(mf.gridmap.has_value()) << path;
+  return mf.gridmap ? mf.gridmap->cells : std::vector<float>{};
+}
+
+// Cells whose bits differ (a size mismatch counts every cell).
+size_t differing(const std::vector<float> &a, const std::vector<float> &b) {
+  if (a.size() != b.size()) return std::max(a.size(), b.size());
+  size_t n = 0;
+  for (size_t i = 0; i < a.size(); ++i) n += std::memcmp(&a[i], &b[i], sizeof(float)) != 0;
+  return n;
+}
+
+class Log2MapPoses : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    scans_ = intel_scans();
+    ASSERT_EQ(scans_.size(), 910u);
+    moved_ = perturbed(scans_);
+    maptest::write_bytes(dir_.file("moved.log"), log_text(moved_, 0, moved_.size()));
+    const ToolRun r = log2map({"--backend", "cpu_double", "--quiet", dir_.file("moved.log"), dir_.file("want.map")});
+    ASSERT_EQ(r.status, 0) << r.output;
+    want_ = gridmap_of(dir_.file("want.map"));
+  }
+  TempDir dir_;
+  std::vector<Flaser> scans_, moved_;
+  std::vector<float> want_;
+};
+
+TEST_F(Log2MapPoses, G2oPosesInOrderGiveTheMapOfALogCarryingThem) {
+  std::string g2o = "# after a loop closure\n";
+  for (size_t i = 0; i < moved_.size(); ++i)
+    g2o += "VERTEX_SE2 " + std::to_string(i) + " " + g17(moved_[i].get(0)) + " " + g17(moved_[i].get(1)) + " " +
+           g17(moved_[i].get(2)) + "\n";
+  g2o += "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n";  // edges are not poses
+  maptest::write_bytes(dir_.file("opt.g2o"), g2o);
+  for (const char *backend : {"cpu_double", "cpu_threads"}) {
+    const ToolRun r = log2map({"--backend", backend, "--poses", dir_.file("opt.g2o"), kIntel, dir_.file("got.map")});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "poses from")) << r.output;
+    EXPECT_EQ(differing(gridmap_of(dir_.file("got.map")), want_), 0u) << backend;
+  }
+}
+
+TEST_F(Log2MapPoses, ACarmenLogsPosesByTimestampGiveTheSameBits) {
+  // The stamps are the same numbers in both logs: every scan takes its pose
+  // unchanged, none is interpolated.
+  const ToolRun r = log2map({"--backend", "cpu_double", "--json", "--poses", dir_.file("moved.log"), kIntel,
+                             dir_.file("got.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"posed_from_file\":910")) << r.output;
+  EXPECT_EQ(differing(gridmap_of(dir_.file("got.map")), want_), 0u);
+}
+
+TEST_F(Log2MapPoses, TumPosesByTimestampAgreeUpToTheQuaternionsRounding) {
+  std::string tum = "# t x y z qx qy qz qw\n";
+  for (const Flaser &f : moved_) {
+    const double th = f.get(2);
+    tum += g17(f.stamp()) + " " + g17(f.get(0)) + " " + g17(f.get(1)) + " 0 0 0 " + g17(std::sin(th / 2)) + " " +
+           g17(std::cos(th / 2)) + "\n";
+  }
+  maptest::write_bytes(dir_.file("traj.txt"), tum);
+  const ToolRun r = log2map({"--backend", "cpu_double", "--poses", dir_.file("traj.txt"), kIntel, dir_.file("got.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  // The heading goes through sin/cos and atan2: it comes back within a few
+  // ulps (|dtheta| < 1e-15 rad). A beam end moves by at most range x dtheta
+  // < 50 m x 1e-15 = 5e-14 m, so a cell changes only where a beam end lies
+  // that close to a cell border: none of intel's ~160 000 beams is expected
+  // to, and a handful is the most we accept (0.01% of the cells).
+  const std::vector<float> got = gridmap_of(dir_.file("got.map"));
+  ASSERT_EQ(got.size(), want_.size());
+  EXPECT_LE(differing(got, want_), want_.size() / 10000);
+}
+
+TEST_F(Log2MapPoses, AScanWithoutAPoseIsNamedOrSkippedWhenAsked) {
+  // Poses for every other scan only, by timestamp: scan 1 falls between two
+  // poses 2 scans apart (intel's scans are ~0.2 s apart: beyond 0.1 s).
+  std::string tum;
+  for (size_t i = 0; i < moved_.size(); i += 2)
+    tum += g17(moved_[i].stamp()) + " " + g17(moved_[i].get(0)) + " " + g17(moved_[i].get(1)) + " 0 0 0 0 1\n";
+  maptest::write_bytes(dir_.file("sparse.txt"), tum);
+  const ToolRun bad = log2map({"--poses", dir_.file("sparse.txt"), "--pose-tolerance", "0.01", kIntel, dir_.file("x.map")});
+  EXPECT_EQ(bad.status, 1) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "sparse.txt")) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "scan 1")) << bad.output;
+  EXPECT_FALSE(maptest::file_exists(dir_.file("x.map")));
+
+  const ToolRun skip = log2map({"--json", "--poses", dir_.file("sparse.txt"), "--pose-tolerance", "0.01",
+                                "--skip-unposed", kIntel, dir_.file("x.map")});
+  ASSERT_EQ(skip.status, 0) << skip.output;
+  EXPECT_TRUE(contains(skip.output, "\"posed_from_file\":455")) << skip.output;
+  EXPECT_TRUE(contains(skip.output, "\"unposed_skipped\":455")) << skip.output;
+}
+
+TEST_F(Log2MapPoses, BadPoseOptionsAreUsageErrors) {
+  EXPECT_EQ(log2map({"--pose-tolerance", "0.5", kIntel, dir_.file("x.map")}).status, 2);
+  EXPECT_EQ(log2map({"--poses", "p.txt", "--pose-match", "sideways", kIntel, dir_.file("x.map")}).status, 2);
+  EXPECT_EQ(log2map({"--transform", "1,2", kIntel, dir_.file("x.map")}).status, 2);
+  EXPECT_EQ(log2map({"--add", kIntel + "@1,2,nan", kIntel, dir_.file("x.map")}).status, 2);
+  const ToolRun missing = log2map({"--poses", dir_.file("none.g2o"), kIntel, dir_.file("x.map")});
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_TRUE(contains(missing.output, "none.g2o")) << missing.output;
+  std::string short_g2o = "VERTEX_SE2 0 0 0 0\n";
+  maptest::write_bytes(dir_.file("short.g2o"), short_g2o);
+  const ToolRun count = log2map({"--poses", dir_.file("short.g2o"), kIntel, dir_.file("x.map")});
+  EXPECT_EQ(count.status, 1);
+  EXPECT_TRUE(contains(count.output, "short.g2o")) << count.output;
+  EXPECT_TRUE(contains(count.output, "910")) << count.output;
+}
+
+// Several sessions: two halves of intel as two logs give the map of the
+// whole log; the second half in another frame, with its transform, gives the
+// map of one log holding those scans taken into the shared frame.
+TEST_F(Log2MapPoses, TwoSessionsGiveTheMapOfOneLogHoldingBoth) {
+  maptest::write_bytes(dir_.file("a.log"), log_text(scans_, 0, 400));
+  maptest::write_bytes(dir_.file("b.log"), log_text(scans_, 400, scans_.size()));
+  for (const char *backend : {"cpu_double", "cpu_threads"}) {
+    ToolRun r = log2map({"--backend", backend, dir_.file("a.log"), "--add", dir_.file("b.log"), dir_.file("ab.map")});
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = log2map({"--backend", backend, kIntel, dir_.file("whole.map")});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(differing(gridmap_of(dir_.file("ab.map")), gridmap_of(dir_.file("whole.map"))), 0u) << backend;
+  }
+}
+
+TEST_F(Log2MapPoses, ASessionsTransformTakesItIntoTheSharedFrame) {
+  // b's poses as its own robot saw them: in a frame 3 m east, 1 m south and
+  // turned by 0.25 rad. The shared-frame log holds x' = tx + cos(a) x -
+  // sin(a) y, y' = ty + sin(a) x + cos(a) y, theta' = theta + a.
+  const double tx = 3.0, ty = -1.0, a = 0.25;
+  std::vector<Flaser> shared = scans_;
+  for (size_t i = 400; i < shared.size(); ++i) {
+    const double x = scans_[i].get(0), y = scans_[i].get(1), th = scans_[i].get(2);
+    shared[i].set(0, tx + std::cos(a) * x - std::sin(a) * y);
+    shared[i].set(1, ty + std::sin(a) * x + std::cos(a) * y);
+    shared[i].set(2, th + a);
+  }
+  maptest::write_bytes(dir_.file("a.log"), log_text(scans_, 0, 400));
+  maptest::write_bytes(dir_.file("b.log"), log_text(scans_, 400, scans_.size()));
+  maptest::write_bytes(dir_.file("shared.log"), log_text(shared, 0, shared.size()));
+  ToolRun r = log2map({"--backend", "cpu_double", "--json", dir_.file("a.log"), "--add",
+                       dir_.file("b.log") + "@3,-1,0.25", dir_.file("ab.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"sessions\":2")) << r.output;
+  r = log2map({"--backend", "cpu_double", dir_.file("shared.log"), dir_.file("shared.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(differing(gridmap_of(dir_.file("ab.map")), gridmap_of(dir_.file("shared.map"))), 0u);
+}
+
+}  // namespace
