@@ -77,10 +77,10 @@ constexpr const char *kLoadLogDoc =
     "``lenient=True`` skips bad lines and counts them in ``Log.stats['bad_lines']``. The GIL is\n"
     "released while the log is read.\n\n"
     "Poses from a SLAM back end (log2map --poses): ``poses`` a TUM trajectory, g2o file or CARMEN log;\n"
-    "``pose_format`` 'auto' | 'tum' | 'g2o' | 'carmen'; ``pose_match`` 'auto' | 'order' | 'id' | 'time';\n"
-    "``pose_tolerance`` seconds (0.1); ``pose_ids`` a file of 'id scan' pairs; ``skip_unposed`` leave out\n"
-    "scans without a pose; ``pose_frame`` 'laser' | 'robot'; ``laser_mount`` (x, y, theta) of the laser\n"
-    "on the robot. Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared\n"
+    "with it (None: the default) ``pose_format`` 'auto' | 'tum' | 'g2o' | 'carmen'; ``pose_match`` 'auto' |\n"
+    "'order' | 'id' | 'time'; ``pose_tolerance`` seconds (0.1); ``pose_ids`` a file of 'id scan' pairs;\n"
+    "``skip_unposed`` leave out scans without a pose; ``pose_frame`` 'laser' | 'robot'; ``laser_mount``\n"
+    "(x, y, theta) of the laser on the robot. Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared\n"
     "frame, ``add`` further logs, each a path or (path, (x, y, theta)).";
 
 }  // namespace
@@ -120,9 +120,10 @@ void bind_log(nb::module_ &m) {
         "lenient"_a = false, "kwargs"_a,
         nb::sig("def load_log(path: str | os.PathLike, param_file: str | os.PathLike | None = None, "
                 "robot: str = '', overrides: dict[str, float | int] | None = None, lenient: bool = False, *, "
-                "poses: str | os.PathLike | None = None, pose_format: str = 'auto', pose_match: str = 'auto', "
-                "pose_tolerance: float = 0.1, pose_ids: str | os.PathLike | None = None, skip_unposed: bool = False, "
-                "pose_frame: str = 'laser', laser_mount: tuple[float, float, float] | None = None, "
+                "poses: str | os.PathLike | None = None, pose_format: str | None = None, pose_match: str | None = None, "
+                "pose_tolerance: float | None = None, pose_ids: str | os.PathLike | None = None, "
+                "skip_unposed: bool | None = None, pose_frame: str | None = None, "
+                "laser_mount: tuple[float, float, float] | None = None, "
                 "transform: tuple[float, float, float] | None = None, "
                 "add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float]]] | None = None) -> Log"),
         kLoadLogDoc);

@@ -154,6 +154,21 @@ void bind_scans_methods(nb::class_<ScanBatch> &cls) {
           },
           nb::rv_policy::reference, "Beams per scan (int64): a new array.")
       .def("ranges_of", &ranges_of, "s"_a, nb::rv_policy::reference, "The ranges of scan s (a view).")
+      .def(
+          "transform",
+          [](ScanBatch &b, double x, double y, double theta) {
+            if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(theta))
+              throw Error(ErrorCode::BadInput, "transform: x, y and theta must be finite");
+            b.validate();
+            b.transform(x, y, theta);
+          },
+          "x"_a, "y"_a, "theta"_a,
+          "Takes every pose into another frame, in place: x' = x0 + cos(a) x - sin(a) y, y' = y0 + sin(a) x\n"
+          "+ cos(a) y, theta' = theta + a for the transform (x0, y0, a) of this session into the shared frame\n"
+          "of several (the identity changes no bit).")
+      .def(
+          "extend", [](ScanBatch &b, const ScanBatch &other) { b.append(other); }, "other"_a,
+          "Appends other's scans (copied) after this batch's: several sessions into one batch.")
       .def("select", [](const ScanBatch &b, long first, long count) { return b.select(first, count); }, "first"_a, "count"_a = -1,
            "Scans [first, first + count) as new Scans (count -1: to the end), clipped to the batch.")
       .def("__repr__", [](const ScanBatch &b) {

@@ -12,8 +12,6 @@ namespace vasco {
 
 namespace {
 
-bool is_identity(const Pose2 &t) { return t.x == 0 && t.y == 0 && t.theta == 0; }
-
 // The ini and the command line, validated now, before a long log is read.
 carmen::ParamFile command_line_params(const LogInputOptions &options, std::vector<std::string> *warnings) {
   carmen::ParamFile params;
@@ -138,18 +136,8 @@ void check_sessions(const LogInputOptions &options) {
 
 }  // namespace
 
-void transform_poses(ScanBatch &batch, const Pose2 &transform) {
-  if (is_identity(transform)) return;
-  for (size_t s = 0; s < batch.num_scans(); ++s) {
-    const Pose2 p = compose(transform, Pose2{batch.x[s], batch.y[s], batch.theta[s]});
-    batch.x[s] = p.x;
-    batch.y[s] = p.y;
-    batch.theta[s] = p.theta;
-  }
-}
-
 void StampedScans::append(StampedScans &&more, const Pose2 &transform) {
-  transform_poses(more.batch, transform);  // the mounts are in the robot's frame: unchanged
+  more.batch.transform(transform.x, transform.y, transform.theta);  // the mounts are in the robot's frame: unchanged
   more.stamps.resize(more.batch.num_scans(), std::numeric_limits<double>::quiet_NaN());
   more.mounts.resize(more.batch.num_scans());
   more.has_mount.resize(more.batch.num_scans(), 0);
@@ -207,7 +195,7 @@ LogInput load_log_input(const LogInputOptions &options) {
   LogInput in;
   carmen::ParamFile params = command_line_params(options, &in.warnings);
   StampedScans scans = read_stamped_scans(options.log, options, &in.load);
-  transform_poses(scans.batch, options.transform);
+  scans.batch.transform(options.transform.x, options.transform.y, options.transform.theta);
   auto add_params = [&](const LogLoadStats &load, const std::string &path) {
     for (size_t i = 0; i < load.params.size(); ++i)
       params.add_fallback(load.params[i].first, load.params[i].second, path, load.param_lines[i]);
@@ -235,7 +223,7 @@ LogInput log_input_from_scans(StampedScans scans, const LogInputOptions &options
   LogInput in;
   carmen::ParamFile params = command_line_params(options, &in.warnings);
   in.load.laser_messages = static_cast<long>(scans.batch.num_scans());
-  transform_poses(scans.batch, options.transform);
+  scans.batch.transform(options.transform.x, options.transform.y, options.transform.theta);
   return finish_input(std::move(scans), params, options, std::move(in), "scans");
 }
 

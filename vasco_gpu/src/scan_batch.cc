@@ -8,6 +8,7 @@
 
 #include "vasco_gpu/error.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/pose_file.h"
 
 namespace vasco {
 
@@ -120,6 +121,17 @@ void ScanBatch::append(const ScanBatch &other) {
   } catch (...) {
     truncate(before);
     throw;
+  }
+}
+
+void ScanBatch::transform(double tx, double ty, double ta) {
+  if (tx == 0 && ty == 0 && ta == 0) return;
+  const Pose2 t{tx, ty, ta};
+  for (size_t s = 0; s < num_scans(); ++s) {
+    const Pose2 p = compose(t, Pose2{x[s], y[s], theta[s]});
+    x[s] = p.x;
+    y[s] = p.y;
+    theta[s] = p.theta;
   }
 }
 

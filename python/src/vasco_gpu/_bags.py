@@ -81,13 +81,44 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     from ._errors import FileError
 
     bag = _bag_module()
-    try:
-        d = _read(path, scan_topic=scan_topic, fixed_frame=fixed_frame, base_frame=base_frame, pose_topic=pose_topic,
-                  laser_mount=laser_mount, no_return=no_return, need_poses=pose_keywords.get("poses") is None,
-                  progress=progress)
-    except bag.BagError as e:
-        raise FileError(str(e), file=os.fspath(path), line=None, message=str(e)) from e
+    more = pose_keywords.pop("add", None) or []
+    transform = pose_keywords.pop("transform", None)
+    sessions = [(path, transform)] + [m if isinstance(m, tuple) else (m, None) for m in more]
+    options = dict(scan_topic=scan_topic, fixed_frame=fixed_frame, base_frame=base_frame, pose_topic=pose_topic,
+                   laser_mount=laser_mount, no_return=no_return, need_poses=pose_keywords.get("poses") is None,
+                   progress=progress)
+    if len(sessions) > 1 and pose_keywords.get("poses") is not None:
+        raise _core_usage_error("poses= applies to one input: write each session's poses into it first")
+    d = None
+    for p, t in sessions:
+        try:
+            one = _read(p, **options)
+        except bag.BagError as e:
+            raise FileError(str(e), file=os.fspath(p), line=None, message=str(e)) from e
+        d = _append_session(d, one, t)
     return _core._log_from_scans(d, os.fspath(path), param_file, robot, overrides, **pose_keywords)
+
+
+def _core_usage_error(message: str):
+    from ._errors import UsageError
+    return UsageError(message)
+
+
+def _append_session(d: dict | None, more: dict, transform) -> dict:
+    """Scans of one more session, taken into the shared frame by `transform`, after d's."""
+    if transform is not None:
+        x, y, theta = (float(v) for v in transform)
+        more["scans"].transform(x, y, theta)
+    if d is None:
+        return more
+    n0, n1 = len(d["scans"]), len(more["scans"])
+    d["scans"].extend(more["scans"])
+    d["stamps"] = np.concatenate([d["stamps"], more["stamps"]])
+    if d["mounts"] is not None or more["mounts"] is not None:
+        unknown = lambda n: np.full((n, 3), np.nan)
+        d["mounts"] = np.concatenate([d["mounts"] if d["mounts"] is not None else unknown(n0),
+                                      more["mounts"] if more["mounts"] is not None else unknown(n1)])
+    return d
 
 
 def _tool_reader(path: str, values: dict, progress) -> dict:
@@ -168,7 +199,7 @@ def bag2carmen_main(argv: list[str] | None = None) -> int:
         def write(tmp):
             if gz:
                 import gzip
-                with gzip.open(tmp, "wt", encoding="ascii", newline="\n") as f:
+                with gzip.open(tmp, "wt", compresslevel=6, encoding="ascii", newline="\n") as f:
                     bag.write_carmen_log(d["bag"], f)
             else:
                 with open(tmp, "w", encoding="ascii", newline="\n") as f:

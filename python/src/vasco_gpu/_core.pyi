@@ -291,6 +291,18 @@ class Scans:
     def ranges_of(self, s: int) -> Annotated[NDArray[numpy.float32], dict(shape=(None,), order='C')]:
         """The ranges of scan s (a view)."""
 
+    def transform(self, x: float, y: float, theta: float) -> None:
+        """
+        Takes every pose into another frame, in place: x' = x0 + cos(a) x - sin(a) y, y' = y0 + sin(a) x
+        + cos(a) y, theta' = theta + a for the transform (x0, y0, a) of this session into the shared frame
+        of several (the identity changes no bit).
+        """
+
+    def extend(self, other: Scans) -> None:
+        """
+        Appends other's scans (copied) after this batch's: several sessions into one batch.
+        """
+
     def select(self, first: int, count: int = -1) -> Scans:
         """
         Scans [first, first + count) as new Scans (count -1: to the end), clipped to the batch.
@@ -330,6 +342,20 @@ class Log:
         """All ranges, float32 (a view; see Scans)."""
 
     @property
+    def stamps(self) -> NDArray[numpy.float64]:
+        """
+        Each selected scan's timestamp in seconds, float64 (a new array; NaN where unknown).
+        """
+
+    @property
+    def posed_from_file(self) -> int:
+        """Scans whose pose came from ``poses`` (0 without)."""
+
+    @property
+    def unposed_skipped(self) -> int:
+        """Scans left out for want of a pose (``skip_unposed``)."""
+
+    @property
     def warnings(self) -> list[str]:
         """Unknown vasco_* keys and the like."""
 
@@ -344,7 +370,7 @@ class Log:
 
     def __repr__(self) -> str: ...
 
-def load_log(path: str | os.PathLike, param_file: str | os.PathLike | None = None, robot: str = '', overrides: dict[str, float | int] | None = None, lenient: bool = False) -> Log:
+def load_log(path: str | os.PathLike, param_file: str | os.PathLike | None = None, robot: str = '', overrides: dict[str, float | int] | None = None, lenient: bool = False, *, poses: str | os.PathLike | None = None, pose_format: str | None = None, pose_match: str | None = None, pose_tolerance: float | None = None, pose_ids: str | os.PathLike | None = None, skip_unposed: bool | None = None, pose_frame: str | None = None, laser_mount: tuple[float, float, float] | None = None, transform: tuple[float, float, float] | None = None, add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float]]] | None = None) -> Log:
     """
     Reads a CARMEN log (.log, .clf, gzipped if the name ends in .gz) as log2map does.
 
@@ -353,6 +379,13 @@ def load_log(path: str | os.PathLike, param_file: str | os.PathLike | None = Non
     PARAM lines). Strict by default: a bad line raises FileError with ``.file`` and ``.line``;
     ``lenient=True`` skips bad lines and counts them in ``Log.stats['bad_lines']``. The GIL is
     released while the log is read.
+
+    Poses from a SLAM back end (log2map --poses): ``poses`` a TUM trajectory, g2o file or CARMEN log;
+    with it (None: the default) ``pose_format`` 'auto' | 'tum' | 'g2o' | 'carmen'; ``pose_match`` 'auto' |
+    'order' | 'id' | 'time'; ``pose_tolerance`` seconds (0.1); ``pose_ids`` a file of 'id scan' pairs;
+    ``skip_unposed`` leave out scans without a pose; ``pose_frame`` 'laser' | 'robot'; ``laser_mount``
+    (x, y, theta) of the laser on the robot. Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared
+    frame, ``add`` further logs, each a path or (path, (x, y, theta)).
     """
 
 class Map:

@@ -48,6 +48,12 @@ struct ScanBatch {
                 int n, long source_line);
   // Appends every scan of `other` (validated first).
   void append(const ScanBatch &other);
+  // Takes every pose into another frame: the rigid transform (tx, ty, ta)
+  // applied to it, x' = tx + cos(ta) x - sin(ta) y, y' = ty + sin(ta) x +
+  // cos(ta) y, theta' = theta + ta (vasco::compose of pose_file.h). How a
+  // session of several is put into the shared frame; the identity changes
+  // no bit.
+  void transform(double tx, double ty, double ta);
   // Keeps the first `scans` scans and their beams (scans <= num_scans());
   // never throws: how a failed append is undone.
   void truncate(size_t scans) noexcept;

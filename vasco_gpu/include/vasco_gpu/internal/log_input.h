@@ -111,10 +111,6 @@ LogInput log_input_from_scans(StampedScans scans, const LogInputOptions &options
 // message; no selection), counting into *stats.
 StampedScans read_stamped_scans(const std::string &path, const LogInputOptions &options, LogLoadStats *stats);
 
-// Every pose of `batch` taken into another frame: compose(transform, pose).
-// The identity leaves every bit as it was.
-void transform_poses(ScanBatch &batch, const Pose2 &transform);
-
 }  // namespace vasco
 
 #endif  // VASCO_GPU_LOG_INPUT_H
