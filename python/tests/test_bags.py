@@ -235,3 +235,32 @@ def test_load_bag_errors(tmp_path, intel):
         vg.load_bag(tmp_path / "missing.bag")
     with pytest.raises(vg.UsageError):
         vg.load_bag(path, pose_tolerance=0.5)  # a pose option without poses=
+
+
+def test_pgm_and_yaml_as_nav2_map_server_reads_them(tmp_path, intel):
+    """map_server (nav2_map_server's map_io) reads the YAML's image (relative to the YAML),
+    resolution, origin, negate, occupied_thresh, free_thresh and mode, and in trinary mode
+    turns a pixel v into p = (255 - v) / 255: occupied above occupied_thresh, free below
+    free_thresh, else unknown. Done here by hand, against the map's own cells."""
+    yaml = pytest.importorskip("ruamel.yaml")
+    path = tf_bag(tmp_path, "mcap", intel)
+    r = run_script("bag2map", "--backend", "cpu_double", path, tmp_path / "map.pgm", tmp_path / "map.map")
+    assert r.returncode == 0, r.stderr
+    y = yaml.YAML(typ="safe").load((tmp_path / "map.yaml").read_text())
+    assert set(y) >= {"image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh", "mode"}
+    assert y["mode"] == "trinary" and y["negate"] == 0
+    m = vg.read_map(tmp_path / "map.map")
+    assert y["resolution"] == pytest.approx(m.resolution)
+    assert y["origin"][:2] == pytest.approx(list(m.origin[:2]))
+    data = (tmp_path / y["image"]).read_bytes()
+    fields = data.split(maxsplit=4)  # P5, width, height, maxval, pixels
+    assert fields[0] == b"P5"
+    w, h = int(fields[1]), int(fields[2])
+    assert (w, h) == (m.size_x, m.size_y)
+    pixels = np.frombuffer(data[len(data) - w * h:], dtype=np.uint8).reshape(h, w)
+    p = (255.0 - pixels) / 255.0
+    ros = np.where(p > y["occupied_thresh"], 100, np.where(p < y["free_thresh"], 0, -1))
+    cells = m.image  # row 0 at the top, as the PGM
+    want = np.where(cells == -1, -1, np.where(cells > 0.65, 100, np.where(cells < 0.196, 0, -1)))
+    assert np.array_equal(ros, want)
+    assert (ros == 100).sum() > 1000 and (ros == 0).sum() > 10000
