@@ -59,7 +59,17 @@ void apply_pose_file(StampedScans &scans, const PoseSource &src, const std::stri
   }
   in->posed_from_file = b.num_scans() - m.unmatched;
   in->unposed_skipped = m.unmatched;
+  if (m.unmatched > 0 && m.unmatched == b.num_scans())
+    throw carmen::FileError(src.file, "none of the " + std::to_string(b.num_scans()) + " scans of " + source +
+                                          " has a pose in this file (all left out by --skip-unposed)");
   if (m.unmatched > 0) scans.keep_only(m.matched);
+}
+
+// The stamps of the scans select() keeps.
+void select_stamps(std::vector<double> &stamps, long first_scan, size_t kept) {
+  const size_t begin = std::min<size_t>(static_cast<size_t>(std::max(first_scan, 0L)), stamps.size());
+  stamps.erase(stamps.begin(), stamps.begin() + static_cast<std::ptrdiff_t>(begin));
+  stamps.resize(kept);
 }
 
 // A block larger than the grid leaves nothing to finish: say so, naming
@@ -83,11 +93,7 @@ LogInput finish_input(StampedScans scans, carmen::ParamFile &params, const LogIn
   const long laser_messages = in.load.laser_messages;
   in.stamps = std::move(scans.stamps);
   in.batch = std::move(scans.batch).select(in.params.first_scan, in.params.num_scans);  // no copy of the ranges
-  {
-    const auto begin = std::min<size_t>(static_cast<size_t>(std::max(in.params.first_scan, 0L)), in.stamps.size());
-    in.stamps.erase(in.stamps.begin(), in.stamps.begin() + static_cast<std::ptrdiff_t>(begin));
-    in.stamps.resize(in.batch.num_scans());
-  }
+  select_stamps(in.stamps, in.params.first_scan, in.batch.num_scans());
   in.load.scans_used = static_cast<long>(in.batch.num_scans());
   if (in.batch.num_scans() == 0)
     throw carmen::FileError(
