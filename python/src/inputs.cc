@@ -100,6 +100,8 @@ vasco::StampedScans stamped_scans_of(nb::handle d) {
   s.stamps.assign(stamps.data(), stamps.data() + n);
   s.mounts.resize(n);
   s.has_mount.assign(n, 0);
+  nb::object unposed = d.attr("get")("unposed");
+  if (!unposed.is_none()) s.unposed = nb::cast<uint64_t>(unposed);
   nb::object mounts = d.attr("get")("mounts");
   if (!mounts.is_none()) {
     auto m = as_array<double>(mounts, "float64", "mounts", 2);

@@ -264,3 +264,19 @@ def test_pgm_and_yaml_as_nav2_map_server_reads_them(tmp_path, intel):
     want = np.where(cells == -1, -1, np.where(cells > 0.65, 100, np.where(cells < 0.196, 0, -1)))
     assert np.array_equal(ros, want)
     assert (ros == 100).sum() > 1000 and (ros == 0).sum() > 10000
+
+
+def test_scans_before_the_first_transform(tmp_path, intel):
+    # tf starts at the 11th scan, as when a recorder starts the laser first: an error naming
+    # the link and the stamp, or those scans left out and counted when asked.
+    n = len(intel)
+    path = make_bag(tmp_path, "mcap", intel, tf_poses=intel.poses[10:], tf_stamps=scan_stamps(n)[10:],
+                    static_mount=(0.0, 0.0, 0.0))
+    with pytest.raises(vg.FileError) as e:
+        vg.load_bag(path)
+    assert "map -> base_link" in str(e.value) and "1000.000000000" in str(e.value)
+    log = vg.load_bag(path, skip_unposed=True)
+    assert len(log) == n - 10 and log.unposed_skipped == 10
+    r = run_script("bag2map", "--skip-unposed", path, tmp_path / "m.map")
+    assert r.returncode == 0, r.stderr
+    assert "10 scans outside the poses' time span left out" in r.stderr

@@ -58,7 +58,7 @@ void apply_pose_file(StampedScans &scans, const PoseSource &src, const std::stri
     b.theta[s] = p.theta;
   }
   in->posed_from_file = b.num_scans() - m.unmatched;
-  in->unposed_skipped = m.unmatched;
+  in->unposed_skipped += m.unmatched;
   if (m.unmatched > 0 && m.unmatched == b.num_scans())
     throw carmen::FileError(src.file, "none of the " + std::to_string(b.num_scans()) + " scans of " + source +
                                           " has a pose in this file (all left out by --skip-unposed)");
@@ -154,6 +154,7 @@ void StampedScans::append(StampedScans &&more, const Pose2 &transform) {
   stamps.insert(stamps.end(), more.stamps.begin(), more.stamps.end());
   mounts.insert(mounts.end(), more.mounts.begin(), more.mounts.end());
   has_mount.insert(has_mount.end(), more.has_mount.begin(), more.has_mount.end());
+  unposed += more.unposed;
 }
 
 void StampedScans::keep_only(const std::vector<uint8_t> &keep) {
@@ -166,6 +167,7 @@ void StampedScans::keep_only(const std::vector<uint8_t> &keep) {
     kept.mounts.push_back(s < mounts.size() ? mounts[s] : Pose2{});
     kept.has_mount.push_back(s < has_mount.size() ? has_mount[s] : 0);
   }
+  kept.unposed = unposed;
   *this = std::move(kept);
 }
 
@@ -228,7 +230,8 @@ LogInput log_input_from_scans(StampedScans scans, const LogInputOptions &options
   scans.batch.validate();
   LogInput in;
   carmen::ParamFile params = command_line_params(options, &in.warnings);
-  in.load.laser_messages = static_cast<long>(scans.batch.num_scans());
+  in.load.laser_messages = static_cast<long>(scans.batch.num_scans() + scans.unposed);
+  in.unposed_skipped = scans.unposed;
   scans.batch.transform(options.transform.x, options.transform.y, options.transform.theta);
   return finish_input(std::move(scans), params, options, std::move(in), "scans");
 }

@@ -157,6 +157,7 @@ vasco::LogInput read_input(const Options &opt, const ToolSpec &spec) {
   std::map<std::string, std::string> values = opt.extra;
   if (!opt.poses.file.empty()) values["poses"] = opt.poses.file;
   if (opt.poses.has_mount) values["laser-mount"] = opt.laser_mount_text;
+  if (opt.poses.match.skip_unmatched) values["skip-unposed"] = "1";
   vasco::StampedScans scans = spec.read(opt.log, values, in.progress);
   for (const vasco::SessionInput &more : opt.more) {
     bar.done();
@@ -192,6 +193,9 @@ void print_summary(const Options &opt, const RunResult &r) {
                (unsigned long long)ms.cell_updates);
   if (!opt.more.empty())
     std::fprintf(stderr, "%s: %zu sessions mapped into one grid\n", opt.tool.c_str(), opt.more.size() + 1);
+  if (opt.poses.file.empty() && r.input.unposed_skipped > 0)
+    std::fprintf(stderr, "%s: %llu scans outside the poses' time span left out (--skip-unposed)\n", opt.tool.c_str(),
+                 (unsigned long long)r.input.unposed_skipped);
   if (!opt.poses.file.empty())
     std::fprintf(stderr, "%s: poses from %s for %llu scans%s\n", opt.tool.c_str(), opt.poses.file.c_str(),
                  (unsigned long long)r.input.posed_from_file,

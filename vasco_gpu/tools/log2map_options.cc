@@ -103,10 +103,11 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
   }
   if (!raw.transform.empty()) opt.transform = parse_pose_triple(raw.transform, "--transform");
   for (const std::string &a : raw.adds) opt.more.push_back(parse_session(a));
+  // A bag reader takes --laser-mount (a pose topic's mount) and --skip-unposed
+  // (scans outside the poses' time span) without --poses too.
   const bool pose_options = app.count("--pose-format") || app.count("--pose-match") || app.count("--pose-ids") ||
-                            app.count("--pose-tolerance") || app.count("--skip-unposed") ||
-                            app.count("--pose-frame") ||
-                            (app.count("--laser-mount") && !spec.read);  // a bag's pose topic needs one too
+                            app.count("--pose-tolerance") || app.count("--pose-frame") ||
+                            ((app.count("--laser-mount") || app.count("--skip-unposed")) && !spec.read);
   if (pose_options && opt.poses.file.empty())
     throw Error(ErrorCode::Usage, "the --pose-* options, --skip-unposed and --laser-mount go with --poses FILE");
 }

@@ -651,7 +651,8 @@ class _TfTree:
         if bad is not None:
             raise BagError(self.path, f"scan stamp {_stamp_text(bad)} is outside the time span "
                                       f"{edge.span_text()} of tf {edge.parent} -> {edge.child} "
-                                      f"({len(times)} samples); tf is not extrapolated",
+                                      f"({len(times)} samples); tf is not extrapolated (skip_unposed / --skip-unposed "
+                                      f"leaves such scans out)",
                            topic="/tf", stamp=_stamp_seconds(bad))
         hit, i, lo, hi, f = _bracket(times, ns)
         t = tr[lo] + (tr[hi] - tr[lo]) * f[:, None]
@@ -673,6 +674,19 @@ class _TfTree:
             if link is not None:
                 total = link if total is None else _compose(total, link)
         return total
+
+    def inside_spans(self, target: str, source: str, ns: np.ndarray) -> np.ndarray:
+        """Which stamps ns lie within the time span of every /tf link between the two frames
+        (static links have none): the stamps lookup can answer without extrapolating."""
+        up_s, up_t = self.path_between(target, source)
+        inside = np.ones(len(ns), dtype=bool)
+        for chain in (up_s, up_t):
+            for child in chain[:-1]:
+                edge = self.edges[child]
+                if not edge.static:
+                    times = edge.arrays()[0]
+                    inside &= (ns >= times[0]) & (ns <= times[-1])
+        return inside
 
     def lookup(self, target: str, source: str, ns: np.ndarray, static_only: bool = False):
         """T_target_source (translations (n, 3), quaternions (n, 4)) at stamps ns:
@@ -750,6 +764,13 @@ class _PoseSeries:
                                       f"child_frame_id {child!r}, not the base frame {self.base_frame!r}",
                            topic=self.topic, stamp=_stamp_seconds(ns))
 
+    def inside_span(self, ns: np.ndarray) -> np.ndarray:
+        """Which stamps ns lie within the topic's time span."""
+        if not self.ns:
+            return np.zeros(len(ns), dtype=bool)
+        times, _ = _sorted_samples(self.ns, self.values, 3)
+        return (ns >= times[0]) & (ns <= times[-1])
+
     def at(self, ns: np.ndarray) -> np.ndarray:
         """(n, 3) base poses at stamps ns: samples on exact hits, else linear x, y and shortest-arc
         yaw between the bracketing samples; a stamp outside the topic's span is a BagError."""
@@ -760,7 +781,8 @@ class _PoseSeries:
         if bad is not None:
             raise BagError(self.path, f"scan stamp {_stamp_text(bad)} is outside the time span "
                                       f"[{_stamp_text(times[0])}, {_stamp_text(times[-1])}] of pose topic "
-                                      f"{self.topic!r}", topic=self.topic, stamp=_stamp_seconds(bad))
+                                      f"{self.topic!r} (skip_unposed / --skip-unposed leaves such scans out)",
+                           topic=self.topic, stamp=_stamp_seconds(bad))
         hit, i, lo, hi, f = _bracket(times, ns)
         a, b = vals[lo], vals[hi]
         out = np.empty((len(ns), 3))
@@ -851,7 +873,7 @@ class _Progress:
             self._report()
 
 
-def _check_arguments(pose_source, no_return, pose_topic):
+def _check_arguments(pose_source, no_return, pose_topic, outside_span="error"):
     """ValueError for arguments that no bag could make valid."""
     if no_return not in NO_RETURN_MODES:
         raise ValueError(f"no_return must be one of {NO_RETURN_MODES}, not {no_return!r}")
@@ -859,6 +881,8 @@ def _check_arguments(pose_source, no_return, pose_topic):
         raise ValueError(f"pose_source must be one of {POSE_SOURCES}, not {pose_source!r}")
     if pose_source == "topic" and pose_topic is None:
         raise ValueError("pose_source 'topic' needs pose_topic")
+    if outside_span not in ("error", "skip"):
+        raise ValueError(f"outside_span must be 'error' or 'skip', not {outside_span!r}")
 
 
 def _read_messages(reader, path, handlers: dict, progress: _Progress) -> None:
@@ -886,7 +910,8 @@ def _read_messages(reader, path, handlers: dict, progress: _Progress) -> None:
 
 
 def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_topic=None,
-             laser_mount=None, pose_source="auto", no_return="skip", progress=None) -> BagScans:
+             laser_mount=None, pose_source="auto", no_return="skip", progress=None,
+             outside_span="error") -> BagScans:
     """The scans of one LaserScan topic of the bag at path, with the laser pose at each stamp.
 
     scan_topic: the LaserScan topic; None takes the only one. fixed_frame: the frame of the
@@ -897,11 +922,14 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     base frame, instead of /tf_static. pose_source: "auto" (pose_topic if given, else tf),
     "tf", "topic" or "none" (NaN poses; the caller brings them). no_return: "skip" or "free"
     (see the module docstring). progress: progress(done_messages, total_messages).
+    outside_span: a scan stamp outside the time span of the poses (a /tf link on the chain, or
+    the pose topic) is a BagError ("error", the default) or gets a NaN pose ("skip": the caller
+    leaves those scans out; recorders often start the laser before tf).
 
     Raises BagError for anything about the bag, ValueError for arguments that are wrong in
     themselves.
     """
-    _check_arguments(pose_source, no_return, pose_topic)
+    _check_arguments(pose_source, no_return, pose_topic, outside_span)
     mount_arg = _check_mount(laser_mount)
     with _open_bag(path) as reader:
         topics = reader.topics
@@ -930,7 +958,8 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     if not scans.ns:
         raise BagError(path, f"LaserScan topic {topic!r} has no messages", topic=topic)
     ns = np.frombuffer(scans.ns, dtype=np.int64).copy()
-    poses, mounts, label = _poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mount_arg)
+    poses, mounts, label = _poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mount_arg,
+                                      outside_span)
     return BagScans(
         path=os.fspath(path), topic=topic, frame_id=scans.frame_id, stamps=_stamp_seconds(ns), poses=poses,
         mounts=mounts, ranges=np.concatenate(scans.ranges) if scans.ranges else np.zeros(0, np.float32),
@@ -941,11 +970,28 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     )
 
 
-def _poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mount_arg):
-    """(poses (n, 3), mounts (n, 3) or None, pose_source label) for the scans' stamps."""
+def _inside(ns: np.ndarray, inside: np.ndarray | None, pose_at) -> np.ndarray:
+    """pose_at(ns) where inside (all when None), NaN rows elsewhere."""
+    if inside is None:
+        return pose_at(ns)
+    poses = np.full((len(ns), 3), np.nan)
+    if inside.any():
+        poses[inside] = pose_at(ns[inside])
+    return poses
+
+
+def _poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mount_arg, outside_span="error"):
+    """(poses (n, 3), mounts (n, 3) or None, pose_source label) for the scans' stamps; with
+    outside_span "skip", NaN rows for the scans outside the poses' time span."""
     n, frame = len(ns), scans.frame_id
+    skip = outside_span == "skip"
     if source == "tf":
-        poses = _tf_poses(path, tf, fixed_frame, frame, ns)
+        if skip and tf.edges:
+            root = fixed_frame if fixed_frame is not None else tf.up(frame)[-1]
+            inside = tf.inside_spans(root, frame, ns)
+        else:
+            inside = None
+        poses = _inside(ns, inside, lambda t: _tf_poses(path, tf, fixed_frame, frame, t))
         mount = mount_arg if mount_arg is not None else _static_mount(tf, base_frame or "base_link", frame)
         label = "tf"
     elif source == "topic":
@@ -955,7 +1001,8 @@ def _poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mou
             raise BagError(path, f"no static tf chain (/tf_static) from the base frame {base!r} to the "
                                  f"scans' frame {frame!r}; pass laser_mount (--laser-mount x,y,yaw)",
                            topic=series.topic)
-        poses = _planar_compose(series.at(ns), mount)
+        poses = _inside(ns, series.inside_span(ns) if skip else None,
+                        lambda t: _planar_compose(series.at(t), mount))
         label = f"topic:{series.topic}"
     else:
         poses = np.full((n, 3), np.nan)

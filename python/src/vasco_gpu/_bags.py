@@ -48,16 +48,25 @@ def _mount_of(text: str | None):
 
 
 def _read(path, *, scan_topic=None, fixed_frame=None, base_frame=None, pose_topic=None, laser_mount=None,
-          no_return="skip", need_poses=True, progress=None):
-    """The bag's scans as the engine takes them: {'scans', 'stamps', 'mounts'}."""
+          no_return="skip", need_poses=True, skip_unposed=False, progress=None):
+    """The bag's scans as the engine takes them: {'scans', 'stamps', 'mounts', 'unposed'}; with
+    skip_unposed the scans outside the poses' time span are left out and counted."""
     bag = _bag_module()
     b = bag.read_bag(os.fspath(path), scan_topic=scan_topic,
                      fixed_frame=fixed_frame if fixed_frame is not None else ("map" if pose_topic is None else None),
                      base_frame=base_frame, pose_topic=pose_topic, laser_mount=laser_mount,
-                     pose_source="auto" if need_poses else "none", no_return=no_return, progress=progress)
-    scans = _core.Scans(b.poses, b.ranges, b.beam_counts.astype(np.float64), b.first_angle, b.angle_step)
+                     pose_source="auto" if need_poses else "none", no_return=no_return, progress=progress,
+                     outside_span="skip" if skip_unposed and need_poses else "error")
+    keep = np.isfinite(b.poses).all(axis=1) if need_poses else np.ones(len(b.stamps), dtype=bool)
+    if need_poses and not keep.any():
+        raise bag.BagError(os.fspath(path), f"none of the {len(keep)} scans of {b.topic} lies within the time "
+                                            "span of the poses", topic=b.topic)
+    counts = b.beam_counts[keep]
+    ranges = b.ranges[np.repeat(keep, b.beam_counts)]
+    scans = _core.Scans(b.poses[keep], ranges, counts.astype(np.float64), b.first_angle[keep], b.angle_step[keep])
     scans.lines[:] = 0  # a bag has no lines: errors name the scan by its index
-    return {"scans": scans, "stamps": b.stamps, "mounts": b.mounts, "bag": b}
+    mounts = None if b.mounts is None else b.mounts[keep]
+    return {"scans": scans, "stamps": b.stamps[keep], "mounts": mounts, "unposed": int((~keep).sum()), "bag": b}
 
 
 def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame: str | None = None,
@@ -74,9 +83,12 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     from ``/tf`` + ``/tf_static`` (the chain from ``fixed_frame``, default ``map``, to the scan's
     frame, interpolated in time), or from ``pose_topic`` (Odometry, PoseStamped,
     PoseWithCovarianceStamped) and the mount (``/tf_static`` or ``laser_mount``), or from a pose
-    file: ``poses=FILE`` and the other pose keywords of :func:`load_log`, matched by stamp. The
-    parameters come from ``param_file`` and ``overrides`` (a bag has no PARAM lines). Errors name
-    the bag, and the topic and stamp where one is at fault (:class:`FileError`).
+    file: ``poses=FILE`` and the other pose keywords of :func:`load_log`, matched by stamp.
+    ``skip_unposed=True`` without a pose file leaves out (and counts, ``Log.unposed_skipped``)
+    the scans outside the poses' time span, which are otherwise an error. ``add=[bag, (bag,
+    (x, y, theta))]`` and ``transform=`` put several sessions into one grid, as in load_log.
+    The parameters come from ``param_file`` and ``overrides`` (a bag has no PARAM lines). Errors
+    name the bag, and the topic and stamp where one is at fault (:class:`FileError`).
     """
     from ._errors import FileError
 
@@ -84,8 +96,10 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     more = pose_keywords.pop("add", None) or []
     transform = pose_keywords.pop("transform", None)
     sessions = [(path, transform)] + [m if isinstance(m, tuple) else (m, None) for m in more]
+    need_poses = pose_keywords.get("poses") is None
     options = dict(scan_topic=scan_topic, fixed_frame=fixed_frame, base_frame=base_frame, pose_topic=pose_topic,
-                   laser_mount=laser_mount, no_return=no_return, need_poses=pose_keywords.get("poses") is None,
+                   laser_mount=laser_mount, no_return=no_return, need_poses=need_poses,
+                   skip_unposed=bool(pose_keywords.pop("skip_unposed", False)) if need_poses else False,
                    progress=progress)
     if len(sessions) > 1 and pose_keywords.get("poses") is not None:
         raise _core_usage_error("poses= applies to one input: write each session's poses into it first")
@@ -113,6 +127,7 @@ def _append_session(d: dict | None, more: dict, transform) -> dict:
         return more
     n0, n1 = len(d["scans"]), len(more["scans"])
     d["scans"].extend(more["scans"])
+    d["unposed"] += more["unposed"]
     d["stamps"] = np.concatenate([d["stamps"], more["stamps"]])
     if d["mounts"] is not None or more["mounts"] is not None:
         unknown = lambda n: np.full((n, 3), np.nan)
@@ -127,7 +142,7 @@ def _tool_reader(path: str, values: dict, progress) -> dict:
     return _read(path, scan_topic=values.get("scan-topic"), fixed_frame=values.get("fixed-frame"),
                  base_frame=values.get("base-frame"), pose_topic=values.get("pose-topic"),
                  laser_mount=_mount_of(mount), no_return=values.get("no-return", "skip"),
-                 need_poses="poses" not in values, progress=progress)
+                 need_poses="poses" not in values, skip_unposed="skip-unposed" in values, progress=progress)
 
 
 BAG2MAP_SUMMARY = (

@@ -55,6 +55,7 @@ struct StampedScans {
   std::vector<double> stamps;     // one per scan (NaN where unknown)
   std::vector<Pose2> mounts;      // one per scan where has_mount[s]
   std::vector<uint8_t> has_mount;
+  uint64_t unposed = 0;           // scans the reader left out for want of a pose (--skip-unposed)
   // Appends `more` with every pose taken into the shared frame by `transform`.
   void append(StampedScans &&more, const Pose2 &transform);
   // Keeps the scans where keep[s] (what skip_unmatched leaves).
