@@ -18,6 +18,7 @@
 #include "cuda_check.h"
 #include "egrid_kernels.h"
 #include "line_rec.cuh"
+#include "warp_sum.cuh"
 #include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
@@ -386,8 +387,8 @@ __global__ void __launch_bounds__(kTileThreads)
     __syncthreads();
   }
   if (active) grid[static_cast<size_t>(cx) * m.size_y + cy] = cell;
-  const unsigned warp_sum = __reduce_add_sync(0xffffffffu, count);
-  if ((threadIdx.x & 31) == 0 && warp_sum) atomicAdd(updates, static_cast<unsigned long long>(warp_sum));
+  const unsigned in_warp = warp_sum(count);
+  if ((threadIdx.x & 31) == 0 && in_warp) atomicAdd(updates, static_cast<unsigned long long>(in_warp));
 }
 
 __global__ void tile_keys_kernel(const uint32_t *begin, const uint32_t *end, size_t n,

@@ -23,6 +23,7 @@
 
 #include "cuda_check.h"
 #include "egrid_kernels.h"
+#include "warp_sum.cuh"
 #include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
@@ -209,9 +210,9 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
     __syncthreads();
   }
   // counters: beams used, beams skipped, cell updates
-  used = __reduce_add_sync(0xffffffffu, used);
-  skipped = __reduce_add_sync(0xffffffffu, skipped);
-  updates = __reduce_add_sync(0xffffffffu, updates);
+  used = warp_sum(used);
+  skipped = warp_sum(skipped);
+  updates = warp_sum(updates);
   if (lane == 0) {
     if (used) atomicAdd(counters + 0, static_cast<unsigned long long>(used));
     if (skipped) atomicAdd(counters + 1, static_cast<unsigned long long>(skipped));
