@@ -71,6 +71,7 @@ bench: all
 	$(BUILD)/bin/oracle_o2_bench
 	$(BUILD)/bin/mapping_bench
 	$(BUILD)/bin/session_bench
+	python3 bench/batch_bench.py --bin $(BUILD)/bin
 
 # Our CPU backends beside MRPT's COccupancyGridMap2D and OctoMap's OcTree on the same logs and poses.
 # Needs the optional packages libmrpt-maps-dev and liboctomap-dev (neither `make deps` nor CI installs

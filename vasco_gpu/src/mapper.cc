@@ -175,6 +175,19 @@ void Mapper::set_max_memory_bytes(uint64_t bytes) {
   }
 }
 
+void Mapper::start_over(const MapperParams &params) {
+  MapperParams p = params;
+  p.validate();
+  if (fixed_frame_) check_fixed_frame(geo_, p);
+  params_ = p;
+  scans_ = ScanBatch();
+  extent_ = PoseExtent();
+  stats_ = MapStats{};
+  grid_lost_ = false;
+  shift_invariant_ = true;
+  if (!fixed_frame_) geo_ = grid_ = GridGeometry();
+}
+
 void Mapper::check_grid_usable(const char *what) const {
   if (scans_.num_scans() == 0) throw Error(ErrorCode::State, std::string(what) + ": no scans inserted");
   if (grid_lost_)

@@ -18,6 +18,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "carmen_compat/atomic_file.h"
@@ -25,7 +26,10 @@
 #include "carmen_compat/map_format.h"
 #include "cli_support.h"
 #include "log2map_app.h"
+#include "backend_choice.h"
+#include "log2map_batch.h"
 #include "log2map_options.h"
+#include "log2map_steps.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/internal/egrid_math.h"
@@ -46,67 +50,13 @@ namespace {
 using cli::Clock;
 using cli::seconds_since;
 
-// A one-line progress bar on stderr, only when stderr is a terminal.
-class ProgressBar {
- public:
-  ProgressBar(const char *label, bool enabled) : label_(label), enabled_(enabled) {}
-  ~ProgressBar() { done(); }
-  void update(uint64_t done_units, uint64_t total) {
-    if (!enabled_ || total == 0) return;
-    const int pct = static_cast<int>(100.0 * double(done_units) / double(total));
-    if (pct == last_) return;
-    last_ = pct;
-    const int width = 40, filled = std::min(width, pct * width / 100);
-    std::fprintf(stderr, "\r%-8s [%s%s] %3d%%", label_, std::string(filled, '#').c_str(),
-                 std::string(width - filled, ' ').c_str(), std::min(pct, 100));
-    std::fflush(stderr);
-    shown_ = true;
-  }
-  void done() {
-    if (shown_) std::fprintf(stderr, "\r%*s\r", 60, "");
-    shown_ = false;
-  }
-
- private:
-  const char *label_;
-  bool enabled_;
-  int last_ = -1;
-  bool shown_ = false;
-};
-
-std::string basename_of(const std::string &path) {
-  const size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
-// Every file the run creates (a .pgm's .yaml too), for the checks made
-// before any work.
-std::vector<std::string> files_written(const std::vector<std::string> &outputs) {
-  std::vector<std::string> files;
-  for (const std::string &out : outputs) {
-    const std::vector<std::string> of_one = carmen::map_output_files(out);
-    files.insert(files.end(), of_one.begin(), of_one.end());
-  }
-  return files;
-}
-
-// What one run produced, for the summary and --json.
-struct RunResult {
-  vasco::LogInput input;
-  vasco::MapStats stats;
-  vasco::FinishedMap map;
-  carmen::GlobalOffset origin;  // of the map's cell (0, 0), in the world
-  std::string backend;
-  uint64_t known = 0;
-  double parse_s = 0, map_total_s = 0, finish_s = 0, write_s = 0, total_s = 0;
-};
-
-// CUDA initialisation costs a few tenths of a second: started on another
-// thread while the log is parsed.
+// CUDA initialisation costs a few tenths of a second: for --backend cuda
+// it starts on another thread while the log is parsed (auto decides after
+// reading, by the work: backend_choice.h).
 std::future<bool> start_cuda(const Options &opt, const vasco::BackendOptions &bopt) {
   std::future<bool> ready;
 #if defined(VASCO_HAVE_CUDA)
-  if (opt.backend == "cuda" || opt.backend == "auto") {
+  if (opt.backend == "cuda") {
     ready = std::async(std::launch::async, [dev = bopt.cuda_device] {
       std::string why;
       return vasco::cuda_usable(dev, &why);
@@ -130,57 +80,6 @@ std::string no_gpu_reason(const vasco::BackendOptions &bopt) {
 #endif
 }
 
-// Parameters (command line > ini > the log's PARAM lines > defaults), the
-// scans (of every session, with poses from --poses when given) and the grid,
-// with a progress bar on a terminal.
-vasco::LogInput read_input(const Options &opt, const ToolSpec &spec) {
-  vasco::LogInputOptions in;
-  in.log = opt.log;
-  in.transform = opt.transform;
-  in.poses = opt.poses;
-  in.param_file = opt.param_file;
-  in.robot = opt.robot;
-  in.overrides = opt.overrides;
-  in.lenient = opt.lenient;
-  in.memory_budget = opt.max_memory_bytes;  // the scans alone may not pass what the map may use
-  in.budget_option = "--max-memory";
-  ProgressBar bar(spec.read ? "read" : "parse", !opt.quiet && isatty(STDERR_FILENO));
-  in.progress = [&](uint64_t done, uint64_t total) { bar.update(done, total); };
-  if (!spec.read) {
-    in.more_logs = opt.more;
-    return vasco::load_log_input(in);
-  }
-  // Another kind of input: the tool's reader makes the scans, the sessions
-  // are appended here, the rest is a log's.
-  // The reader learns of --poses (its inputs' poses are then not needed)
-  // and --laser-mount (the mount of a pose topic's robot) too.
-  std::map<std::string, std::string> values = opt.extra;
-  if (!opt.poses.file.empty()) values["poses"] = opt.poses.file;
-  if (opt.poses.has_mount) values["laser-mount"] = opt.laser_mount_text;
-  if (opt.poses.match.skip_unmatched) values["skip-unposed"] = "1";
-  vasco::StampedScans scans = spec.read(opt.log, values, in.progress);
-  for (const vasco::SessionInput &more : opt.more) {
-    bar.done();
-    scans.append(spec.read(more.path, values, in.progress), more.transform);
-  }
-  bar.done();
-  return vasco::log_input_from_scans(std::move(scans), in);
-}
-
-// Every output as one transaction: all are written to temporaries first and
-// renamed only when every one is written, so a failure touches no output
-// (an existing file stays as it was) and leaves no temporary.
-void write_outputs(const Options &opt, const RunResult &r) {
-  carmen::MapToWrite map = vasco::map_to_write(r.map, r.input.geo);
-  map.author = opt.tool;
-  map.source = basename_of(opt.log);
-  map.description = "vasco_gpu " + std::string(vasco::version()) + " " + r.backend;
-  map.time = static_cast<int64_t>(std::time(nullptr));
-  carmen::OutputTransaction tx;
-  for (const std::string &out : opt.outputs) carmen::write_map(tx, out, map);
-  tx.commit();
-}
-
 void print_summary(const Options &opt, const RunResult &r) {
   const auto &ls = r.input.load.log;
   const vasco::MapStats &ms = r.stats;
@@ -188,7 +87,7 @@ void print_summary(const Options &opt, const RunResult &r) {
   std::fprintf(stderr,
                "%s: %s: %zu scans (of %ld laser messages), %llu beams used, %llu skipped "
                "(>= 50 m, NaN or inf), %llu cell updates\n",
-               opt.tool.c_str(), opt.log.c_str(), r.input.batch.num_scans(), r.input.load.laser_messages,
+               opt.tool.c_str(), opt.log.c_str(), r.scans, r.input.load.laser_messages,
                (unsigned long long)ms.beams_used, (unsigned long long)ms.beams_skipped,
                (unsigned long long)ms.cell_updates);
   if (!opt.more.empty())
@@ -227,7 +126,7 @@ void print_json(const Options &opt, const RunResult &r) {
   std::ostringstream j;
   j.precision(9);
   j << "{\"log\":" << cli::json_string(opt.log) << ",\"backend\":" << cli::json_string(r.backend)
-    << ",\"scans\":" << r.input.batch.num_scans() << ",\"laser_messages\":" << r.input.load.laser_messages
+    << ",\"scans\":" << r.scans << ",\"laser_messages\":" << r.input.load.laser_messages
     << ",\"beams_used\":" << ms.beams_used << ",\"beams_skipped\":" << ms.beams_skipped
     << ",\"cell_updates\":" << ms.cell_updates << ",\"nan_ranges\":" << ls.nan_ranges
     << ",\"inf_ranges\":" << ls.inf_ranges << ",\"negative_ranges\":" << ls.negative_ranges
@@ -253,46 +152,28 @@ void check_before_work(const Options &opt) {
   if (opt.json) cli::check_stdout_writable("--json");
 }
 
-// Why a log's scans updated no cell, for the error that says so (there is
-// no map to write: finish crops to the known cells).
-std::string why_nothing_was_mapped(const vasco::LogInput &in) {
-  const vasco::ScanBatch &b = in.batch;
-  uint64_t used = 0;
-  for (float r : b.range) used += vasco::egrid::is_beam_used(r);
-  std::ostringstream m;
-  m << "no beam updated any cell: ";
-  if (used == 0) {
-    m << "every one of the " << b.num_beams() << " ranges of the " << b.num_scans()
-      << " scans mapped is " << vasco::egrid::kLaserRangeLimit << " m or more, NaN or +inf (CARMEN uses a beam only below "
-      << vasco::egrid::kLaserRangeLimit << " m)";
-  } else {
-    m << used << " beams were used, but none reached a cell of the grid";
+// --backend auto for one input: the backend expected to finish first, and
+// a note saying which and why.
+std::string chosen_backend(const Options &opt, const vasco::BackendOptions &bopt, const vasco::LogInput &in) {
+  if (opt.backend != "auto") return opt.backend;
+  const int cores = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const BackendChoice c = choose_backend(estimated_cell_updates(in.batch, in.params), cores);
+  std::string backend = "cpu_threads", why = c.why;
+  if (c.gpu) {
+    const std::string gpu = no_gpu_reason(bopt);
+    if (gpu == "GPU usable")
+      backend = "cuda";
+    else
+      why += "; " + gpu;
   }
-  return m.str();
+  if (!opt.quiet) std::fprintf(stderr, "%s: --backend auto: %s: using %s\n", opt.tool.c_str(), why.c_str(), backend.c_str());
+  return backend;
 }
 
 // The mapping session in the PROTOCOL frame, fed every scan at once.
 void make_map(const Options &opt, const vasco::BackendOptions &bopt, RunResult &r) {
-  vasco::Mapper mapper(r.input.params, opt.backend, bopt);
-  r.backend = mapper.backend_name();
-  if (opt.backend == "auto" && !mapper.backend_traits().grid_on_device && !opt.quiet)
-    std::fprintf(stderr, "%s: --backend auto: %s: using %s\n", opt.tool.c_str(), no_gpu_reason(bopt).c_str(), r.backend.c_str());
-  auto t = Clock::now();
-  try {
-    mapper.insert(r.input.batch);
-  } catch (const carmen::Error &e) {
-    // Over the memory budget: the log's poses decide the grid, so name it.
-    if (e.code() == carmen::ErrorCode::OutOfMemory) throw carmen::FileError(opt.log, e.what(), e.code());
-    throw;
-  }
-  r.stats = mapper.last_stats();
-  r.map_total_s = seconds_since(t);
-  t = Clock::now();
-  r.map = mapper.finish();
-  r.finish_s = seconds_since(t);
-  for (float v : r.map.cells) r.known += v != -1.0f;
-  if (r.known == 0) throw carmen::FileError(opt.log, why_nothing_was_mapped(r.input));
-  r.origin = vasco::world_origin(r.map, r.input.geo);
+  vasco::Mapper mapper(r.input.params, chosen_backend(opt, bopt, r.input), bopt);
+  map_input(mapper, opt.log, r);
 }
 
 // The statistics come after the maps are in place: a failure to print them
@@ -311,21 +192,20 @@ int run(const Options &opt, const ToolSpec &spec) {
   const auto t_start = Clock::now();
   carmen::remove_temporaries_on_signals();
   check_before_work(opt);
-  vasco::BackendOptions bopt;
-  bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
-  bopt.threads = opt.threads;
-  bopt.max_memory_bytes = opt.max_memory_bytes;
-  bopt.budget_hint = "--max-memory MiB";
+  const vasco::BackendOptions bopt = backend_options(opt);
   std::future<bool> gpu_ready = start_cuda(opt, bopt);
 
   RunResult r;
   auto t = Clock::now();
-  r.input = read_input(opt, spec);
+  {
+    ProgressBar bar(spec.read ? "read" : "parse", progress_wanted(opt));
+    r.input = read_input(opt, spec, &bar);
+  }
   r.parse_s = seconds_since(t);
   if (gpu_ready.valid()) gpu_ready.wait();
   make_map(opt, bopt, r);
   t = Clock::now();
-  write_outputs(opt, r);
+  write_outputs(opt, opt.log, opt.outputs, r);
   r.write_s = seconds_since(t);
   r.total_s = seconds_since(t_start);
   print_report(opt, r);
@@ -340,7 +220,7 @@ int run_tool(int argc, const char *const *argv, const ToolSpec &spec) {
   if (parsed >= 0) return parsed;
   const char *tool = spec.name.c_str();
   try {
-    return run(opt, spec);
+    return opt.out_dir.empty() ? run(opt, spec) : run_batch(opt, spec);
   } catch (const std::bad_alloc &) {
     std::fprintf(stderr, "%s: out of memory\n", tool);
   } catch (const std::exception &e) {

@@ -30,9 +30,26 @@ bool parse_double(const std::string &text, double *out) {
 
 void add_input_options(CLI::App &app, const ToolSpec &spec, Options &opt) {
   app.add_option(spec.input_name, opt.log, spec.input_help)->required();
-  app.add_option("OUT", opt.outputs, "output files: .map, .map.gz, .pgm, .png")->required();
+  app.add_option("OUT", opt.outputs,
+                 "output files: .map, .map.gz, .pgm, .png (with --out-dir: further " + spec.input_name + "s)");
   app.add_option("--param-file", opt.param_file, "carmen.ini with vasco_* keys (default: vasco's defaults)");
   app.add_option("--robot", opt.robot, "robot section of the ini to use");
+}
+
+// What --out-dir takes along; checked after parsing.
+struct BatchText {
+  std::string formats = "map.gz";
+};
+
+void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchText &raw) {
+  app.add_option("--out-dir", opt.out_dir,
+                 "batch mode: map every " + spec.input_name + " given, in one process, to DIR/NAME.FORMAT")
+      ->type_name("DIR");
+  app.add_option("--formats", raw.formats, "batch mode: the outputs of each input, of map, map.gz, pgm, png (default map.gz)")
+      ->type_name("LIST");
+  app.add_flag("--fail-fast", opt.fail_fast, "batch mode: stop at the first input that fails (default: report it, go on)");
+  app.add_option("--jobs", opt.jobs, "batch mode: threads reading inputs and writing maps (default: all cores)")
+      ->check(CLI::Range(0, vasco::kMaxThreads));
 }
 
 void add_backend_options(CLI::App &app, Options &opt) {
@@ -43,6 +60,7 @@ void add_backend_options(CLI::App &app, Options &opt) {
   app.add_option("--threads", opt.threads,
                  "threads of cpu_threads, 1 to " + std::to_string(vasco::kMaxThreads) + " (default: all cores)")
       ->check(CLI::Range(0, vasco::kMaxThreads));
+  app.add_option("--device", opt.device, "the CUDA device of the cuda backend (default 0)")->check(CLI::NonNegativeNumber);
   app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
       ->check(CLI::IsMember({"float", "exact"}));
   app.add_flag("--lenient", opt.lenient, "skip bad log lines (and report them) instead of stopping");
@@ -79,8 +97,10 @@ void add_pose_options(CLI::App &app, Options &opt, PoseText &raw) {
       ->type_name("X,Y,THETA");
   app.add_option("--transform", raw.transform, "the input into the shared frame of several sessions (default: identity)")
       ->type_name("X,Y,THETA");
-  app.add_option("--add", raw.adds, "a further session mapped into the same grid, its transform after an '@'")
-      ->type_name("INPUT[@X,Y,THETA]");
+  // One value an occurrence: what follows it is OUT (or the next input).
+  app.add_option("--add", raw.adds, "a further session mapped into the same grid, its transform after an '@' (repeatable)")
+      ->type_name("INPUT[@X,Y,THETA]")
+      ->allow_extra_args(false);
 }
 
 void add_param_options(CLI::App &app, std::map<std::string, std::string> &raw) {
@@ -88,11 +108,45 @@ void add_param_options(CLI::App &app, std::map<std::string, std::string> &raw) {
     app.add_option("--" + key, raw[key], "override " + key)->type_name("VALUE");
 }
 
+// "map.gz,png" as the extensions of batch outputs; each known, none twice.
+std::vector<std::string> parse_formats(const std::string &text) {
+  std::vector<std::string> formats;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = std::min(text.find(',', start), text.size());
+    const std::string f = text.substr(start, comma - start);
+    if (f != "map" && f != "map.gz" && f != "pgm" && f != "png")
+      throw Error(ErrorCode::Usage, "--formats '" + text + "': '" + f + "' is none of map, map.gz, pgm, png");
+    if (std::find(formats.begin(), formats.end(), f) != formats.end())
+      throw Error(ErrorCode::Usage, "--formats '" + text + "': " + f + " is named twice");
+    formats.push_back(f);
+    start = comma + 1;
+  }
+  return formats;
+}
+
+// Batch mode: every positional is an input; the one-input options refused.
+void finish_batch_options(const CLI::App &app, const BatchText &raw, Options &opt) {
+  const bool batch_only = app.count("--formats") || app.count("--fail-fast") || app.count("--jobs");
+  if (opt.out_dir.empty()) {
+    if (batch_only) throw Error(ErrorCode::Usage, "--formats, --fail-fast and --jobs go with --out-dir DIR");
+    if (opt.outputs.empty()) throw Error(ErrorCode::Usage, "no output named: give OUT [OUT...], or --out-dir DIR for a batch");
+    return;
+  }
+  for (const char *one : {"--poses", "--add", "--transform"})
+    if (app.count(one)) throw Error(ErrorCode::Usage, std::string(one) + " is for one input: not with --out-dir");
+  opt.formats = parse_formats(raw.formats);
+  opt.inputs.push_back(opt.log);
+  opt.inputs.insert(opt.inputs.end(), opt.outputs.begin(), opt.outputs.end());
+  opt.outputs.clear();
+}
+
 // Everything checked after parsing that CLI11 cannot: a usage error.
 void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &raw, const std::string &max_memory,
                     Options &opt) {
   if (app.count("--max-memory") > 0) opt.max_memory_bytes = cli::parse_mebibytes(max_memory, "--max-memory");
-  for (const auto &out : opt.outputs) carmen::map_format_of(out);  // an unknown extension
+  for (const auto &out : opt.outputs)
+    if (opt.out_dir.empty()) carmen::map_format_of(out);  // an unknown extension
   opt.poses.format = vasco::pose_file_format_from_name(raw.format);
   opt.poses.match.matching = vasco::pose_matching_from_name(raw.match);
   opt.poses.robot_frame = raw.frame == "robot";
@@ -153,6 +207,8 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
   std::map<std::string, std::string> extra;
   for (const ExtraOption &e : spec.extra_options) app.add_option("--" + e.name, extra[e.name], e.help)->type_name(e.type_name);
   add_backend_options(app, *opt);
+  BatchText raw_batch;
+  add_batch_options(app, spec, *opt, raw_batch);
   std::string max_memory;
   app.add_option("--max-memory", max_memory, "host memory the map may use, in MiB (default 2048; 0: no limit)")
       ->type_name("MiB");
@@ -172,6 +228,7 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
     if (app.count("--" + kv.first) > 0) opt->extra[kv.first] = kv.second;
   try {
     finish_options(app, spec, raw_poses, max_memory, *opt);
+    finish_batch_options(app, raw_batch, *opt);
   } catch (const carmen::Error &e) {
     std::fprintf(stderr, "%s: %s\n", spec.name.c_str(), carmen::printable(e.what()).c_str());
     return 2;

@@ -16,8 +16,16 @@ namespace log2map {
 
 struct Options {
   std::string tool = "log2map";
-  std::string log;  // the first input
+  std::string log;  // the first input (one-log runs); the one being read (batch)
   std::vector<std::string> outputs;
+  // Batch mode (--out-dir DIR): every positional is an input, mapped in one
+  // process to DIR/STEM.FORMAT for each of `formats`.
+  std::string out_dir;
+  std::vector<std::string> inputs;
+  std::vector<std::string> formats;  // map, map.gz, pgm, png
+  bool fail_fast = false;
+  int jobs = 0;  // batch threads reading and writing logs (0: all cores)
+  int device = 0;
   std::string param_file;
   std::string robot;
   std::string backend = "auto";

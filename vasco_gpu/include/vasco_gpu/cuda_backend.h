@@ -14,8 +14,8 @@ namespace vasco {
 
 // Whether CUDA device `device` can be used; initialises the CUDA context on
 // the first call (a few tenths of a second: log2map starts it on another
-// thread while the log is parsed). Thread-safe; later calls return the cached
-// answer. `why` (optional) receives the reason when it cannot.
+// thread while the log is parsed). Thread-safe; later calls for the same device
+// return the cached answer. `why` (optional) receives the reason when it cannot.
 bool cuda_usable(int device, std::string *why);
 
 // The device's name and memory, for messages ("NVIDIA H100 80GB HBM3, 79 GiB").

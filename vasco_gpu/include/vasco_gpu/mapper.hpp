@@ -108,6 +108,13 @@ class Mapper {
   std::vector<float> read(const GridWindow &window) const;
   std::vector<float> read() const;  // the whole full-resolution grid
 
+  // A new session on the same backend: the stored scans, their frame and
+  // the grid dropped, `params` in force (checked first: a refusal changes
+  // nothing; a fixed frame stays, and its resolution must equal the new
+  // vasco_resolution). The renderer is kept, with its GPU context and
+  // scratch: a batch of logs pays the backend's start-up once.
+  void start_over(const MapperParams &params);
+
   // A new host-memory budget (0: none). Error(OutOfMemory), keeping the old
   // one, when the session already needs more.
   void set_max_memory_bytes(uint64_t bytes);
@@ -169,8 +176,8 @@ class Mapper {
   std::unique_ptr<Renderer> renderer_;
   MapStats stats_;
   size_t renders_ = 0;
-  bool grid_lost_ = false;
-  bool shift_invariant_ = true;  // no stored beam's end can wrap: a margin is allowed  // a failed restore: the grid does not match the stored scans
+  bool grid_lost_ = false;        // a failed restore: the grid does not match the stored scans
+  bool shift_invariant_ = true;  // no stored beam's end can wrap: a margin is allowed
 };
 
 }  // namespace vasco

@@ -2,6 +2,7 @@
 // its mode.
 #include "vasco_gpu/cuda_backend.h"
 
+#include <map>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -15,14 +16,20 @@
 namespace vasco {
 namespace {
 
+// Whether each device asked about is usable, decided once per device (the
+// first question creates its context).
 struct UsableState {
-  std::once_flag once;
   bool usable = false;
   std::string why;
 };
 
-UsableState &usable_state() {
-  static UsableState s;
+std::mutex &usable_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+std::map<int, UsableState> &usable_states() {
+  static std::map<int, UsableState> s;
   return s;
 }
 
@@ -50,13 +57,16 @@ std::string unusable_reason(int device) {
 }  // namespace
 
 bool cuda_usable(int device, std::string *why) {
-  UsableState &s = usable_state();
-  std::call_once(s.once, [&] {
+  std::lock_guard<std::mutex> lock(usable_mutex());
+  auto found = usable_states().find(device);
+  if (found == usable_states().end()) {
+    UsableState s;
     s.why = unusable_reason(device);
     s.usable = s.why.empty();
-  });
-  if (!s.usable && why != nullptr) *why = s.why;
-  return s.usable;
+    found = usable_states().emplace(device, s).first;
+  }
+  if (!found->second.usable && why != nullptr) *why = found->second.why;
+  return found->second.usable;
 }
 
 std::string cuda_device_description(int device) {

@@ -1,0 +1,159 @@
+#!/usr/bin/env python3
+"""batch_bench: logs a second through log2map's batch mode against one
+process per log, on this host, for every backend that runs here, in one run;
+then one-log runs of each bundled log with --backend auto against
+cpu_threads and cuda (auto should never be more than 10 % slower than the
+faster of the two); last, the constants of auto's cost model
+(vasco_gpu/tools/backend_choice.cc) as measured on this host.
+
+    python3 bench/batch_bench.py [--bin build/bin] [--copies 200] [--per-process 20]
+
+The batch is N copies (symbolic links under distinct names) of the bundled
+logs, fr079 first: --log picks another. Times are wall-clock seconds of the
+whole command, outputs (.map.gz) included; the best of --repeat runs.
+"""
+from __future__ import annotations
+
+import argparse
+import gzip
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+LOGS = os.path.join(ROOT, "logs")
+
+
+def timed(cmd: list[str]) -> tuple[float, subprocess.CompletedProcess]:
+    t = time.perf_counter()
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return time.perf_counter() - t, p
+
+
+def best(cmd: list[str], repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        s, p = timed(cmd)
+        if p.returncode != 0:
+            sys.exit(f"batch_bench: {' '.join(cmd[:6])} ...: exit {p.returncode}\n{p.stderr[-2000:]}")
+        times.append(s)
+    return min(times)
+
+
+def gpu_usable(log2map: str, log: str, out: str) -> bool:
+    p = subprocess.run([log2map, "--backend", "cuda", "--quiet", log, out], capture_output=True, text=True)
+    return p.returncode == 0
+
+
+def tiny_log(path: str, scans: int = 20) -> None:
+    """The first `scans` laser lines of the bundled intel log (and what precedes them)."""
+    with gzip.open(os.path.join(LOGS, "intel.gfs.log.gz"), "rt") as f, open(path, "w") as out:
+        n = 0
+        for line in f:
+            out.write(line)
+            n += line.startswith("FLASER")
+            if n == scans:
+                break
+
+
+def run_json(log2map: str, backend: str, log: str, out: str) -> dict:
+    p = subprocess.run([log2map, "--backend", backend, "--quiet", "--json", log, out], capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit(f"batch_bench: log2map --backend {backend} {log}: exit {p.returncode}\n{p.stderr[-2000:]}")
+    return json.loads(p.stdout)
+
+
+def cost_model(log2map: str, backends: list[str], tmp: str, repeat: int) -> list[str]:
+    """auto's constants measured here: cpu_threads' cells per core-second and the GPU's cells
+    per second (cell_updates over seconds.map_total, the best of `repeat`, on the bundled
+    log with the most cells), and the GPU's start-up as one process pays it (the wall-clock
+    time of a cuda run of a 20-scan log less that of a cpu_threads run)."""
+    cores = os.cpu_count() or 1
+    out = os.path.join(tmp, "model.map")
+    biggest = max((os.path.join(LOGS, n) for n in os.listdir(LOGS)),
+                  key=lambda p: run_json(log2map, "cpu_threads", p, out)["cell_updates"])
+    lines = []
+    for b in backends:
+        runs = [run_json(log2map, b, biggest, out) for _ in range(repeat)]
+        cells = runs[0]["cell_updates"]
+        s = min(r["seconds"]["map_total"] for r in runs)
+        if b == "cpu_threads":
+            lines.append(f"kCpuCellsPerCoreSecond  {cells / s / cores:10.3g}   ({cells} cells of {os.path.basename(biggest)} "
+                         f"in {s:.4f} s on {cores} cores)")
+        else:
+            lines.append(f"kGpuCellsPerSecond      {cells / s:10.3g}   ({cells} cells in {s:.4f} s)")
+    if "cuda" in backends:
+        tiny = os.path.join(tmp, "tiny.log")
+        tiny_log(tiny)
+        start = best([log2map, "--backend", "cuda", "--quiet", tiny, out], repeat) - \
+            best([log2map, "--backend", "cpu_threads", "--quiet", tiny, out], repeat)
+        lines.append(f"kGpuStartSeconds        {start:10.3f}   (a 20-scan log: cuda less cpu_threads, wall-clock)")
+    return lines
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--log", default=os.path.join(LOGS, "fr079-complete.gfs.log.gz"))
+    ap.add_argument("--copies", type=int, default=200)
+    ap.add_argument("--per-process", type=int, default=20, help="logs run one process each (the rate's sample)")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--formats", default="map.gz")
+    a = ap.parse_args()
+    log2map = os.path.join(a.bin, "log2map")
+    with tempfile.TemporaryDirectory(prefix="batch_bench_") as tmp:
+        logs = []
+        for i in range(a.copies):
+            link = os.path.join(tmp, f"log{i:05d}.log.gz")
+            os.symlink(os.path.abspath(a.log), link)
+            logs.append(link)
+        out = os.path.join(tmp, "maps")
+        backends = ["cpu_threads"]
+        if gpu_usable(log2map, logs[0], os.path.join(tmp, "probe.map")):
+            backends += ["cuda"]
+        rows = []
+        for b in ["cpu_double"] + backends:
+            # cpu_double is the reference: one core, so a tenth of the copies, run once.
+            n = max(1, len(logs) // 10) if b == "cpu_double" else len(logs)
+            s = best([log2map, "--backend", b, "--quiet", "--out-dir", out, "--formats", a.formats] + logs[:n],
+                     1 if b == "cpu_double" else a.repeat) / n * len(logs)
+            k = min(a.per_process, len(logs))
+            t = time.perf_counter()
+            for i in range(k):
+                _, p = timed([log2map, "--backend", b, "--quiet", logs[i], os.path.join(tmp, f"one.{a.formats}")])
+                if p.returncode != 0:
+                    sys.exit(f"batch_bench: log2map {b} {logs[i]}: exit {p.returncode}\n{p.stderr}")
+            per = (time.perf_counter() - t) / k
+            rows.append((b, len(logs) / s, 1.0 / per))
+        one = []
+        for log in sorted(os.listdir(LOGS)):
+            path = os.path.join(LOGS, log)
+            t = {b: best([log2map, "--backend", b, "--quiet", path, os.path.join(tmp, "one.map.gz")], a.repeat)
+                 for b in ["auto"] + backends}
+            one.append((log, t))
+        model = cost_model(log2map, backends, tmp, a.repeat)
+
+    print(f"batch_bench: {a.copies} copies of {os.path.basename(a.log)}, outputs {a.formats}, "
+          f"{os.cpu_count()} cores, best of {a.repeat}")
+    print(f"{'backend':12} {'batch logs/s':>13} {'process-per-log logs/s':>23} {'batch / per-process':>20} "
+          f"{'batch / cpu_double batch':>25}")
+    ref = rows[0][1]
+    for b, batch, per in rows:
+        print(f"{b:12} {batch:13.1f} {per:23.2f} {batch / per:19.1f}x {batch / ref:24.1f}x")
+    print()
+    print(f"{'one log':30} " + " ".join(f"{b + ' s':>14}" for b in ["auto"] + backends) + f" {'auto / fastest':>15}")
+    for log, t in one:
+        fastest = min(t[b] for b in backends)
+        print(f"{log:30} " + " ".join(f"{t[b]:14.3f}" for b in ["auto"] + backends) + f" {t['auto'] / fastest:15.2f}")
+    print()
+    print("auto's cost model measured here (compare vasco_gpu/tools/backend_choice.cc):")
+    for line in model:
+        print("  " + line)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

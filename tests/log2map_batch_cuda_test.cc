@@ -1,0 +1,79 @@
+// log2map's batch mode and --device on the GPU, run as a program: exact
+// mode's outputs are CARMEN's maps (the golden digests the project
+// carries), float mode's the same GRIDMAP as a one-log cuda run (float mode
+// is deterministic), and a --device that does not exist is refused naming
+// it. Skips without a usable GPU.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "carmen_compat/map_digest.h"
+#include "carmen_compat/map_file.h"
+#include "golden_support.h"
+#include "map_test_support.h"
+#include "tool_support.h"
+
+namespace {
+
+using maptest::TempDir;
+using tooltest::contains;
+using tooltest::ToolRun;
+
+ToolRun log2map(const std::vector<std::string> &args) { return tooltest::run_tool("log2map", args, true); }
+
+const std::string kLogs = VASCO_LOGS_DIR;
+const std::string kIntel = kLogs + "/intel.gfs.log.gz";
+const std::string kFr079 = kLogs + "/fr079-complete.gfs.log.gz";
+const std::string kGolden = std::string(VASCO_TEST_DATA_DIR) + "/golden";
+
+std::string digest_of(const std::string &path) {
+  const carmen::MapFile mf = carmen::read_map_file(path);
+  if (!mf.gridmap) return "no GRIDMAP in " + path;
+  return carmen::gridmap_payload_sha256(mf.gridmap->size_x, mf.gridmap->size_y, mf.gridmap->resolution,
+                                        mf.gridmap->cells);
+}
+
+class Log2MapBatchCuda : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string why;
+    if (!vasco::golden::cuda_available(&why)) GTEST_SKIP() << "no usable GPU: " << why;
+  }
+};
+
+TEST_F(Log2MapBatchCuda, ExactModeWritesCarmensMaps) {
+  std::map<std::string, std::string> golden;
+  std::ifstream in(kGolden + "/SHA256SUMS");
+  for (std::string sha, name; in >> sha >> name;) golden[name] = sha;
+  TempDir dir;
+  const ToolRun r = log2map({"--backend", "cuda", "--cuda-mode", "exact", "--device", "0", "--param-file",
+                             kGolden + "/params/vasco_default_ds4.ini", "--out-dir", dir.file("maps"), kIntel, kFr079});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "backend cuda_exact")) << r.output;
+  EXPECT_EQ(digest_of(dir.file("maps/intel.gfs.map.gz")), golden.at("intel.gfs__vasco_default_ds4"));
+  EXPECT_EQ(digest_of(dir.file("maps/fr079-complete.gfs.map.gz")), golden.at("fr079-complete.gfs__vasco_default_ds4"));
+}
+
+TEST_F(Log2MapBatchCuda, FloatModeGivesEachLogsOneRunMap) {
+  TempDir dir;
+  const ToolRun batch = log2map({"--backend", "auto", "--out-dir", dir.file("maps"), kIntel, kFr079});
+  ASSERT_EQ(batch.status, 0) << batch.output;
+  EXPECT_TRUE(contains(batch.output, "backend cuda_float")) << batch.output;  // auto in a batch: the GPU
+  for (const std::string stem : {"intel.gfs", "fr079-complete.gfs"}) {
+    const ToolRun one = log2map({"--backend", "cuda", "--quiet", kLogs + "/" + stem + ".log.gz", dir.file(stem + ".map.gz")});
+    ASSERT_EQ(one.status, 0) << one.output;
+    EXPECT_EQ(digest_of(dir.file("maps/" + stem + ".map.gz")), digest_of(dir.file(stem + ".map.gz"))) << stem;
+  }
+}
+
+TEST_F(Log2MapBatchCuda, ADeviceThatDoesNotExistIsRefusedNamingIt) {
+  TempDir dir;
+  const ToolRun r = log2map({"--backend", "cuda", "--device", "999", kIntel, dir.file("a.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "CUDA device 999 does not exist")) << r.output;
+}
+
+}  // namespace

@@ -1,0 +1,234 @@
+#include "log2map_batch.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <future>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "batch_report.h"
+#include "carmen_compat/atomic_file.h"
+#include "carmen_compat/error.h"
+#include "cli_support.h"
+#include "log2map_steps.h"
+#include "task_pool.h"
+#include "vasco_gpu/mapper.hpp"
+
+namespace log2map {
+
+std::string batch_stem(const std::string &input) {
+  std::string name = input;
+  while (name.size() > 1 && name.back() == '/') name.pop_back();  // a ROS 2 bag's directory
+  name = basename_of(name);
+  if (name.size() > 3 && name.compare(name.size() - 3, 3, ".gz") == 0) name.resize(name.size() - 3);
+  const size_t dot = name.rfind('.');
+  if (dot != std::string::npos && dot > 0) name.resize(dot);
+  return name;
+}
+
+std::vector<std::string> batch_outputs(const Options &opt, const std::string &input) {
+  std::vector<std::string> outputs;
+  const std::string dir = opt.out_dir.back() == '/' ? opt.out_dir : opt.out_dir + "/";
+  for (const std::string &f : opt.formats) outputs.push_back(dir + batch_stem(input) + "." + f);
+  return outputs;
+}
+
+namespace {
+
+using carmen::Error;
+using carmen::ErrorCode;
+
+// The output directory, made when missing (its parent must exist).
+void make_out_dir(const std::string &dir) {
+  struct stat st;
+  if (::stat(dir.c_str(), &st) == 0) {
+    if (!S_ISDIR(st.st_mode)) throw carmen::FileError(dir, "--out-dir: not a directory", ErrorCode::Io);
+    return;
+  }
+  if (::mkdir(dir.c_str(), 0777) != 0)
+    throw carmen::FileError(dir, std::string("--out-dir: cannot make the directory: ") + std::strerror(errno), ErrorCode::Io);
+}
+
+// Each input's entry; two inputs writing the same outputs are refused.
+std::vector<BatchEntry> plan_entries(const Options &opt) {
+  std::vector<BatchEntry> entries;
+  std::map<std::string, std::string> by_stem;
+  for (const std::string &input : opt.inputs) {
+    const auto [at, fresh] = by_stem.emplace(batch_stem(input), input);
+    if (!fresh)
+      throw Error(ErrorCode::Usage, at->second + " and " + input + " would both write " + opt.out_dir + "/" + at->first +
+                                        ".*: give inputs of different names (or map them in two runs)");
+    BatchEntry e;
+    e.input = input;
+    e.outputs = batch_outputs(opt, input);
+    entries.push_back(std::move(e));
+  }
+  return entries;
+}
+
+std::string what_of(const std::exception_ptr &error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const std::bad_alloc &) {
+    return "out of memory";
+  } catch (const std::exception &e) {
+    return e.what();
+  } catch (...) {
+    return "unknown error";
+  }
+}
+
+// How many read or mapped inputs may wait at once: bounds the memory held.
+class Slots {
+ public:
+  explicit Slots(size_t n) : free_(n) {}
+  void take() {
+    std::unique_lock<std::mutex> lock(m_);
+    freed_.wait(lock, [this] { return free_ > 0; });
+    --free_;
+  }
+  void give() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      ++free_;
+    }
+    freed_.notify_one();
+  }
+
+ private:
+  std::mutex m_;
+  std::condition_variable freed_;
+  size_t free_;
+};
+
+// One batch: inputs read on the pool, mapped here in order, written on the pool.
+class BatchRun {
+ public:
+  BatchRun(const Options &opt, const ToolSpec &spec, BatchReport &report, int jobs)
+      : opt_(opt), spec_(spec), report_(report), ahead_(2 * static_cast<size_t>(jobs)), writes_(ahead_),
+        pool_(jobs), read_(opt.inputs.size()) {}
+
+  ~BatchRun() { stop_ = true; }  // queued reads return at once; the pool drains
+
+  void start_reads() {
+    for (size_t i = 0; i < std::min(ahead_, read_.size()); ++i) submit_read(i);
+  }
+
+  void map_all(vasco::Mapper &mapper) {
+    const size_t n = read_.size();
+    for (size_t i = 0; i < n && !stop_; ++i) {
+      std::unique_ptr<RunResult> r;
+      try {
+        r = read_[i].get();
+      } catch (...) {
+        fail(i, std::current_exception());
+      }
+      if (i + ahead_ < n && !stop_) submit_read(i + ahead_);
+      if (r) map_one(mapper, i, std::move(r));
+    }
+    if (stop_)
+      for (size_t i = 0; i < n; ++i) report_.not_run(i);
+  }
+
+ private:
+  void submit_read(size_t i) {
+    auto done = std::make_shared<std::promise<std::unique_ptr<RunResult>>>();
+    read_[i] = done->get_future();
+    pool_.submit([this, i, done] {
+      if (stop_) return done->set_value(nullptr);
+      try {
+        Options one = opt_;
+        one.log = opt_.inputs[i];
+        auto r = std::make_unique<RunResult>();
+        const auto t = cli::Clock::now();
+        r->input = read_input(one, spec_, nullptr);
+        r->parse_s = cli::seconds_since(t);
+        done->set_value(std::move(r));
+      } catch (...) {
+        done->set_exception(std::current_exception());
+      }
+    });
+  }
+
+  void map_one(vasco::Mapper &mapper, size_t i, std::unique_ptr<RunResult> r) {
+    const std::string &input = opt_.inputs[i];
+    try {
+      map_input(mapper, input, *r);
+    } catch (...) {
+      return fail(i, std::current_exception());
+    }
+    report_.mapped(i, *r);
+    r->input.batch = vasco::ScanBatch();  // the scans are not needed to write
+    writes_.take();
+    std::shared_ptr<RunResult> mapped(std::move(r));
+    pool_.submit(
+        [this, i, mapped] {
+          try {
+            const auto t = cli::Clock::now();
+            write_outputs(opt_, opt_.inputs[i], batch_outputs(opt_, opt_.inputs[i]), *mapped);
+            report_.written(i, cli::seconds_since(t));
+          } catch (...) {
+            fail(i, std::current_exception());
+          }
+          writes_.give();
+        },
+        true);
+  }
+
+  void fail(size_t i, const std::exception_ptr &error) {
+    report_.failed(i, what_of(error));
+    if (opt_.fail_fast) stop_ = true;
+  }
+
+  const Options &opt_;
+  const ToolSpec &spec_;
+  BatchReport &report_;
+  const size_t ahead_;
+  Slots writes_;
+  std::atomic<bool> stop_{false};
+  cli::TaskPool pool_;  // after what its tasks use: joined first
+  std::vector<std::future<std::unique_ptr<RunResult>>> read_;
+};
+
+int all_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+
+}  // namespace
+
+int run_batch(const Options &opt, const ToolSpec &spec) {
+  const auto t_start = cli::Clock::now();
+  carmen::remove_temporaries_on_signals();
+  std::vector<BatchEntry> entries = plan_entries(opt);
+  std::vector<std::string> inputs = opt.inputs, files;
+  if (!opt.param_file.empty()) inputs.push_back(opt.param_file);
+  for (const BatchEntry &e : entries)
+    for (const std::string &f : files_written(e.outputs)) files.push_back(f);
+  if (opt.json) cli::check_stdout_writable("--json");
+  make_out_dir(opt.out_dir);
+  cli::check_outputs(inputs, files);
+
+  BatchReport report(opt, std::move(entries));
+  {
+    BatchRun run(opt, spec, report, opt.jobs > 0 ? opt.jobs : all_cores());
+    run.start_reads();  // while the backend starts
+    // One mapper for every input: its backend (a GPU's context and
+    // scratch) starts once. auto is the GPU when one is usable: its
+    // start-up is paid once for the whole batch.
+    vasco::Mapper mapper(vasco::MapperParams{}, opt.backend, backend_options(opt));
+    report.set_backend(mapper.backend_name());
+    if (opt.backend == "auto" && !mapper.backend_traits().grid_on_device && !opt.quiet)
+      std::fprintf(stderr, "%s: --backend auto: no usable GPU: using %s\n", opt.tool.c_str(), mapper.backend_name().c_str());
+    run.map_all(mapper);
+  }  // every write done
+  report.print_end(cli::seconds_since(t_start));
+  return report.failures() > 0 ? 1 : 0;
+}
+
+}  // namespace log2map

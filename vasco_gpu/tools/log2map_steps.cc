@@ -1,0 +1,156 @@
+#include "log2map_steps.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <ctime>
+#include <map>
+#include <sstream>
+
+#include "carmen_compat/atomic_file.h"
+#include "carmen_compat/error.h"
+#include "cli_support.h"
+#include "vasco_gpu/internal/egrid_math.h"
+#include "vasco_gpu/map_output.h"
+#include "vasco_gpu/version.h"
+
+namespace log2map {
+
+void ProgressBar::update(uint64_t done_units, uint64_t total) {
+  if (!enabled_ || total == 0) return;
+  const int pct = static_cast<int>(100.0 * double(done_units) / double(total));
+  if (pct == last_) return;
+  last_ = pct;
+  const int width = 40, filled = std::min(width, pct * width / 100);
+  std::fprintf(stderr, "\r%-8s [%s%s] %3d%%", label_, std::string(filled, '#').c_str(),
+               std::string(width - filled, ' ').c_str(), std::min(pct, 100));
+  std::fflush(stderr);
+  shown_ = true;
+}
+
+void ProgressBar::done() {
+  if (shown_) std::fprintf(stderr, "\r%*s\r", 60, "");
+  shown_ = false;
+  last_ = -1;
+}
+
+bool progress_wanted(const Options &opt) { return !opt.quiet && isatty(STDERR_FILENO); }
+
+std::string basename_of(const std::string &path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::vector<std::string> files_written(const std::vector<std::string> &outputs) {
+  std::vector<std::string> files;
+  for (const std::string &out : outputs) {
+    const std::vector<std::string> of_one = carmen::map_output_files(out);
+    files.insert(files.end(), of_one.begin(), of_one.end());
+  }
+  return files;
+}
+
+vasco::BackendOptions backend_options(const Options &opt) {
+  vasco::BackendOptions bopt;
+  bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
+  bopt.threads = opt.threads;
+  bopt.cuda_device = opt.device;
+  bopt.max_memory_bytes = opt.max_memory_bytes;
+  bopt.budget_hint = "--max-memory MiB";
+  return bopt;
+}
+
+vasco::LogInput read_input(const Options &opt, const ToolSpec &spec, ProgressBar *bar) {
+  vasco::LogInputOptions in;
+  in.log = opt.log;
+  in.transform = opt.transform;
+  in.poses = opt.poses;
+  in.param_file = opt.param_file;
+  in.robot = opt.robot;
+  in.overrides = opt.overrides;
+  in.lenient = opt.lenient;
+  in.memory_budget = opt.max_memory_bytes;  // the scans alone may not pass what the map may use
+  in.budget_option = "--max-memory";
+  if (bar != nullptr) in.progress = [bar](uint64_t done, uint64_t total) { bar->update(done, total); };
+  if (!spec.read) {
+    in.more_logs = opt.more;
+    return vasco::load_log_input(in);
+  }
+  // Another kind of input: the tool's reader makes the scans, the sessions
+  // are appended here, the rest is a log's. The reader learns of --poses
+  // (its inputs' poses are then not needed), --laser-mount (the mount of a
+  // pose topic's robot) and --skip-unposed too.
+  std::map<std::string, std::string> values = opt.extra;
+  if (!opt.poses.file.empty()) values["poses"] = opt.poses.file;
+  if (opt.poses.has_mount) values["laser-mount"] = opt.laser_mount_text;
+  if (opt.poses.match.skip_unmatched) values["skip-unposed"] = "1";
+  const auto no_progress = [](uint64_t, uint64_t) {};
+  const std::function<void(uint64_t, uint64_t)> progress = in.progress ? in.progress : no_progress;
+  vasco::StampedScans scans = spec.read(opt.log, values, progress);
+  for (const vasco::SessionInput &more : opt.more) {
+    if (bar != nullptr) bar->done();
+    scans.append(spec.read(more.path, values, progress), more.transform);
+  }
+  if (bar != nullptr) bar->done();
+  return vasco::log_input_from_scans(std::move(scans), in);
+}
+
+namespace {
+
+// Why a log's scans updated no cell, for the error that says so (there is
+// no map to write: finish crops to the known cells).
+std::string why_nothing_was_mapped(const vasco::ScanBatch &b) {
+  uint64_t used = 0;
+  for (float r : b.range) used += vasco::egrid::is_beam_used(r);
+  std::ostringstream m;
+  m << "no beam updated any cell: ";
+  if (used == 0) {
+    m << "every one of the " << b.num_beams() << " ranges of the " << b.num_scans() << " scans mapped is "
+      << vasco::egrid::kLaserRangeLimit << " m or more, NaN or +inf (CARMEN uses a beam only below "
+      << vasco::egrid::kLaserRangeLimit << " m)";
+  } else {
+    m << used << " beams were used, but none reached a cell of the grid";
+  }
+  return m.str();
+}
+
+}  // namespace
+
+void map_input(vasco::Mapper &mapper, const std::string &log, RunResult &r) {
+  using cli::Clock;
+  mapper.start_over(r.input.params);
+  r.backend = mapper.backend_name();
+  r.scans = r.input.batch.num_scans();
+  auto t = Clock::now();
+  try {
+    mapper.insert(std::move(r.input.batch));
+  } catch (const carmen::Error &e) {
+    // Over the memory budget: the log's poses decide the grid, so name it.
+    if (e.code() == carmen::ErrorCode::OutOfMemory) throw carmen::FileError(log, e.what(), e.code());
+    throw;
+  }
+  r.stats = mapper.last_stats();
+  r.map_total_s = cli::seconds_since(t);
+  t = Clock::now();
+  r.map = mapper.finish();
+  r.finish_s = cli::seconds_since(t);
+  r.known = 0;
+  for (float v : r.map.cells) r.known += v != -1.0f;
+  if (r.known == 0) throw carmen::FileError(log, why_nothing_was_mapped(mapper.scans()));
+  r.origin = vasco::world_origin(r.map, r.input.geo);
+}
+
+void write_outputs(const Options &opt, const std::string &log, const std::vector<std::string> &outputs,
+                   const RunResult &r) {
+  carmen::MapToWrite map = vasco::map_to_write(r.map, r.input.geo);
+  map.author = opt.tool;
+  map.source = basename_of(log);
+  map.description = "vasco_gpu " + std::string(vasco::version()) + " " + r.backend;
+  map.time = static_cast<int64_t>(std::time(nullptr));
+  carmen::OutputTransaction tx;
+  for (const std::string &out : outputs) carmen::write_map(tx, out, map);
+  tx.commit();
+}
+
+}  // namespace log2map

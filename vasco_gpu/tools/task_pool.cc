@@ -1,0 +1,44 @@
+#include "task_pool.h"
+
+#include <algorithm>
+
+namespace cli {
+
+TaskPool::TaskPool(int threads) {
+  threads_.reserve(static_cast<size_t>(std::max(threads, 1)));
+  for (int i = 0; i < std::max(threads, 1); ++i) threads_.emplace_back([this] { work(); });
+}
+
+TaskPool::~TaskPool() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  ready_.notify_all();
+  for (std::thread &t : threads_) t.join();
+}
+
+void TaskPool::submit(std::function<void()> task, bool urgent) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    (urgent ? urgent_ : normal_).push_back(std::move(task));
+  }
+  ready_.notify_one();
+}
+
+void TaskPool::work() {
+  for (;;) {
+    std::function<void()> task;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      ready_.wait(lock, [this] { return stopping_ || !urgent_.empty() || !normal_.empty(); });
+      if (urgent_.empty() && normal_.empty()) return;  // stopping, and nothing left
+      std::deque<std::function<void()>> &queue = urgent_.empty() ? normal_ : urgent_;
+      task = std::move(queue.front());
+      queue.pop_front();
+    }
+    task();
+  }
+}
+
+}  // namespace cli
