@@ -4,9 +4,11 @@
 // run_interruptible: on a worker thread, the GIL released, Ctrl-C seen while
 // they run. Calls on one Mapper are serialised by the session lock, which is
 // only ever taken with the GIL released, so a thread waiting for it never
-// stops the others. What len, frame, last_stats, renders and repr report
-// comes from a snapshot published after every call, read under a lock that
-// is held only to copy it: they answer at once, even during an insert.
+// stops the others. What len, frame, params, last_stats, renders and repr
+// report comes from a snapshot published after every call, read under a lock
+// that is held only to copy it: they answer at once, even during an insert.
+// start_over (a new session on the same backend) takes the session lock with
+// the GIL released too, so it lands between two calls, never inside one.
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/optional.h>
@@ -46,6 +48,7 @@ struct Snapshot {
   vasco::GridGeometry frame;
   vasco::MapStats stats;
   size_t renders = 0;
+  vasco::MapperParams params;  // start_over replaces them
 };
 
 struct Session {
@@ -54,11 +57,10 @@ struct Session {
   std::mutex snapshot_lock;  // held only to copy `snapshot`
   Snapshot snapshot;
   std::string backend;
-  vasco::MapperParams params;
 
   // Publishes the mapper's state; call with `lock` held.
   void publish() {
-    Snapshot s{mapper->num_scans(), mapper->frame(), mapper->last_stats(), mapper->renders()};
+    Snapshot s{mapper->num_scans(), mapper->frame(), mapper->last_stats(), mapper->renders(), mapper->params()};
     std::lock_guard<std::mutex> g(snapshot_lock);
     snapshot = s;
   }
@@ -139,7 +141,6 @@ void init_mapper(Session *self, std::optional<vasco::MapperParams> params, const
   }
   auto *s = new (self) Session();
   s->backend = mp->backend_name();
-  s->params = mp->params();
   s->mapper = std::move(mp);
   s->publish();
 }
@@ -153,12 +154,22 @@ void render(Session &s, nb::handle poses) {
   run_interruptible([&] { s.locked([&](vasco::Mapper &m) { m.render(p); }); });
 }
 
+// The defaults are the params in force when the call runs (under the lock:
+// a start_over from another thread lands before or after, never between).
 Map finish(Session &s, std::optional<int> downsample, std::optional<int> border) {
-  const int ds = downsample ? *downsample : static_cast<int>(s.params.downsample);
-  const int b = border ? *border : static_cast<int>(s.params.border);
   return run_interruptible([&] {
-    return s.locked([&](vasco::Mapper &m) { return map_from_finished(m.finish(ds, b), m.frame()); });
+    return s.locked([&](vasco::Mapper &m) {
+      const int ds = downsample ? *downsample : static_cast<int>(m.params().downsample);
+      const int b = border ? *border : static_cast<int>(m.params().border);
+      return map_from_finished(m.finish(ds, b), m.frame());
+    });
   });
+}
+
+void start_over(Session &s, const vasco::MapperParams &params) {
+  const vasco::MapperParams p = params;  // copied while the GIL guards the Params object
+  nb::gil_scoped_release release;
+  s.locked([&](vasco::Mapper &m) { m.start_over(p); });
 }
 
 nb::ndarray<nb::numpy, float> read(Session &s, std::optional<std::tuple<int, int, int, int>> window) {
@@ -235,7 +246,13 @@ void bind_mapper_mapping(nb::class_<Session> &cls) {
       .def("finish", &finish, "downsample"_a = nb::none(), "border"_a = nb::none(),
            "CARMEN's finish of the current grid (block means, crop to the known area plus ``border``),\n"
            "on the GPU for cuda; ``downsample``/``border`` default to the params'. Returns a Map whose\n"
-           "cells are moved, not copied, out of the session.");
+           "cells are moved, not copied, out of the session.")
+      .def("start_over", &start_over, "params"_a,
+           "A new session on the same backend: the stored scans, the frame and the grid dropped,\n"
+           "``params`` in force (validated first: a refusal raises ValueError and changes nothing; a\n"
+           "fixed frame stays, and its resolution must equal the new one). The backend is kept, with\n"
+           "its CUDA context and GPU scratch memory, so that many logs mapped in turn pay its start-up\n"
+           "once (map_logs does this). ``renders`` keeps counting.");
 }
 
 void bind_mapper_arrays(nb::class_<Session> &cls) {
@@ -251,7 +268,8 @@ void bind_mapper_state(nb::class_<Session> &cls) {
   cls.def("__len__", [](Session &s) { return s.state().num_scans; })
       .def_prop_ro("num_scans", [](Session &s) { return s.state().num_scans; }, "Scans stored.")
       .def_prop_ro("frame", [](Session &s) { return s.state().frame; }, "The current frame (a copy).")
-      .def_prop_ro("params", [](Session &s) { return s.params; }, "The session's parameters (a copy).")
+      .def_prop_ro("params", [](Session &s) { return s.state().params; },
+                   "The session's parameters (a copy; start_over replaces them).")
       .def_prop_ro("backend", [](Session &s) { return s.backend; },
                    "The backend's name (cpu_double, cpu_threads, cpu_float, cuda_float, cuda_exact).")
       .def_prop_ro("last_stats", [](Session &s) { return stats_dict(s.state().stats); },

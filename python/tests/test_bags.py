@@ -209,6 +209,27 @@ def test_bag2map_errors_name_the_bag(tmp_path, intel):
     assert r.returncode == 2
 
 
+def test_bag2map_batch_mode_gives_each_bags_map(tmp_path, intel):
+    # log2map's --out-dir through bag2map: bags of two formats mapped in one process, each to
+    # the map its own bag2map run writes; a file that is no bag reported and skipped (exit 1).
+    first = tf_bag(tmp_path, "mcap", intel, name="first", count=500)
+    second = tf_bag(tmp_path, "rosbag1", intel, name="second", first=500)
+    not_a_bag = tmp_path / "notes.bag"
+    not_a_bag.write_text("not a bag\n")
+    out = tmp_path / "maps"
+    r = run_script("bag2map", "--backend", "cpu_threads", "--out-dir", out, "--formats", "map,pgm",
+                   first, not_a_bag, second)
+    assert r.returncode == 1, r.stderr
+    assert "2 of 3 inputs mapped" in r.stderr and "notes.bag" in r.stderr
+    assert sorted(os.listdir(out)) == ["first.map", "first.pgm", "first.yaml", "second.map", "second.pgm", "second.yaml"]
+    for bag, stem in ((first, "first"), (second, "second")):
+        one = tmp_path / f"{stem}_one.map"
+        r = run_script("bag2map", "--backend", "cpu_threads", bag, one)
+        assert r.returncode == 0, r.stderr
+        want, got = vg.read_map(one), vg.read_map(out / f"{stem}.map")
+        assert got.shape == want.shape and np.array_equal(got.cells, want.cells), stem
+
+
 def test_no_return_free_clears_space(tmp_path, intel):
     # Every reading at or beyond 50 m is +inf in this bag: skipped, CARMEN's way, or free
     # up to vasco_range_max, the ROS mappers' way, which knows more cells.

@@ -16,6 +16,14 @@ The mapping session of the C++ library (``vasco::Mapper``) with NumPy arrays in 
 ROS bags (ROS 1 ``.bag``, ROS 2 sqlite3 and MCAP, read with ``rosbags``) give the same ``Log``:
 ``vg.load_bag("run.mcap")``; poses from a SLAM back end: ``vg.load_log(path, poses="opt.g2o")``.
 
+Many logs to files, as log2map's batch mode, here or on the workers of any
+``concurrent.futures.Executor`` (a Dask cluster, a process pool), each worker keeping one
+mapper for all its logs::
+
+    results = vg.map_logs(["a.log.gz", "b.clf"], "maps", formats=("map.gz", "png"),
+                          executor=client.get_executor())     # maps/a.map.gz, maps/a.png, ...
+    failed = [r for r in results if not r.ok]                 # r.error names the file
+
 Arrays: ``Map.cells`` is a float32 view of shape (size_x, size_y) indexed ``cells[x, y]`` as
 CARMEN stores maps (-1 unknown, else the occupancy probability); ``Map.image`` is the same
 memory as a picture (``cells.T[::-1]``, row 0 at the top). ``Scans`` arrays are views too;
@@ -59,11 +67,13 @@ from ._core import (
 )
 from . import _core
 from ._bags import load_bag
+from ._batch import BatchError, LogResult, map_logs
 
 __version__: str = _core.__version__
 
 __all__ = [
     "BadInputError",
+    "BatchError",
     "Comparison",
     "Error",
     "FileError",
@@ -71,6 +81,7 @@ __all__ = [
     "InternalError",
     "IoError",
     "Log",
+    "LogResult",
     "Map",
     "Mapper",
     "NoGpuError",
@@ -88,6 +99,7 @@ __all__ = [
     "has_cuda",
     "load_bag",
     "load_log",
+    "map_logs",
     "read_map",
     "write_map",
 ]

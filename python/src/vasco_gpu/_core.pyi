@@ -625,6 +625,15 @@ class Mapper:
         cells are moved, not copied, out of the session.
         """
 
+    def start_over(self, params: Params) -> None:
+        """
+        A new session on the same backend: the stored scans, the frame and the grid dropped,
+        ``params`` in force (validated first: a refusal raises ValueError and changes nothing; a
+        fixed frame stays, and its resolution must equal the new one). The backend is kept, with
+        its CUDA context and GPU scratch memory, so that many logs mapped in turn pay its start-up
+        once (map_logs does this). ``renders`` keeps counting.
+        """
+
     def read(self, window: tuple[int, int, int, int] | None = None) -> numpy.typing.NDArray[numpy.float32]:
         """
         The full-resolution grid, or the window (x0, y0, width, height) of it, as a (width, height)
@@ -647,7 +656,7 @@ class Mapper:
 
     @property
     def params(self) -> Params:
-        """The session's parameters (a copy)."""
+        """The session's parameters (a copy; start_over replaces them)."""
 
     @property
     def backend(self) -> str:

@@ -1,0 +1,460 @@
+"""map_logs: many CARMEN logs mapped to files, in this process or through any Executor.
+
+``map_logs(paths, out_dir)`` is log2map's batch mode (``log2map --out-dir DIR LOG...``) from
+Python: each log is read, mapped and written to ``DIR/STEM.FORMAT`` for each format, its
+outputs as one transaction, and a failed log is reported, not raised. With an ``executor``
+(any :class:`concurrent.futures.Executor`: a ``ProcessPoolExecutor``, a Dask ``Client``'s
+``get_executor()``, dask-cuda's cluster through its client, ...) one task is submitted per log
+and the logs are mapped where the executor runs them; each worker process keeps one
+:class:`Mapper` per backend configuration for all the logs it maps, so it pays the backend's
+start-up (a CUDA context, device memory) once.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import dataclasses
+import operator
+import os
+import pickle
+import shutil
+import socket
+import tempfile
+import threading
+import time
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+from . import _core
+from ._errors import FileError
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+#: The output formats, as log2map's ``--formats`` names them.
+FORMATS = ("map", "map.gz", "pgm", "png")
+
+# The names Mapper(backend=...) accepts; whether one can run is the worker's business (the
+# process calling map_logs may have no GPU while its workers do).
+_BACKEND_NAMES = ("auto", "cpu_double", "cpu_threads", "cpu_float", "cuda", "cuda_exact", "cuda_float")
+
+
+@dataclasses.dataclass
+class LogResult:
+    """What became of one log of :func:`map_logs`.
+
+    Attributes:
+        path: the log, as given.
+        outputs: the files written (or that would have been), one per format; a ``.pgm``
+            has its ``.yaml`` beside it.
+        ok: whether every output was written.
+        error: why not (the exception's message, naming the file), or None.
+        scans: scans mapped (0 when the log could not be read).
+        backend: the backend that mapped it (``cpu_threads``, ``cuda_float``, ...; the name
+            asked for when no mapper was made).
+        seconds: ``{"read": ..., "map": ..., "write": ...}``: reading the log, mapping it
+            (``start_over``, ``insert``, ``finish``) and writing the outputs.
+        worker: ``"HOST:PID"`` of the process that mapped it.
+        mapper_logs: how many logs that process's mapper has mapped, this one included (1:
+            the mapper was made for it; more: it was reused).
+    """
+
+    path: str
+    outputs: List[str]
+    ok: bool = False
+    error: Optional[str] = None
+    scans: int = 0
+    backend: str = ""
+    seconds: Dict[str, float] = dataclasses.field(default_factory=lambda: {"read": 0.0, "map": 0.0, "write": 0.0})
+    worker: str = ""
+    mapper_logs: int = 0
+    # The exception itself where it survives pickling (fail_fast chains it), else None.
+    exception: Optional[BaseException] = dataclasses.field(default=None, repr=False, compare=False)
+
+
+class BatchError(RuntimeError):
+    """:func:`map_logs` with ``fail_fast=True``: a log failed.
+
+    ``str(error)`` is the failed log's error. Attributes: ``result``, that log's
+    :class:`LogResult`; ``results``, one per path in the order given (logs not run because
+    of the failure have ``ok`` False and say so). The log's own exception is the
+    ``__cause__`` where it could travel back from the worker.
+    """
+
+    def __init__(self, result: LogResult, results: List[LogResult]) -> None:
+        super().__init__(result.error)
+        self.result = result
+        self.results = results
+
+    def __reduce__(self):
+        return (type(self), (self.result, self.results))
+
+
+def output_stem(path: PathLike) -> str:
+    """The name of a log's outputs, as log2map's batch mode makes it: the file name less a
+    trailing ``.gz`` and then less one extension (``fr079-complete.gfs.log.gz`` ->
+    ``fr079-complete.gfs``)."""
+    name = os.fspath(path)
+    while len(name) > 1 and name.endswith("/"):  # a directory (a ROS 2 bag's)
+        name = name[:-1]
+    name = name[name.rfind("/") + 1:]
+    if len(name) > 3 and name.endswith(".gz"):
+        name = name[:-3]
+    dot = name.rfind(".")
+    if dot > 0:
+        name = name[:dot]
+    return name
+
+
+# ---------------------------------------------------------------------------------------------
+# The worker side: one Mapper per backend configuration per process.
+
+
+class _CachedMapper:
+    __slots__ = ("mapper", "lock", "logs")
+
+    def __init__(self) -> None:
+        self.mapper: Optional[_core.Mapper] = None
+        self.lock = threading.Lock()  # held from start_over to finish: one log at a time
+        self.logs = 0
+
+
+_MAPPERS: Dict[Tuple[Any, ...], _CachedMapper] = {}
+_MAPPERS_LOCK = threading.Lock()
+_FORKED_AWAY: List[Dict[Tuple[Any, ...], _CachedMapper]] = []
+
+
+def _forget_mappers_after_fork() -> None:
+    # A forked child must not use its parent's sessions (a CUDA context does not survive a
+    # fork, a lock may have been held by a thread that is gone) nor destroy them: they are kept,
+    # unused, and the child makes its own.
+    global _MAPPERS, _MAPPERS_LOCK
+    _FORKED_AWAY.append(_MAPPERS)
+    _MAPPERS = {}
+    _MAPPERS_LOCK = threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_mappers_after_fork)
+
+
+def _cached_mapper(key: Tuple[Any, ...]) -> _CachedMapper:
+    with _MAPPERS_LOCK:
+        entry = _MAPPERS.get(key)
+        if entry is None:
+            entry = _MAPPERS[key] = _CachedMapper()
+        return entry
+
+
+def _release_mappers() -> int:
+    """Drops this process's cached mappers (their backends, CUDA contexts included, go when
+    no log is mapping on them); returns how many there were."""
+    with _MAPPERS_LOCK:
+        entries = list(_MAPPERS.values())
+        _MAPPERS.clear()
+    for entry in entries:
+        with entry.lock:
+            entry.mapper = None
+    return len(entries)
+
+
+def _error_text(path: str, e: BaseException) -> str:
+    text = str(e) or type(e).__name__
+    return text if path in text else f"{path}: {text}"
+
+
+def _travels(e: BaseException) -> Optional[BaseException]:
+    """``e`` when it survives pickling (a result goes back from a worker pickled), else None."""
+    try:
+        pickle.loads(pickle.dumps(e))
+    except Exception:
+        return None
+    return e
+
+
+def _commit(outputs: Sequence[str], write) -> None:
+    """Writes ``outputs`` as one transaction: ``write(path)`` writes one of them (with what
+    belongs to it, a .pgm's .yaml) under its own name in a hidden staging directory beside
+    it; once every one is written the files are renamed into place, an existing file kept
+    until all renames are done and put back should one fail. The staging directory goes,
+    whatever happens."""
+    staging: Dict[str, str] = {}
+    try:
+        for out in outputs:
+            folder = os.path.dirname(os.path.abspath(out))
+            if folder not in staging:
+                staging[folder] = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.", suffix=".tmp", dir=folder)
+            try:
+                write(os.path.join(staging[folder], os.path.basename(out)))
+            except Exception as e:  # named as the output, not as its temporary
+                text = str(e).replace(staging[folder] + os.sep, folder + os.sep)
+                raise FileError(text, file=out, message=text, code=getattr(e, "code", "I/O")) from e
+        moves = []
+        for folder, stage in staging.items():
+            kept = os.path.join(stage, ".old")
+            os.mkdir(kept)
+            moves += [(os.path.join(stage, n), os.path.join(folder, n), os.path.join(kept, n))
+                      for n in sorted(os.listdir(stage)) if n != ".old"]
+        for _, final, _ in moves:  # every target checked before the first rename
+            if os.path.lexists(final) and not os.path.isfile(final):
+                why = "cannot be replaced: it is not a regular file"
+                raise FileError(f"{final}: {why}", file=final, message=why, code="I/O")
+        done: List[Tuple[str, Optional[str]]] = []
+        try:
+            for staged, final, old in moves:
+                if os.path.lexists(final):
+                    try:
+                        os.link(final, old)
+                    except OSError:
+                        shutil.copy2(final, old)
+                else:
+                    old = None
+                try:
+                    os.replace(staged, final)
+                except OSError as e:
+                    why = f"cannot be replaced: {e.strerror or e}"
+                    raise FileError(f"{final}: {why}", file=final, message=why, code="I/O") from e
+                done.append((final, old))
+        except BaseException:
+            for final, old in reversed(done):
+                try:
+                    if old is None:
+                        os.unlink(final)
+                    else:
+                        os.replace(old, final)
+                except OSError:
+                    pass
+            raise
+    finally:
+        for stage in staging.values():
+            shutil.rmtree(stage, ignore_errors=True)
+
+
+def _map_one(path: PathLike, outputs: Sequence[str], backend: str = "auto", cuda_mode: Optional[str] = None,
+             threads: int = 0, cuda_device: int = 0, max_memory_bytes: Optional[int] = None,
+             load_options: Optional[Dict[str, Any]] = None) -> LogResult:
+    """One log of :func:`map_logs`, in the process that runs it: read, mapped on this
+    process's mapper for (backend, cuda_mode, threads, cuda_device, max_memory_bytes), its
+    outputs written as one transaction. Never raises for the log's failure: the result says."""
+    path = os.fspath(path)
+    result = LogResult(path=path, outputs=[os.fspath(o) for o in outputs], backend=backend,
+                       worker=f"{socket.gethostname()}:{os.getpid()}")
+    t = time.perf_counter()
+    phase = "read"
+    try:
+        log = _core.load_log(path, **(load_options or {}))
+        result.scans = len(log)
+        now = time.perf_counter()
+        result.seconds["read"], t, phase = now - t, now, "map"
+        key = (backend, cuda_mode, threads, cuda_device, max_memory_bytes)
+        entry = _cached_mapper(key)
+        with entry.lock:
+            if entry.mapper is None:
+                kw = {} if max_memory_bytes is None else {"max_memory_bytes": max_memory_bytes}
+                entry.mapper = _core.Mapper(backend=backend, cuda_mode=cuda_mode, threads=threads,
+                                            cuda_device=cuda_device, **kw)
+            mapper = entry.mapper
+            result.backend = mapper.backend
+            try:
+                mapper.start_over(log.params)
+                entry.logs += 1
+                result.mapper_logs = entry.logs
+                mapper.insert(log.scans)
+                del log
+                m = mapper.finish()
+            finally:
+                try:
+                    mapper.start_over(_core.Params())  # the scans' memory goes now, not at the next log
+                except Exception:
+                    pass
+        if m.size_x == 0 or not (m.cells != -1).any():
+            # As log2map: a map without a known cell is not written (finish crops to them).
+            raise FileError(f"{path}: no beam updated any cell", file=path,
+                            message="no beam updated any cell")
+        now = time.perf_counter()
+        result.seconds["map"], t, phase = now - t, now, "write"
+        description = f"vasco_gpu {_core.__version__} {result.backend}"
+        _commit(result.outputs, lambda out: _core.write_map(out, m, description=description))
+        result.seconds["write"] = time.perf_counter() - t
+        result.ok = True
+    except Exception as e:
+        result.seconds[phase] = time.perf_counter() - t
+        result.error = _error_text(path, e)
+        result.exception = _travels(e)
+    return result
+
+
+# ---------------------------------------------------------------------------------------------
+# The caller's side.
+
+
+def _check_formats(formats: Union[str, Sequence[str]]) -> List[str]:
+    if isinstance(formats, str):
+        formats = [formats]
+    formats = list(formats)
+    if not formats:
+        raise ValueError("map_logs: formats: at least one of map, map.gz, pgm, png")
+    for f in formats:
+        if f not in FORMATS:
+            raise ValueError(f"map_logs: format {f!r} is none of map, map.gz, pgm, png")
+        if formats.count(f) > 1:
+            raise ValueError(f"map_logs: format {f!r} is named twice")
+    return formats
+
+
+def _check_options(backend: str, cuda_mode: Optional[str], threads: int, load_options: Dict[str, Any]) -> None:
+    if backend not in _BACKEND_NAMES:
+        raise ValueError(f"map_logs: backend {backend!r}: expected one of {', '.join(_BACKEND_NAMES)}")
+    if cuda_mode not in (None, "float", "exact"):
+        raise ValueError(f"map_logs: cuda_mode {cuda_mode!r}: expected 'float' or 'exact'")
+    try:
+        n = operator.index(threads)
+    except TypeError:
+        n = -1
+    if isinstance(threads, bool) or not 0 <= n <= 1024:
+        raise ValueError(f"map_logs: threads {threads!r}: must be 0 (all cores) to 1024")
+    # load_log's own checks of its options, before any work: a call on no file binds the
+    # keywords (TypeError for an unknown one), reads the ini and the overrides (errors naming
+    # them) and fails on the empty path, the one error expected here.
+    try:
+        _core.load_log("", **load_options)
+    except FileError as e:
+        if e.file != "":
+            raise
+    except TypeError as e:
+        raise TypeError(f"map_logs: {e}") from None
+
+
+def _plan(paths: Sequence[PathLike], out_dir: PathLike, formats: List[str]) -> List[Tuple[str, List[str]]]:
+    if isinstance(paths, (str, bytes, os.PathLike)):
+        raise TypeError("map_logs: paths: expected a list of logs, not one path")
+    out = os.fspath(out_dir)
+    seen: Dict[str, str] = {}
+    plan = []
+    for p in paths:
+        p = os.fspath(p)
+        stem = output_stem(p)
+        if not stem:
+            raise ValueError(f"map_logs: {p!r}: no file name to name its outputs after")
+        if stem in seen:
+            raise ValueError(f"map_logs: {seen[stem]} and {p} would both write {os.path.join(out, stem)}.*: "
+                             "give logs of different names (or map them in two calls)")
+        seen[stem] = p
+        plan.append((p, [os.path.join(out, f"{stem}.{f}") for f in formats]))
+    return plan
+
+
+def _not_run(path: str, outputs: List[str], backend: str) -> LogResult:
+    return LogResult(path=path, outputs=outputs, backend=backend,
+                     error=f"{path}: not mapped: an earlier log failed and fail_fast is set")
+
+
+def _lost(path: str, outputs: List[str], backend: str, e: BaseException) -> LogResult:
+    # The task itself failed (a worker that died, a result that could not travel back).
+    return LogResult(path=path, outputs=outputs, backend=backend,
+                     error=f"{path}: the task failed: {type(e).__name__}: {e}", exception=e)
+
+
+def _raise_fast(failed: LogResult, results: List[LogResult]) -> None:
+    raise BatchError(failed, results) from failed.exception
+
+
+def map_logs(paths: Sequence[PathLike], out_dir: PathLike, formats: Union[str, Sequence[str]] = ("map.gz",),
+             backend: str = "auto", executor: Optional[cf.Executor] = None, *, cuda_mode: Optional[str] = None,
+             threads: int = 0, cuda_device: int = 0, max_memory_bytes: Optional[int] = None,
+             fail_fast: bool = False, **load_options: Any) -> List[LogResult]:
+    """Maps many CARMEN logs to files, as ``log2map --out-dir OUT_DIR --formats ... LOG...`` does.
+
+    Each log ``DIR/NAME.EXT[.gz]`` is read with ``load_log(path, **load_options)`` (its PARAM
+    lines, ``param_file``, ``overrides``, ``lenient``, ``poses``, ... as load_log takes them),
+    mapped with its parameters and written to ``out_dir/NAME.FORMAT`` for each of ``formats``
+    (``map``, ``map.gz``, ``pgm`` with its ``.yaml``, ``png``): the bytes log2map writes for the
+    log with the same backend (the GRIDMAP; the header's time differs). ``out_dir`` is made when
+    missing. A log's outputs are one transaction: all are written under temporary names beside
+    them and renamed at the end, so a failed log leaves no file behind and an existing output
+    untouched.
+
+    ``backend``: as Mapper's (``auto``: cuda when a GPU is usable where the log is mapped, else
+    cpu_threads); ``cuda_mode``, ``threads``, ``cuda_device`` and ``max_memory_bytes`` are
+    Mapper's too (None: its defaults).
+
+    ``executor=None`` maps the logs here, one after the other. Any
+    :class:`concurrent.futures.Executor` maps them where it runs tasks: one task a log
+    (``executor.submit``), each returning its :class:`LogResult`. A Dask cluster::
+
+        from dask.distributed import Client, LocalCluster
+        with LocalCluster(n_workers=4, threads_per_worker=1) as cluster, Client(cluster) as client:
+            results = vg.map_logs(logs, "maps", executor=client.get_executor())
+
+    (dask-cuda's ``LocalCUDACluster`` gives each worker its own GPU the same way), or
+    ``ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"))`` (spawn or
+    forkserver: a process that has used CUDA must not fork). Each process keeps one Mapper,
+    and so one backend and CUDA context, for all the logs it maps (``Mapper.start_over``
+    between them); threads of one process take turns on it. The paths travel to the workers
+    made absolute: they must see the logs and ``out_dir`` at the same place.
+
+    Returns one :class:`LogResult` per path, in their order. A log that fails (cannot be read,
+    mapped or written) is reported in its result (``ok`` False, ``error`` naming the file) and
+    the others go on; with ``fail_fast=True`` the first failure stops the batch: logs not yet
+    started are cancelled, those running finish, then :class:`BatchError` is raised (its
+    ``results`` say what became of each log). An executor that cancels running tasks too
+    (Dask's) reports them as not mapped, though a task that was past its start still writes
+    its outputs, whole.
+
+    Raises before any work: ValueError for a format that is none of map, map.gz, pgm, png (or
+    one named twice), two logs of the same output name (``a/x.log`` and ``b/x.log.gz``), an
+    unknown backend or cuda_mode, threads outside 0..1024; TypeError for a keyword load_log
+    does not take; load_log's errors for its options (a missing ``param_file``, a bad override).
+    """
+    fmts = _check_formats(formats)
+    plan = _plan(paths, out_dir, fmts)
+    _check_options(backend, cuda_mode, threads, load_options)
+    threads = operator.index(threads)
+    os.makedirs(os.fspath(out_dir), exist_ok=True)
+    args = (backend, cuda_mode, threads, cuda_device, max_memory_bytes, load_options)
+
+    if executor is None:
+        results: List[LogResult] = []
+        for i, (path, outputs) in enumerate(plan):
+            r = _map_one(path, outputs, *args)
+            results.append(r)
+            if fail_fast and not r.ok:
+                results += [_not_run(p, o, backend) for p, o in plan[i + 1:]]
+                _raise_fast(r, results)
+        return results
+
+    futures: List[cf.Future] = []
+    try:
+        for path, outputs in plan:
+            futures.append(executor.submit(_map_one, os.path.abspath(path),
+                                           [os.path.abspath(o) for o in outputs], *args))
+    except BaseException:
+        for f in futures:
+            f.cancel()
+        raise
+    index = {f: i for i, f in enumerate(futures)}
+    got: List[Optional[LogResult]] = [None] * len(plan)
+    failed: Optional[LogResult] = None
+
+    def collect(f: cf.Future) -> LogResult:
+        path, outputs = plan[index[f]]
+        if f.cancelled():
+            return _not_run(path, outputs, backend)
+        try:
+            r = f.result()
+        except Exception as e:
+            return _lost(path, outputs, backend, e)
+        # The caller's spelling of the paths, not the absolute ones the task was given.
+        return dataclasses.replace(r, path=path, outputs=list(outputs))
+
+    for f in cf.as_completed(futures):
+        i = index[f]
+        got[i] = collect(f)
+        if fail_fast and not got[i].ok:
+            failed = got[i]
+            for g in futures:
+                g.cancel()
+            cf.wait(futures)
+            break
+    results = [r if r is not None else collect(futures[i]) for i, r in enumerate(got)]
+    if failed is not None:
+        _raise_fast(failed, results)
+    return results
