@@ -208,6 +208,25 @@ TEST_F(MapperCuda, FloatSessionIsTheSameBytesWhateverTheRunAndTheInserts) {
   testing_support::expect_bit_identical(first, grown.read(), geo, "float inserts of 50 scans, rendered again");
 }
 
+// start_over keeps the renderer (its context, scratch, and in float mode
+// the ranges it sent): the next log's map must be a fresh Mapper's, in
+// both modes. Float mode once kept the first log's ranges on the device
+// and mapped the second log's beams with them.
+TEST_F(MapperCuda, StartOverMapsTheNextLogAsAFreshMapperInEitherMode) {
+  const ScanBatch first = scans_.select(0, 350), second = scans_.select(350, 350);
+  for (CudaMode cm : {CudaMode::Float, CudaMode::Exact}) {
+    SCOPED_TRACE(cm == CudaMode::Float ? "float" : "exact");
+    Mapper m(params_, "cuda", mode(cm));
+    m.insert(first);
+    m.start_over(params_);
+    m.insert(second);
+    Mapper fresh(params_, "cuda", mode(cm));
+    fresh.insert(second);
+    testing_support::expect_bit_identical(fresh.read(), m.read(), fresh.frame(), m.backend_name() + " after start_over");
+    EXPECT_EQ(golden::digest(m.finish()), golden::digest(fresh.finish()));
+  }
+}
+
 // Both modes look updates up in per-(i, j) tables when the table is small
 // enough and compute them in full otherwise (VASCO_CUDA_NO_TABLES forces the
 // latter): the two must agree bit for bit, and exact mode with cpu_double.

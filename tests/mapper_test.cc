@@ -83,6 +83,30 @@ TEST_P(MapperExact, InsertsInPiecesEqualOneShot) {
   testing_support::expect_bit_identical(one_shot, m.read(), protocol, m.backend_name() + ", rendered again");
 }
 
+// start_over: a second log mapped on the same renderer gives the map a
+// fresh Mapper gives it (nothing of the first log stays), new params in
+// force; refused params change nothing.
+TEST_P(MapperExact, StartOverMapsTheNextLogAsAFreshMapper) {
+  const Fixture f = fr079(400);
+  const ScanBatch first = part(f.scans, 0, 200), second = part(f.scans, 200, 400);
+  MapperParams other = f.params;
+  other.p_occ = 0.7;  // the second log's own parameters
+  Mapper m = make(f.params);
+  m.insert(first);
+  MapperParams bad = other;
+  bad.resolution = -1;
+  EXPECT_THROW(m.start_over(bad), Error);
+  EXPECT_EQ(m.num_scans(), first.num_scans()) << "a refused start_over changes nothing";
+  m.start_over(other);
+  EXPECT_EQ(m.num_scans(), 0u);
+  EXPECT_EQ(m.params().p_occ, 0.7);
+  m.insert(second);
+  Mapper fresh = make(other);
+  fresh.insert(second);
+  testing_support::expect_bit_identical(fresh.read(), m.read(), fresh.frame(), m.backend_name() + " after start_over");
+  EXPECT_EQ(golden::digest(m.finish()), golden::digest(fresh.finish()));
+}
+
 TEST_P(MapperExact, RenderWithNewPosesEqualsAFreshMapOfALogCarryingThem) {
   const Fixture f = fr079(600);
   Mapper m = make(f.params);

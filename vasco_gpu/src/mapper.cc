@@ -186,6 +186,7 @@ void Mapper::start_over(const MapperParams &params) {
   grid_lost_ = false;
   shift_invariant_ = true;
   if (!fixed_frame_) geo_ = grid_ = GridGeometry();
+  renderer_->forget_scans();  // the next log's beams are not the last one's
 }
 
 void Mapper::check_grid_usable(const char *what) const {

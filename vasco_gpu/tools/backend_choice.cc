@@ -10,16 +10,19 @@ namespace log2map {
 
 namespace {
 
-// Measured on an H200 host (16 cores) with `log2map --json` (seconds.map
-// against cell_updates) over the bundled logs; see the README's
-// "Choosing a backend". One core of cpu_threads updates about this many
-// cells a second (the threads scale close to linearly: the grid is split
-// into stripes with no shared cell).
-constexpr double kCpuCellsPerCoreSecond = 6.0e7;
-// The GPU: start-up of a process's first CUDA use (context and module) and
-// cells a second once running (float mode; exact mode is within 2x).
-constexpr double kGpuStartSeconds = 0.28;
-constexpr double kGpuCellsPerSecond = 2.0e10;
+// Measured on an H200 host (16 cores, CUDA 13) by `python3 bench/batch_bench.py`
+// (its last table; README "Choosing a backend"): one core of cpu_threads
+// updates about 7.0e7 cells a second on fr101 (3.0e8 cells in 0.27 s on 16
+// cores; the threads scale close to linearly: the grid is split into
+// stripes with no shared cell), the GPU 2.3e10 once running (float mode;
+// exact mode is within 2x), and its start-up in one process (context and
+// module) costs 0.29 s of wall-clock time. Another host's cores may be
+// faster or slower (a 2-core development machine measured 9e7): batch_bench
+// prints its values; a wrong rate moves the choice only for logs on which
+// both backends take about as long.
+constexpr double kCpuCellsPerCoreSecond = 7.0e7;
+constexpr double kGpuStartSeconds = 0.29;
+constexpr double kGpuCellsPerSecond = 2.3e10;
 
 }  // namespace
 

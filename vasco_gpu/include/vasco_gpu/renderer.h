@@ -56,6 +56,11 @@ class Renderer {
   // since its reset (CUDA float mode's fixed-point range); the Mapper asks
   // before it stores scans or poses. By default every count fits.
   virtual void check_capacity(uint64_t beams) const { (void)beams; }
+  // The session's scans were replaced by others (Mapper::start_over): a
+  // renderer that keeps a copy of the scans applied so far (CUDA float
+  // mode's device ranges, sent once and reused) must drop it. The grid is
+  // reset before the next apply, as always.
+  virtual void forget_scans() {}
   // What the renderer is: the Mapper asks this instead of reading its name.
   virtual RendererTraits traits() const = 0;
 };

@@ -17,6 +17,7 @@ class CudaFloatRenderer final : public CudaRenderer {
   CudaFloatRenderer(const BackendOptions &options, cudaStream_t stream) : CudaRenderer(options, stream, false) {}
   std::string name() const override { return "cuda_float"; }
   void check_capacity(uint64_t beams) const override;
+  void forget_scans() override { ranges_.forget(); }
 
  private:
   void reserve_grid(const GridGeometry &geo) override;

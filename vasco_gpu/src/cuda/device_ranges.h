@@ -22,6 +22,8 @@ class DeviceRanges {
   void upload(const ScanBatch &scans, size_t last, cudaStream_t stream);
   // The ranges sent since the last commit are those of the session's scans.
   void commit() { stored_ = sent_; }
+  // The session's scans are others now: none of the ranges here is theirs.
+  void forget() { stored_ = sent_ = 0; }
   const float *get() const { return ranges_.get(); }
 
  private:
