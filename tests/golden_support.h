@@ -249,6 +249,21 @@ inline carmen::Agreement compare_finished(const FinishedMap &ref, const Finished
 inline std::string carried_dir() { return std::string(VASCO_TEST_DATA_DIR) + "/golden"; }
 inline std::vector<Case> carried_cases() { return read_cases(carried_dir() + "/SHA256SUMS"); }
 
+// CARMEN's digest of the carried case `name` (`<log>__<params>`).
+inline std::string carried_digest(const std::string &name) {
+  for (const Case &c : carried_cases())
+    if (c.name == name) return c.sha256;
+  throw std::runtime_error(carried_dir() + "/SHA256SUMS: no case " + name);
+}
+
+// The GRIDMAP payload digest of the map file at `path` (what SHA256SUMS holds).
+inline std::string map_file_digest(const std::string &path) {
+  const carmen::MapFile mf = carmen::read_map_file(path);
+  if (!mf.gridmap) return "no GRIDMAP in " + path;
+  return carmen::gridmap_payload_sha256(mf.gridmap->size_x, mf.gridmap->size_y, mf.gridmap->resolution,
+                                        mf.gridmap->cells);
+}
+
 // Where `got` departs from the golden map file, cell by cell (when the
 // project carries that map).
 inline std::string cell_report(const Case &c, const FinishedMap &got) {

@@ -5,12 +5,9 @@
 // it. Skips without a usable GPU.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <map>
 #include <string>
 #include <vector>
 
-#include "carmen_compat/map_digest.h"
 #include "carmen_compat/map_file.h"
 #include "golden_support.h"
 #include "map_test_support.h"
@@ -21,20 +18,14 @@ namespace {
 using maptest::TempDir;
 using tooltest::contains;
 using tooltest::ToolRun;
+using vasco::golden::carried_digest;
+using vasco::golden::map_file_digest;
 
 ToolRun log2map(const std::vector<std::string> &args) { return tooltest::run_tool("log2map", args, true); }
 
 const std::string kLogs = VASCO_LOGS_DIR;
 const std::string kIntel = kLogs + "/intel.gfs.log.gz";
 const std::string kFr079 = kLogs + "/fr079-complete.gfs.log.gz";
-const std::string kGolden = std::string(VASCO_TEST_DATA_DIR) + "/golden";
-
-std::string digest_of(const std::string &path) {
-  const carmen::MapFile mf = carmen::read_map_file(path);
-  if (!mf.gridmap) return "no GRIDMAP in " + path;
-  return carmen::gridmap_payload_sha256(mf.gridmap->size_x, mf.gridmap->size_y, mf.gridmap->resolution,
-                                        mf.gridmap->cells);
-}
 
 class Log2MapBatchCuda : public ::testing::Test {
  protected:
@@ -45,16 +36,15 @@ class Log2MapBatchCuda : public ::testing::Test {
 };
 
 TEST_F(Log2MapBatchCuda, ExactModeWritesCarmensMaps) {
-  std::map<std::string, std::string> golden;
-  std::ifstream in(kGolden + "/SHA256SUMS");
-  for (std::string sha, name; in >> sha >> name;) golden[name] = sha;
   TempDir dir;
   const ToolRun r = log2map({"--backend", "cuda", "--cuda-mode", "exact", "--device", "0", "--param-file",
-                             kGolden + "/params/vasco_default_ds4.ini", "--out-dir", dir.file("maps"), kIntel, kFr079});
+                             vasco::golden::carried_dir() + "/params/vasco_default_ds4.ini", "--out-dir",
+                             dir.file("maps"), kIntel, kFr079});
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "backend cuda_exact")) << r.output;
-  EXPECT_EQ(digest_of(dir.file("maps/intel.gfs.map.gz")), golden.at("intel.gfs__vasco_default_ds4"));
-  EXPECT_EQ(digest_of(dir.file("maps/fr079-complete.gfs.map.gz")), golden.at("fr079-complete.gfs__vasco_default_ds4"));
+  EXPECT_EQ(map_file_digest(dir.file("maps/intel.gfs.map.gz")), carried_digest("intel.gfs__vasco_default_ds4"));
+  EXPECT_EQ(map_file_digest(dir.file("maps/fr079-complete.gfs.map.gz")),
+            carried_digest("fr079-complete.gfs__vasco_default_ds4"));
 }
 
 TEST_F(Log2MapBatchCuda, FloatModeGivesEachLogsOneRunMap) {
@@ -65,7 +55,7 @@ TEST_F(Log2MapBatchCuda, FloatModeGivesEachLogsOneRunMap) {
   for (const std::string stem : {"intel.gfs", "fr079-complete.gfs"}) {
     const ToolRun one = log2map({"--backend", "cuda", "--quiet", kLogs + "/" + stem + ".log.gz", dir.file(stem + ".map.gz")});
     ASSERT_EQ(one.status, 0) << one.output;
-    EXPECT_EQ(digest_of(dir.file("maps/" + stem + ".map.gz")), digest_of(dir.file(stem + ".map.gz"))) << stem;
+    EXPECT_EQ(map_file_digest(dir.file("maps/" + stem + ".map.gz")), map_file_digest(dir.file(stem + ".map.gz"))) << stem;
   }
 }
 

@@ -10,12 +10,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <string>
 #include <vector>
 
-#include "carmen_compat/map_digest.h"
 #include "carmen_compat/map_file.h"
+#include "golden_support.h"
 #include "map_test_support.h"
 #include "tool_support.h"
 
@@ -24,6 +23,8 @@ namespace {
 using maptest::TempDir;
 using tooltest::contains;
 using tooltest::ToolRun;
+using vasco::golden::carried_digest;
+using vasco::golden::map_file_digest;
 
 ToolRun log2map(const std::vector<std::string> &args) { return tooltest::run_tool("log2map", args, true); }
 
@@ -31,22 +32,6 @@ const std::string kLogs = VASCO_LOGS_DIR;
 const std::string kIntel = kLogs + "/intel.gfs.log.gz";
 const std::string kFr079 = kLogs + "/fr079-complete.gfs.log.gz";
 const std::string kFr101 = kLogs + "/fr101.carmen.log.gz";
-const std::string kGolden = std::string(VASCO_TEST_DATA_DIR) + "/golden";
-
-// CARMEN's GRIDMAP digests (tests/data/golden/SHA256SUMS), by case name.
-std::map<std::string, std::string> golden_digests() {
-  std::map<std::string, std::string> d;
-  std::ifstream in(kGolden + "/SHA256SUMS");
-  for (std::string sha, name; in >> sha >> name;) d[name] = sha;
-  return d;
-}
-
-std::string digest_of(const std::string &path) {
-  const carmen::MapFile mf = carmen::read_map_file(path);
-  if (!mf.gridmap) return "no GRIDMAP in " + path;
-  return carmen::gridmap_payload_sha256(mf.gridmap->size_x, mf.gridmap->size_y, mf.gridmap->resolution,
-                                        mf.gridmap->cells);
-}
 
 bool exists(const std::string &path) { return std::filesystem::exists(path); }
 
@@ -63,18 +48,17 @@ std::string read_all(const std::string &path) {
 }
 
 TEST(Log2MapBatch, EveryOutputIsCarmensMap) {
-  const auto golden = golden_digests();
-  ASSERT_EQ(golden.count("intel.gfs__vasco_default_ds4"), 1u);
-  ASSERT_EQ(golden.count("fr079-complete.gfs__vasco_default_ds4"), 1u);
+  ASSERT_FALSE(carried_digest("intel.gfs__vasco_default_ds4").empty());  // throws when the case is missing
+  ASSERT_FALSE(carried_digest("fr079-complete.gfs__vasco_default_ds4").empty());
   for (const char *backend : {"cpu_double", "cpu_threads"}) {
     TempDir dir;
     const std::string out = dir.file("maps");
-    const ToolRun r = log2map({"--backend", backend, "--param-file", kGolden + "/params/vasco_default_ds4.ini",
+    const ToolRun r = log2map({"--backend", backend, "--param-file", vasco::golden::carried_dir() + "/params/vasco_default_ds4.ini",
                                "--out-dir", out, "--formats", "map.gz,map", kIntel, kFr079});
     ASSERT_EQ(r.status, 0) << r.output;
     for (const char *fmt : {".map.gz", ".map"}) {
-      EXPECT_EQ(digest_of(out + "/intel.gfs" + fmt), golden.at("intel.gfs__vasco_default_ds4")) << backend << fmt;
-      EXPECT_EQ(digest_of(out + "/fr079-complete.gfs" + fmt), golden.at("fr079-complete.gfs__vasco_default_ds4"))
+      EXPECT_EQ(map_file_digest(out + "/intel.gfs" + fmt), carried_digest("intel.gfs__vasco_default_ds4")) << backend << fmt;
+      EXPECT_EQ(map_file_digest(out + "/fr079-complete.gfs" + fmt), carried_digest("fr079-complete.gfs__vasco_default_ds4"))
           << backend << fmt;
     }
     EXPECT_TRUE(contains(r.output, "2 of 2 inputs mapped")) << r.output;
@@ -92,7 +76,7 @@ TEST(Log2MapBatch, EachOutputIsTheMapOfARunOnThatLogAlone) {
     const ToolRun one = log2map({"--backend", "cpu_threads", "--quiet", log, dir.file(stem + ".map.gz"),
                                  dir.file(stem + ".pgm"), dir.file(stem + ".png")});
     ASSERT_EQ(one.status, 0) << one.output;
-    EXPECT_EQ(digest_of(dir.file("batch/" + stem + ".map.gz")), digest_of(dir.file(stem + ".map.gz"))) << stem;
+    EXPECT_EQ(map_file_digest(dir.file("batch/" + stem + ".map.gz")), map_file_digest(dir.file(stem + ".map.gz"))) << stem;
     for (const char *ext : {".pgm", ".yaml", ".png"}) {
       const std::string a = read_all(dir.file("batch/" + stem + ext)), b = read_all(dir.file(stem + ext));
       // The YAML names its image: the same name in another directory.
@@ -177,7 +161,7 @@ TEST(Log2MapAuto, OneLogSaysWhatItChoseAndWhy) {
   const ToolRun quiet = log2map({"--backend", "auto", "--quiet", kIntel, dir.file("b.map")});
   ASSERT_EQ(quiet.status, 0) << quiet.output;
   EXPECT_EQ(quiet.output, "");
-  EXPECT_EQ(digest_of(dir.file("a.map")), digest_of(dir.file("b.map")));
+  EXPECT_EQ(map_file_digest(dir.file("a.map")), map_file_digest(dir.file("b.map")));
 }
 
 }  // namespace
