@@ -199,7 +199,7 @@ int run(const Options &opt, const ToolSpec &spec) {
   auto t = Clock::now();
   {
     ProgressBar bar(spec.read ? "read" : "parse", progress_wanted(opt));
-    r.input = read_input(opt, spec, &bar);
+    r.input = read_input(opt, opt.log, spec, &bar);
   }
   r.parse_s = seconds_since(t);
   if (gpu_ready.valid()) gpu_ready.wait();

@@ -145,11 +145,9 @@ class BatchRun {
     pool_.submit([this, i, done] {
       if (stop_) return done->set_value(nullptr);
       try {
-        Options one = opt_;
-        one.log = opt_.inputs[i];
         auto r = std::make_unique<RunResult>();
         const auto t = cli::Clock::now();
-        r->input = read_input(one, spec_, nullptr);
+        r->input = read_input(opt_, opt_.inputs[i], spec_, nullptr);
         r->parse_s = cli::seconds_since(t);
         done->set_value(std::move(r));
       } catch (...) {

@@ -61,9 +61,9 @@ vasco::BackendOptions backend_options(const Options &opt) {
   return bopt;
 }
 
-vasco::LogInput read_input(const Options &opt, const ToolSpec &spec, ProgressBar *bar) {
+vasco::LogInput read_input(const Options &opt, const std::string &log, const ToolSpec &spec, ProgressBar *bar) {
   vasco::LogInputOptions in;
-  in.log = opt.log;
+  in.log = log;
   in.transform = opt.transform;
   in.poses = opt.poses;
   in.param_file = opt.param_file;
@@ -87,7 +87,7 @@ vasco::LogInput read_input(const Options &opt, const ToolSpec &spec, ProgressBar
   if (opt.poses.match.skip_unmatched) values["skip-unposed"] = "1";
   const auto no_progress = [](uint64_t, uint64_t) {};
   const std::function<void(uint64_t, uint64_t)> progress = in.progress ? in.progress : no_progress;
-  vasco::StampedScans scans = spec.read(opt.log, values, progress);
+  vasco::StampedScans scans = spec.read(log, values, progress);
   for (const vasco::SessionInput &more : opt.more) {
     if (bar != nullptr) bar->done();
     scans.append(spec.read(more.path, values, progress), more.transform);

@@ -62,9 +62,10 @@ struct RunResult {
 };
 
 // Parameters (command line > ini > the log's PARAM lines > defaults), the
-// scans of opt.log (and of every session, with poses from --poses when
-// given) and the grid; `bar` (optional) shows the reading.
-vasco::LogInput read_input(const Options &opt, const ToolSpec &spec, ProgressBar *bar);
+// scans of `log` (opt.log, or one input of a batch; and of every session,
+// with poses from --poses when given) and the grid; `bar` (optional) shows
+// the reading. `opt` is shared by every input of a batch, never copied.
+vasco::LogInput read_input(const Options &opt, const std::string &log, const ToolSpec &spec, ProgressBar *bar);
 
 // Maps r.input's scans on `mapper` (started over with the input's
 // parameters) and finishes the map; r.input.batch is handed to the mapper.
