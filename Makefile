@@ -5,6 +5,21 @@
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
+# The CUDA code of a development build (make, make test, make demo): machine
+# code for the GPU of this machine where one is visible, PTX alone where none
+# is (a GPU found later compiles it once, on first use). `make install` and the
+# pip wheel build every architecture of cmake/cuda_architectures.cmake instead.
+DEV_CUDA_ARCHS ?= $(shell nvidia-smi -L >/dev/null 2>&1 && echo native || echo 75-virtual)
+CONFIGURE_ARGS = -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES=$(DEV_CUDA_ARCHS) $(CMAKE_FLAGS)
+INSTALL_BUILD ?= build-install
+INSTALL_CONFIGURE_ARGS = -DCMAKE_BUILD_TYPE=Release -DVASCO_GPU_BUILD_TESTS=OFF -DVASCO_GPU_BUILD_BENCH=OFF $(CMAKE_FLAGS)
+
+# $(call configure_in,DIR,ARGS): configures DIR when it has no cache yet or was
+# last configured by make with other arguments, so that a changed CMAKE_FLAGS
+# takes effect. (A -D flag, once given, stays in DIR's cache when a later make
+# leaves it out, as with cmake itself; `make clean` forgets it.)
+configure_in = if [ ! -f $(1)/CMakeCache.txt ] || [ "$$(cat $(1)/.make-configure-args 2>/dev/null)" != "$(2)" ]; then \
+	  cmake -S . -B $(1) $(2) && echo "$(2)" > $(1)/.make-configure-args; fi
 GOLDEN_DIR ?= ../shared/golden
 GOLDEN_DATA ?= ../shared/data
 
@@ -14,17 +29,20 @@ all: configure
 	cmake --build $(BUILD) -j $(JOBS)
 
 configure: deps
-	@test -f $(BUILD)/CMakeCache.txt || cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
+	@$(call configure_in,$(BUILD),$(CONFIGURE_ARGS))
 
 test: all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow
 
 # Installs headers, static and shared libraries (also under CARMEN's names libegrid,
 # libmap_io, libreadlog), tools, the CMake package, vasco_gpu.pc (shared) and
-# vasco_gpu-static.pc into PREFIX.
+# vasco_gpu-static.pc into PREFIX, from a build of its own ($(INSTALL_BUILD):
+# no tests, CUDA code for every architecture).
 PREFIX ?= /usr/local
-install: all
-	cmake --install $(BUILD) --prefix $(PREFIX)
+install: deps
+	@$(call configure_in,$(INSTALL_BUILD),$(INSTALL_CONFIGURE_ARGS))
+	cmake --build $(INSTALL_BUILD) -j $(JOBS)
+	cmake --install $(INSTALL_BUILD) --prefix $(PREFIX)
 
 # The CPU test suite under AddressSanitizer + UndefinedBehaviorSanitizer
 # (a separate build in build-asan).
@@ -61,12 +79,15 @@ golden: all
 	@$(BUILD)/bin/golden_check --golden $(GOLDEN_DIR) --data $(GOLDEN_DATA); rc=$$?; \
 	  if [ $$rc = 77 ]; then echo "make golden: $(GOLDEN_DIR) is not here: no golden maps to check against"; exit 0; fi; exit $$rc
 
-demo: all
+# Builds log2map alone, then maps the bundled log.
+demo: configure
+	cmake --build $(BUILD) -j $(JOBS) --target log2map
 	$(BUILD)/bin/log2map logs/fr079-complete.gfs.log.gz $(BUILD)/fr079.png $(BUILD)/fr079.map.gz
 
 # Parse speed, the -O2 reference, the mapping table, then the mapping-session
 # table (GPU rows when a GPU is usable).
 bench: all
+	cmake --build $(BUILD) -j $(JOBS) --target benchmarks
 	$(BUILD)/bin/parse_bench
 	$(BUILD)/bin/oracle_o2_bench
 	$(BUILD)/bin/mapping_bench
@@ -106,4 +127,4 @@ deps:
 	fi
 
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) $(INSTALL_BUILD)

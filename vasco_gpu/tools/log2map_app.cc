@@ -106,8 +106,8 @@ void print_summary(const Options &opt, const RunResult &r) {
                  (unsigned long long)ls.nan_ranges, (unsigned long long)ls.inf_ranges,
                  (unsigned long long)ls.negative_ranges);
   if (ls.total_bad_lines())
-    std::fprintf(stderr, "%s: lenient: skipped %llu bad lines\n%s", opt.tool.c_str(), (unsigned long long)ls.total_bad_lines(),
-                 ls.summary().c_str());
+    std::fprintf(stderr, "%s: lenient: skipped %llu bad lines\n%s\n", opt.tool.c_str(),
+                 (unsigned long long)ls.total_bad_lines(), ls.summary().c_str());
   std::fprintf(stderr, "%s: grid %d x %d at %g m -> map %d x %d at %g m (%llu known cells)\n", opt.tool.c_str(), geo.size_x,
                geo.size_y, geo.resolution, r.map.size_x, r.map.size_y, r.map.resolution,
                (unsigned long long)r.known);
@@ -202,10 +202,20 @@ int run(const Options &opt, const ToolSpec &spec) {
     r.input = read_input(opt, opt.log, spec, &bar);
   }
   r.parse_s = seconds_since(t);
-  if (gpu_ready.valid()) gpu_ready.wait();
-  make_map(opt, bopt, r);
+  {
+    PhaseTicker ticker("start the GPU", progress_wanted(opt) && gpu_ready.valid());
+    if (gpu_ready.valid()) gpu_ready.wait();
+  }
+  {
+    PhaseTicker ticker("map (" + (opt.backend == "auto" ? std::string("auto") : opt.backend) + ")",
+                       progress_wanted(opt));
+    make_map(opt, bopt, r);
+  }
   t = Clock::now();
-  write_outputs(opt, opt.log, opt.outputs, r);
+  {
+    PhaseTicker ticker("write", progress_wanted(opt));
+    write_outputs(opt, opt.log, opt.outputs, r);
+  }
   r.write_s = seconds_since(t);
   r.total_s = seconds_since(t_start);
   print_report(opt, r);

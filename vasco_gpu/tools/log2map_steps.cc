@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <map>
@@ -35,6 +36,33 @@ void ProgressBar::done() {
   last_ = -1;
 }
 
+PhaseTicker::PhaseTicker(std::string label, bool enabled) : label_(std::move(label)) {
+  if (enabled) thread_ = std::thread([this] { tick(); });
+}
+
+PhaseTicker::~PhaseTicker() {
+  if (!thread_.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  stop_cv_.notify_one();
+  thread_.join();
+}
+
+void PhaseTicker::tick() {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (stop_cv_.wait_for(lock, std::chrono::milliseconds(500), [this] { return stop_; })) return;
+  do {
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "\r%-24s %6.1f s", label_.c_str(), s);
+    std::fflush(stderr);
+  } while (!stop_cv_.wait_for(lock, std::chrono::milliseconds(200), [this] { return stop_; }));
+  std::fprintf(stderr, "\r%*s\r", 60, "");
+  std::fflush(stderr);
+}
+
 bool progress_wanted(const Options &opt) { return !opt.quiet && isatty(STDERR_FILENO); }
 
 std::string basename_of(const std::string &path) {
@@ -61,7 +89,31 @@ vasco::BackendOptions backend_options(const Options &opt) {
   return bopt;
 }
 
+namespace {
+
+vasco::LogInput read_input_once(const Options &opt, const std::string &log, const ToolSpec &spec, ProgressBar *bar);
+
+}  // namespace
+
+// --lenient skips bad lines, and only them: a file that cannot be read on (a
+// truncated or corrupt .gz, a read error) still stops the run, since the map
+// would silently lack the rest of the log. The message says so.
 vasco::LogInput read_input(const Options &opt, const std::string &log, const ToolSpec &spec, ProgressBar *bar) {
+  try {
+    return read_input_once(opt, log, spec, bar);
+  } catch (const carmen::FileError &e) {
+    // A failure at a line of a lenient read is the file's, not a line's.
+    if (!opt.lenient || e.line() <= 0) throw;
+    throw carmen::FileError(e.file(), e.line(),
+                            e.message() + " (--lenient skips bad lines, not a damaged file: the run stops rather "
+                                          "than map part of the log)",
+                            e.code());
+  }
+}
+
+namespace {
+
+vasco::LogInput read_input_once(const Options &opt, const std::string &log, const ToolSpec &spec, ProgressBar *bar) {
   vasco::LogInputOptions in;
   in.log = log;
   in.transform = opt.transform;
@@ -95,8 +147,6 @@ vasco::LogInput read_input(const Options &opt, const std::string &log, const Too
   if (bar != nullptr) bar->done();
   return vasco::log_input_from_scans(std::move(scans), in);
 }
-
-namespace {
 
 // Why a log's scans updated no cell, for the error that says so (there is
 // no map to write: finish crops to the known cells).

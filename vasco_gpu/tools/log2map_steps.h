@@ -5,6 +5,9 @@
 #ifndef VASCO_GPU_TOOLS_LOG2MAP_STEPS_H
 #define VASCO_GPU_TOOLS_LOG2MAP_STEPS_H
 
+#include <condition_variable>
+#include <mutex>
+#include <thread>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -34,6 +37,26 @@ class ProgressBar {
   bool enabled_;
   int last_ = -1;
   bool shown_ = false;
+};
+
+// A phase whose progress has no measure (the mapping and finish, the
+// writing): once it has lasted half a second, "label  1.3 s" on stderr,
+// redrawn five times a second until the phase ends (then erased). Only when
+// enabled (a terminal). Its thread only sleeps and prints.
+class PhaseTicker {
+ public:
+  PhaseTicker(std::string label, bool enabled);
+  ~PhaseTicker();
+  PhaseTicker(const PhaseTicker &) = delete;
+  PhaseTicker &operator=(const PhaseTicker &) = delete;
+
+ private:
+  void tick();
+  std::string label_;
+  std::mutex mutex_;
+  std::condition_variable stop_cv_;
+  bool stop_ = false;
+  std::thread thread_;
 };
 
 // Whether progress bars are drawn: a terminal on stderr and no --quiet.
