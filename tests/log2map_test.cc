@@ -300,8 +300,10 @@ TEST(Log2Map, SmallDefectsGiveClearErrors) {
   // --threads 100000: a usage error, not a raw errno.
   EXPECT_EQ(log2map({"--threads", "100000", kIntel, dir.file("a.map")}).status, 2);
   // vasco_downsample larger than the grid and range_max 0 name the key.
+  // Every bad --vasco_KEY value is the command line's fault, so a usage error
+  // (exit 2), this one too, though it takes the log's grid to see it.
   const ToolRun ds = log2map({"--vasco_downsample", "1000000", kIntel, dir.file("a.map")});
-  EXPECT_EQ(ds.status, 1);
+  EXPECT_EQ(ds.status, 2);
   EXPECT_TRUE(contains(ds.output, "command line: vasco_downsample = 1000000 is larger than the grid")) << ds.output;
   const ToolRun rm = log2map({"--vasco_range_max", "0", kIntel, dir.file("a.map")});
   EXPECT_EQ(rm.status, 2);
@@ -450,6 +452,71 @@ TEST(Log2Map, JsonToAFullStdoutSaysTheMapsWereWritten) {
   std::string err;
   EXPECT_EQ(log2map_json_to(dir, ">/dev/full", &err), 1);
   EXPECT_TRUE(contains(err, "the maps were written")) << err;
+}
+
+}  // namespace
+
+namespace {
+
+const std::string kTestLogs = std::string(VASCO_TEST_DATA_DIR) + "/logs/";
+
+TEST(Log2MapConventions, EveryMessageNamesTheProgramAndABadParameterValueIsAUsageError) {
+  TempDir dir;
+  const ToolRun none = log2map({});
+  EXPECT_EQ(none.status, 2);
+  EXPECT_EQ(none.output.rfind("log2map: ", 0), 0u) << none.output;
+  const ToolRun bad = log2map({kIntel, dir.file("a.map"), "--vasco_range_max", "abc"});
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "log2map: command line: vasco_range_max: 'abc' is not a number")) << bad.output;
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(Log2MapConventions, ShortQuietFlagAndHelpShowsEachParametersMeaningAndDefault) {
+  TempDir dir;
+  const ToolRun q = log2map({"-q", "--backend", "cpu_threads", kIntel, dir.file("a.map")});
+  EXPECT_EQ(q.status, 0) << q.output;
+  EXPECT_EQ(q.output, "");
+  const ToolRun help = log2map({"--help"});
+  EXPECT_TRUE(contains(help.output, "--vasco_p_occ VALUE         evidence of a hit (default 0.55)")) << help.output;
+  EXPECT_TRUE(contains(help.output, "(default 0.025)")) << help.output;
+}
+
+TEST(Log2MapConventions, OptionsThatDoNothingForTheBackendAreWarnedAboutAndInTheJson) {
+  TempDir dir;
+  const ToolRun r = log2map({"--json", "-q", "--backend", "cpu_double", "--cuda-mode", "exact", "--threads", "2",
+                             "--robot", "r2", kIntel, dir.file("a.map")});
+  EXPECT_EQ(r.status, 0) << r.output;
+  for (const char *w : {"log2map: warning: --cuda-mode does nothing with --backend cpu_double",
+                        "log2map: warning: --threads does nothing with --backend cpu_double",
+                        "log2map: warning: --robot does nothing without --param-file"})
+    EXPECT_TRUE(contains(r.output, w)) << w << "\n" << r.output;
+  EXPECT_TRUE(contains(r.output, "\"warnings\":[\"--cuda-mode does nothing")) << r.output;
+  // The effective parameters: the defaults here, one overridden.
+  const ToolRun o = log2map({"--json", "-q", "--backend", "cpu_double", "--vasco_downsample", "2", kIntel,
+                             dir.file("b.map")}, false);
+  EXPECT_TRUE(contains(o.output, "\"parameters\":{\"vasco_resolution\":0.025,")) << o.output;
+  EXPECT_TRUE(contains(o.output, "\"vasco_downsample\":2,")) << o.output;
+}
+
+TEST(Log2MapConventions, JsonAfterAFailureIsStillOneObjectWithTheError) {
+  TempDir dir;
+  const ToolRun r = log2map({"--json", kTestLogs + "truncated.log.gz", dir.file("a.map")}, false);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.output, "{\"error\":{\"file\":\"" + kTestLogs +
+                          "truncated.log.gz\",\"line\":264,\"message\":\"truncated gzip stream: the compressed data "
+                          "ends after 26312 uncompressed bytes, before the end of the stream\",\"kind\":\"bad input\"}}\n");
+}
+
+TEST(Log2MapConventions, LenientSummaryEndsItsLinesAndADamagedFileSaysWhyItStops) {
+  TempDir dir;
+  const ToolRun ok = log2map({"--lenient", "--backend", "cpu_threads", kTestLogs + "mixed_bad.log", dir.file("a.map")});
+  EXPECT_EQ(ok.status, 0) << ok.output;
+  EXPECT_TRUE(contains(ok.output, "(first at line 12)\nlog2map: grid ")) << ok.output;
+  const ToolRun gz = log2map({"--lenient", kTestLogs + "truncated.log.gz", dir.file("b.map")});
+  EXPECT_EQ(gz.status, 1);
+  EXPECT_TRUE(contains(gz.output, "truncated gzip stream")) << gz.output;
+  EXPECT_TRUE(contains(gz.output, "--lenient skips bad lines, not a damaged file")) << gz.output;
+  EXPECT_TRUE(dir.entries() == std::vector<std::string>{"a.map"});
 }
 
 }  // namespace

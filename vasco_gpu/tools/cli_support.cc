@@ -9,6 +9,7 @@
 
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
+#include "carmen_compat/ini_file.h"
 
 namespace cli {
 
@@ -33,7 +34,11 @@ std::string json_string(const std::string &text) {
 
 int exit_status(const std::exception &e, int usage, int other) {
   const auto *error = dynamic_cast<const carmen::Error *>(&e);
-  return error != nullptr && error->code() == carmen::ErrorCode::Usage ? usage : other;
+  if (error != nullptr && error->code() == carmen::ErrorCode::Usage) return usage;
+  // A bad --vasco_KEY value is the command line's: a usage error too.
+  const auto *file_error = dynamic_cast<const carmen::FileError *>(&e);
+  if (file_error != nullptr && file_error->file() == carmen::ParamFile::kCommandLine) return usage;
+  return other;
 }
 
 namespace {

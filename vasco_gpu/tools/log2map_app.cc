@@ -139,8 +139,45 @@ void print_json(const Options &opt, const RunResult &r) {
     << ",\"finish\":" << r.finish_s << ",\"write\":" << r.write_s << ",\"total\":" << r.total_s
     << "},\"outputs\":[";
   for (size_t i = 0; i < opt.outputs.size(); ++i) j << (i ? "," : "") << cli::json_string(opt.outputs[i]);
+  j << "],\"parameters\":{";
+  bool first = true;
+  for (const vasco::ParamSpec &p : vasco::param_table()) {
+    j << (first ? "" : ",") << cli::json_string(p.key) << ":" << p.get(r.input.params);
+    first = false;
+  }
+  j << "},\"warnings\":[";
+  first = true;
+  for (const std::string &w : opt.warnings) {
+    j << (first ? "" : ",") << cli::json_string(w);
+    first = false;
+  }
+  for (const std::string &w : r.input.warnings) {
+    j << (first ? "" : ",") << cli::json_string(w);
+    first = false;
+  }
   j << "]}\n";
   std::fputs(j.str().c_str(), stdout);
+}
+
+// --json after a failure: still one object on stdout, the error's file and
+// line (where it has them), message and kind, so that a script reading the
+// JSON learns why there is no map.
+void print_json_error(const std::exception &e) {
+  std::ostringstream j;
+  j << "{\"error\":{";
+  const auto *file_error = dynamic_cast<const carmen::FileError *>(&e);
+  if (file_error != nullptr) {
+    j << "\"file\":" << cli::json_string(file_error->file()) << ",";
+    if (file_error->line() > 0) j << "\"line\":" << file_error->line() << ",";
+    j << "\"message\":" << cli::json_string(file_error->message());
+  } else {
+    j << "\"message\":" << cli::json_string(e.what());
+  }
+  const auto *error = dynamic_cast<const carmen::Error *>(&e);
+  j << ",\"kind\":" << cli::json_string(error != nullptr ? carmen::error_code_name(error->code()) : "internal")
+    << "}}\n";
+  std::fputs(j.str().c_str(), stdout);
+  std::fflush(stdout);
 }
 
 // Everything refused before the log is read: outputs that cannot or must
@@ -233,8 +270,10 @@ int run_tool(int argc, const char *const *argv, const ToolSpec &spec) {
     return opt.out_dir.empty() ? run(opt, spec) : run_batch(opt, spec);
   } catch (const std::bad_alloc &) {
     std::fprintf(stderr, "%s: out of memory\n", tool);
+    if (opt.json) print_json_error(carmen::Error(carmen::ErrorCode::OutOfMemory, "out of memory"));
   } catch (const std::exception &e) {
     std::fprintf(stderr, "%s: %s\n", tool, carmen::printable(e.what()).c_str());
+    if (opt.json) print_json_error(e);
     return cli::exit_status(e);
   }
   return 1;

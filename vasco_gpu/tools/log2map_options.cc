@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_format.h"
@@ -65,7 +66,7 @@ void add_backend_options(CLI::App &app, Options &opt) {
       ->check(CLI::IsMember({"float", "exact"}));
   app.add_flag("--lenient", opt.lenient, "skip bad log lines (and report them) instead of stopping");
   app.add_flag("--json", opt.json, "print machine-readable statistics on stdout");
-  app.add_flag("--quiet", opt.quiet, "no progress and no summary");
+  app.add_flag("-q,--quiet", opt.quiet, "no progress and no summary");
 }
 
 // What --poses and --add take; checked after parsing (raw holds the text).
@@ -103,9 +104,14 @@ void add_pose_options(CLI::App &app, Options &opt, PoseText &raw) {
       ->allow_extra_args(false);
 }
 
+// Each vasco_* key with its meaning and vasco's default, from the one table
+// (params.h) that the README's parameter table is checked against.
 void add_param_options(CLI::App &app, std::map<std::string, std::string> &raw) {
-  for (const auto &key : vasco::mapper_param_keys())
-    app.add_option("--" + key, raw[key], "override " + key)->type_name("VALUE");
+  for (const vasco::ParamSpec &p : vasco::param_table()) {
+    std::ostringstream help;
+    help << p.meaning << " (default " << p.default_value << ")";
+    app.add_option(std::string("--") + p.key, raw[p.key], help.str())->type_name("VALUE");
+  }
 }
 
 // "map.gz,png" as the extensions of batch outputs; each known, none twice.
@@ -141,6 +147,8 @@ void finish_batch_options(const CLI::App &app, const BatchText &raw, Options &op
   opt.outputs.clear();
 }
 
+void warn_about_idle_options(const CLI::App &app, Options &opt);
+
 // Everything checked after parsing that CLI11 cannot: a usage error.
 void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &raw, const std::string &max_memory,
                     Options &opt) {
@@ -164,6 +172,22 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
                             ((app.count("--laser-mount") || app.count("--skip-unposed")) && !spec.read);
   if (pose_options && opt.poses.file.empty())
     throw Error(ErrorCode::Usage, "the --pose-* options, --skip-unposed and --laser-mount go with --poses FILE");
+  warn_about_idle_options(app, opt);
+}
+
+// Options that change nothing for the chosen backend: a warning each (the
+// run goes on), printed at once and carried by --json.
+void warn_about_idle_options(const CLI::App &app, Options &opt) {
+  const bool cpu = opt.backend.rfind("cpu_", 0) == 0;
+  if (app.count("--cuda-mode") && cpu)
+    opt.warnings.push_back("--cuda-mode does nothing with --backend " + opt.backend + " (only cuda has modes)");
+  if (app.count("--device") && cpu)
+    opt.warnings.push_back("--device does nothing with --backend " + opt.backend);
+  if (app.count("--threads") && (opt.backend == "cpu_double" || opt.backend == "cpu_float" || opt.backend == "cuda"))
+    opt.warnings.push_back("--threads does nothing with --backend " + opt.backend + " (only cpu_threads and auto use it)");
+  if (app.count("--robot") && opt.param_file.empty())
+    opt.warnings.push_back("--robot does nothing without --param-file (it picks a robot section of the ini)");
+  for (const std::string &w : opt.warnings) std::fprintf(stderr, "%s: warning: %s\n", opt.tool.c_str(), w.c_str());
 }
 
 }  // namespace
@@ -198,6 +222,11 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
   opt->tool = spec.name;
   opt->max_memory_bytes = vasco::kDefaultMaxMemoryBytes;
   CLI::App app{spec.summary};
+  // Errors name the program, as every message of the tools does.
+  const std::string tool = spec.name;
+  app.failure_message([tool](const CLI::App *, const CLI::Error &e) {
+    return tool + ": " + e.what() + "\nRun '" + tool + " --help' for usage.\n";
+  });
   app.set_version_flag("--version", [&spec] {
     std::string s = spec.name + " (vasco_gpu) " + vasco::version() + "\nbackends compiled in:";
     for (const auto &b : vasco::compiled_backends()) s += " " + b;

@@ -39,6 +39,7 @@ struct Options {
   vasco::PoseSource poses;                       // --poses FILE and its options
   std::string laser_mount_text;                  // --laser-mount as given
   std::map<std::string, std::string> extra;      // the tool's own options, as given
+  std::vector<std::string> warnings;             // options that change nothing here (said at parse time)
 };
 
 // Parses argv into *opt. Returns -1 to go on, else the exit status to
