@@ -48,6 +48,17 @@ TEST_F(MapConvert, Usage) {
   EXPECT_TRUE(contains(ext.output, "out.jpg")) << ext.output;
 }
 
+TEST_F(MapConvert, VersionAndQuiet) {
+  const ToolRun v = mapconvert({"--version"});
+  EXPECT_EQ(v.status, 0);
+  EXPECT_EQ(v.output.rfind("mapconvert (vasco_gpu) ", 0), 0u) << v.output;
+  TempDir dir;
+  const ToolRun q = mapconvert({"-q", map_fixture("freiburg.map"), dir.file("f.map")});
+  EXPECT_EQ(q.status, 0) << q.output;
+  EXPECT_EQ(q.output, "");
+  EXPECT_TRUE(maptest::file_exists(dir.file("f.map")));
+}
+
 TEST_F(MapConvert, InfoOnFreiburg) {
   const ToolRun r = mapconvert({"--info", map_fixture("freiburg.map")});
   ASSERT_EQ(r.status, 0) << r.output;

@@ -19,12 +19,14 @@
 #include "carmen_compat/map_file.h"
 #include "carmen_compat/map_format.h"
 #include "cli_support.h"
+#include "vasco_gpu/version.h"
 
 namespace {
 
 const char kUsage[] =
-    "usage: mapconvert [--mode trinary|scale|raw] IN OUT\n"
+    "usage: mapconvert [-q] [--mode trinary|scale|raw] IN OUT\n"
     "       mapconvert --info IN\n"
+    "       mapconvert --version\n"
     "\n"
     "Converts the CARMEN map IN (.map or .map.gz) to OUT, chosen by OUT's extension:\n"
     "  .map     CARMEN map (every chunk it reads; HMAP, unknown and repeated chunks\n"
@@ -35,6 +37,7 @@ const char kUsage[] =
     "           grey levels (default trinary)\n"
     "  .png     8-bit grey picture (black occupied, white free, mid grey unknown)\n"
     "--info prints the size, resolution, chunks, unknown fraction and value range.\n"
+    "-q, --quiet leaves out the notes (chunks not copied); errors are still said.\n"
     "\n"
     "Exit status: 0 ok, 1 a file could not be read or written, 2 usage error.\n";
 
@@ -116,7 +119,7 @@ void print_info(const std::string &path, const carmen::MapFile &m) {
 
 // The command line, parsed.
 struct Args {
-  bool info = false, mode_given = false, help = false;
+  bool info = false, mode_given = false, help = false, version = false, quiet = false;
   carmen::PgmMode mode = carmen::PgmMode::Trinary;
   std::vector<std::string> files;
 };
@@ -128,6 +131,11 @@ int parse_args(const std::vector<std::string> &args, Args *a) {
     if (s == "--help" || s == "-h") {
       a->help = true;
       return 0;
+    } else if (s == "--version") {
+      a->version = true;
+      return 0;
+    } else if (s == "-q" || s == "--quiet") {
+      a->quiet = true;
     } else if (s == "--info") {
       a->info = true;
     } else if (s == "--mode" || s.rfind("--mode=", 0) == 0) {
@@ -173,10 +181,10 @@ int check_args(const Args &a, OutKind *kind) {
 
 // Writes map m, read from `in`, to `out` in the format `kind`.
 void convert(const std::string &in, const carmen::MapFile &m, const std::string &out, OutKind kind,
-             carmen::PgmMode mode) {
+             carmen::PgmMode mode, bool quiet) {
   if (kind == OutKind::Map) {
     carmen::write_map_file(out, m);
-    if (m.unknown_chunks > 0) {
+    if (m.unknown_chunks > 0 && !quiet) {
       std::fprintf(stderr, "mapconvert: note: %d chunk(s) of %s not copied (HMAP, unknown or repeated)\n",
                    m.unknown_chunks, in.c_str());
     }
@@ -199,6 +207,10 @@ int main(int argc, char **argv) {
     std::fputs(kUsage, stdout);
     return 0;
   }
+  if (a.version) {
+    std::printf("mapconvert (vasco_gpu) %s\n", vasco::version());
+    return 0;
+  }
   OutKind kind = OutKind::None;
   if (const int rc = check_args(a, &kind)) return rc;
   try {
@@ -213,7 +225,7 @@ int main(int argc, char **argv) {
     if (a.info) {
       print_info(a.files[0], m);
     } else {
-      convert(a.files[0], m, a.files[1], kind, a.mode);
+      convert(a.files[0], m, a.files[1], kind, a.mode, a.quiet);
     }
     return 0;
   } catch (const carmen::Error &e) {  // names the file itself
