@@ -106,10 +106,11 @@ bench-peers: all
 # Installs what is missing through apt-get (Debian/Ubuntu; needs root or
 # sudo); a no-op when everything is there. Every build runs it first.
 # DEPS_OPTIONAL_PKGS are used when present (libisal-dev: ISA-L's inflate,
-# about 3.5x zlib's, for .gz logs); failing to install them (no network, no
-# such package) is reported, not an error: the build then uses zlib.
+# about 3.5x zlib's, for .gz logs; help2man: the tools' man pages); failing to
+# install them (no network, no such package) is reported, not an error: the
+# build then uses zlib, and makes no man pages.
 DEPS_PKGS = cmake g++ make zlib1g-dev libpng-dev libgtest-dev libgmock-dev libcli11-dev libssl-dev pkg-config
-DEPS_OPTIONAL_PKGS = libisal-dev
+DEPS_OPTIONAL_PKGS = libisal-dev help2man
 deps:
 	@command -v dpkg >/dev/null 2>&1 || { echo "make deps: no dpkg here; install $(DEPS_PKGS) (and, optionally, $(DEPS_OPTIONAL_PKGS)) by hand"; exit 0; }; \
 	missing=""; for p in $(DEPS_PKGS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
@@ -123,7 +124,7 @@ deps:
 	  echo "installing (optional):$$optional"; \
 	  { [ -n "$$missing" ] || $$SUDO apt-get update -qq; } >/dev/null 2>&1; \
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$optional >/dev/null 2>&1 \
-	    || echo "make deps: optional$$optional not installed (.gz logs inflate with zlib instead)"; \
+	    || echo "make deps: optional$$optional not installed (without libisal-dev .gz logs inflate with zlib; without help2man no man pages)"; \
 	fi
 
 clean:

@@ -35,7 +35,7 @@ class MapConvert : public ::testing::Test {
 TEST_F(MapConvert, Usage) {
   const ToolRun help = mapconvert({"--help"});
   EXPECT_EQ(help.status, 0);
-  EXPECT_TRUE(contains(help.output, "usage: mapconvert")) << help.output;
+  EXPECT_TRUE(contains(help.output, "Usage: mapconvert")) << help.output;
   EXPECT_EQ(mapconvert({}).status, 2);
   EXPECT_EQ(mapconvert({"only-one.map"}).status, 2);
   EXPECT_EQ(mapconvert({"a.map", "b.map", "c.map"}).status, 2);

@@ -221,7 +221,7 @@ vasco::SessionInput parse_session(const std::string &text) {
 int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Options *opt) {
   opt->tool = spec.name;
   opt->max_memory_bytes = vasco::kDefaultMaxMemoryBytes;
-  CLI::App app{spec.summary};
+  CLI::App app{spec.summary, spec.name};  // named: usage lines say "log2map", not argv[0]
   // Errors name the program, as every message of the tools does.
   const std::string tool = spec.name;
   app.failure_message([tool](const CLI::App *, const CLI::Error &e) {

@@ -24,9 +24,9 @@
 namespace {
 
 const char kUsage[] =
-    "usage: mapconvert [-q] [--mode trinary|scale|raw] IN OUT\n"
-    "       mapconvert --info IN\n"
-    "       mapconvert --version\n"
+    "Usage: mapconvert [-q] [--mode trinary|scale|raw] IN OUT\n"
+    "   or: mapconvert --info IN\n"
+    "   or: mapconvert --version\n"
     "\n"
     "Converts the CARMEN map IN (.map or .map.gz) to OUT, chosen by OUT's extension:\n"
     "  .map     CARMEN map (every chunk it reads; HMAP, unknown and repeated chunks\n"

@@ -374,7 +374,7 @@ void add_options(CLI::App &app, Options &o) {
 
 // Parses the command line; returns -1 to go on, else the exit status.
 int parse(int argc, char **argv, Options &o) {
-  CLI::App app{"mapdiff: compares the GRIDMAPs of two CARMEN maps (exit 0 same, 1 different, 2 error)."};
+  CLI::App app{"mapdiff: compares the GRIDMAPs of two CARMEN maps (exit 0 same, 1 different, 2 error).", "mapdiff"};
   add_options(app, o);
   try {
     app.parse(argc, argv);
