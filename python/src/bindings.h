@@ -13,7 +13,7 @@ namespace vasco_py {
 namespace nb = nanobind;
 
 void bind_errors(nb::module_ &m);   // C++ error codes -> vasco_gpu._errors classes
-void bind_module(nb::module_ &m);   // version, backends, cuda_available
+void bind_module(nb::module_ &m);   // version, backends, _cuda_available
 void bind_params(nb::module_ &m);   // Params
 void bind_frame(nb::module_ &m);    // Frame
 void bind_scans(nb::module_ &m);    // Scans

@@ -32,7 +32,10 @@ constexpr const char *kMapDoc =
     "rows above the lower-left corner; -1 is unknown, else the occupancy probability.\n"
     "``image`` is the same memory seen as a picture (``cells.T[::-1]``: row 0 at the top, +y up),\n"
     "also a view. ``origin`` is the world pose (x, y, theta) of the lower-left corner of cell\n"
-    "(0, 0), as CARMEN's OFFSET chunk and map_server's YAML give it.";
+    "(0, 0), as CARMEN's OFFSET chunk and map_server's YAML give it.\n\n"
+    "``Map(cells, resolution, origin)`` refuses the cells read_map would refuse (BadInputError, a\n"
+    "ValueError, naming the first bad cell); values later written into the ``cells`` view are\n"
+    "checked when the map is written (write_map) or compared (compare).";
 
 constexpr const char *kWriteMapDoc =
     "Writes a map, the format chosen by the name: ``.map`` / ``.map.gz`` (CARMEN, with an OFFSET\n"
@@ -68,6 +71,7 @@ void init_map(Map *self, nb::handle cells, double resolution, Origin origin) {
   mp.grid.size_y = map_side(a.shape(1), "size_y");
   mp.grid.resolution = resolution;
   mp.grid.cells.assign(a.data(), a.data() + a.size());
+  check_cells(mp, "Map");  // what read_map would refuse is refused here, not once written
   mp.origin = {std::get<0>(origin), std::get<1>(origin), std::get<2>(origin)};
   mp.has_origin = true;
   new (self) Map(std::move(mp));
@@ -91,7 +95,10 @@ void bind_map_cells(nb::class_<Map> &cls) {
   cls.def("__init__", &init_map, "cells"_a, "resolution"_a, "origin"_a = std::make_tuple(0.0, 0.0, 0.0),
           nb::sig("def __init__(self, cells: numpy.typing.ArrayLike, resolution: float, "
                   "origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None"),
-          "A map from x-major cells (size_x, size_y), copied into the map.")
+          "A map from x-major cells (size_x, size_y), copied into the map. Each cell is -1 (unknown), a\n"
+          "probability in [0, 1] or an off-limits value in [2, 3] (what read_map accepts); any other\n"
+          "value (NaN and inf among them) is a BadInputError (a ValueError) naming the first such\n"
+          "cell (x, y) and its value.")
       .def_prop_ro("cells", &cells_view, nb::rv_policy::reference,
                    nb::sig("def cells(self) -> numpy.typing.NDArray[numpy.float32]"),
                    "(size_x, size_y) float32, x-major (cells[x, y]); a view of the map's memory.")

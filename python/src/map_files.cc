@@ -42,8 +42,9 @@ void check_cells(const Map &m, const std::string &what) {
     if (carmen::valid_cell_value(c[i])) continue;
     const size_t sy = static_cast<size_t>(m.grid.size_y > 0 ? m.grid.size_y : 1);
     std::ostringstream os;
+    os.precision(9);  // a float32 in full: 1.00000012 does not read as 1
     os << what << ": cell (" << i / sy << ", " << i % sy << ") is " << c[i]
-       << ": a cell is -1 (unknown) or a probability in [0, 1]";
+       << ": a cell is -1 (unknown), a probability in [0, 1] or an off-limits value in [2, 3]";
     throw carmen::Error(carmen::ErrorCode::BadInput, os.str());
   }
 }

@@ -21,6 +21,7 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "bindings.h"
 #include "vasco_gpu/backend.h"
@@ -42,12 +43,21 @@ bool cuda_available(std::string *why) {
 #endif
 }
 
-// backends()'s docstring: what it returns in this build, and what each is,
-// from the backend registry.
+// backends()'s docstring: exactly what it returns in this build, and what
+// each name is, from the backend registry.
 std::string backends_doc() {
+  const std::vector<std::string> compiled = vasco::compiled_backends();
   std::string names;
-  for (const std::string &n : vasco::compiled_backends()) names += (names.empty() ? "" : ", ") + n;
-  std::string doc = "The backends compiled into this build: " + names + ".\n\nEach is a Mapper(backend=...) name:\n";
+  bool has_auto = false;
+  for (const std::string &n : compiled) {
+    names += (names.empty() ? "'" : ", '") + n + "'";
+    has_auto = has_auto || n == "auto";
+  }
+  std::string doc = "Returns the names Mapper(backend=...) takes in this build:\n\n  [" + names + "]\n\n";
+  doc += has_auto ? "That is every backend compiled into this build, then 'auto', which is no backend of its own\n"
+                    "but picks one of them when the Mapper is made. "
+                  : "That is every backend compiled into this build. ";
+  doc += "Aliases are not listed; each follows its\nbackend's line:\n";
   for (const vasco::BackendInfo &b : vasco::backend_registry()) {
     if (!b.compiled) continue;
     doc += std::string("\n  ") + b.name + ": " + b.summary;
@@ -68,17 +78,19 @@ void bind_module(nb::module_ &m) {
 #endif
   static const std::string doc = backends_doc();
   m.def("backends", &vasco::compiled_backends, doc.c_str());
+  // vasco_gpu.cuda_available() (_cuda.py) wraps this one: its CudaStatus is
+  // true or false, where a pair would always be true.
   m.def(
-      "cuda_available",
+      "_cuda_available",
       []() {
         std::string why;
         nb::gil_scoped_release r;
         const bool ok = cuda_available(&why);
         return std::make_pair(ok, why);
       },
-      "Whether the CUDA backend can run here (built with CUDA and a usable GPU), and why not.\n\n"
-      "Returns ``(True, '')`` or ``(False, reason)``. The first call starts the CUDA context (a few\n"
-      "tenths of a second).");
+      nb::sig("def _cuda_available() -> tuple[bool, str]"),
+      "``(True, '')`` when the CUDA backend can run here, else ``(False, reason)``, the reason as\n"
+      "the engine gives it (vasco_gpu.cuda_available() says it in the user's words).");
 }
 
 }  // namespace vasco_py

@@ -43,6 +43,6 @@ def gridmap_digest(cells: np.ndarray, resolution: float) -> str:
 def cuda_or_skip():
     import vasco_gpu as vg
 
-    ok, why = vg.cuda_available()
-    if not ok:
-        pytest.skip(f"CUDA backend not usable here: {why}")
+    status = vg.cuda_available()
+    if not status:
+        pytest.skip(f"CUDA backend not usable here: {status.reason}")

@@ -415,3 +415,4 @@ def test_module_info():
     assert ("cuda" in vg.backends()) == vg.has_cuda
     ok, why = vg.cuda_available()
     assert isinstance(ok, bool) and (ok or why)
+    assert bool(vg.cuda_available()) is ok  # its truth is the answer (a pair was always true)

@@ -3,8 +3,10 @@ that cannot be read back: each is refused with a clear error now."""
 
 from __future__ import annotations
 
+import ast
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -16,7 +18,7 @@ import numpy as np
 import pytest
 
 import vasco_gpu as vg
-from conftest import FR079
+from conftest import FR079, ROOT
 
 
 def _two_scans():
@@ -243,15 +245,74 @@ def test_map_shape_beyond_int_is_refused(shape):
         vg.Map(huge, 0.05)
 
 
+def test_map_of_sevens_is_refused_before_it_is_written():
+    # Once accepted and written, then refused by read_map (and mapconvert) as damaged.
+    with pytest.raises(vg.BadInputError, match=r"^Map: cell \(0, 0\) is 7: ") as e:
+        vg.Map(np.full((4, 3), 7), 0.05)
+    assert isinstance(e.value, ValueError)
+
+
+@pytest.mark.parametrize("bad, shown", [(7.0, "7"), (-0.5, "-0.5"), (math.nan, "nan"), (math.inf, "inf"),
+                                        (-math.inf, "-inf"), (1.5, "1.5"), (3.5, "3.5"), (-1.0001, "-1.00010002")])
+def test_map_refuses_cells_read_map_refuses(bad, shown):
+    cells = np.full((4, 3), -1.0, np.float32)
+    cells[0, 0] = 0.5
+    cells[2, 1] = bad  # the first bad cell, x-major
+    cells[3, 0] = bad
+    with pytest.raises(vg.BadInputError, match=rf"cell \(2, 1\) is {re.escape(shown)}: a cell is -1"):
+        vg.Map(cells, 0.05)
+    with pytest.raises(ValueError, match=r"cell \(2, 1\)"):
+        vg.Map(cells.astype(np.float64), 0.05)  # converted first, then checked
+
+
+@pytest.mark.parametrize("value", [0.0, 1.0, -1.0, 0.5, -0.0, 2.0, 2.5, 3.0])
+def test_map_accepts_what_read_map_accepts(tmp_path, value):
+    # -1 unknown, a probability, or an off-limits value in [2, 3] (CARMEN's overlay, a
+    # probability plus 2), which CARMEN's map files may hold and read_map gives back.
+    cells = np.full((4, 3), value)
+    m = vg.Map(cells, 0.05)
+    np.testing.assert_array_equal(m.cells, cells.astype(np.float32))
+    vg.write_map(tmp_path / "m.map", m)
+    back = vg.read_map(tmp_path / "m.map")
+    np.testing.assert_array_equal(back.cells, m.cells)
+    assert vg.Map(back.cells, back.resolution, back.origin).sha256() == m.sha256()
+
+
+@pytest.mark.parametrize("name", ["maps/freiburg.map", "golden/maps/edge_cases__paper.map.gz",
+                                  "golden/maps/intel.gfs__vasco_default_ds4.map.gz"])
+def test_maps_read_map_gives_are_constructible(name):
+    m = vg.read_map(ROOT / "tests" / "data" / name)
+    again = vg.Map(m.cells, m.resolution, m.origin)
+    assert again.sha256() == m.sha256()
+
+
+def test_maps_read_from_images_are_constructible(tmp_path, small_map):
+    small_map.cells[0, 0] = 0.0
+    small_map.cells[3, 2] = 1.0
+    for name in ("m.png", "m.pgm"):
+        vg.write_map(tmp_path / name, small_map)
+        m = vg.read_map(tmp_path / name)
+        assert vg.Map(m.cells, m.resolution, m.origin).sha256() == m.sha256()
+
+
+def test_map_cells_written_later_are_refused_where_they_leave_python(tmp_path, small_map):
+    small_map.cells[1, 2] = 7  # the view is writable: write_map and compare check it
+    with pytest.raises(vg.BadInputError, match=r"cell \(1, 2\) is 7"):
+        vg.write_map(tmp_path / "m.map", small_map)
+    with pytest.raises(vg.BadInputError, match=r"cell \(1, 2\) is 7"):
+        vg.Map(small_map.cells, small_map.resolution)
+
+
 # ---- Docstrings that say what the calls do ----
 
 def test_backends_docstring_lists_what_backends_returns():
     doc = vg.backends.__doc__
-    listed = doc.split("compiled into this build: ", 1)[1].split(".", 1)[0].split(", ")
-    assert listed == vg.backends()
+    listed = ast.literal_eval(doc.split("takes in this build:\n\n  ", 1)[1].split("\n", 1)[0])
+    assert listed == vg.backends()  # exactly the list it returns, auto included
+    assert vg.backends()[-1] == "auto" and "then 'auto'" in doc
     for name in vg.backends():
         assert f"\n  {name}: " in doc, name  # each explained
-        if name != "cuda" or vg.cuda_available()[0]:
+        if name != "cuda" or vg.cuda_available():
             vg.Mapper(backend=name)  # and each a name Mapper takes
 
 

@@ -13,6 +13,10 @@ The mapping session of the C++ library (``vasco::Mapper``) with NumPy arrays in 
     m = mapper.finish()                                       # Map: .cells (size_x, size_y), x-major
     vg.write_map("fr079.png", m)
 
+``vg.cuda_available()`` is true where ``backend="cuda"`` can run; its ``.reason`` says why not
+("no GPU found (...)", a build without CUDA). ``vg.backends()`` lists the backend names this
+build takes.
+
 ROS bags (ROS 1 ``.bag``, ROS 2 sqlite3 and MCAP, read with ``rosbags``) give the same ``Log``:
 ``vg.load_bag("run.mcap")``; poses from a SLAM back end: ``vg.load_log(path, poses="opt.g2o")``.
 
@@ -60,12 +64,12 @@ from ._core import (
     Scans,
     backends,
     compare,
-    cuda_available,
     has_cuda,
     load_log,
     write_map,
 )
 from . import _core
+from ._cuda import CudaStatus, cuda_available
 from ._bags import load_bag
 from ._batch import BatchError, LogResult, map_logs
 
@@ -75,6 +79,7 @@ __all__ = [
     "BadInputError",
     "BatchError",
     "Comparison",
+    "CudaStatus",
     "Error",
     "FileError",
     "Frame",

@@ -14,22 +14,18 @@ has_cuda: bool
 
 def backends() -> list[str]:
     """
-    The backends compiled into this build: cpu_double, cpu_threads, cpu_float, auto.
+    Returns the names Mapper(backend=...) takes in this build:
 
-    Each is a Mapper(backend=...) name:
+      ['cpu_double', 'cpu_threads', 'cpu_float', 'auto']
+
+    That is every backend compiled into this build, then 'auto', which is no backend of its own
+    but picks one of them when the Mapper is made. Aliases are not listed; each follows its
+    backend's line:
 
       cpu_double: CARMEN's arithmetic to the letter, one core: bit-identical to CARMEN
       cpu_threads: cpu_double's bytes on all cores (--threads)
       cpu_float: single precision on one core, fast; measured against CARMEN's maps
       auto: cuda when a GPU is usable, else cpu_threads
-    """
-
-def cuda_available() -> tuple[bool, str]:
-    """
-    Whether the CUDA backend can run here (built with CUDA and a usable GPU), and why not.
-
-    Returns ``(True, '')`` or ``(False, reason)``. The first call starts the CUDA context (a few
-    tenths of a second).
     """
 
 class Params:
@@ -398,10 +394,19 @@ class Map:
     ``image`` is the same memory seen as a picture (``cells.T[::-1]``: row 0 at the top, +y up),
     also a view. ``origin`` is the world pose (x, y, theta) of the lower-left corner of cell
     (0, 0), as CARMEN's OFFSET chunk and map_server's YAML give it.
+
+    ``Map(cells, resolution, origin)`` refuses the cells read_map would refuse (BadInputError, a
+    ValueError, naming the first bad cell); values later written into the ``cells`` view are
+    checked when the map is written (write_map) or compared (compare).
     """
 
     def __init__(self, cells: numpy.typing.ArrayLike, resolution: float, origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
-        """A map from x-major cells (size_x, size_y), copied into the map."""
+        """
+        A map from x-major cells (size_x, size_y), copied into the map. Each cell is -1 (unknown), a
+        probability in [0, 1] or an off-limits value in [2, 3] (what read_map accepts); any other
+        value (NaN and inf among them) is a BadInputError (a ValueError) naming the first such
+        cell (x, y) and its value.
+        """
 
     @property
     def cells(self) -> numpy.typing.NDArray[numpy.float32]:

@@ -2,6 +2,8 @@
 // its mode.
 #include "vasco_gpu/cuda_backend.h"
 
+#include <dlfcn.h>
+
 #include <map>
 #include <memory>
 #include <mutex>
@@ -33,11 +35,27 @@ std::map<int, UsableState> &usable_states() {
   return s;
 }
 
+// Why cudaGetDeviceCount failed, in words for someone who may have no GPU
+// at all: the runtime says "CUDA driver version is insufficient" also when
+// there is no driver, so tell that case apart by whether the driver's
+// library can be loaded.
+std::string no_device_reason(cudaError_t err) {
+  if (err == cudaErrorNoDevice) return "no GPU found (the NVIDIA driver sees no device)";
+  if (err == cudaErrorInsufficientDriver) {
+    void *driver = dlopen("libcuda.so.1", RTLD_LAZY | RTLD_LOCAL);
+    if (driver == nullptr) return "no GPU found (no NVIDIA driver is installed: libcuda.so.1 cannot be loaded)";
+    dlclose(driver);
+    return std::string("the NVIDIA driver is older than this build's CUDA runtime (") + cudaGetErrorString(err) +
+           "): update the driver";
+  }
+  return std::string("no GPU found (") + cudaGetErrorString(err) + ")";
+}
+
 // Why `device` cannot run this build's kernels, or "" when it can.
 std::string unusable_reason(int device) {
   int count = 0;
   cudaError_t err = cudaGetDeviceCount(&count);
-  if (err != cudaSuccess) return std::string("no CUDA device (") + cudaGetErrorString(err) + ")";
+  if (err != cudaSuccess) return no_device_reason(err);
   if (device < 0 || device >= count)
     return "CUDA device " + std::to_string(device) + " does not exist (" + std::to_string(count) + " present)";
   cudaDeviceProp prop;
