@@ -36,6 +36,19 @@
                               defined(CARMEN_STANDIN_SIMULATOR_MESSAGES) && defined(CARMEN_STANDIN_BASE_MESSAGES))
 #error "CARMEN's headers did not define the shared message types"
 #endif
+/* The module headers CARMEN's carmen.h leaves out: our readlog.h includes
+ * CARMEN's, so that CARMEN's types are the ones defined. */
+#if defined(WITH_CARMEN) && !(defined(CARMEN_STANDIN_ARM_MESSAGES) && defined(CARMEN_STANDIN_GPS_NMEA_MESSAGES) && \
+                              defined(CARMEN_STANDIN_IMU_MESSAGES) && defined(CARMEN_STANDIN_PANTILT_MESSAGES))
+#error "CARMEN's module headers did not define the other message types"
+#endif
+/* A program may include them again, in any order. */
+#ifdef WITH_CARMEN
+#include <carmen/imu_messages.h>
+#include <carmen/arm_messages.h>
+#include <carmen/pantilt_messages.h>
+#include <carmen/gps_nmea_messages.h>
+#endif
 #if defined(EXPECT_CARMEN_MAP) != defined(CARMEN_STANDIN_MAP)
 #error "the wrong map.h was used"
 #endif
@@ -66,6 +79,30 @@ static int check_flaser(void) {
   return ok ? 0 : fail("FLASER fields wrong");
 }
 
+/* The other converters, with CARMEN's structs; and a bad line leaves a
+ * message CARMEN's callers can use. */
+static int check_others(void) {
+  char imu_line[] = "IMU 0.1 0.2 9.8 1 0 0 0 0.3 0.4 0.5 0.01 0.02 0.03 7.5 host 1.25\n";
+  char sonar_line[] = "SONAR 0.5 2 1.25 2.5 0.1 0.2 0.3 -0.1 -0.2 -0.3 7.5 host 1.25\n";
+  char bad_line[] = "SONAR 0.5 2000000000 1\n";
+  carmen_imu_message imu;
+  carmen_base_sonar_message sonar;
+  memset(&imu, 0, sizeof imu);
+  memset(&sonar, 0, sizeof sonar);
+  char *rest = carmen_string_to_imu_message(imu_line, &imu);
+  int ok = rest != NULL && atof(rest) == 1.25 && imu.accZ == 9.8 && imu.gyroZ == 0.03 && strcmp(imu.host, "host") == 0;
+  rest = carmen_string_to_base_sonar_message(sonar_line, &sonar);
+  ok = ok && rest != NULL && sonar.num_sonars == 2 && sonar.sonar_offsets[1].theta == -0.3;
+  rest = carmen_string_to_base_sonar_message(bad_line, &sonar);
+  ok = ok && rest != NULL && atof(rest) == 0.0 && sonar.num_sonars == 0 && sonar.range == NULL && sonar.host != NULL &&
+       sonar.host[0] == '\0' && carmen_readlog_last_error()[0] != '\0';
+  free(imu.host);
+  free(sonar.range);
+  free(sonar.sonar_offsets);
+  free(sonar.host);
+  return ok ? 0 : fail("other converters wrong");
+}
+
 static int check_map(char *file) {
   carmen_map_config_t config;
   if (carmen_map_read_gridmap_config(file, &config) != 0) return fail("map config not read");
@@ -88,5 +125,5 @@ static int check_egrid(void) {
 
 int main(int argc, char **argv) {
   if (argc != 2) return fail("usage: coexist FREIBURG_MAP");
-  return check_flaser() || check_map(argv[1]) || check_egrid();
+  return check_flaser() || check_others() || check_map(argv[1]) || check_egrid();
 }

@@ -3,7 +3,9 @@
  * carmen_fopen & co. (strong symbols) must win over our weak ones, statically
  * and with the shared library, without a duplicate-symbol error. This one
  * does all I/O through zlib (which reads plain files too and writes them
- * with "T") and says on stderr that it was used. */
+ * with "T"), says on stderr that it was used, and returns what CARMEN's
+ * returns: carmen_fread gzread's count cast to size_t, so (size_t)-1 on a
+ * gzip error, and carmen_fseek gzseek's new offset, not 0. */
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,7 +25,7 @@ carmen_FILE *carmen_fopen(const char *filename, const char *mode) {
   carmen_FILE *f = calloc(1, sizeof *f);
   if (f == NULL) return NULL;
   f->compressed = 1;
-  f->comp_fp = gzopen(filename, m);
+  f->comp_fp = (gzFile *)gzopen(filename, m); /* CARMEN's field holds the gzFile itself */
   if (f->comp_fp == NULL) {
     free(f);
     return NULL;
@@ -32,37 +34,35 @@ carmen_FILE *carmen_fopen(const char *filename, const char *mode) {
   return f;
 }
 
+static gzFile gz(carmen_FILE *fp) { return (gzFile)fp->comp_fp; }
+
 int carmen_fclose(carmen_FILE *fp) {
-  const int rc = gzclose(fp->comp_fp) == Z_OK ? 0 : EOF;
+  const int rc = gzclose(gz(fp)) == Z_OK ? 0 : EOF;
   free(fp);
   return rc;
 }
 
-int carmen_fgetc(carmen_FILE *fp) { return gzgetc(fp->comp_fp); }
-int carmen_fputc(int c, carmen_FILE *fp) { return gzputc(fp->comp_fp, c); }
-char *carmen_fgets(char *s, int size, carmen_FILE *fp) { return gzgets(fp->comp_fp, s, size); }
-int carmen_feof(carmen_FILE *fp) { return gzeof(fp->comp_fp); }
-int carmen_fseek(carmen_FILE *fp, long offset, int whence) {
-  return gzseek(fp->comp_fp, offset, whence) < 0 ? -1 : 0;
-}
-long carmen_ftell(carmen_FILE *fp) { return gztell(fp->comp_fp); }
-int carmen_fflush(carmen_FILE *fp) { return gzflush(fp->comp_fp, Z_SYNC_FLUSH) == Z_OK ? 0 : EOF; }
+int carmen_fgetc(carmen_FILE *fp) { return gzgetc(gz(fp)); }
+int carmen_fputc(int c, carmen_FILE *fp) { return gzputc(gz(fp), c); }
+char *carmen_fgets(char *s, int size, carmen_FILE *fp) { return gzgets(gz(fp), s, size); }
+int carmen_feof(carmen_FILE *fp) { return gzeof(gz(fp)); }
+int carmen_fseek(carmen_FILE *fp, off_t offset, int whence) { return (int)gzseek(gz(fp), offset, whence); }
+off_t carmen_ftell(carmen_FILE *fp) { return gztell(gz(fp)); }
+int carmen_fflush(carmen_FILE *fp) { return gzflush(gz(fp), Z_SYNC_FLUSH) == Z_OK ? 0 : EOF; }
 
 size_t carmen_fread(void *ptr, size_t size, size_t nmemb, carmen_FILE *fp) {
-  const int n = gzread(fp->comp_fp, ptr, (unsigned)(size * nmemb));
-  return n <= 0 ? 0 : (size_t)n / size;
+  return (size_t)gzread(gz(fp), ptr, (unsigned)(size * nmemb));
 }
 
 size_t carmen_fwrite(const void *ptr, size_t size, size_t nmemb, carmen_FILE *fp) {
-  const int n = gzwrite(fp->comp_fp, ptr, (unsigned)(size * nmemb));
-  return n <= 0 ? 0 : (size_t)n / size;
+  return (size_t)gzwrite(gz(fp), ptr, (unsigned)(size * nmemb));
 }
 
-int carmen_fprintf(carmen_FILE *fp, const char *fmt, ...) {
+void carmen_fprintf(carmen_FILE *fp, const char *fmt, ...) {
   char buf[4096];
   va_list ap;
   va_start(ap, fmt);
   const int n = vsnprintf(buf, sizeof buf, fmt, ap);
   va_end(ap);
-  return n < 0 ? n : gzputs(fp->comp_fp, buf);
+  if (n >= 0) gzputs(gz(fp), buf);
 }

@@ -5,12 +5,13 @@
  * CARMEN's names and signatures so existing code links unchanged. */
 /* DGC_MY_STDIO_H is CARMEN's guard for its carmen_stdio.h: whichever of the
  * two a program includes first is the one it gets (carmen_FILE is a typedef
- * of an anonymous struct, which C cannot define twice). The layouts agree;
- * CARMEN declares comp_fp as gzFile * and carmen_fprintf as returning void. */
+ * of an anonymous struct, which C cannot define twice). The two agree in
+ * every declaration: layout, member types and signatures. */
 #ifndef DGC_MY_STDIO_H
 #define DGC_MY_STDIO_H
 
 #include <stdio.h>
+#include <sys/types.h>
 #include <zlib.h>
 
 #ifdef __cplusplus
@@ -20,7 +21,10 @@ extern "C" {
 typedef struct {
   int compressed;  /* 1 when the stream goes through zlib */
   FILE *fp;        /* plain stream (compressed == 0) */
-  gzFile comp_fp;  /* zlib stream (compressed == 1) */
+  /* zlib stream (compressed == 1). The type is CARMEN's; what it holds is
+   * the gzFile itself (as CARMEN stores gzdopen's result), so pass
+   * (gzFile)fp->comp_fp to zlib. */
+  gzFile *comp_fp;
 } carmen_FILE;
 
 /* Opens `filename` with an fopen() mode ("r", "w", "rb", "wb", "a"...).
@@ -34,7 +38,8 @@ int carmen_fputc(int c, carmen_FILE *fp);
 char *carmen_fgets(char *s, int size, carmen_FILE *fp);
 size_t carmen_fread(void *ptr, size_t size, size_t nmemb, carmen_FILE *fp);
 size_t carmen_fwrite(const void *ptr, size_t size, size_t nmemb, carmen_FILE *fp);
-int carmen_fprintf(carmen_FILE *fp, const char *fmt, ...)
+/* As CARMEN's, returns nothing: carmen_ferror() tells whether it failed. */
+void carmen_fprintf(carmen_FILE *fp, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif
@@ -44,10 +49,14 @@ int carmen_feof(carmen_FILE *fp);
  * or truncated gzip stream). Not in CARMEN; offered so callers can tell a
  * clean end of file from damage. */
 int carmen_ferror(carmen_FILE *fp);
-/* Seeks; on a compressed stream only SEEK_SET/SEEK_CUR are supported and a
- * backward seek rewinds and decompresses again (slow, as in CARMEN). */
-int carmen_fseek(carmen_FILE *fp, long offset, int whence);
-long carmen_ftell(carmen_FILE *fp);
+/* Seeks; returns 0, or -1 on failure. On a compressed stream only
+ * SEEK_SET/SEEK_CUR are supported and a backward seek rewinds and
+ * decompresses again (slow, as in CARMEN). (CARMEN's returns gzseek's new
+ * offset on a compressed stream: a caller that may get CARMEN's should
+ * treat only a negative result as failure.) */
+int carmen_fseek(carmen_FILE *fp, off_t offset, int whence);
+/* The position (uncompressed, for a compressed stream), or -1. */
+off_t carmen_ftell(carmen_FILE *fp);
 int carmen_fflush(carmen_FILE *fp);
 
 #ifdef __cplusplus

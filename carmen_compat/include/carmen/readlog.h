@@ -8,17 +8,37 @@
  *
  * Unlike CARMEN, bad input is never misread and never kills the process. The
  * text is parsed by the same code as carmen::LogReader (strict mode):
- *   - a converter returns NULL for a truncated line, a count that disagrees
- *     with the fields present, a non-numeric field, a negative count or one
- *     above 100000, a NaN/inf pose or timestamp, or extra fields; the message
- *     struct is then left untouched, and carmen_readlog_last_error() says why.
+ *   - a converter refuses a truncated line, a count that disagrees with the
+ *     fields present, a non-numeric field, a negative count or one above
+ *     100000 (so no count makes an unbounded allocation), a NaN/inf pose or
+ *     timestamp, or extra fields. It then says why on stderr (naming the
+ *     converter and the field) and in carmen_readlog_last_error(), and leaves
+ *     the message a valid empty one that CARMEN's callers can use unchanged:
+ *     every array freed and NULL with its count 0, every other number 0, and
+ *     `host` a malloc()ed "" (the caller frees it, as after a good line).
+ *     It returns a pointer to the end of the line (its '\n' or NUL), so a
+ *     caller that reads the logger timestamp there, as CARMEN's playback
+ *     does, reads 0 instead of crashing. So a converter returns NULL only
+ *     for a NULL argument; test carmen_readlog_last_error()[0] for success.
  *     NaN, inf and negative ranges are accepted, as data.
- *   - carmen_logfile_index_messages() indexes what precedes a read error or
- *     a corrupt / truncated gzip stream, as CARMEN does, and says so.
+ *     Where memory runs out, the message is emptied likewise; where not even
+ *     its "" host can be allocated, the process exits with "Out of memory"
+ *     on stderr, as CARMEN's converters do on any failed allocation.
+ *   - carmen_logfile_index_messages() prints CARMEN's progress on stderr
+ *     ("\n\rIndexing messages (0%)", a "\rIndexing messages (N%)" every
+ *     10 MB read, then "\rIndexing messages (100%) - N messages found.");
+ *     it indexes what precedes a read error or a corrupt / truncated gzip
+ *     stream, as CARMEN does, and says so.
+ *   - every carmen_stdio call's result is checked as CARMEN's libglobal may
+ *     return it when a program links that library (whose functions then
+ *     replace ours: carmen_stdio.h): a carmen_fread of (size_t)-1 (zlib's
+ *     error) or more than was asked is a read error; a carmen_fseek that
+ *     returns the new offset (gzseek's) instead of 0 is a success, checked
+ *     with carmen_ftell.
  *   - carmen_logfile_read_line() returns -1 (instead of dying) for a message
  *     number out of range, a message of max_line_length bytes or more, or a
- *     failed seek or short read; for the last two kinds it also moves on to
- *     the next message (or to the end), so a loop of
+ *     failed seek or short read (`line` is then ""); for the last two kinds
+ *     it also moves on to the next message (or to the end), so a loop of
  *     carmen_logfile_read_next_line() until carmen_logfile_eof() never spins.
  */
 /* The message structs are CARMEN's, from carmen_compat/carmen_shared_types.h
@@ -78,8 +98,10 @@ int carmen_logfile_read_next_line(carmen_logfile_index_p index, carmen_FILE *inf
 /* Converters. The message name is skipped when the string starts with it
  * (for RAWLASERn / ROBOTLASERn the number after the name becomes `id`;
  * without the name, id = -1), so both whole log lines and the text after the
- * name are accepted. The string ends at '\n' or NUL. Each returns a pointer
- * just past the host, or NULL for bad input (see above). */
+ * name (what CARMEN's playback passes) are accepted. The string ends at '\n'
+ * or NUL. After the message's fields come "ipc_timestamp host
+ * logger_timestamp", as the logger writes them. Each returns a pointer just
+ * past the host (at " logger_timestamp"); for bad input, see above. */
 char *carmen_string_to_laser_laser_message(char *string, carmen_laser_laser_message *laser);
 /* Old "LASERn num_readings ranges..." lines (and FLASER / RLASER lines, whose
  * poses are then dropped); the config is guessed as for FLASER. */
@@ -93,6 +115,44 @@ char *carmen_string_to_robot_laser_message_orig(char *string, carmen_robot_laser
 char *carmen_string_to_base_odometry_message(char *string, carmen_base_odometry_message *odometry);
 char *carmen_string_to_simulator_truepos_message(char *string,
                                                  carmen_simulator_truepos_message *truepos);
+
+/* The other messages CARMEN's logger writes, with their line formats (the
+ * fields before the trailer). Arrays are realloc()ed to the counts read, as
+ * in CARMEN; a count of 0 leaves the array NULL.
+ *   ARM flags num_joints angles.. num_currents currents.. num_vels vels.. gripper_closed */
+char *carmen_string_to_arm_state_message(char *string, carmen_arm_state_message *arm);
+/*   SONAR cone_angle num_sonars ranges.. (x y theta of each sonar).. */
+char *carmen_string_to_base_sonar_message(char *string, carmen_base_sonar_message *sonar);
+/*   BUMPER num_bumpers states.. (x y of each bumper)..  (a state is an
+ *   integer 0..255) */
+char *carmen_string_to_base_bumper_message(char *string, carmen_base_bumper_message *bumper);
+/*   BASEVELOCITY tv rv */
+char *carmen_string_to_base_velocity_message(char *string, carmen_base_velocity_message *msg);
+/*   NMEAGGA nr utc latitude_dm lat_orient longitude_dm long_orient gps_quality
+ *           num_satellites hdop sea_level altitude geo_sea_level geo_sep data_age
+ * latitude / longitude are the DDMM.MMMM values in degrees (DD + MM.MMMM/60,
+ * unsigned: the orientation letters are kept apart, as in CARMEN); an
+ * orientation is one character. */
+char *carmen_string_to_gps_gpgga_message(char *string, carmen_gps_gpgga_message *gps_msg);
+/*   NMEARMC nr validity utc latitude_dm lat_orient longitude_dm long_orient
+ *           speed true_course variation var_dir date */
+char *carmen_string_to_gps_gprmc_message(char *string, carmen_gps_gprmc_message *gps_msg);
+/*   IMU accX accY accZ q0 q1 q2 q3 magX magY magZ gyroX gyroY gyroZ */
+char *carmen_string_to_imu_message(char *string, carmen_imu_message *msg);
+/*   POSITIONLASER id x y z phi theta psi */
+char *carmen_string_to_pantilt_laserpos_message(char *string, carmen_pantilt_laserpos_message *laserpos);
+/*   SCANMARK type laserid */
+char *carmen_string_to_pantilt_scanmark_message(char *string, carmen_pantilt_scanmark_message *scanmark);
+/*   FOLLOWTRAJECTORY x y theta tv rv length (x y theta tv rv of each point)..
+ * (CARMEN's converter skips a leading "ROBOTVELOCITY" instead: both names
+ * are skipped here.) */
+char *carmen_string_to_robot_follow_trajectory_message(char *string,
+                                                       carmen_robot_follow_trajectory_message *msg);
+/*   VECTORMOVE distance theta */
+char *carmen_string_to_robot_vector_move_message(char *string, carmen_robot_vector_move_message *msg);
+/*   ROBOTVELOCITY tv rv  (the name CARMEN's converter skips is "VELOCITY":
+ * both are skipped here) */
+char *carmen_string_to_robot_velocity_message(char *string, carmen_robot_velocity_message *msg);
 
 /* Field of view and angle increment CARMEN assumes for an old laser line of
  * num_beams beams (see carmen_compat/log_reader.h for the exact expressions). */

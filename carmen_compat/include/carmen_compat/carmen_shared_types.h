@@ -6,6 +6,20 @@
  *   carmen_robot_laser_message          robot_messages.h      CARMEN_ROBOT_MESSAGES_H
  *   carmen_base_odometry_message        base_messages.h       CARMEN_BASE_MESSAGES_H
  *   carmen_simulator_truepos_message    simulator_messages.h  SIMULATOR_MESSAGES_H
+ * and, for the other converters of readlog.h:
+ *   carmen_position_t, carmen_traj_point_t  global.h          CARMEN_GLOBAL_H
+ *   carmen_base_velocity_message,
+ *   carmen_base_sonar_message,
+ *   carmen_base_bumper_message          base_messages.h       CARMEN_BASE_MESSAGES_H
+ *   carmen_robot_velocity_message,
+ *   carmen_robot_vector_move_message,
+ *   carmen_robot_follow_trajectory_message  robot_messages.h  CARMEN_ROBOT_MESSAGES_H
+ *   carmen_arm_state_message            arm_messages.h        CARMEN_ARM_MESSAGES_H
+ *   carmen_gps_gpgga_message,
+ *   carmen_gps_gprmc_message            gps_nmea_messages.h   GPS_NMEA_MESSAGES_H
+ *   carmen_imu_message                  imu_messages.h        CARMEN_IMU_MESSAGES_H
+ *   carmen_pantilt_scanmark_message,
+ *   carmen_pantilt_laserpos_message     pantilt_messages.h    CARMEN_PANTILT_MESSAGES_H
  * (right: the include guard CARMEN's header uses). The layouts are CARMEN's,
  * field for field.
  *
@@ -36,6 +50,27 @@
 #include <carmen/carmen.h>
 #endif
 #endif
+/* CARMEN's readlog.h includes the headers of the modules whose messages it
+ * converts; carmen.h may not include all of them. Where CARMEN is present,
+ * so do we (before our own definitions, for the reason above), so that a
+ * program that includes one of them after our readlog.h still compiles. */
+#if !defined(VASCO_CARMEN_STANDALONE) && defined(__has_include)
+#if defined(CARMEN_H) && !defined(VASCO_CARMEN_MODULE_HEADERS_SEARCHED)
+#define VASCO_CARMEN_MODULE_HEADERS_SEARCHED
+#if __has_include(<carmen/arm_messages.h>)
+#include <carmen/arm_messages.h>
+#endif
+#if __has_include(<carmen/gps_nmea_messages.h>)
+#include <carmen/gps_nmea_messages.h>
+#endif
+#if __has_include(<carmen/imu_messages.h>)
+#include <carmen/imu_messages.h>
+#endif
+#if __has_include(<carmen/pantilt_messages.h>)
+#include <carmen/pantilt_messages.h>
+#endif
+#endif
+#endif
 
 #ifndef CARMEN_COMPAT_CARMEN_SHARED_TYPES_H
 #define CARMEN_COMPAT_CARMEN_SHARED_TYPES_H
@@ -52,6 +87,21 @@ typedef struct {
   double y;
   double theta;
 } carmen_point_t, *carmen_point_p;
+#endif
+#if !defined(CARMEN_GLOBAL_H) && !defined(VASCO_CARMEN_GLOBAL_TYPES_DEFINED)
+#define VASCO_CARMEN_GLOBAL_TYPES_DEFINED
+typedef struct {
+  double x;
+  double y;
+} carmen_position_t, *carmen_position_p;
+
+typedef struct {
+  double x;
+  double y;
+  double theta;
+  double t_vel;
+  double r_vel;
+} carmen_traj_point_t, *carmen_traj_point_p;
 #endif
 
 /* laser_messages.h */
@@ -115,6 +165,30 @@ typedef struct {
   double timestamp;
   char *host;
 } carmen_robot_laser_message;
+
+/* ROBOTVELOCITY */
+typedef struct {
+  double tv, rv;
+  double timestamp;
+  char *host;
+} carmen_robot_velocity_message;
+
+/* FOLLOWTRAJECTORY */
+typedef struct {
+  int trajectory_length;
+  carmen_traj_point_t *trajectory;
+  carmen_traj_point_t robot_position;
+  double timestamp;
+  char *host;
+} carmen_robot_follow_trajectory_message;
+
+/* VECTORMOVE */
+typedef struct {
+  double distance;
+  double theta;
+  double timestamp;
+  char *host;
+} carmen_robot_vector_move_message;
 #endif
 
 /* base_messages.h */
@@ -128,6 +202,32 @@ typedef struct {
   double timestamp;
   char *host;
 } carmen_base_odometry_message;
+
+/* BASEVELOCITY */
+typedef struct {
+  double tv, rv;
+  double timestamp;
+  char *host;
+} carmen_base_velocity_message;
+
+/* SONAR */
+typedef struct {
+  int num_sonars;
+  double cone_angle; /* width of a sonar's cone (rad) */
+  double *range;
+  carmen_point_t *sonar_offsets;
+  double timestamp;
+  char *host;
+} carmen_base_sonar_message;
+
+/* BUMPER */
+typedef struct {
+  int num_bumpers;
+  unsigned char *state;
+  carmen_position_t *bumper_offsets;
+  double timestamp;
+  char *host;
+} carmen_base_bumper_message;
 #endif
 
 /* simulator_messages.h (CARMEN's guard there has no CARMEN_ prefix) */
@@ -141,6 +241,105 @@ typedef struct {
   double timestamp;
   char *host;
 } carmen_simulator_truepos_message;
+#endif
+
+/* arm_messages.h */
+#if !defined(CARMEN_ARM_MESSAGES_H) && !defined(VASCO_CARMEN_ARM_DEFINED)
+#define VASCO_CARMEN_ARM_DEFINED
+/* ARM */
+typedef struct {
+  int flags;
+  int num_joints;
+  double *joint_angles;
+  int num_currents;
+  double *joint_currents;
+  int num_vels;
+  double *joint_angular_vels;
+  int gripper_closed;
+  double timestamp;
+  char *host;
+} carmen_arm_state_message;
+#endif
+
+/* gps_nmea_messages.h (no CARMEN_ prefix in CARMEN's guard either) */
+#if !defined(GPS_NMEA_MESSAGES_H) && !defined(VASCO_CARMEN_GPS_DEFINED)
+#define VASCO_CARMEN_GPS_DEFINED
+/* NMEAGGA */
+typedef struct {
+  int nr;              /* number of the GPS unit */
+  double utc;
+  double latitude;     /* degrees */
+  double latitude_dm;  /* DDMM.MMMM, as in the NMEA sentence */
+  char lat_orient;     /* 'N' or 'S' */
+  double longitude;
+  double longitude_dm;
+  char long_orient;    /* 'E' or 'W' */
+  int gps_quality;
+  int num_satellites;
+  double hdop;
+  double sea_level;
+  double altitude;
+  double geo_sea_level;
+  double geo_sep;
+  int data_age;
+  double timestamp;
+  char *host;
+} carmen_gps_gpgga_message;
+
+/* NMEARMC */
+typedef struct {
+  int nr;
+  int validity;        /* 1 valid, 0 not */
+  double utc;
+  double latitude;
+  double latitude_dm;
+  char lat_orient;
+  double longitude;
+  double longitude_dm;
+  char long_orient;
+  double speed;
+  double true_course;
+  double variation;
+  char var_dir;
+  int date;
+  double timestamp;
+  char *host;
+} carmen_gps_gprmc_message;
+#endif
+
+/* imu_messages.h */
+#if !defined(CARMEN_IMU_MESSAGES_H) && !defined(VASCO_CARMEN_IMU_DEFINED)
+#define VASCO_CARMEN_IMU_DEFINED
+/* IMU */
+typedef struct {
+  double accX, accY, accZ;
+  double q0, q1, q2, q3; /* orientation quaternion (w, x, y, z) */
+  double magX, magY, magZ;
+  double gyroX, gyroY, gyroZ;
+  double timestamp;
+  char *host;
+} carmen_imu_message;
+#endif
+
+/* pantilt_messages.h */
+#if !defined(CARMEN_PANTILT_MESSAGES_H) && !defined(VASCO_CARMEN_PANTILT_DEFINED)
+#define VASCO_CARMEN_PANTILT_DEFINED
+/* SCANMARK */
+typedef struct {
+  int type; /* 0 start of a 3D scan, 1 its end */
+  int laserid;
+  double timestamp;
+  char *host;
+} carmen_pantilt_scanmark_message;
+
+/* POSITIONLASER */
+typedef struct {
+  int id;
+  double x, y, z;
+  double phi, theta, psi;
+  double timestamp;
+  char *host;
+} carmen_pantilt_laserpos_message;
 #endif
 
 #ifdef __cplusplus

@@ -23,6 +23,23 @@ typedef struct {
   char *host;
 } carmen_base_velocity_message;
 
+typedef struct {
+  int num_sonars;
+  double cone_angle;
+  double *range;
+  carmen_point_t *sonar_offsets;
+  double timestamp;
+  char *host;
+} carmen_base_sonar_message;
+
+typedef struct {
+  int num_bumpers;
+  unsigned char *state;
+  carmen_position_t *bumper_offsets;
+  double timestamp;
+  char *host;
+} carmen_base_bumper_message;
+
 #ifdef __cplusplus
 }
 #endif

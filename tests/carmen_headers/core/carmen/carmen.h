@@ -19,6 +19,7 @@ extern "C" {
 #include <carmen/simulator_messages.h>
 #include <carmen/laser_messages.h>
 #include <carmen/robot_messages.h>
+#include <carmen/gps_nmea_messages.h>
 #include <carmen/map.h>
 #include <carmen/map_io.h>
 #include <carmen/readlog.h>

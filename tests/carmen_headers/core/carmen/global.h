@@ -25,6 +25,11 @@ typedef struct {
   double r_vel;
 } carmen_traj_point_t, *carmen_traj_point_p;
 
+typedef struct {
+  double x;
+  double y;
+} carmen_position_t, *carmen_position_p;
+
 int carmen_file_exists(char *filename);
 
 #ifdef __cplusplus

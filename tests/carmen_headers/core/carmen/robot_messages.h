@@ -33,6 +33,21 @@ typedef struct {
   char *host;
 } carmen_robot_velocity_message;
 
+typedef struct {
+  int trajectory_length;
+  carmen_traj_point_t *trajectory;
+  carmen_traj_point_t robot_position;
+  double timestamp;
+  char *host;
+} carmen_robot_follow_trajectory_message;
+
+typedef struct {
+  double distance;
+  double theta;
+  double timestamp;
+  char *host;
+} carmen_robot_vector_move_message;
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,5 +1,6 @@
 /* Stand-in for CARMEN's carmen_stdio.h (see ../../README.md): CARMEN's guard,
- * comp_fp as gzFile *, carmen_fprintf returning void. */
+ * comp_fp as gzFile *, carmen_fprintf returning void, off_t offsets: the
+ * same declarations as ours. */
 #ifndef DGC_MY_STDIO_H
 #define DGC_MY_STDIO_H
 #define CARMEN_STANDIN_STDIO 1
@@ -20,14 +21,15 @@ typedef struct {
 carmen_FILE *carmen_fopen(const char *filename, const char *mode);
 int carmen_fgetc(carmen_FILE *fp);
 int carmen_feof(carmen_FILE *fp);
-int carmen_fseek(carmen_FILE *fp, long offset, int whence);
-long carmen_ftell(carmen_FILE *fp);
+int carmen_fseek(carmen_FILE *fp, off_t offset, int whence);
+off_t carmen_ftell(carmen_FILE *fp);
 int carmen_fclose(carmen_FILE *fp);
 size_t carmen_fread(void *ptr, size_t size, size_t nmemb, carmen_FILE *fp);
 size_t carmen_fwrite(const void *ptr, size_t size, size_t nmemb, carmen_FILE *fp);
 char *carmen_fgets(char *s, int size, carmen_FILE *fp);
 int carmen_fputc(int c, carmen_FILE *fp);
 void carmen_fprintf(carmen_FILE *fp, const char *fmt, ...);
+int carmen_fflush(carmen_FILE *fp);
 
 #ifdef __cplusplus
 }
