@@ -524,3 +524,22 @@ TEST(Log2MapConventions, LenientSummaryEndsItsLinesAndADamagedFileSaysWhyItStops
 }
 
 }  // namespace
+
+namespace {
+
+// "-": the log from standard input, a CARMEN map to standard output, the same
+// bytes in the GRIDMAP as a file written the usual way.
+TEST(Log2MapConventions, DashIsStandardInputAndOutput) {
+  TempDir dir;
+  const std::string piped = dir.file("piped.map");
+  ASSERT_EQ(tooltest::run_tool_piped(kIntel, "log2map", {"-q", "--backend", "cpu_threads", "-", "-"}, piped), 0)
+      << maptest::read_bytes(piped + ".err");
+  ASSERT_EQ(log2map({"-q", "--backend", "cpu_threads", kIntel, dir.file("file.map")}).status, 0);
+  const carmen::MapFile a = carmen::read_map_file(piped), b = carmen::read_map_file(dir.file("file.map"));
+  ASSERT_TRUE(a.gridmap && b.gridmap);
+  EXPECT_EQ(a.gridmap->cells, b.gridmap->cells);
+  EXPECT_EQ(log2map({kIntel, "-", "-"}).status, 2);            // standard output twice
+  EXPECT_EQ(log2map({"--json", kIntel, "-"}).status, 2);       // --json wants it too
+}
+
+}  // namespace

@@ -59,6 +59,19 @@ TEST_F(MapConvert, VersionAndQuiet) {
   EXPECT_TRUE(maptest::file_exists(dir.file("f.map")));
 }
 
+// "-": a map from standard input, a CARMEN map to standard output.
+TEST_F(MapConvert, DashIsStandardInputAndOutput) {
+  TempDir dir;
+  const std::string out = dir.file("out.map");
+  ASSERT_EQ(tooltest::run_tool_piped(map_fixture("freiburg.map"), "mapconvert", {"-", "-"}, out), 0)
+      << read_bytes(out + ".err");
+  const carmen::MapFile a = carmen::read_map_file(out), b = carmen::read_map_file(map_fixture("freiburg.map"));
+  ASSERT_TRUE(a.gridmap && b.gridmap);
+  EXPECT_EQ(a.gridmap->cells, b.gridmap->cells);
+  ASSERT_EQ(tooltest::run_tool_piped(map_fixture("freiburg.map"), "mapconvert", {"-", dir.file("f.png")}, out), 0);
+  EXPECT_TRUE(maptest::file_exists(dir.file("f.png")));
+}
+
 TEST_F(MapConvert, InfoOnFreiburg) {
   const ToolRun r = mapconvert({"--info", map_fixture("freiburg.map")});
   ASSERT_EQ(r.status, 0) << r.output;

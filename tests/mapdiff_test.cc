@@ -126,6 +126,18 @@ TEST_F(MapDiff, IdenticalMaps) {
   EXPECT_TRUE(contains(moved.output, "note: the OFFSET chunks differ\n")) << moved.output;
 }
 
+// "-" reads a map (uncompressed: a map's reader goes by the name's .gz) from
+// standard input; both A and B "-" is a usage error.
+TEST_F(MapDiff, DashIsStandardInput) {
+  write_grid(dir_.file("b.map"), base_grid());
+  const std::string out = dir_.file("out.txt");
+  EXPECT_EQ(tooltest::run_tool_piped(dir_.file("b.map"), "mapdiff", {"-q", a_, "-"}, out), 0);
+  EXPECT_EQ(maptest::read_bytes(out), "identical\n");
+  const std::string b = write_b([](GridMap &g) { g.at(0, 0) = 0.9f; });
+  EXPECT_EQ(tooltest::run_tool_piped(b, "mapdiff", {"-q", "-", a_}, out), 1);
+  EXPECT_EQ(tooltest::run_tool_piped(a_, "mapdiff", {"-", "-"}, out), 2);
+}
+
 // The same GRIDMAP 1.9e8 m away is another map, unless --no-offset.
 TEST_F(MapDiff, IdenticalGridsWithOtherOffsetsDiffer) {
   write_grid(dir_.file("here.map"), base_grid(), GlobalOffset{0, 0, 0});

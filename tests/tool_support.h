@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,17 @@ inline ToolRun run_tool(const std::string &tool, const std::vector<std::string> 
   const int st = ::pclose(p);
   r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   return r;
+}
+
+// Runs `stdin_file | <build>/bin/TOOL args > stdout_file` (stderr to
+// stdout_file's ".err"), for the tools' "-" (standard input and output).
+inline int run_tool_piped(const std::string &stdin_file, const std::string &tool, const std::vector<std::string> &args,
+                          const std::string &stdout_file) {
+  std::string cmd = "timeout -k 5 120 " + quote(std::string(VASCO_BIN_DIR) + "/" + tool);
+  for (const std::string &a : args) cmd += " " + quote(a);
+  cmd += " < " + quote(stdin_file) + " > " + quote(stdout_file) + " 2> " + quote(stdout_file + ".err");
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
 inline bool contains(const std::string &s, const std::string &part) {

@@ -92,7 +92,8 @@ void LogSource::wait_for_data(int fd, int wait_ms) const {
 
 // Reads the first two bytes (kept, to be handed out first: nothing is
 // rewound) and starts inflating when they are gzip's magic and the name ends
-// in ".gz" or the input is a pipe (which has no name to go by).
+// in ".gz" or the input is a pipe or standard input (which have no name to go
+// by: a tool's "-" is /dev/stdin, a file redirected there is regular).
 void LogSource::sniff(const std::string &path, std::size_t block_size) {
   char magic[2] = {0, 0};
   const std::size_t got = std::fread(magic, 1, 2, fp_);
@@ -103,7 +104,7 @@ void LogSource::sniff(const std::string &path, std::size_t block_size) {
   gzip_magic_ = got == 2 && static_cast<unsigned char>(magic[0]) == 0x1f &&
                 static_cast<unsigned char>(magic[1]) == 0x8b;
   // As zlib's gzread: a .gz name with non-gzip content is read as it is.
-  gz_ = gzip_magic_ && (ends_with(path, ".gz") || !regular_);
+  gz_ = gzip_magic_ && (ends_with(path, ".gz") || !regular_ || path == "/dev/stdin");
   if (!gz_) return;
   try {
     inflater_ = std::make_unique<gzip::BackgroundInflater>(fp_, block_size, prefix_);

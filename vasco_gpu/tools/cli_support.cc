@@ -4,8 +4,11 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <charconv>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
@@ -77,6 +80,35 @@ uint64_t parse_mebibytes(const std::string &text, const std::string &option) {
     throw carmen::Error(carmen::ErrorCode::Usage, option + " " + text + ": more than the largest budget, " +
                                                       std::to_string(UINT64_MAX >> 20) + " MiB");
   return mib << 20;
+}
+
+std::string input_path(const std::string &arg) { return arg == kStdio ? "/dev/stdin" : arg; }
+
+StdoutFile::StdoutFile(const std::string &extension) {
+  const char *tmp = std::getenv("TMPDIR");
+  std::string pattern = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/vasco_stdout.XXXXXX";
+  if (::mkdtemp(pattern.data()) == nullptr)
+    throw carmen::Error(carmen::ErrorCode::Io, "cannot make a temporary directory for the output '-': " +
+                                                   std::string(std::strerror(errno)));
+  dir_ = pattern;
+  path_ = dir_ + "/stdout" + extension;
+}
+
+StdoutFile::~StdoutFile() {
+  ::unlink(path_.c_str());
+  ::rmdir(dir_.c_str());
+}
+
+void StdoutFile::send() const {
+  FILE *in = std::fopen(path_.c_str(), "rb");
+  if (in == nullptr) throw carmen::Error(carmen::ErrorCode::Io, "the output '-' was not made");
+  char buf[1 << 16];
+  size_t n;
+  bool ok = true;
+  while (ok && (n = std::fread(buf, 1, sizeof buf, in)) > 0) ok = std::fwrite(buf, 1, n, stdout) == n;
+  std::fclose(in);
+  if (!ok || std::fflush(stdout) != 0)
+    throw carmen::Error(carmen::ErrorCode::Io, "standard output refused the map: " + std::string(std::strerror(errno)));
 }
 
 void check_stdout_writable(const std::string &why) {

@@ -34,6 +34,32 @@ void check_outputs(const std::vector<std::string> &inputs, const std::vector<std
 // `option` for anything but digits, or a value whose bytes overflow 64 bits.
 uint64_t parse_mebibytes(const std::string &text, const std::string &option);
 
+// "-" names standard input (an input) or standard output (an output), as
+// Unix tools do. An input "-" is read as /dev/stdin (a pipe or a file: the
+// readers read it front to back). An output "-" is a CARMEN map (.map) on
+// standard output.
+constexpr const char *kStdio = "-";
+std::string input_path(const std::string &arg);
+
+// An output "-": the file is made in a private temporary directory (by the
+// same writers and transaction as any output), then copied to standard
+// output once whole, so a failed run writes nothing there; the directory is
+// removed whatever happens.
+class StdoutFile {
+ public:
+  explicit StdoutFile(const std::string &extension);  // ".map"
+  ~StdoutFile();
+  StdoutFile(const StdoutFile &) = delete;
+  StdoutFile &operator=(const StdoutFile &) = delete;
+  const std::string &path() const { return path_; }
+  // Copies the finished file to standard output; carmen::Error(Io) when
+  // standard output refuses it.
+  void send() const;
+
+ private:
+  std::string dir_, path_;
+};
+
 // Throws carmen::Error(Io) when standard output is closed or read-only, so
 // that `--json` fails before the maps are made rather than after.
 void check_stdout_writable(const std::string &why);

@@ -30,9 +30,10 @@ bool parse_double(const std::string &text, double *out) {
 }
 
 void add_input_options(CLI::App &app, const ToolSpec &spec, Options &opt) {
-  app.add_option(spec.input_name, opt.log, spec.input_help)->required();
+  app.add_option(spec.input_name, opt.log, spec.input_help + "; - for standard input")->required();
   app.add_option("OUT", opt.outputs,
-                 "output files: .map, .map.gz, .pgm, .png (with --out-dir: further " + spec.input_name + "s)");
+                 "output files: .map, .map.gz, .pgm, .png; - for a CARMEN map on standard output (with --out-dir: "
+                 "further " + spec.input_name + "s)");
   app.add_option("--param-file", opt.param_file, "carmen.ini with vasco_* keys (default: vasco's defaults)");
   app.add_option("--robot", opt.robot, "robot section of the ini to use");
 }
@@ -154,7 +155,14 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
                     Options &opt) {
   if (app.count("--max-memory") > 0) opt.max_memory_bytes = cli::parse_mebibytes(max_memory, "--max-memory");
   for (const auto &out : opt.outputs)
-    if (opt.out_dir.empty()) carmen::map_format_of(out);  // an unknown extension
+    if (opt.out_dir.empty() && out != cli::kStdio) carmen::map_format_of(out);  // an unknown extension
+  if (opt.out_dir.empty()) {
+    const auto to_stdout = std::count(opt.outputs.begin(), opt.outputs.end(), std::string(cli::kStdio));
+    if (to_stdout > 1) throw Error(ErrorCode::Usage, "the output '-' (standard output) is named twice: give it once");
+    if (to_stdout == 1 && opt.json)
+      throw Error(ErrorCode::Usage, "--json and the output '-' both want standard output: write the map to a file");
+    opt.log = cli::input_path(opt.log);
+  }
   opt.poses.format = vasco::pose_file_format_from_name(raw.format);
   opt.poses.match.matching = vasco::pose_matching_from_name(raw.match);
   opt.poses.robot_frame = raw.frame == "robot";

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <ctime>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "carmen_compat/atomic_file.h"
@@ -73,6 +74,7 @@ std::string basename_of(const std::string &path) {
 std::vector<std::string> files_written(const std::vector<std::string> &outputs) {
   std::vector<std::string> files;
   for (const std::string &out : outputs) {
+    if (out == cli::kStdio) continue;  // standard output: nothing to replace
     const std::vector<std::string> of_one = carmen::map_output_files(out);
     files.insert(files.end(), of_one.begin(), of_one.end());
   }
@@ -199,8 +201,17 @@ void write_outputs(const Options &opt, const std::string &log, const std::vector
   map.description = "vasco_gpu " + std::string(vasco::version()) + " " + r.backend;
   map.time = static_cast<int64_t>(std::time(nullptr));
   carmen::OutputTransaction tx;
-  for (const std::string &out : outputs) carmen::write_map(tx, out, map);
+  std::unique_ptr<cli::StdoutFile> to_stdout;  // the output "-": a CARMEN map
+  for (const std::string &out : outputs) {
+    if (out == cli::kStdio) {
+      to_stdout = std::make_unique<cli::StdoutFile>(".map");
+      carmen::write_map(tx, to_stdout->path(), map);
+    } else {
+      carmen::write_map(tx, out, map);
+    }
+  }
   tx.commit();
+  if (to_stdout) to_stdout->send();
 }
 
 }  // namespace log2map

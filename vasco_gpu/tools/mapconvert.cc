@@ -38,6 +38,7 @@ const char kUsage[] =
     "  .png     8-bit grey picture (black occupied, white free, mid grey unknown)\n"
     "--info prints the size, resolution, chunks, unknown fraction and value range.\n"
     "-q, --quiet leaves out the notes (chunks not copied); errors are still said.\n"
+    "IN '-' reads standard input; OUT '-' writes a CARMEN map (.map) to standard output.\n"
     "\n"
     "Exit status: 0 ok, 1 a file could not be read or written, 2 usage error.\n";
 
@@ -153,7 +154,7 @@ int parse_args(const std::vector<std::string> &args, Args *a) {
     } else if (s == "--") {
       a->files.insert(a->files.end(), args.begin() + static_cast<long>(i) + 1, args.end());
       break;
-    } else if (s.size() > 1 && s[0] == '-') {
+    } else if (s.size() > 1 && s[0] == '-') {  // "-" alone is standard input or output
       return usage_error("unknown option '" + s + "'");
     } else {
       a->files.push_back(s);
@@ -171,7 +172,7 @@ int check_args(const Args &a, OutKind *kind) {
     return 0;
   }
   if (a.files.size() != 2) return usage_error(a.files.empty() ? "no files given" : "expected IN and OUT");
-  *kind = kind_of(a.files[1]);
+  *kind = a.files[1] == cli::kStdio ? OutKind::Map : kind_of(a.files[1]);
   if (*kind == OutKind::None) {
     return usage_error("cannot tell the output format of '" + a.files[1] + "' (use .map, .map.gz, .pgm or .png)");
   }
@@ -182,8 +183,14 @@ int check_args(const Args &a, OutKind *kind) {
 // Writes map m, read from `in`, to `out` in the format `kind`.
 void convert(const std::string &in, const carmen::MapFile &m, const std::string &out, OutKind kind,
              carmen::PgmMode mode, bool quiet) {
-  if (kind == OutKind::Map) {
+  if (kind == OutKind::Map && out == cli::kStdio) {
+    const cli::StdoutFile to_stdout(".map");
+    carmen::write_map_file(to_stdout.path(), m);
+    to_stdout.send();
+  } else if (kind == OutKind::Map) {
     carmen::write_map_file(out, m);
+  }
+  if (kind == OutKind::Map) {
     if (m.unknown_chunks > 0 && !quiet) {
       std::fprintf(stderr, "mapconvert: note: %d chunk(s) of %s not copied (HMAP, unknown or repeated)\n",
                    m.unknown_chunks, in.c_str());
@@ -216,12 +223,12 @@ int main(int argc, char **argv) {
   try {
     // The output (and a .pgm's .yaml) is checked before the map is read: it
     // must be replaceable and must not be the input.
-    if (!a.info) cli::check_outputs({a.files[0]}, carmen::map_output_files(a.files[1]));
+    if (!a.info && a.files[1] != cli::kStdio) cli::check_outputs({a.files[0]}, carmen::map_output_files(a.files[1]));
     // --info lists named GRIDMAP chunks without parsing them: a file of
     // thousands of them costs their headers, not their cells.
     carmen::MapReadOptions read;
     if (a.info) read.named_chunks = carmen::NamedChunkReading::Index;
-    const carmen::MapFile m = carmen::read_map_file(a.files[0], read);
+    const carmen::MapFile m = carmen::read_map_file(cli::input_path(a.files[0]), read);
     if (a.info) {
       print_info(a.files[0], m);
     } else {

@@ -351,8 +351,8 @@ const char kFooter[] =
 
 void add_options(CLI::App &app, Options &o) {
   app.set_version_flag("--version", [] { return std::string("mapdiff (vasco_gpu) ") + vasco::version(); });
-  app.add_option("A", o.a, "reference map (.map or .map.gz)")->required();
-  app.add_option("B", o.b, "map to compare with A")->required();
+  app.add_option("A", o.a, "reference map (.map or .map.gz; - for standard input)")->required();
+  app.add_option("B", o.b, "map to compare with A (- for standard input)")->required();
   app.add_option("--top", o.top, "list the N largest differences (default 10)")
       ->type_name("N")->check(CLI::NonNegativeNumber);
   app.add_option("--tolerance", o.tolerance, "max |dp| over cells known in both (default 0)")
@@ -401,8 +401,10 @@ int run(const Options &o) {
   // The picture's file is checked, and both maps read, before anything is
   // written: a bad input or target leaves no picture.
   if (o.png_given) cli::check_outputs({o.a, o.b}, {o.png});
-  const Input a = load(o.a);
-  const Input b = load(o.b);
+  if (o.a == cli::kStdio && o.b == cli::kStdio)
+    throw carmen::Error(carmen::ErrorCode::Usage, "A and B are both '-': standard input holds one map");
+  const Input a = load(cli::input_path(o.a));
+  const Input b = load(cli::input_path(o.b));
   const bool identical = identical_grids(a.grid, b.grid);
   const Alignment al = align(a, b, identical, o.no_offset);
   carmen::GridComparison c;
