@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <ctime>
 #include <limits>
 #include <new>
 #include <random>
@@ -526,20 +527,108 @@ TEST(MapFile, CommentsAreKeptReadableByCarmen) {
   EXPECT_EQ(back.comments, (std::vector<std::string>{std::string(97, 'x'), "two lines", ""}));
 }
 
-TEST(MapFile, StandardCommentsDescribeTheMap) {
-  const auto lines = carmen::standard_map_comments(300, 200, 0.05, "fr079.log", "test run", "me", 0);
-  bool size_line = false, res_line = false;
-  for (const std::string &l : lines) {
-    size_line |= l.find("300 x 200") != std::string::npos;
-    res_line |= l.find("0.05") != std::string::npos;
-  }
-  EXPECT_TRUE(size_line);
-  EXPECT_TRUE(res_line);
+// CARMEN 0.7.4's comment block (carmen_map_write_comment_chunk), line by
+// line. This test used to look for "0.05": CARMEN prints the resolution with
+// "%.1f", and the block is now CARMEN's, so 0.05 reads "0.1" there (the
+// gridmap chunk holds the exact value).
+TEST(MapFile, StandardCommentsAreCarmens) {
+  const time_t t = 1700000000;
+  const auto lines = carmen::standard_map_comments(300, 200, 0.05, "fr079.log", "test run", "me", t);
+  std::string date = std::asctime(std::localtime(&t));
+  date.pop_back();  // asctime's newline ends the line
+  const std::string rule(52, '#');
+  EXPECT_EQ(lines, (std::vector<std::string>{rule, "", " Carnegie Mellon Robot Toolkit (CARMEN) map file", "",
+                                             " Map author    : me", " Creation date : " + date,
+                                             " Map size      : 300 x 200", " Resolution    : 0.1",
+                                             " Origin        : fr079.log", " Description   : test run#", rule}));
+  // Written out, they are CARMEN's bytes: 53 '#', and the Description line
+  // running into the '#' CARMEN writes next.
+  const std::string bytes = carmen::encode_comment_lines(lines);
+  EXPECT_EQ(bytes.substr(0, 54), std::string(53, '#') + "\n");
+  EXPECT_NE(bytes.find("# Description   : test run#\n" + std::string(53, '#') + "\n"), std::string::npos);
+  // A description with its own newline: CARMEN's "#" then has a line of its own.
+  const auto own = carmen::standard_map_comments(1, 1, 1, "o", "d\n", "me", t);
+  EXPECT_EQ(own[9], " Description   : d");
+  EXPECT_EQ(own[10], "");
+  EXPECT_EQ(own[11], rule);
 }
 
 // ---------------------------------------------------------------------------
 // Bad input
 // ---------------------------------------------------------------------------
+// ---------------------------------------------------------------------------
+// One chunk, found as CARMEN finds it
+// ---------------------------------------------------------------------------
+TEST(MapFileFirstChunk, ScanStopsAtTheChunkAskedFor) {
+  TempDir dir;
+  const std::string grid = i32(2) + i32(1) + f32(0.5f) + f32(0.25f) + f32(-1.0f);
+  const std::string places = i32(1) + i32(0) + field("p", 20) + f32(1) + f32(2);
+  // A named gridmap first, then an unnamed one, then a chunk whose header
+  // claims far more bytes than the file holds.
+  const std::string head = kId + chunk(1, "GRIDMAP", grid, "named", true) + chunk(1, "GRIDMAP", grid) +
+                           chunk(4, "PLACES", places);
+  const size_t damaged_at = head.size();
+  const std::string bytes = head + std::string(1, '\x66') + i32(0x50000000) + "JUNK      " + "xyz";
+  for (const std::string name : {"f.map", "f.map.gz"}) {
+    const std::string path = dir.file(name);
+    if (name.size() > 6) {
+      gzip_to_file(path, bytes);
+    } else {
+      write_bytes(path, bytes);
+    }
+    const auto g = carmen::read_first_chunk(path, carmen::kGridmapChunk);
+    ASSERT_TRUE(g);
+    EXPECT_EQ(g->info.offset, 17);
+    EXPECT_TRUE(g->info.named());
+    EXPECT_EQ(g->info.name, "named");
+    EXPECT_EQ(std::get<carmen::GridMap>(g->payload).cells, (std::vector<float>{0.25f, -1.0f}));
+    const std::string unnamed_name = "named";
+    const auto n = carmen::find_first_chunk(path, carmen::kGridmapChunk | carmen::kNamedChunkFlag, &unnamed_name);
+    ASSERT_TRUE(n);
+    EXPECT_EQ(n->offset, 17);
+    const auto h = carmen::read_first_gridmap_header(path);
+    ASSERT_TRUE(h);
+    EXPECT_EQ(h->size_x, 2);
+    EXPECT_EQ(h->size_y, 1);
+    EXPECT_EQ(h->resolution, 0.5);
+    const auto p = carmen::read_first_chunk(path, carmen::kPlacesChunk);
+    ASSERT_TRUE(p);
+    EXPECT_EQ(std::get<carmen::PlaceList>(p->payload).size(), 1u);
+    // What lies after the damage cannot be found: the damage is reported
+    // with its offset.
+    try {
+      carmen::find_first_chunk(path, carmen::kCreatorChunk);
+      ADD_FAILURE() << "no error for the damaged chunk";
+    } catch (const FileError &e) {
+      EXPECT_NE(std::string(e.what()).find("at byte " + std::to_string(damaged_at)), std::string::npos)
+          << e.what();
+    }
+    const std::string other = "other";
+    EXPECT_THROW(carmen::read_first_chunk(path, carmen::kGridmapChunk, &other), FileError);
+    EXPECT_THROW(carmen::read_first_chunk(path, carmen::kHmapChunk), std::invalid_argument);
+  }
+}
+
+TEST(MapFileFirstChunk, GridmapHeaderNeedsNoCells) {
+  TempDir dir;
+  // A 1000 x 1000 gridmap whose cells are missing, in a gzip file (whose
+  // size is not known before reading): the header is read, the cells are
+  // refused when asked for, and nothing near 4 MB is allocated up front.
+  const std::string body = i32(1000) + i32(1000) + f32(0.1f);
+  const std::string bytes =
+      kId + std::string(1, '\x01') + i32(10 + 12 + 4 * 1000000) + "GRIDMAP   " + body + f32(0.5f);
+  const std::string path = dir.file("short.map.gz");
+  gzip_to_file(path, bytes);
+  const auto h = carmen::read_first_gridmap_header(path);
+  ASSERT_TRUE(h);
+  EXPECT_EQ(h->size_x, 1000);
+  EXPECT_EQ(h->info.size, 10 + 12 + 4 * 1000000);
+  EXPECT_THROW(carmen::read_first_chunk(path, carmen::kGridmapChunk), FileError);
+  // A header whose size does not match its cells is damage, even here.
+  write_bytes(dir.file("bad.map"), kId + chunk(1, "GRIDMAP", i32(3) + i32(3) + f32(0.1f) + f32(0)));
+  EXPECT_THROW(carmen::read_first_gridmap_header(dir.file("bad.map")), FileError);
+}
+
 TEST(MapFileBad, MissingEmptyAndForeignFiles) {
   TempDir dir;
   expect_rejected(dir.file("nope.map"), {"cannot open"});

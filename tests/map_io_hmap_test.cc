@@ -149,7 +149,8 @@ TEST_P(MapIoHmap, DamagedChunksAreRefusedOnReading) {
     EXPECT_EQ(carmen_map_read_hmap_chunk(file.c_str(), &back), -1);
     const std::string err = testing::internal::GetCapturedStderr();
     EXPECT_NE(err.find(file), std::string::npos) << err;
-    EXPECT_EQ(back.zone_names, nullptr);  // left untouched
+    EXPECT_EQ(back.zone_names, nullptr);  // cleared: no stale pointer
+    EXPECT_EQ(back.num_zones, 0);
   }
   const std::string none = path("none");
   write(none, kId);
@@ -157,6 +158,27 @@ TEST_P(MapIoHmap, DamagedChunksAreRefusedOnReading) {
   EXPECT_EQ(carmen_map_read_hmap_chunk(none.c_str(), &back), -1);
   EXPECT_EQ(carmen_map_read_hmap_chunk(nullptr, &back), -1);
   EXPECT_NE(testing::internal::GetCapturedStderr().find("has no HMAP chunk"), std::string::npos);
+}
+
+// CARMEN's reader finds the first HMAP chunk, named or not, and skips its
+// name; a damaged chunk after it does not matter.
+TEST_P(MapIoHmap, TheFirstHmapIsReadNamedOrNot) {
+  Sample s;
+  const std::string file = path("named_hmap");
+  const std::string damaged_after = std::string(1, '\x66') + i32(0x7ffffff0) + "JUNK      ";
+  write(file, kId + chunk(3, "HMAP", s.payload(), "zones", true) + chunk(3, "HMAP", i32(0) + i32(0)) +
+                  damaged_after);
+  carmen_hmap_t back;
+  std::memset(&back, 0x5a, sizeof back);
+  ASSERT_EQ(carmen_map_read_hmap_chunk(file.c_str(), &back), 0);
+  ASSERT_EQ(back.num_zones, 3);
+  EXPECT_STREQ(back.zone_names[0], "ground");
+  EXPECT_STREQ(back.zone_names[2], "roof");
+  ASSERT_EQ(back.num_links, 2);
+  EXPECT_EQ(back.links[1].type, CARMEN_HMAP_LINK_ELEVATOR);
+  EXPECT_EQ(back.links[1].points[2].theta, 0.75);
+  free_hmap(back);
+  EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_HMAP_CHUNK), int(10 + 6 + s.payload().size()));
 }
 
 INSTANTIATE_TEST_SUITE_P(PlainAndGzip, MapIoHmap, ::testing::Values(".map", ".map.gz"), [](const auto &info) {

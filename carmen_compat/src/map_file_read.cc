@@ -241,6 +241,54 @@ class Reader {
     return nc;
   }
 
+  // CARMEN's lookup (map_file.h, find_first_chunk): scans from the start to
+  // the first chunk of `type` (named flag masked) or, with a name, the first
+  // named one of that type called *name. On true, the input is at its
+  // payload; false when the data ends first.
+  bool seek_first(int type, const std::string *name, ChunkInfo *info, uint64_t *left) {
+    read_comments();
+    read_id();
+    while (read_chunk_header(info, left)) {
+      if (info->base_type() == type && (name == nullptr || (info->named() && info->name == *name))) return true;
+      skip(*left);
+      *info = ChunkInfo{};
+      chunk_ = nullptr;
+    }
+    return false;
+  }
+
+  std::optional<ChunkInfo> find_first(int type, const std::string *name) {
+    ChunkInfo info;
+    uint64_t left = 0;
+    if (!seek_first(type, name, &info, &left)) return std::nullopt;
+    chunk_ = nullptr;
+    return info;
+  }
+
+  std::optional<FoundChunk> read_first(int type, const std::string *name) {
+    if (type != kOldCreatorChunk && !is_named_kind(type))
+      throw std::invalid_argument("read_first_chunk: chunk type " + std::to_string(type) + " is not read into a payload");
+    ChunkInfo info;
+    uint64_t left = 0;
+    if (!seek_first(type, name, &info, &left)) return std::nullopt;
+    chunk_ = &info;
+    ChunkPayload p = parse_or_fail(
+        [&] { return type == kOldCreatorChunk ? ChunkPayload(parse_creator(payload(left))) : named_payload(type, left); });
+    if (const auto *g = std::get_if<GridMap>(&p); g != nullptr && opts_.check_cells) check_cells(*g);
+    chunk_ = nullptr;
+    return FoundChunk{std::move(info), std::move(p)};
+  }
+
+  std::optional<GridMapHeader> read_first_header(const std::string *name) {
+    ChunkInfo info;
+    uint64_t left = 0;
+    if (!seek_first(kGridmapChunk, name, &info, &left)) return std::nullopt;
+    chunk_ = &info;
+    const GridMap g = read_gridmap_header(left);
+    chunk_ = nullptr;
+    return GridMapHeader{std::move(info), g.size_x, g.size_y, g.resolution};
+  }
+
   // The comments and id only; true when the id is CARMEN's.
   bool check_id_only() {
     try {
@@ -334,7 +382,8 @@ class Reader {
     std::string where = "the file ";
     if (chunk_ != nullptr) {
       where = "the " + chunk_type_name(chunk_->type) + " chunk at byte " + std::to_string(chunk_->offset) +
-              (chunk_->named() ? " (named \"" + printable(chunk_->name) + "\")" : "") + " ";
+              (chunk_->named() && !chunk_->name.empty() ? " (named \"" + printable(chunk_->name) + "\")" : "") +
+              " ";
     }
     throw FileError(in_.path(), where + msg);
   }
@@ -478,9 +527,10 @@ class Reader {
            " MiB of chunk data (MapReadOptions::max_kept_bytes): refused rather than allocated");
   }
 
-  GridMap read_gridmap(uint64_t left) {
+  // The size and resolution, checked against the chunk size; the cells are
+  // left unread.
+  GridMap read_gridmap_header(uint64_t left) {
     if (left < 12) fail("has " + std::to_string(left) + " payload bytes, too few for the map size");
-    keep(left);
     unsigned char hdr[12];
     const size_t hgot = in_.read(hdr, 12);
     if (hgot < 12) fail_short("the map size");
@@ -504,6 +554,13 @@ class Reader {
            std::to_string(g.size_y) + " cells need a size of " + std::to_string(needed) +
            ": the file is damaged");
     }
+    return g;
+  }
+
+  GridMap read_gridmap(uint64_t left) {
+    if (left >= 12) keep(left);
+    GridMap g = read_gridmap_header(left);
+    const uint64_t ncells = uint64_t(g.size_x) * uint64_t(g.size_y);
     // ncells * 4 + 22 <= INT32_MAX here, so ncells < 2^29.
     const bool known = in_.remaining() >= 0;
     if (known) g.cells.reserve(static_cast<size_t>(ncells));
@@ -568,6 +625,22 @@ NamedChunk read_named_chunk(const std::string &path, const ChunkInfo &chunk, con
 std::vector<ChunkInfo> list_map_chunks(const std::string &path) {
   Reader r(path, MapReadOptions{}, ReadMode::HeadersOnly);
   return r.run().chunks;
+}
+
+std::optional<ChunkInfo> find_first_chunk(const std::string &path, int type, const std::string *name) {
+  Reader r(path, MapReadOptions{}, ReadMode::HeadersOnly);
+  return r.find_first(type & ~kNamedChunkFlag, name);
+}
+
+std::optional<FoundChunk> read_first_chunk(const std::string &path, int type, const std::string *name,
+                                           const MapReadOptions &options) {
+  Reader r(path, options, ReadMode::Full);
+  return r.read_first(type & ~kNamedChunkFlag, name);
+}
+
+std::optional<GridMapHeader> read_first_gridmap_header(const std::string &path, const std::string *name) {
+  Reader r(path, MapReadOptions{}, ReadMode::HeadersOnly);
+  return r.read_first_header(name);
 }
 
 bool is_map_file(const std::string &path) {

@@ -319,29 +319,49 @@ void write_map_file(const std::string &path, const MapFile &map) {
   out.commit();
 }
 
+// What asctime(localtime(&t)) gives, without its newline, by the C
+// standard's definition of asctime (written out here: asctime's own buffer is
+// shared and too short for years past 9999).
+static std::string carmen_date(int64_t time) {
+  static const char *const kDays[] = {"Sun", "Mon", "Tue", "Wed", "Thu", "Fri", "Sat"};
+  static const char *const kMonths[] = {"Jan", "Feb", "Mar", "Apr", "May", "Jun",
+                                        "Jul", "Aug", "Sep", "Oct", "Nov", "Dec"};
+  const std::time_t t = static_cast<std::time_t>(time);
+  std::tm tm{};
+  if (localtime_r(&t, &tm) == nullptr || tm.tm_wday < 0 || tm.tm_wday > 6 || tm.tm_mon < 0 || tm.tm_mon > 11)
+    return "unknown";
+  char date[96];
+  std::snprintf(date, sizeof date, "%.3s %.3s%3d %.2d:%.2d:%.2d %d", kDays[tm.tm_wday], kMonths[tm.tm_mon],
+                tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, 1900 + tm.tm_year);
+  return date;
+}
+
 std::vector<std::string> standard_map_comments(int size_x, int size_y, double resolution,
                                                const std::string &origin, const std::string &description,
                                                const std::string &author, int64_t time) {
-  const std::string rule(52, '#');
-  char date[64] = "unknown";
-  const std::time_t t = static_cast<std::time_t>(time);
-  std::tm tm_utc;
-  if (gmtime_r(&t, &tm_utc) != nullptr) std::strftime(date, sizeof date, "%a %b %e %H:%M:%S %Y UTC", &tm_utc);
-  std::ostringstream res;
-  res << resolution;
-  return {
+  const std::string rule(52, '#');  // encode_comment_lines adds the 53rd '#'
+  char res[64];
+  std::snprintf(res, sizeof res, "%.1f", resolution);
+  // CARMEN writes no newline after the description: the "#" of its next line
+  // ends that line, unless the description brings its own newline.
+  std::string desc = description;
+  const bool own_newline = !desc.empty() && desc.back() == '\n';
+  if (own_newline) desc.pop_back();
+  std::vector<std::string> lines = {
       rule,
       "",
-      " CARMEN map file (format CARMENMAPFILEv020)",
+      " Carnegie Mellon Robot Toolkit (CARMEN) map file",
       "",
       " Map author    : " + author,
-      std::string(" Creation date : ") + date,
+      " Creation date : " + carmen_date(time),
       " Map size      : " + std::to_string(size_x) + " x " + std::to_string(size_y),
-      " Resolution    : " + res.str(),
+      std::string(" Resolution    : ") + res,
       " Origin        : " + origin,
-      " Description   : " + description,
-      rule,
+      " Description   : " + desc + (own_newline ? "" : "#"),
   };
+  if (own_newline) lines.push_back("");
+  lines.push_back(rule);
+  return lines;
 }
 
 std::string encode_raw_chunk(int type, const std::string &payload, const std::string &name) {

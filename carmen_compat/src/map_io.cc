@@ -1,14 +1,20 @@
 // CARMEN's map_io C API on top of carmen_compat/map_file.h.
 #include "carmen/map_io.h"
 
+#include <unistd.h>
+
+#include <climits>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <exception>
+#include <mutex>
 #include <new>
+#include <optional>
 #include <string>
+#include <variant>
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_file.h"
@@ -32,11 +38,6 @@ namespace {
 using carmen::map_io_detail::guarded;
 using carmen::map_io_detail::report;
 
-carmen::MapFile read_file(const char *filename) {
-  if (filename == nullptr) throw std::invalid_argument("no file name given");
-  return carmen::read_map_file(filename);
-}
-
 [[noreturn]] void missing(const char *filename, const char *what) {
   throw carmen::FileError(filename, std::string("has no ") + what + " chunk");
 }
@@ -44,17 +45,6 @@ carmen::MapFile read_file(const char *filename) {
 [[noreturn]] void missing_named(const char *filename, const char *what, const char *name) {
   throw carmen::FileError(filename, std::string("has no ") + what + " chunk named \"" +
                                         carmen::printable(name ? name : "") + "\"");
-}
-
-template <typename T>
-const T *find_named(const carmen::MapFile &m, const char *name) {
-  if (name == nullptr) return nullptr;
-  for (const carmen::NamedChunk &nc : m.named) {
-    if (nc.name == name) {
-      if (const T *p = std::get_if<T>(&nc.payload)) return p;
-    }
-  }
-  return nullptr;
 }
 
 int write_bytes(carmen_FILE *fp, const std::string &bytes, const char *func) {
@@ -67,6 +57,13 @@ int write_bytes(carmen_FILE *fp, const std::string &bytes, const char *func) {
     return -1;
   }
   return 0;
+}
+
+// The user CARMEN's writers name: getlogin(), or "UNKNOWN" when the process
+// has no login name (no controlling terminal: cron, containers, daemons).
+std::string login_name() {
+  const char *user = getlogin();
+  return user != nullptr ? user : "UNKNOWN";
 }
 
 carmen::GridMap grid_from(float **prob, int size_x, int size_y, double resolution) {
@@ -135,6 +132,12 @@ carmen::LaserScanList scans_from(const carmen_laser_scan_t *scans, int n) {
   return out;
 }
 
+// The payload of a chunk found by first_chunk (its type was asked for).
+template <typename T>
+const T &payload_of(const carmen::FoundChunk &c) {
+  return std::get<T>(c.payload);
+}
+
 // A malloc()ed copy of `text`, as CARMEN's readers make for map_name.
 char *malloc_copy(const char *text) {
   const size_t n = std::strlen(text) + 1;
@@ -142,14 +145,6 @@ char *malloc_copy(const char *text) {
   if (copy == nullptr) throw std::bad_alloc();
   std::memcpy(copy, text, n);
   return copy;
-}
-
-void fill_config(const carmen::GridMap &g, const char *map_name, carmen_map_config_p config) {
-  char *name = malloc_copy(map_name);
-  config->x_size = g.size_x;
-  config->y_size = g.size_y;
-  config->resolution = g.resolution;
-  config->map_name = name;
 }
 
 // map_name: what CARMEN's reader puts there (the file or the chunk name).
@@ -256,9 +251,24 @@ bool read_i32(carmen_FILE *fp, int32_t *v) {
   return true;
 }
 
+// carmen_fseek, its result taken as CARMEN's libglobal may give it (a
+// program can link it ahead of ours): for a .gz file CARMEN's returns
+// gzseek's new offset, not 0, and a plain one fseek's 0. So success is the
+// file being where it was asked to go, as carmen_ftell says.
+bool seek(carmen_FILE *fp, long offset, int whence) {
+  long target = offset;
+  if (whence == SEEK_CUR) {
+    const long here = carmen_ftell(fp);
+    if (here < 0 || offset > LONG_MAX - here) return false;
+    target = here + offset;
+  }
+  if (carmen_fseek(fp, offset, whence) == -1) return false;
+  return whence == SEEK_END || carmen_ftell(fp) == target;
+}
+
 // Rewinds and reads past the comments and the id; false if they are not there.
 bool skip_to_first_chunk(carmen_FILE *fp) {
-  if (carmen_fseek(fp, 0, SEEK_SET) != 0) return false;
+  if (!seek(fp, 0, SEEK_SET)) return false;
   int c;
   while ((c = carmen_fgetc(fp)) == '#') {
     while ((c = carmen_fgetc(fp)) != EOF && c != '\n') {
@@ -284,7 +294,7 @@ int advance(carmen_FILE *fp, int specific_chunk, const char *chunk_name) {
     if (!read_i32(fp, &size) || size < 10) return -1;
     long skip = size;
     if ((type & ~CARMEN_MAP_NAMED_CHUNK_FLAG) == specific_chunk) {
-      if (chunk_name == nullptr) return carmen_fseek(fp, at_type, SEEK_SET) == 0 ? 0 : -1;
+      if (chunk_name == nullptr) return seek(fp, at_type, SEEK_SET) ? 0 : -1;
       if (type & CARMEN_MAP_NAMED_CHUNK_FLAG) {
         char desc[10];
         if (carmen_fread(desc, 1, 10, fp) != 10) return -1;
@@ -297,10 +307,10 @@ int advance(carmen_FILE *fp, int specific_chunk, const char *chunk_name) {
           name.push_back(static_cast<char>(c));
           if (name.size() > 4096) return -1;
         }
-        if (name == chunk_name) return carmen_fseek(fp, at_type, SEEK_SET) == 0 ? 0 : -1;
+        if (name == chunk_name) return seek(fp, at_type, SEEK_SET) ? 0 : -1;
       }
     }
-    if (carmen_fseek(fp, skip, SEEK_CUR) != 0) return -1;
+    if (!seek(fp, skip, SEEK_CUR)) return -1;
   }
 }
 
@@ -340,6 +350,10 @@ int write_offset(const char *fn, carmen_FILE *fp, const char *name, const carmen
   });
 }
 
+// What carmen_map_set_filename stored (CARMEN's map server would publish it).
+std::mutex server_mutex;
+std::string server_filename;
+
 }  // namespace
 
 extern "C" {
@@ -347,14 +361,16 @@ extern "C" {
 // ---------------------------------------------------------------------------
 // Writers
 // ---------------------------------------------------------------------------
+// CARMEN's bytes (map_file.h, standard_map_comments): the author is
+// getlogin(), or "UNKNOWN" when it has none; a NULL origin or description is
+// written "(null)", as glibc's printf writes CARMEN's NULL.
 int carmen_map_write_comment_chunk(carmen_FILE *fp, int size_x, int size_y, double resolution,
                                    const char *origin, const char *description) {
   const char *const fn = __func__;
   return guarded(fn, nullptr, [&] {
-    const char *user = std::getenv("USER");
-    const auto lines = carmen::standard_map_comments(size_x, size_y, resolution, origin ? origin : "",
-                                                     description ? description : "", user ? user : "unknown",
-                                                     static_cast<int64_t>(std::time(nullptr)));
+    const auto lines = carmen::standard_map_comments(
+        size_x, size_y, resolution, origin ? origin : "(null)", description ? description : "(null)",
+        login_name(), static_cast<int64_t>(std::time(nullptr)));
     return write_bytes(fp, carmen::encode_comment_lines(lines), fn);
   });
 }
@@ -365,8 +381,7 @@ static int write_creator(const char *fn, carmen_FILE *fp, const char *name, cons
                          const char *description) {
   return guarded(fn, nullptr, [&] {
     carmen::CreatorInfo c;
-    const char *user = std::getenv("USER");
-    c.user = user ? user : "unknown";
+    c.user = login_name();
     c.origin = origin ? origin : "";
     c.description = description ? description : "";
     c.time = static_cast<int64_t>(std::time(nullptr));
@@ -451,44 +466,120 @@ int carmen_map_write_all(carmen_FILE *fp, float **prob, int size_x, int size_y, 
 // ---------------------------------------------------------------------------
 // Readers
 // ---------------------------------------------------------------------------
-static int read_gridmap(const char *fn, const char *filename, const char *chunk_name, carmen_map_p map) {
+// Every reader first clears its outputs, so that a failure never leaves them
+// as the caller had them (often uninitialised): a program that then free()s
+// or realloc()s them, as CARMEN's maptool does, gets NULL and zero counts.
+// The chunk is found as CARMEN finds it (map_file.h, read_first_chunk): the
+// first of its type, named or not, for the unnamed readers; the first named
+// one called chunk_name for the named readers; chunks after it are not read.
+// A missing chunk is reported on stderr where CARMEN reports it (gridmap,
+// laser scans, creator, every named reader) and is a silent -1 where CARMEN's
+// is (the unnamed places, off-limits and offset readers: maptool and the
+// PPM writer ask for those on every map).
+
+static void clear_config(carmen_map_config_p config) {
+  config->x_size = 0;
+  config->y_size = 0;
+  config->resolution = 0;
+  config->map_name = nullptr;
+}
+
+static void clear_map(carmen_map_p map) {
+  clear_config(&map->config);
+  map->complete_map = nullptr;
+  map->map = nullptr;
+}
+
+// The first chunk of `type` (chunk_name NULL: named or not), or nullopt.
+static std::optional<carmen::FoundChunk> first_chunk(const char *filename, int type, const char *chunk_name) {
+  carmen::map_io_detail::need_name(filename);
+  const std::string name = chunk_name ? chunk_name : "";
+  return carmen::read_first_chunk(filename, type, chunk_name ? &name : nullptr);
+}
+
+static void need_chunk_name(const char *chunk_name) {
+  if (chunk_name == nullptr) throw std::invalid_argument("no chunk name given (NULL)");
+}
+
+[[noreturn]] static void missing_chunk(const char *filename, const char *what, const char *chunk_name) {
+  if (chunk_name != nullptr) missing_named(filename, what, chunk_name);
+  missing(filename, what);
+}
+
+// Cells that are none of CARMEN's values (damage) are returned as stored, as
+// CARMEN returns them, with a warning on stderr naming the chunk: a map whose
+// layout is intact is read, whatever its cells hold.
+static void warn_invalid_cells(const char *fn, const char *filename, const carmen::FoundChunk &c) {
+  const carmen::GridMap &g = payload_of<carmen::GridMap>(c);
+  size_t bad = 0, first = 0;
+  for (size_t i = 0; i < g.cells.size(); ++i) {
+    if (!carmen::valid_cell_value(g.cells[i]) && bad++ == 0) first = i;
+  }
+  if (bad == 0) return;
+  std::fprintf(stderr,
+               "%s: %s: warning: the GRIDMAP chunk at byte %lld holds %zu invalid cell values of %zu (the first "
+               "is cell (%zu, %zu) = %.9g): the map is damaged; its cells are returned as stored\n",
+               fn, filename, static_cast<long long>(c.info.offset), bad, g.cells.size(),
+               first / size_t(g.size_y), first % size_t(g.size_y), double(g.cells[first]));
+}
+
+static int read_gridmap(const char *fn, const char *filename, const char *chunk_name, bool named,
+                        carmen_map_p map) {
+  if (map != nullptr) clear_map(map);
   return guarded(fn, filename, [&] {
     if (map == nullptr) throw std::invalid_argument("no map given (NULL)");
-    const carmen::MapFile m = read_file(filename);
-    const carmen::GridMap *g =
-        chunk_name ? find_named<carmen::GridMap>(m, chunk_name) : (m.gridmap ? &*m.gridmap : nullptr);
-    if (g == nullptr) missing(filename, "GRIDMAP");
-    fill_map(*g, chunk_name ? chunk_name : filename, map);
+    if (named) need_chunk_name(chunk_name);
+    carmen::map_io_detail::need_name(filename);
+    carmen::MapReadOptions opts;
+    opts.check_cells = false;  // checked below, as a warning
+    const std::string name = chunk_name ? chunk_name : "";
+    const auto c = carmen::read_first_chunk(filename, CARMEN_MAP_GRIDMAP_CHUNK, chunk_name ? &name : nullptr, opts);
+    if (!c) missing_chunk(filename, "GRIDMAP", chunk_name);
+    warn_invalid_cells(fn, filename, *c);
+    fill_map(payload_of<carmen::GridMap>(*c), chunk_name ? chunk_name : filename, map);
     return 0;
   });
 }
 int carmen_map_read_named_gridmap_chunk(const char *filename, const char *chunk_name, carmen_map_p map) {
-  return read_gridmap(__func__, filename, chunk_name, map);
+  return read_gridmap(__func__, filename, chunk_name, true, map);
 }
 int carmen_map_read_gridmap_chunk(const char *filename, carmen_map_p map) {
-  return read_gridmap(__func__, filename, nullptr, map);
+  return read_gridmap(__func__, filename, nullptr, false, map);
 }
 
-static int read_gridmap_config(const char *fn, const char *filename, const char *chunk_name,
+// Only the gridmap's header is read, as CARMEN's config reader does: the
+// cells (and anything after the chunk) may be damaged.
+static int read_gridmap_config(const char *fn, const char *filename, const char *chunk_name, bool named,
                                carmen_map_config_p config) {
+  if (config != nullptr) clear_config(config);
   return guarded(fn, filename, [&] {
     if (config == nullptr) throw std::invalid_argument("no config given (NULL)");
-    const carmen::MapFile m = read_file(filename);
-    const carmen::GridMap *g =
-        chunk_name ? find_named<carmen::GridMap>(m, chunk_name) : (m.gridmap ? &*m.gridmap : nullptr);
-    if (g == nullptr && chunk_name) missing_named(filename, "GRIDMAP", chunk_name);
-    if (g == nullptr) missing(filename, "GRIDMAP");
-    fill_config(*g, chunk_name ? chunk_name : filename, config);
+    if (named) need_chunk_name(chunk_name);
+    carmen::map_io_detail::need_name(filename);
+    const std::string name = chunk_name ? chunk_name : "";
+    const auto h = carmen::read_first_gridmap_header(filename, chunk_name ? &name : nullptr);
+    if (!h) missing_chunk(filename, "GRIDMAP", chunk_name);
+    char *copy = malloc_copy(chunk_name ? chunk_name : filename);
+    config->x_size = h->size_x;
+    config->y_size = h->size_y;
+    config->resolution = h->resolution;
+    config->map_name = copy;
     return 0;
   });
 }
 int carmen_map_read_gridmap_config(const char *filename, carmen_map_config_p config) {
-  return read_gridmap_config(__func__, filename, nullptr, config);
+  return read_gridmap_config(__func__, filename, nullptr, false, config);
 }
 int carmen_map_read_named_gridmap_config(const char *filename, const char *chunk_name,
                                          carmen_map_config_p config) {
-  if (chunk_name == nullptr) return read_gridmap_config(__func__, filename, "", config);
-  return read_gridmap_config(__func__, filename, chunk_name, config);
+  return read_gridmap_config(__func__, filename, chunk_name, true, config);
+}
+
+static void clear_creator(time_t *creation_time, char *username, char *origin, char *description) {
+  if (creation_time != nullptr) *creation_time = 0;
+  if (username != nullptr) *username = '\0';
+  if (origin != nullptr) *origin = '\0';
+  if (description != nullptr) *description = '\0';
 }
 
 static void copy_creator(const carmen::CreatorInfo &c, time_t *creation_time, char *username, char *origin,
@@ -499,13 +590,30 @@ static void copy_creator(const carmen::CreatorInfo &c, time_t *creation_time, ch
   copy_text(description, 81, c.description);
 }
 
+// CARMEN's order: the first CREATOR chunk, else the first old-style (code 0)
+// one, which is reported. Damage met while looking for a CREATOR chunk is
+// reported only when there is no old-style creator to fall back to.
 int carmen_map_read_creator_chunk(const char *filename, time_t *creation_time, char *username, char *origin,
                                   char *description) {
+  clear_creator(creation_time, username, origin, description);
   return guarded(__func__, filename, [&] {
-    const carmen::MapFile m = read_file(filename);
-    if (!m.creator) missing(filename, "CREATOR");
-    if (m.old_style_creator) std::fprintf(stderr, "%s: old-style map (creator chunk code 0)\n", filename);
-    copy_creator(*m.creator, creation_time, username, origin, description);
+    std::optional<carmen::FoundChunk> c;
+    try {
+      c = first_chunk(filename, CARMEN_MAP_CREATOR_CHUNK, nullptr);
+    } catch (const carmen::FileError &) {
+      std::optional<carmen::FoundChunk> old;
+      try {
+        old = first_chunk(filename, CARMEN_MAP_CREATOR_OLD_CHUNK, nullptr);
+      } catch (const carmen::FileError &) {
+      }
+      if (!old) throw;
+      c = std::move(old);
+    }
+    if (!c) c = first_chunk(filename, CARMEN_MAP_CREATOR_OLD_CHUNK, nullptr);
+    if (!c) missing(filename, "CREATOR");
+    if (c->info.base_type() == CARMEN_MAP_CREATOR_OLD_CHUNK)
+      std::fprintf(stderr, "%s: old-style map (creator chunk code 0)\n", filename);
+    copy_creator(payload_of<carmen::CreatorInfo>(*c), creation_time, username, origin, description);
     return 0;
   });
 }
@@ -514,97 +622,107 @@ int carmen_map_read_creator_chunk(const char *filename, time_t *creation_time, c
 // answers here.
 int carmen_map_read_named_creator_chunk(const char *filename, const char *chunk_name, time_t *creation_time,
                                         char *username, char *origin, char *description) {
+  clear_creator(creation_time, username, origin, description);
   return guarded(__func__, filename, [&] {
-    const carmen::MapFile m = read_file(filename);
-    const carmen::CreatorInfo *c = find_named<carmen::CreatorInfo>(m, chunk_name);
-    if (c == nullptr) missing_named(filename, "CREATOR", chunk_name);
-    copy_creator(*c, creation_time, username, origin, description);
+    need_chunk_name(chunk_name);
+    const auto c = first_chunk(filename, CARMEN_MAP_CREATOR_CHUNK, chunk_name);
+    if (!c) missing_named(filename, "CREATOR", chunk_name);
+    copy_creator(payload_of<carmen::CreatorInfo>(*c), creation_time, username, origin, description);
     return 0;
   });
 }
 
-static int read_places(const char *fn, const char *filename, const char *chunk_name,
+static int read_places(const char *fn, const char *filename, const char *chunk_name, bool named,
                        carmen_map_placelist_p places) {
+  if (places != nullptr) {
+    places->places = nullptr;
+    places->num_places = 0;
+  }
   return guarded(fn, filename, [&] {
     if (places == nullptr) throw std::invalid_argument("no place list given (NULL)");
-    const carmen::MapFile m = read_file(filename);
-    const carmen::PlaceList *p =
-        chunk_name ? find_named<carmen::PlaceList>(m, chunk_name) : (m.places ? &*m.places : nullptr);
-    if (p == nullptr) missing(filename, "PLACES");
-    fill_places(*p, places);
+    if (named) need_chunk_name(chunk_name);
+    const auto c = first_chunk(filename, CARMEN_MAP_PLACES_CHUNK, chunk_name);
+    if (!c && !named) return -1;  // silent, as CARMEN's
+    if (!c) missing_named(filename, "PLACES", chunk_name);
+    fill_places(payload_of<carmen::PlaceList>(*c), places);
     return 0;
   });
 }
 int carmen_map_read_named_places_chunk(const char *filename, const char *chunk_name,
                                        carmen_map_placelist_p places) {
-  return read_places(__func__, filename, chunk_name, places);
+  return read_places(__func__, filename, chunk_name, true, places);
 }
 int carmen_map_read_places_chunk(const char *filename, carmen_map_placelist_p places) {
-  return read_places(__func__, filename, nullptr, places);
+  return read_places(__func__, filename, nullptr, false, places);
 }
 
-static int read_offlimits(const char *fn, const char *filename, const char *chunk_name,
+static int read_offlimits(const char *fn, const char *filename, const char *chunk_name, bool named,
                           carmen_offlimits_p *offlimits_list, int *list_length) {
+  if (offlimits_list != nullptr) *offlimits_list = nullptr;
+  if (list_length != nullptr) *list_length = 0;
   return guarded(fn, filename, [&] {
     if (offlimits_list == nullptr || list_length == nullptr)
       throw std::invalid_argument("NULL output argument");
-    const carmen::MapFile m = read_file(filename);
-    const carmen::OffLimits *o =
-        chunk_name ? find_named<carmen::OffLimits>(m, chunk_name) : (m.offlimits ? &*m.offlimits : nullptr);
-    if (o == nullptr) missing(filename, "OFFLIMITS");
-    fill_offlimits(*o, offlimits_list, list_length);
+    if (named) need_chunk_name(chunk_name);
+    const auto c = first_chunk(filename, CARMEN_MAP_OFFLIMITS_CHUNK, chunk_name);
+    if (!c && !named) return -1;  // silent, as CARMEN's
+    if (!c) missing_named(filename, "OFFLIMITS", chunk_name);
+    fill_offlimits(payload_of<carmen::OffLimits>(*c), offlimits_list, list_length);
     return 0;
   });
 }
 int carmen_map_read_named_offlimits_chunk(const char *filename, const char *chunk_name,
                                           carmen_offlimits_p *offlimits_list, int *list_length) {
-  return read_offlimits(__func__, filename, chunk_name, offlimits_list, list_length);
+  return read_offlimits(__func__, filename, chunk_name, true, offlimits_list, list_length);
 }
 int carmen_map_read_offlimits_chunk(const char *filename, carmen_offlimits_p *offlimits_list,
                                     int *list_length) {
-  return read_offlimits(__func__, filename, nullptr, offlimits_list, list_length);
+  return read_offlimits(__func__, filename, nullptr, false, offlimits_list, list_length);
 }
 
-static int read_laserscans(const char *fn, const char *filename, const char *chunk_name,
+static int read_laserscans(const char *fn, const char *filename, const char *chunk_name, bool named,
                            carmen_laser_scan_p *scan_list, int *num_scans) {
+  if (scan_list != nullptr) *scan_list = nullptr;
+  if (num_scans != nullptr) *num_scans = 0;
   return guarded(fn, filename, [&] {
     if (scan_list == nullptr || num_scans == nullptr) throw std::invalid_argument("NULL output argument");
-    const carmen::MapFile m = read_file(filename);
-    const carmen::LaserScanList *s = chunk_name ? find_named<carmen::LaserScanList>(m, chunk_name)
-                                                : (m.laserscans ? &*m.laserscans : nullptr);
-    if (s == nullptr) missing(filename, "LASERSCANS");
-    fill_scans(*s, scan_list, num_scans);
+    if (named) need_chunk_name(chunk_name);
+    const auto c = first_chunk(filename, CARMEN_MAP_LASERSCANS_CHUNK, chunk_name);
+    if (!c) missing_chunk(filename, "LASERSCANS", chunk_name);
+    fill_scans(payload_of<carmen::LaserScanList>(*c), scan_list, num_scans);
     return 0;
   });
 }
 int carmen_map_read_named_laserscans_chunk(const char *filename, const char *chunk_name,
                                            carmen_laser_scan_p *scan_list, int *num_scans) {
-  return read_laserscans(__func__, filename, chunk_name, scan_list, num_scans);
+  return read_laserscans(__func__, filename, chunk_name, true, scan_list, num_scans);
 }
 int carmen_map_read_laserscans_chunk(const char *filename, carmen_laser_scan_p *scan_list, int *num_scans) {
-  return read_laserscans(__func__, filename, nullptr, scan_list, num_scans);
+  return read_laserscans(__func__, filename, nullptr, false, scan_list, num_scans);
 }
 
-static int read_global_offset(const char *fn, const char *filename, const char *chunk_name,
+static int read_global_offset(const char *fn, const char *filename, const char *chunk_name, bool named,
                               carmen_global_offset_p global_offset) {
+  if (global_offset != nullptr) *global_offset = carmen_global_offset_t{0, 0, 0};
   return guarded(fn, filename, [&] {
     if (global_offset == nullptr) throw std::invalid_argument("no offset given (NULL)");
-    const carmen::MapFile m = read_file(filename);
-    const carmen::GlobalOffset *o =
-        chunk_name ? find_named<carmen::GlobalOffset>(m, chunk_name) : (m.offset ? &*m.offset : nullptr);
-    if (o == nullptr) missing(filename, "OFFSET");
-    global_offset->x = o->x;
-    global_offset->y = o->y;
-    global_offset->theta = o->theta;
+    if (named) need_chunk_name(chunk_name);
+    const auto c = first_chunk(filename, CARMEN_MAP_GLOBAL_OFFSET_CHUNK, chunk_name);
+    if (!c && !named) return -1;  // silent, as CARMEN's
+    if (!c) missing_named(filename, "OFFSET", chunk_name);
+    const carmen::GlobalOffset &o = payload_of<carmen::GlobalOffset>(*c);
+    global_offset->x = o.x;
+    global_offset->y = o.y;
+    global_offset->theta = o.theta;
     return 0;
   });
 }
 int carmen_map_read_named_global_offset_chunk(const char *filename, const char *chunk_name,
                                               carmen_global_offset_p global_offset) {
-  return read_global_offset(__func__, filename, chunk_name, global_offset);
+  return read_global_offset(__func__, filename, chunk_name, true, global_offset);
 }
 int carmen_map_read_global_offset_chunk(const char *filename, carmen_global_offset_p global_offset) {
-  return read_global_offset(__func__, filename, nullptr, global_offset);
+  return read_global_offset(__func__, filename, nullptr, false, global_offset);
 }
 
 // ---------------------------------------------------------------------------
@@ -614,21 +732,44 @@ int carmen_map_file(const char *filename) {
   return filename != nullptr && carmen::is_map_file(filename) ? 1 : 0;
 }
 
-int carmen_map_named_chunk_exists(const char *filename, int specific_chunk, const char *chunk_name) {
-  const int rc = guarded(__func__, filename, [&] {
+// Found as CARMEN's advance finds it: chunks after the one asked for are not
+// read, so damage there does not hide it.
+static int chunk_exists(const char *fn, const char *filename, int specific_chunk, const char *chunk_name) {
+  const int rc = guarded(fn, filename, [&] {
     if (filename == nullptr) throw std::invalid_argument("no file name given");
-    for (const carmen::ChunkInfo &c : carmen::list_map_chunks(filename)) {
-      if (c.base_type() != specific_chunk) continue;
-      if (chunk_name != nullptr && (!c.named() || c.name != chunk_name)) continue;
-      return static_cast<int>(c.size);
-    }
-    return 0;
+    const std::string name = chunk_name ? chunk_name : "";
+    const auto c = carmen::find_first_chunk(filename, specific_chunk, chunk_name ? &name : nullptr);
+    return c ? static_cast<int>(c->size) : 0;
   });
   return rc < 0 ? 0 : rc;
 }
-int carmen_map_chunk_exists(const char *filename, int specific_chunk) {
-  return carmen_map_named_chunk_exists(filename, specific_chunk, nullptr);
+int carmen_map_named_chunk_exists(const char *filename, int specific_chunk, const char *chunk_name) {
+  return chunk_exists(__func__, filename, specific_chunk, chunk_name);
 }
+int carmen_map_chunk_exists(const char *filename, int specific_chunk) {
+  return chunk_exists(__func__, filename, specific_chunk, nullptr);
+}
+
+// ---------------------------------------------------------------------------
+// CARMEN's map-server calls (map_interface.c in CARMEN), without IPC
+// ---------------------------------------------------------------------------
+int carmen_map_initialize_ipc(void) {
+  std::string name;
+  {
+    const std::lock_guard<std::mutex> lock(server_mutex);
+    name = server_filename;
+  }
+  std::fprintf(stderr, "%s: no IPC in vasco_gpu: %s cannot be served to other processes\n", __func__,
+               name.empty() ? "the map" : name.c_str());
+  return -1;
+}
+
+void carmen_map_set_filename(const char *new_filename) {
+  const std::lock_guard<std::mutex> lock(server_mutex);
+  server_filename = new_filename ? new_filename : "";
+}
+
+void carmen_map_publish_update(void) {}
 
 int carmen_map_advance_to_chunk(carmen_FILE *fp, int specific_chunk) {
   return advance(fp, specific_chunk, nullptr);

@@ -215,11 +215,11 @@ carmen_hmap_t parse_hmap(const std::string &payload, const char *file) {
   return to_c(zones, links);
 }
 
-const carmen::ChunkInfo &first_unnamed_hmap(const std::vector<carmen::ChunkInfo> &chunks, const char *file) {
-  for (const carmen::ChunkInfo &c : chunks) {
-    if (c.type == CARMEN_MAP_HMAP_CHUNK) return c;
-  }
-  throw carmen::FileError(file, "has no HMAP chunk");
+// The first HMAP chunk, named or not, as CARMEN's advance finds it.
+carmen::ChunkInfo first_hmap(const char *file) {
+  const auto c = carmen::find_first_chunk(file, CARMEN_MAP_HMAP_CHUNK);
+  if (!c) throw carmen::FileError(file, "has no HMAP chunk");
+  return *c;
 }
 
 }  // namespace
@@ -234,12 +234,15 @@ int carmen_map_write_hmap_chunk(carmen_FILE *fp, carmen_hmap_p hmap) {
 }
 
 int carmen_map_read_hmap_chunk(const char *filename, carmen_hmap_p hmap) {
+  if (hmap != nullptr) *hmap = carmen_hmap_t{};  // cleared first: a failure leaves no stale pointers
   return guarded(__func__, filename, [&] {
     carmen::map_io_detail::need_name(filename);
     if (hmap == nullptr) throw std::invalid_argument("no hmap given (NULL)");
-    const std::vector<carmen::ChunkInfo> chunks = carmen::list_map_chunks(filename);
-    const std::string body = carmen::read_chunk_body(filename, first_unnamed_hmap(chunks, filename));
-    *hmap = parse_hmap(body.substr(10), filename);
+    const carmen::ChunkInfo c = first_hmap(filename);
+    const std::string body = carmen::read_chunk_body(filename, c);
+    // A named chunk's name and NUL come between the description and the payload.
+    const size_t skip = 10 + (c.named() ? c.name.size() + 1 : 0);
+    *hmap = parse_hmap(body.substr(skip), filename);
     return 0;
   });
 }

@@ -64,8 +64,10 @@ int32_t read_le_i32(const unsigned char *b) {
   return v;
 }
 
-// The chunks after the id: each one copied unless its type (named flag
-// masked off) is in strip.
+// The chunks after the id: each one copied unless its type is in strip. As
+// in CARMEN, whose table is indexed by the raw type byte, a named chunk
+// (type | 0x80) is never stripped: a map's named gridmaps, places or hmap
+// zones survive maptool's strip, rotate and add_place.
 void copy_chunks(carmen_FILE *in, carmen_FILE *out, const bool strip[128]) {
   int type;
   while ((type = carmen_fgetc(in)) != EOF) {
@@ -73,7 +75,7 @@ void copy_chunks(carmen_FILE *in, carmen_FILE *out, const bool strip[128]) {
     if (carmen_fread(size_bytes, 1, 4, in) != 4) throw std::runtime_error("input ends inside a chunk header");
     const int32_t size = read_le_i32(size_bytes);
     if (size < 10) throw std::runtime_error("damaged chunk: size " + std::to_string(size) + " (at least 10)");
-    const bool keep = !strip[type & ~CARMEN_MAP_NAMED_CHUNK_FLAG];
+    const bool keep = CARMEN_MAP_CHUNK_IS_NAMED(type) || !strip[type];
     if (keep)
       put_bytes(out, std::string(1, static_cast<char>(type)) +
                          std::string(reinterpret_cast<char *>(size_bytes), 4));
@@ -184,20 +186,18 @@ void write_file(const char *filename, const std::string &bytes) {
 }
 
 // ---- Naming a chunk ----------------------------------------------------------
-const carmen::ChunkInfo &first_chunk(const std::vector<carmen::ChunkInfo> &chunks, const char *file,
-                                     int type) {
-  for (const carmen::ChunkInfo &c : chunks) {
-    if (c.base_type() == type) return c;
-  }
-  throw carmen::FileError(file, "has no " + carmen::chunk_type_name(type) + " chunk");
+// The first chunk of `type`, named or not, found as CARMEN's advance finds it.
+carmen::ChunkInfo first_chunk(const char *file, int type) {
+  const auto c = carmen::find_first_chunk(file, type);
+  if (!c) throw carmen::FileError(file, "has no " + carmen::chunk_type_name(type) + " chunk");
+  return *c;
 }
 
 void check_name_free(const char *out_file, int type, const char *name) {
-  for (const carmen::ChunkInfo &c : carmen::list_map_chunks(out_file)) {
-    if (c.named() && c.base_type() == type && c.name == name) {
-      throw carmen::FileError(out_file, "already has a " + carmen::chunk_type_name(type) + " chunk named \"" +
-                                            carmen::printable(name) + "\"");
-    }
+  const std::string wanted = name;
+  if (carmen::find_first_chunk(out_file, type, &wanted)) {
+    throw carmen::FileError(out_file, "already has a " + carmen::chunk_type_name(type) + " chunk named \"" +
+                                          carmen::printable(name) + "\"");
   }
 }
 
@@ -257,8 +257,7 @@ int carmen_map_name_chunk(const char *in_file, const char *out_file, int chunk_t
     if (in_file == nullptr || out_file == nullptr) throw std::invalid_argument("no file name given");
     if (chunk_name == nullptr || *chunk_name == '\0') throw std::invalid_argument("no chunk name given");
     const int type = chunk_type & ~CARMEN_MAP_NAMED_CHUNK_FLAG;
-    const std::vector<carmen::ChunkInfo> chunks = carmen::list_map_chunks(in_file);
-    const carmen::ChunkInfo &c = first_chunk(chunks, in_file, type);
+    const carmen::ChunkInfo c = first_chunk(in_file, type);
     if (c.named()) {
       throw carmen::FileError(in_file,
                               "its first " + carmen::chunk_type_name(type) + " chunk is already named");

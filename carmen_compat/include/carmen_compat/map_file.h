@@ -211,6 +211,43 @@ NamedChunk read_named_chunk(const std::string &path, const ChunkInfo &chunk,
 // Throws carmen::FileError like read_map_file for a damaged layout.
 std::vector<ChunkInfo> list_map_chunks(const std::string &path);
 
+// ---------------------------------------------------------------------------
+// One chunk, found as CARMEN finds it (carmen_map_advance_to_chunk and
+// carmen_map_advance_to_named_chunk): the chunk headers are scanned from the
+// start of the file up to the first chunk whose type, named flag masked off,
+// is `type` (name == nullptr: named or not; otherwise the first named chunk
+// of that type called *name), and nothing after it is looked at. So a map
+// whose only GRIDMAP is named still has a gridmap, and damage in a chunk
+// after the one asked for does not matter; damage in that chunk or in one
+// before it is a carmen::FileError naming the chunk and its byte offset.
+// Memory stays bounded as for read_map_file: no size a header claims is
+// allocated before the bytes are there.
+// ---------------------------------------------------------------------------
+struct FoundChunk {
+  ChunkInfo info;        // the chunk's header (raw type, offset, size, name)
+  ChunkPayload payload;  // parsed and checked as read_map_file would
+};
+// The header of that chunk, or nullopt when the scan reaches the end of the
+// file without one.
+std::optional<ChunkInfo> find_first_chunk(const std::string &path, int type,
+                                          const std::string *name = nullptr);
+// The same chunk read, in one pass. `type` is a kind ChunkPayload holds
+// (GRIDMAP, CREATOR, OFFSET, PLACES, OFFLIMITS, LASERSCANS) or the old creator
+// code 0 (read as a CreatorInfo); anything else is std::invalid_argument.
+std::optional<FoundChunk> read_first_chunk(const std::string &path, int type, const std::string *name = nullptr,
+                                           const MapReadOptions &options = MapReadOptions{});
+
+// The size and resolution of a gridmap (what carmen_map_read_gridmap_config
+// reads): the first GRIDMAP found as above, its header checked (positive
+// sizes and resolution, a chunk size that matches the cells) but its cells
+// neither read nor checked.
+struct GridMapHeader {
+  ChunkInfo info;
+  int size_x = 0, size_y = 0;
+  double resolution = 0;
+};
+std::optional<GridMapHeader> read_first_gridmap_header(const std::string &path, const std::string *name = nullptr);
+
 // True when the file opens and its comments are followed by the CARMEN id
 // (what CARMEN's carmen_map_file() tests). Never throws.
 bool is_map_file(const std::string &path);
@@ -232,8 +269,13 @@ void write_map_file(const std::string &path, const MapFile &map);
 // The same into an output the caller commits (one of an OutputTransaction's).
 void write_map_file(AtomicOutput &out, const MapFile &map);
 
-// The comment block CARMEN's writer puts at the top of a map (author, date,
-// size, resolution, origin, description), as MapFile::comments lines.
+// The comment block CARMEN 0.7.4's carmen_map_write_comment_chunk writes at
+// the top of a map, as MapFile::comments lines: encode_comment_lines() of
+// these gives CARMEN's bytes. A rule of 53 '#', "#", the title, "#", the
+// author, the date (asctime() of localtime(), as CARMEN's), the size, the
+// resolution as "%.1f", the origin, then the description followed directly by
+// the "#" of the next line (CARMEN's Description line has no newline, so its
+// file reads "...: desc#"), and the rule again.
 std::vector<std::string> standard_map_comments(int size_x, int size_y, double resolution,
                                                const std::string &origin, const std::string &description,
                                                const std::string &author, int64_t time);
