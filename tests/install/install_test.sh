@@ -95,5 +95,87 @@ for kind in global_static global_shared; do
   run_and_compare "$tmp/$kind" "$kind"
   grep -q "fake libglobal: carmen_fopen($log)" "$tmp/$kind.err" || fail "$kind: libglobal's carmen_fopen was not used"
 done
-echo "install_test: pkg-config, find_package, CARMEN's library names (static and shared) and a program's own" \
-     "libglobal all give CARMEN's map"
+# 5. A CMake project in C alone: find_package + the static target, nothing more.
+cmake -S "$src/tests/install/c_project" -B "$tmp/c_project" -DCMAKE_PREFIX_PATH="$prefix" \
+  -DCMAKE_BUILD_TYPE=Release > "$tmp/c_project.log" 2>&1 || { cat "$tmp/c_project.log" >&2; fail "C project: configure"; }
+cmake --build "$tmp/c_project" > "$tmp/c_project_build.log" 2>&1 \
+  || { tail -30 "$tmp/c_project_build.log" >&2; fail "C project: build"; }
+run_and_compare "$tmp/c_project/carmen_client" c_project
+
+# 6. The CUDA runtime is inside our libraries: no libcudart.so is needed to run
+# a static client (nor by libvasco_gpu.so), and the static one runs with an
+# empty library path.
+for bin in "$tmp/pc_static" "$tmp/names_static" "$tmp/consumer/carmen_client" "$lib/libvasco_gpu.so"; do
+  [[ -e $bin ]] || continue
+  if readelf -d "$bin" | grep -q 'NEEDED.*libcudart'; then fail "$bin needs libcudart.so"; fi
+done
+env LD_LIBRARY_PATH= "$tmp/pc_static" "$log" "$tmp/no_path.map" 2> "$tmp/no_path.err" \
+  || { cat "$tmp/no_path.err" >&2; fail "the static client does not run with an empty library path"; }
+
+# 7. Stand-ins for CARMEN's own programs, unchanged CARMEN-style callers of
+# our API (tests/install/*_standin.c), built through pkg-config shared.
+standin() { cc -std=c99 -o "$tmp/$1" "$src/tests/install/$1.c" $(pkg-config --cflags --libs vasco_gpu) -lm; }
+for p in maptool_standin logtool_standin oldlaser_standin make_named_maps; do standin "$p"; done
+maps="$tmp/maps"
+mkdir -p "$maps"
+"$tmp/make_named_maps" "$maps" > "$maps/strip_bytes"
+# Runs a stand-in; a crash (a signal) fails the test whatever the program printed.
+run_standin() {
+  local rc=0
+  "$@" > "$tmp/standin.out" 2> "$tmp/standin.err" || rc=$?
+  if (( rc >= 128 )); then cat "$tmp/standin.err" >&2; fail "$* died of signal $((rc - 128))"; fi
+  return $rc
+}
+expect_out() { grep -qxF -- "$1" "$tmp/standin.out" || { cat "$tmp/standin.out" >&2; fail "$2: no line '$1'"; }; }
+size_of() { stat -c %s "$1"; }
+
+# maptool info on a map whose only gridmap and places are named: CARMEN reads them.
+run_standin "$tmp/maptool_standin" info "$maps/named_only.map" || fail "maptool info: failed on named chunks"
+expect_out "size : 100 x 120" "maptool info (named gridmap)"
+expect_out "places : 3" "maptool info (named places)"
+# toppm: the named gridmap as a picture, and no stderr line for the missing off-limits chunk.
+run_standin "$tmp/maptool_standin" toppm "$maps/named_only.map" "$tmp/named.ppm" || fail "maptool toppm failed"
+[[ ! -s "$tmp/standin.err" ]] || { cat "$tmp/standin.err" >&2; fail "maptool toppm wrote to stderr"; }
+[[ $(head -c 2 "$tmp/named.ppm") == P6 ]] || fail "maptool toppm: not a PPM"
+# add_place reallocs the places read: no crash, and the gridmap survives.
+run_standin "$tmp/maptool_standin" add_place "$maps/named_only.map" p 1 2 || fail "maptool add_place failed"
+run_standin "$tmp/maptool_standin" info "$maps/named_only.map" || fail "maptool info after add_place"
+expect_out "size : 100 x 120" "maptool info after add_place"
+# strip keeps what CARMEN keeps: only the unnamed gridmap goes, named gridmaps stay.
+while read -r name bytes; do
+  run_standin "$tmp/maptool_standin" strip "$maps/$name" "$maps/stripped_$name" gridmap || fail "strip $name"
+  want=$(( $(size_of "$maps/$name") - bytes ))
+  got=$(size_of "$maps/stripped_$name")
+  [[ $got == "$want" ]] || fail "strip $name gridmap: $got bytes, CARMEN keeps the named chunks: $want"
+done < "$maps/strip_bytes"
+run_standin "$tmp/maptool_standin" info "$maps/stripped_rich.map" || fail "info on the stripped map"
+expect_out "size : 110 x 110" "maptool info of rich.map without its unnamed gridmap"
+# A damaged trailing chunk does not hide the intact gridmap before it.
+run_standin "$tmp/maptool_standin" info "$src/tests/data/maps/damaged/thickwean.map.gz" \
+  || fail "maptool info on thickwean (damaged last chunk)"
+expect_out "size : 477 x 170" "maptool info on thickwean"
+
+# clf-get-oldlaser: a ROBOTLASER1 line with a huge remission count between two good ones.
+good="ROBOTLASER1 0 -1.570796 3.141593 0.785398 81.900000 0.010000 0 4 1.00 2.00 3.00 4.00 0"
+pose="0.100000 0.200000 0.300000 0.000000 0.000000 0.000000 0.000000 0.000000 0.300000 0.100000 1000000.000000"
+printf '%s\n' "$good $pose 999.500000 test 0.500000" \
+  "ROBOTLASER1 0 -1.570796 3.141593 0.785398 81.900000 0.010000 0 4 1.00 2.00 3.00 4.00 2000000000 1.0 $pose 1000.0 test 1.0" \
+  "$good $pose 1001.500000 test 1.500000" > "$tmp/huge_remissions.log"
+run_standin "$tmp/oldlaser_standin" "$tmp/huge_remissions.log" || true
+expect_out "FLASER 4 1.00 2.00 3.00 4.00 0.100000 0.200000 0.300000 0.000000 0.000000 0.000000 1001.500000 test 1001.500000" \
+  "clf-get-oldlaser after a bad line"
+
+# logtool: the same counts as the log's own lines, through our carmen_stdio and
+# through a CARMEN-like libglobal; on a corrupt gzip log, a message and no crash.
+zcat "$log" > "$tmp/plain.log"
+want_lasers=$(grep -c -E '^(FLASER|ROBOTLASER1) ' "$tmp/plain.log")
+cc -std=c99 -o "$tmp/logtool_global" "$src/tests/install/logtool_standin.c" -L"$tmp" -lglobal "${static_names[@]}" \
+  $(pkg-config --libs vasco_gpu-static)
+for tool in logtool_standin logtool_global; do
+  run_standin "$tmp/$tool" "$log" || fail "$tool on $log"
+  grep -qE "^messages [0-9]+ lasers $want_lasers\$" "$tmp/standin.out" || { cat "$tmp/standin.out" >&2; fail "$tool: want $want_lasers lasers"; }
+  run_standin "$tmp/$tool" "$src/tests/data/logs/corrupt.log.gz" || true
+done
+
+echo "install_test: pkg-config, find_package (C and C++ projects), CARMEN's library names (static and shared)," \
+     "a program's own libglobal and stand-ins for CARMEN's maptool, logtool and clf-get-oldlaser all behave as CARMEN's"
