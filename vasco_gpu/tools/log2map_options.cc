@@ -57,7 +57,7 @@ void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchT
 void add_backend_options(CLI::App &app, Options &opt) {
   std::vector<std::string> backends;  // the registry's names; one not compiled in says why when run
   for (const vasco::BackendInfo &b : vasco::backend_registry()) backends.push_back(b.name);
-  app.add_option("--backend", opt.backend, "the backend (default: auto), one of:\n" + vasco::backend_help())
+  app.add_option("--backend", opt.backend, "the backend (default: auto; for one LOG, auto takes the one a cost model expects to finish first), one of:\n" + vasco::backend_help())
       ->check(CLI::IsMember(backends));
   app.add_option("--threads", opt.threads,
                  "threads of cpu_threads, 1 to " + std::to_string(vasco::kMaxThreads) + " (default: all cores)")

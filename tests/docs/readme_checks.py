@@ -1,0 +1,302 @@
+"""What checks each fenced block of README.md, keyed by readme_blocks.Block.key, and the
+fixtures that make the files the blocks' commands name (standard library only).
+
+Every block of the README must have an entry here, and every entry a block: a new or
+changed block fails the docs test until this table says how it is checked, and an entry
+whose block is gone fails as stale.
+
+Kinds of check:
+  run          each command of a shell block runs with bash in a scratch directory that the
+               block's fixture prepared, the build's tools first on PATH; it must exit with
+               `status` (by command prefix; default 0), and `outputs` must exist afterwards.
+               Commands starting with a prefix in `skip` are not run (the reason says why);
+               `python=True`: the block needs the Python package's console scripts, so
+               python/tests/test_readme.py runs it and the docs test skips it.
+  make-target  each `make X` line: `make -n -C SOURCE X` (a dry run) must succeed, its
+               output naming `mentions[X]`; the targets themselves are never run here.
+  compile      a C or C++ fragment, put into `harness` (its #include lines first), must
+               compile against the source tree's headers (syntax only).
+  covered-by   another test checks what the block says: each (file, strings) of `files`
+               must exist and contain every string.
+  synopsis     a usage block of `tool`: every option in it must be in `tool --help`; the
+               `examples` commands (the synopsis filled in) run as in `run`.
+  output       a sample of a tool's output: `command` runs (fixture first); with
+               `output_file` that file must equal the block, else one line of the
+               command's stderr must match the block's line with numbers and the
+               alternatives of `alternatives` generalised.
+  layout       the Layout tree: every directory and file it names must exist.
+  python       a Python block: python/tests/test_readme.py runs it (fixture, substitutions
+               `subs` stated here, `outputs` must exist afterwards); skipped by the docs test.
+  skip         not checked: `reason` says why.
+"""
+
+from __future__ import annotations
+
+import gzip
+import math
+import shutil
+import subprocess
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
+
+PY_RUNS_IT = "Python block: python/tests/test_readme.py runs it"
+PY_SCRIPT_RUNS_IT = "Python console script: python/tests/test_readme.py runs it"
+
+
+@dataclass
+class Check:
+    kind: str
+    reason: str = ""
+    fixture: str = ""
+    status: Dict[str, int] = field(default_factory=dict)
+    outputs: Sequence[str] = ()
+    skip: Dict[str, str] = field(default_factory=dict)
+    python: bool = False
+    mentions: Dict[str, Sequence[str]] = field(default_factory=dict)
+    harness: str = ""
+    files: Sequence[Tuple[str, Sequence[str]]] = ()
+    tool: str = ""
+    examples: Sequence[str] = ()
+    command: str = ""
+    output_file: str = ""
+    alternatives: Sequence[Tuple[str, str]] = ()
+    subs: Sequence[Tuple[str, str]] = ()
+    needs: Sequence[str] = ()  # Python modules a python check needs (skipped without them)
+
+
+# ---------------------------------------------------------------------------------------
+# Compile harnesses: the fragment's #include lines go to @INCLUDES@, the rest to @BODY@.
+
+C_HARNESS = r"""
+#include <stdio.h>
+#include <stdlib.h>
+@INCLUDES@
+static void die(const char *why) { fprintf(stderr, "%s\n", why); exit(1); }
+void readme_snippet(size_t n, const double *poses, const int *beam_counts, const float *ranges,
+                    const double *first_angles, const double *angle_steps, const double *new_poses);
+void readme_snippet(size_t n, const double *poses, const int *beam_counts, const float *ranges,
+                    const double *first_angles, const double *angle_steps, const double *new_poses) {
+@BODY@
+}
+"""
+
+CXX_HARNESS = r"""
+#include <vector>
+@INCLUDES@
+std::vector<vasco::Pose> optimizer_poses();
+void readme_snippet(const vasco::ScanBatch &scans, int x0, int y0);
+void readme_snippet(const vasco::ScanBatch &scans, int x0, int y0) {
+@BODY@
+  (void)map;
+  (void)patch;
+}
+"""
+
+# ---------------------------------------------------------------------------------------
+# Fixtures: fixture(scratch, source, bin) makes the files a block's commands name.
+
+
+def laser_lines(log: Path) -> List[List[str]]:
+    """The FLASER lines of a CARMEN log, split into fields."""
+    with gzip.open(log, "rt") as f:
+        return [ln.split() for ln in f if ln.startswith("FLASER ")]
+
+
+def flaser_pose(t: List[str]) -> Tuple[float, float, float, float]:
+    """(stamp, x, y, theta) of a FLASER line: the laser pose after the ranges, the ipc
+    timestamp third from the end."""
+    n = int(t[1])
+    return float(t[-3]), float(t[2 + n]), float(t[3 + n]), float(t[4 + n])
+
+
+def g17(v: float) -> str:
+    return "%.17g" % v
+
+
+def write_log_gz(path: Path, lines: List[List[str]]) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with gzip.open(path, "wt") as f:
+        f.writelines(" ".join(t) + "\n" for t in lines)
+    return path
+
+
+def transformed(lines: List[List[str]], x0: float, y0: float, th0: float) -> List[List[str]]:
+    """FLASER lines with both poses (laser and odometry) moved by the rigid transform
+    (x0, y0, th0)."""
+    c, s = math.cos(th0), math.sin(th0)
+    out = []
+    for t in lines:
+        t = list(t)
+        n = int(t[1])
+        for at in (2 + n, 5 + n):
+            x, y, th = float(t[at]), float(t[at + 1]), float(t[at + 2])
+            t[at:at + 3] = [g17(x0 + c * x - s * y), g17(y0 + s * x + c * y), g17(th + th0)]
+        out.append(t)
+    return out
+
+
+def run_tool(bin_dir: Path, *args: str) -> None:
+    subprocess.run([str(bin_dir / args[0]), *args[1:]], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.PIPE, timeout=120)
+
+
+def fixture_intel(scratch: Path, source: Path, bin_dir: Path) -> None:
+    shutil.copy(source / "logs" / "intel.gfs.log.gz", scratch / "intel.log.gz")
+
+
+def fixture_poses(scratch: Path, source: Path, bin_dir: Path) -> None:
+    """intel.log.gz and intel's own laser poses as a SLAM back end's files: optimized.g2o
+    (VERTEX_SE2 in scan order, 17 digits), trajectory.txt (TUM by stamp, the yaw as a
+    quaternion about z) and corrected.log.gz (a CARMEN log of the FLASER lines alone)."""
+    fixture_intel(scratch, source, bin_dir)
+    lines = laser_lines(scratch / "intel.log.gz")
+    poses = [flaser_pose(t) for t in lines]
+    (scratch / "optimized.g2o").write_text(
+        "".join(f"VERTEX_SE2 {i} {g17(x)} {g17(y)} {g17(th)}\n" for i, (_, x, y, th) in enumerate(poses)))
+    (scratch / "trajectory.txt").write_text(
+        "# timestamp tx ty tz qx qy qz qw\n"
+        + "".join(f"{g17(t)} {g17(x)} {g17(y)} 0 0 0 {g17(math.sin(th / 2))} {g17(math.cos(th / 2))}\n"
+                  for t, x, y, th in poses))
+    write_log_gz(scratch / "corrected.log.gz", lines)
+
+
+# The transform of the README's --add example: tuesday's poses are written in a frame that
+# it takes back into monday's.
+TUESDAY = (12.5, -3.0, 1.5708)
+
+
+def fixture_sessions(scratch: Path, source: Path, bin_dir: Path) -> None:
+    """monday.log.gz and tuesday.log.gz: intel's scans in two halves, tuesday's poses in a
+    frame of its own (the inverse of the README's transform applied)."""
+    lines = laser_lines(source / "logs" / "intel.gfs.log.gz")
+    half = len(lines) // 2
+    write_log_gz(scratch / "monday.log.gz", lines[:half])
+    x, y, th = TUESDAY
+    c, s = math.cos(th), math.sin(th)
+    inverse = (-(c * x + s * y), s * x - c * y, -th)
+    write_log_gz(scratch / "tuesday.log.gz", transformed(lines[half:], *inverse))
+
+
+def fixture_runs(scratch: Path, source: Path, bin_dir: Path) -> None:
+    """runs/run1.log.gz (intel) and runs/run2.log.gz (its first 300 scans)."""
+    (scratch / "runs").mkdir()
+    shutil.copy(source / "logs" / "intel.gfs.log.gz", scratch / "runs" / "run1.log.gz")
+    write_log_gz(scratch / "runs" / "run2.log.gz", laser_lines(source / "logs" / "intel.gfs.log.gz")[:300])
+
+
+def fixture_fr079_maps(scratch: Path, source: Path, bin_dir: Path) -> None:
+    """carmen/fr079.map.gz: CARMEN's own map of fr079 with vasco's defaults (the golden
+    map); today/fr079.map.gz and float/fr079.map.gz: log2map's, on cpu_threads (exact) and
+    cpu_float."""
+    for d in ("carmen", "today", "float"):
+        (scratch / d).mkdir()
+    shutil.copy(source / "tests" / "data" / "golden" / "maps" / "fr079-complete.gfs__vasco_default_ds4.map.gz",
+                scratch / "carmen" / "fr079.map.gz")
+    log = str(source / "logs" / "fr079-complete.gfs.log.gz")
+    run_tool(bin_dir, "log2map", "-q", "--backend", "cpu_threads", log, str(scratch / "today" / "fr079.map.gz"))
+    run_tool(bin_dir, "log2map", "-q", "--backend", "cpu_float", log, str(scratch / "float" / "fr079.map.gz"))
+
+
+def fixture_freiburg(scratch: Path, source: Path, bin_dir: Path) -> None:
+    shutil.copy(source / "tests" / "data" / "maps" / "freiburg.map", scratch / "freiburg.map")
+
+
+FIXTURES: Dict[str, Callable[[Path, Path, Path], None]] = {
+    "intel": fixture_intel,
+    "poses": fixture_poses,
+    "sessions": fixture_sessions,
+    "runs": fixture_runs,
+    "fr079_maps": fixture_fr079_maps,
+    "freiburg": fixture_freiburg,
+}
+
+# ---------------------------------------------------------------------------------------
+# The table: README block key -> check.
+
+CHECKS: Dict[str, Check] = {
+    # Quick start.
+    "sh: make demo": Check(
+        "make-target",
+        mentions={"demo": ["build/bin/log2map", "build/fr079.png", "build/fr079.map.gz"],
+                  "test": ["ctest"]}),
+    # log2map.
+    "text: log2map [options] LOG OUT [OUT...]": Check(
+        "synopsis", tool="log2map", fixture="intel",
+        examples=["log2map -q --backend cpu_threads intel.log.gz a.map a.map.gz a.pgm a.png",
+                  "log2map -q --backend cpu_threads --out-dir d --formats map.gz,png intel.log.gz",
+                  "test -f a.yaml && test -f d/intel.map.gz && test -f d/intel.png"]),
+    "sh: log2map --poses optimized.g2o intel.log.gz after.map.gz": Check(
+        "run", fixture="poses", outputs=["after.map.gz"]),
+    "sh: log2map monday.log.gz --add tuesday.log.gz@12.5,-3.0,1.5708": Check(
+        "run", fixture="sessions", outputs=["both.map.gz"]),
+    "text: log2map: --backend auto: 3.4e+08 cell updates: about 0.302 s": Check(
+        "output", fixture="intel", command="log2map --backend auto intel.log.gz auto.map.gz",
+        alternatives=[("start-up): using cpu_threads",
+                       r"start-up\)(; no usable GPU \(.*\))?: using (cpu_threads|cuda)")]),
+    "sh: log2map --out-dir maps --formats map.gz,png runs/*.log.gz": Check(
+        "run", fixture="runs",
+        outputs=["maps/run1.map.gz", "maps/run1.png", "maps/run2.map.gz", "maps/run2.png"]),
+    "text: summary: 27 cases": Check(
+        "covered-by",
+        files=[("tests/golden_check.cc", ["summary: %d cases", "identical to CARMEN"]),
+               ("Makefile", ["golden_check --golden $(GOLDEN_DIR)"])]),
+    # mapdiff.
+    "sh: mapdiff carmen/fr079.map.gz today/fr079.map.gz": Check(
+        "run", fixture="fr079_maps", status={"mapdiff": 0}, outputs=["diff.png"]),
+    # From a ROS bag.
+    "sh: bag2map run.mcap map.pgm map.map.gz": Check(
+        "run", python=True, fixture="bags",
+        outputs=["map.pgm", "map.yaml", "map.map.gz", "map.png", "run.log.gz"]),
+    'python: log = vg.load_bag("run.mcap")': Check(
+        "python", fixture="bags", outputs=["map.pgm", "map.yaml"], needs=["rosbags"]),
+    "yaml: image: map.pgm": Check(
+        "output", fixture="intel", command="log2map -q --backend cpu_threads intel.log.gz map.pgm",
+        output_file="map.yaml"),
+    "sh: ros2 run nav2_map_server map_server --ros-args -p yaml_filen": Check(
+        "skip", reason="needs ROS 2 (nav2_map_server)"),
+    # Mapping sessions.
+    "cpp: vasco::MapperParams params;": Check("compile", harness=CXX_HARNESS),
+    "c: vasco_mapper_params p;": Check("compile", harness=C_HARNESS),
+    # mapconvert.
+    "text: mapconvert [-q] [--mode trinary|scale|raw] IN OUT": Check(
+        "synopsis", tool="mapconvert", fixture="freiburg",
+        examples=["mapconvert -q --mode scale freiburg.map out.pgm", "test -f out.yaml",
+                  "mapconvert freiburg.map out.map.gz", "mapconvert freiburg.map out.png",
+                  "mapconvert --info freiburg.map", "mapconvert --version"]),
+    # C API: installing in place of CARMEN's libraries.
+    "make: VASCO = /opt/vasco_gpu": Check(
+        "covered-by",
+        files=[("tests/install/install_test.sh", ["-legrid", "-lmap_io", "-lreadlog", "-Wl,-rpath,"]),
+               ("tests/CMakeLists.txt", ["InstalledTreeServesCarmenClients"])]),
+    "make: CFLAGS += $(shell pkg-config --cflags vasco_gpu)": Check(
+        "covered-by",
+        files=[("tests/install/install_test.sh", ["pkg-config --cflags --libs vasco_gpu)",
+                                                  "pkg-config --libs vasco_gpu-static"])]),
+    "cmake: find_package(vasco_gpu REQUIRED)": Check(
+        "covered-by",
+        files=[("tests/install/CMakeLists.txt", ["find_package(vasco_gpu REQUIRED)", "vasco_gpu::vasco_gpu ",
+                                                 "vasco_gpu::vasco_gpu_shared"]),
+               ("tests/install/c_project/CMakeLists.txt", ["find_package(vasco_gpu REQUIRED)"])]),
+    # Python.
+    "sh: pip install .": Check(
+        "run", python=True, reason="python -c needs the package: python/tests/test_readme.py runs it",
+        skip={"pip install": "pip install: CI's pip step (.ci/run) runs it"}),
+    "sh: cmake -S . -B build-py -DVASCO_GPU_BUILD_PYTHON=ON -DPython_": Check(
+        "covered-by",
+        files=[("CMakeLists.txt", ["option(VASCO_GPU_BUILD_PYTHON"]),
+               ("python/CMakeLists.txt", ["add_custom_target(vasco_gpu_python"]),
+               ("python/tests/conftest.py", ["ROOT"])]),
+    'python: log = vg.load_log("logs/fr079-complete.gfs.log.gz")': Check(
+        "python", fixture="loop_closure", outputs=["after.png"],
+        subs=[('backend="cuda"', 'backend=BACKEND'), ("optimizer.poses()", "mapper.poses")]),
+    "python: with LocalCluster(n_workers=4, threads_per_worker=1) as clus": Check(
+        "python", fixture="dask_logs", outputs=["maps/a.map.gz", "maps/a.png", "maps/b.map.gz"],
+        subs=[("n_workers=4", "n_workers=2")], needs=["dask.distributed"]),
+    # Layout.
+    "text: carmen_compat/ CARMEN's formats and C libraries; no mapping": Check("layout"),
+}
+
+
+def check_for(key: str) -> Optional[Check]:
+    return CHECKS.get(key)
