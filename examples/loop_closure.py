@@ -8,7 +8,7 @@ small scale error, accumulated along the trajectory), mapped, and then a loop
 closure "arrives": every pose is replaced by the corrected one and the whole map
 is rendered again from the scans the session already holds. Writes
 ``before.png`` and ``after.png`` and ``before_after.png`` (the two side by
-side) and prints the time of each step.
+side, labelled "before" and "after") and prints the time of each step.
 
 With ``--gtsam`` (and ``pip install gtsam``) the corrected poses come from a
 GTSAM pose graph instead: the drifting odometry as between-factors plus
@@ -84,15 +84,46 @@ def gtsam_correct(odometry: np.ndarray, reference: np.ndarray) -> np.ndarray:
                      for i in range(len(odometry))])
 
 
+# A 5 x 7 bitmap font ('#' ink, top row first), the letters of the two labels.
+GLYPHS = {
+    "A": (".###.", "#...#", "#...#", "#####", "#...#", "#...#", "#...#"),
+    "B": ("####.", "#...#", "#...#", "####.", "#...#", "#...#", "####."),
+    "E": ("#####", "#....", "#....", "####.", "#....", "#....", "#####"),
+    "F": ("#####", "#....", "#....", "####.", "#....", "#....", "#...."),
+    "O": (".###.", "#...#", "#...#", "#...#", "#...#", "#...#", ".###."),
+    "R": ("####.", "#...#", "#...#", "####.", "#.#..", "#..#.", "#...#"),
+    "T": ("#####", "..#..", "..#..", "..#..", "..#..", "..#..", "..#.."),
+}
+
+
+def label(text: str, width: int, scale: int) -> np.ndarray:
+    """A strip of cells ``width`` wide: ``text`` in occupied cells (black) on free ones (white),
+    each font pixel ``scale`` x ``scale`` cells; indexed [x, y] with y up, as Map.cells."""
+    h = 9 * scale
+    strip = np.zeros((width, h), dtype=np.float32)
+    for i, ch in enumerate(text):
+        for r, row in enumerate(GLYPHS[ch]):
+            for c, px in enumerate(row):
+                if px == "#":
+                    x0, y1 = scale * (1 + 6 * i + c), h - scale * (1 + r)
+                    strip[x0 : x0 + scale, y1 - scale : y1] = 1.0
+    return strip
+
+
 def side_by_side(a: vg.Map, b: vg.Map) -> vg.Map:
-    """One map holding a and b next to each other (as images: a left, b right), a black
-    column between them, unknown where one is shorter."""
-    h = max(a.size_y, b.size_y)
+    """One map holding a and b next to each other (as images: a left, b right), labelled
+    "BEFORE" and "AFTER" above them, a black column between them, unknown where one is
+    shorter."""
+    scale = max(1, min(a.size_x, b.size_x) // 100)
+    top = 9 * scale
+    h = max(a.size_y, b.size_y) + top
     gap = 4
     cells = np.full((a.size_x + gap + b.size_x, h), -1.0, dtype=np.float32)
     cells[: a.size_x, : a.size_y] = a.cells
+    cells[: a.size_x, h - top :] = label("BEFORE", a.size_x, scale)
     cells[a.size_x : a.size_x + gap, :] = 1.0
     cells[a.size_x + gap :, : b.size_y] = b.cells
+    cells[a.size_x + gap :, h - top :] = label("AFTER", b.size_x, scale)
     return vg.Map(cells, a.resolution)
 
 

@@ -35,12 +35,29 @@ carmen::MapToWrite sample() {
 }
 
 TEST(MapFormat, TableListsEveryFormat) {
-  EXPECT_EQ(carmen::known_map_extensions(), ".map, .map.gz, .pgm, .png");
+  EXPECT_EQ(carmen::known_map_extensions(), ".map, .map.gz, .pgm, .png+yaml, .yaml, .png");
   ASSERT_NE(carmen::find_map_format("a/b.map.gz"), nullptr);
   EXPECT_EQ(carmen::find_map_format("a/b.map.gz")->format, carmen::MapFormat::CarmenMapGz);
   EXPECT_EQ(carmen::find_map_format("b.map")->format, carmen::MapFormat::CarmenMap);
   EXPECT_EQ(carmen::find_map_format("b.pgm")->format, carmen::MapFormat::PgmYaml);
   EXPECT_EQ(carmen::find_map_format("b.png")->format, carmen::MapFormat::Png);
+  EXPECT_EQ(carmen::find_map_format("b.png+yaml")->format, carmen::MapFormat::PngYaml);
+  EXPECT_EQ(carmen::find_map_format("b.yaml")->format, carmen::MapFormat::Yaml);
+  EXPECT_EQ(carmen::find_map_format("B.PNG+YAML")->format, carmen::MapFormat::PngYaml);
+}
+
+// The files each name stands for: NAME.png+yaml is NAME.png and NAME.yaml
+// (NAME.png alone stays the picture), NAME.yaml written is NAME.pgm too.
+TEST(MapFormat, OutputAndInputFiles) {
+  EXPECT_EQ(carmen::map_output_files("d/x.png+yaml"), (std::vector<std::string>{"d/x.png", "d/x.yaml"}));
+  EXPECT_EQ(carmen::map_output_files("d/x.yaml"), (std::vector<std::string>{"d/x.yaml", "d/x.pgm"}));
+  EXPECT_EQ(carmen::map_output_files("d/x.png"), (std::vector<std::string>{"d/x.png"}));
+  TempDir dir;
+  write_bytes(dir.file("y.yaml"), "image: pics/y.png\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  EXPECT_EQ(carmen::map_input_files(dir.file("y.yaml")),
+            (std::vector<std::string>{dir.file("y.yaml"), dir.file("pics/y.png")}));
+  EXPECT_EQ(carmen::map_input_files(dir.file("none.yaml")), (std::vector<std::string>{dir.file("none.yaml")}));
+  EXPECT_EQ(carmen::map_input_files("x.pgm"), (std::vector<std::string>{"x.pgm", "x.yaml"}));
 }
 
 TEST(MapFormat, ExtensionsIgnoreCase) {
@@ -59,7 +76,8 @@ TEST(MapFormat, UnknownExtensionIsAUsageErrorListingTheKnownOnes) {
       ADD_FAILURE() << path << " was accepted";
     } catch (const carmen::Error &e) {
       EXPECT_EQ(e.code(), carmen::ErrorCode::Usage) << e.what();
-      EXPECT_NE(std::string(e.what()).find(".map, .map.gz, .pgm, .png"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(".map, .map.gz, .pgm, .png+yaml, .yaml, .png"), std::string::npos)
+          << e.what();
     }
   }
   TempDir dir;
@@ -82,7 +100,7 @@ TEST_P(MapFormatRoundTrip, CellsAndOriginComeBack) {
   carmen::write_map(path, m);
   const carmen::MapRead r = carmen::read_map(path);
   const carmen::MapFormat f = carmen::map_format_of(path).format;
-  if (f == carmen::MapFormat::PgmYaml) {
+  if (f == carmen::MapFormat::PgmYaml || f == carmen::MapFormat::PngYaml || f == carmen::MapFormat::Yaml) {
     // Trinary keeps unknown, free and occupied; 0.8 is occupied.
     carmen::GridMap want = m.grid;
     want.at(2, 1) = 1.0f;
@@ -102,7 +120,8 @@ TEST_P(MapFormatRoundTrip, CellsAndOriginComeBack) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryFormat, MapFormatRoundTrip,
-                         ::testing::Values(".map", ".map.gz", ".pgm", ".png", ".MAP.GZ", ".PNG", ".Pgm"));
+                         ::testing::Values(".map", ".map.gz", ".pgm", ".png", ".png+yaml", ".yaml", ".MAP.GZ", ".PNG",
+                                           ".Pgm", ".PNG+YAML"));
 
 TEST(MapFormat, UpperCaseGzIsReallyGzip) {
   TempDir dir;

@@ -168,4 +168,147 @@ TEST_F(MapConvert, AnOutputThatIsTheInputOrSpecialIsRefused) {
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"m.yaml", "p.png"}));
 }
 
+// --free-thresh, --occupied-thresh, --negate: usage errors (exit 2) name
+// the option and write nothing.
+TEST_F(MapConvert, ThresholdOptionsAreChecked) {
+  TempDir dir;
+  const std::string in = map_fixture("freiburg.map");
+  const auto refused = [&](const std::vector<std::string> &args, const std::string &words) {
+    const ToolRun r = mapconvert(args);
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, words)) << r.output;
+  };
+  refused({"--free-thresh", "0.7", in, dir.file("a.pgm")}, "--free-thresh 0.7 must be below --occupied-thresh 0.65");
+  refused({"--occupied-thresh", "1.5", in, dir.file("a.pgm")}, "--occupied-thresh 1.5: must be a number from 0 to 1");
+  refused({"--free-thresh=-0.1", in, dir.file("a.yaml")}, "--free-thresh -0.1");
+  refused({"--free-thresh", "half", in, dir.file("a.pgm")}, "--free-thresh 'half'");
+  refused({"--free-thresh", in, dir.file("a.pgm")}, "");  // the value is missing: IN taken as it
+  refused({"--negate", "--mode", "raw", in, dir.file("a.pgm")}, "--negate");
+  refused({"--negate", in, dir.file("a.map")}, ".pgm, .png+yaml and .yaml output only");
+  refused({"--free-thresh", "0.2", in, dir.file("a.png")}, ".pgm, .png+yaml and .yaml output only");
+  EXPECT_TRUE(dir.entries().empty());
+  const ToolRun ok = mapconvert({"--free-thresh", "0.25", "--occupied-thresh=0.7", "--negate", in, dir.file("n.png+yaml")});
+  ASSERT_EQ(ok.status, 0) << ok.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"n.png", "n.yaml"}));
+  const std::string yaml = read_bytes(dir.file("n.yaml"));
+  EXPECT_TRUE(contains(yaml, "free_thresh: 0.25\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "occupied_thresh: 0.7\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "negate: 1\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "image: n.png\n")) << yaml;
+}
+
+// The cells' classes: unknown, free (p < free_thresh), occupied (p >
+// occupied_thresh), in between.
+int cell_class(float v) { return v < 0 ? 0 : v < 0.196 ? 1 : v > 0.65 ? 2 : 3; }
+
+// log2map's .pgm + .yaml, back to a CARMEN map through the YAML: the same
+// size, resolution and origin, and every cell in its class (trinary: in
+// between reads as unknown, as map_server reads it).
+TEST_F(MapConvert, Log2MapPgmRoundTripsThroughTheYaml) {
+  TempDir dir;
+  const ToolRun made = tooltest::run_tool(
+      "log2map", {"--backend", "cpu_threads", "-q", std::string(VASCO_LOGS_DIR) + "/intel.gfs.log.gz",
+                  dir.file("m.map"), dir.file("m.pgm")});
+  ASSERT_EQ(made.status, 0) << made.output;
+  const ToolRun r = mapconvert({dir.file("m.yaml"), dir.file("back.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  const carmen::MapFile a = carmen::read_map_file(dir.file("m.map")), b = carmen::read_map_file(dir.file("back.map"));
+  ASSERT_TRUE(a.gridmap && b.gridmap && a.offset && b.offset);
+  ASSERT_EQ(a.gridmap->size_x, b.gridmap->size_x);
+  ASSERT_EQ(a.gridmap->size_y, b.gridmap->size_y);
+  EXPECT_FLOAT_EQ(float(a.gridmap->resolution), float(b.gridmap->resolution));
+  EXPECT_NEAR(a.offset->x, b.offset->x, 1e-9);
+  EXPECT_NEAR(a.offset->y, b.offset->y, 1e-9);
+  ASSERT_TRUE(b.creator);
+  EXPECT_EQ(b.creator->origin, "m.yaml");
+  size_t counts[4] = {0, 0, 0, 0};
+  for (size_t i = 0; i < a.gridmap->cells.size(); ++i) {
+    const int ca = cell_class(a.gridmap->cells[i]), cb = cell_class(b.gridmap->cells[i]);
+    ++counts[ca];
+    ASSERT_EQ(cb, ca == 3 ? 0 : ca) << "cell " << i << ": " << a.gridmap->cells[i] << " came back as "
+                                    << b.gridmap->cells[i];
+  }
+  EXPECT_GT(counts[0], 1000u);
+  EXPECT_GT(counts[1], 1000u);
+  EXPECT_GT(counts[2], 1000u);
+  // Scale mode in a PNG: unknown stays unknown, p within a grey level.
+  ASSERT_EQ(mapconvert({"--mode", "scale", dir.file("m.map"), dir.file("s.png+yaml")}).status, 0);
+  ASSERT_EQ(mapconvert({dir.file("s.png+yaml"), dir.file("s.map")}).status, 0);
+  const carmen::MapFile s = carmen::read_map_file(dir.file("s.map"));
+  ASSERT_TRUE(s.gridmap);
+  for (size_t i = 0; i < a.gridmap->cells.size(); ++i) {
+    const float va = a.gridmap->cells[i], vs = s.gridmap->cells[i];
+    if (va < 0) {
+      ASSERT_EQ(vs, -1.0f) << "cell " << i;
+    } else {
+      ASSERT_NEAR(vs, va, 0.5 / 255 + 1e-6) << "cell " << i;
+    }
+  }
+}
+
+TEST_F(MapConvert, YamlInputErrorsExitOneNamingTheFile) {
+  TempDir dir;
+  maptest::write_bytes(dir.file("a.yaml"), "image: gone.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  ToolRun r = mapconvert({dir.file("a.yaml"), dir.file("a.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, dir.file("a.yaml") + ":1:")) << r.output;
+  EXPECT_TRUE(contains(r.output, "gone.pgm")) << r.output;
+  maptest::write_bytes(dir.file("b.yaml"), "image: b.pgm\nresolution: 0.1\norigin: [0, 0]\n");
+  maptest::write_bytes(dir.file("b.pgm"), "P5\n2 2\n255\nab");  // cut short
+  r = mapconvert({dir.file("b.yaml"), dir.file("b.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, dir.file("b.yaml") + ":3:")) << r.output;
+  maptest::write_bytes(dir.file("b.yaml"), "image: b.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  r = mapconvert({dir.file("b.yaml"), dir.file("b.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, dir.file("b.pgm"))) << r.output;
+  EXPECT_TRUE(contains(r.output, "cut short")) << r.output;
+  EXPECT_FALSE(maptest::file_exists(dir.file("b.map")));
+  // A picture holds no resolution: a usage error. Writing over the input: refused.
+  ASSERT_EQ(mapconvert({map_fixture("freiburg.map"), dir.file("p.png")}).status, 0);
+  r = mapconvert({dir.file("p.png"), dir.file("p.map")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "picture")) << r.output;
+  ASSERT_EQ(mapconvert({map_fixture("freiburg.map"), dir.file("f.pgm")}).status, 0);
+  r = mapconvert({dir.file("f.yaml"), dir.file("f.png+yaml")});  // would overwrite f.yaml
+  EXPECT_NE(r.status, 0) << r.output;
+  const ToolRun info = mapconvert({"--info", dir.file("f.yaml")});
+  EXPECT_EQ(info.status, 0) << info.output;
+  EXPECT_TRUE(contains(info.output, "size: 300 x 300 cells")) << info.output;
+  EXPECT_TRUE(contains(info.output, "format: ROS map_server YAML")) << info.output;
+}
+
+// log2map's map_server options: usage errors exit 2 naming the option and
+// write nothing; the values reach the YAML; a warning when no output uses them.
+TEST_F(MapConvert, Log2MapThresholdOptions) {
+  TempDir dir;
+  const std::string log = std::string(VASCO_LOGS_DIR) + "/intel.gfs.log.gz";
+  const auto log2map = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), {"--backend", "cpu_threads", "-q"});
+    return tooltest::run_tool("log2map", args);
+  };
+  ToolRun r = log2map({"--free-thresh", "0.8", log, dir.file("m.pgm")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "--free-thresh 0.8 must be below --occupied-thresh 0.65")) << r.output;
+  r = log2map({"--occupied-thresh", "2", log, dir.file("m.pgm")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "--occupied-thresh 2")) << r.output;
+  r = log2map({"--free-thresh", "x", log, dir.file("m.pgm")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "--free-thresh")) << r.output;
+  r = log2map({"--negate", "--mode", "raw", log, dir.file("m.pgm")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(dir.entries().empty());
+  r = log2map({"--free-thresh", "0.25", "--negate", log, dir.file("m.yaml"), dir.file("m.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"m.map", "m.pgm", "m.yaml"}));
+  const std::string yaml = read_bytes(dir.file("m.yaml"));
+  EXPECT_TRUE(contains(yaml, "free_thresh: 0.25\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "negate: 1\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "image: m.pgm\n")) << yaml;
+  r = log2map({"--free-thresh", "0.25", log, dir.file("only.map")});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "warning: --mode, --free-thresh")) << r.output;
+}
+
 }  // namespace

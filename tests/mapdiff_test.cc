@@ -364,8 +364,8 @@ TEST_F(MapDiffOffsets, PngShowsTheOverlap) {
   EXPECT_EQ(r.status, 1) << r.output;
   RgbImage img;
   ASSERT_TRUE(read_png_rgb(png, &img)) << r.output;
-  ASSERT_EQ(img.width, 5);  // the overlap: A's x 2..6, y 0..3
-  ASSERT_EQ(img.height, 4);
+  ASSERT_GE(img.width, 5);  // the overlap, A's x 2..6, y 0..3, at the top left; the legend below
+  ASSERT_GT(img.height, 4);
   // Column = x - 2, row = 3 - y (row 0 is the highest y).
   const uint8_t *higher = img.pixel(4 - 2, 3 - 2), *lower = img.pixel(2 - 2, 3 - 1);
   const uint8_t *status = img.pixel(5 - 2, 3 - 3), *same = img.pixel(3 - 2, 3 - 0);
@@ -394,6 +394,74 @@ TEST_F(MapDiff, Json) {
   EXPECT_TRUE(contains(r.output, "\"largest\":[{\"x\":3,\"y\":2,\"a\":0.125,\"b\":0.375}]")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"identical\":false,\"offsets_equal\":true,")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"exit\":1}\n")) << r.output;
+}
+
+// Pixels of exactly this colour in rows from `first_row` down.
+size_t count_colour(const RgbImage &img, int first_row, uint8_t r, uint8_t g, uint8_t b) {
+  size_t n = 0;
+  for (int row = first_row; row < img.height; ++row)
+    for (int col = 0; col < img.width; ++col) {
+      const uint8_t *p = img.pixel(col, row);
+      n += p[0] == r && p[1] == g && p[2] == b;
+    }
+  return n;
+}
+
+// The legend below the picture: a swatch of every difference colour, the
+// |dp| ramp, A's grey ramp, the unknown colour and black text.
+TEST_F(MapDiff, PngHasALegend) {
+  GridMap a = base_grid();
+  a.at(0, 0) = carmen::kUnknownCell;  // unknown in both: the unknown colour in the picture
+  write_grid(a_, a);
+  const std::string b = write_b([](GridMap &g) {
+    g.at(0, 0) = carmen::kUnknownCell;
+    g.at(1, 1) = 0.9f;
+  });
+  const std::string png = dir_.file("d.png");
+  const ToolRun r = mapdiff({"--png", png, a_, b});
+  EXPECT_EQ(r.status, 1) << r.output;
+  RgbImage img;
+  ASSERT_TRUE(read_png_rgb(png, &img)) << r.output;
+  const int grid_h = base_grid().size_y;
+  ASSERT_GT(img.height, grid_h + 40);  // the legend's lines
+  ASSERT_GE(img.width, base_grid().size_x);
+  EXPECT_TRUE(contains(r.output, "picture: " + png + " (" + std::to_string(img.width) + " x " +
+                                     std::to_string(img.height)))
+      << r.output;
+  const int legend = grid_h + 1;
+  EXPECT_GT(count_colour(img, legend, 255, 0, 0), 10u);      // red, B higher (full |dp|)
+  EXPECT_GT(count_colour(img, legend, 0, 0, 255), 10u);      // blue, B lower
+  EXPECT_GT(count_colour(img, legend, 255, 0, 255), 10u);    // magenta, known in A only
+  EXPECT_GT(count_colour(img, legend, 0, 200, 0), 10u);      // green, known in B only
+  EXPECT_GT(count_colour(img, legend, 255, 170, 170), 0u);   // the ramp's pale end, |dp| 1e-6
+  size_t mid_greys = 0;  // A's grey ramp: the greys between white and black
+  for (int v = 16; v < 240; ++v) mid_greys += count_colour(img, legend, uint8_t(v), uint8_t(v), uint8_t(v));
+  EXPECT_GT(mid_greys, 40u);
+  EXPECT_GT(count_colour(img, legend, 0x70, 0x89, 0x86), 10u);  // unknown
+  EXPECT_GT(count_colour(img, legend, 0, 0, 0), 200u);       // text
+  // In the picture: the cell unknown in both has the unknown colour.
+  const uint8_t *u = img.pixel(0, grid_h - 1);
+  EXPECT_EQ(u[0], 0x70);
+  EXPECT_EQ(u[1], 0x89);
+  EXPECT_EQ(u[2], 0x86);
+}
+
+// Nothing differs: the legend says IDENTICAL (no difference swatches).
+TEST_F(MapDiff, PngOfIdenticalMapsSaysSo) {
+  const std::string png = dir_.file("same.png");
+  const ToolRun r = mapdiff({"--png", png, a_, a_});
+  EXPECT_EQ(r.status, 0) << r.output;
+  RgbImage img;
+  ASSERT_TRUE(read_png_rgb(png, &img)) << r.output;
+  const int grid_h = base_grid().size_y;
+  ASSERT_GT(img.height, grid_h + 20);
+  EXPECT_EQ(count_colour(img, grid_h + 1, 255, 0, 255), 0u);
+  EXPECT_EQ(count_colour(img, grid_h + 1, 0, 200, 0), 0u);
+  EXPECT_GT(count_colour(img, grid_h + 1, 0, 0, 0), 100u);
+  const ToolRun diff = mapdiff({"--png", dir_.file("d.png"), a_, write_b([](GridMap &g) { g.at(1, 1) = 0.9f; })});
+  RgbImage other;
+  ASSERT_TRUE(read_png_rgb(dir_.file("d.png"), &other)) << diff.output;
+  EXPECT_GT(other.height, img.height);  // the difference lines are left out when identical
 }
 
 // ---- The library ----------------------------------------------------------

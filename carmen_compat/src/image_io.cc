@@ -7,8 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cctype>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
+#include <utility>
 
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
@@ -43,6 +45,28 @@ std::vector<uint8_t> render(const GridMap &map, PixelFn pixel) {
 bool is_unknown(float v) { return std::isnan(v) || v < 0.0f; }
 bool is_offlimits(float v) { return v >= 2.0f; }
 double clamp01(double p) { return p < 0.0 ? 0.0 : (p > 1.0 ? 1.0 : p); }
+
+// How map_server reads a grey level (negate 0): occupancy (255 - v) / 255.
+double level_occupancy(int v) { return (255 - v) / 255.0; }
+// Levels are kept this far inside a threshold: map_servers compute the
+// occupancy in their own floating point (nav2 through GraphicsMagick).
+constexpr double kLevelMargin = 1e-9;
+
+// The trinary unknown level for o's thresholds (before negation): 205, or
+// the level nearest it that reads as unknown (neither below free_thresh nor
+// above occupied_thresh); -1 when there is none.
+int unknown_level(const MapServerOptions &o) {
+  int best = -1;
+  for (int pass = 0; pass < 2 && best < 0; ++pass) {  // strictly inside first, then on a threshold
+    const double margin = pass == 0 ? kLevelMargin : 0.0;
+    for (int v = 0; v <= 255; ++v) {
+      const double occ = level_occupancy(v);
+      if (occ < o.free_thresh + margin || occ > o.occupied_thresh - margin) continue;
+      if (best < 0 || std::abs(v - int(kPgmUnknown)) < std::abs(best - int(kPgmUnknown))) best = v;
+    }
+  }
+  return best;
+}
 
 // Shortest decimal text that reads back as the same double (and, when the
 // value is exactly a float, the shortest that reads back as that float:
@@ -116,26 +140,68 @@ bool parse_pgm_mode(const std::string &name, PgmMode *mode) {
   return false;
 }
 
-uint8_t pgm_pixel(float value, PgmMode mode) {
+std::string map_server_options_problem(const MapServerOptions &o, const std::string &free_name,
+                                       const std::string &occupied_name, const std::string &negate_name) {
+  const auto text = [](double v) { return number_text(v); };
+  if (!(o.free_thresh >= 0.0 && o.free_thresh <= 1.0))
+    return free_name + " " + text(o.free_thresh) + ": must be a number from 0 to 1";
+  if (!(o.occupied_thresh >= 0.0 && o.occupied_thresh <= 1.0))
+    return occupied_name + " " + text(o.occupied_thresh) + ": must be a number from 0 to 1";
+  if (!(o.free_thresh < o.occupied_thresh))
+    return free_name + " " + text(o.free_thresh) + " must be below " + occupied_name + " " + text(o.occupied_thresh);
+  if (o.negate && o.mode == PgmMode::Raw)
+    return negate_name + " does not go with mode raw: ROS 1's map_server negates a raw image and nav2's does not, "
+                         "so the two would read it differently";
+  if (o.mode == PgmMode::Trinary && unknown_level(o) < 0)
+    return free_name + " " + text(o.free_thresh) + " and " + occupied_name + " " + text(o.occupied_thresh) +
+           " leave no grey level between them for unknown cells (map_server reads level v as occupancy "
+           "(255 - v) / 255)";
+  return {};
+}
+
+TrinaryLevels trinary_levels(const MapServerOptions &o) {
+  const std::string problem = map_server_options_problem(o);
+  if (!problem.empty()) throw std::invalid_argument(problem);
+  TrinaryLevels t;
+  t.occupied = kPgmOccupied;  // occupancy 1: occupied under any occupied_thresh below 1
+  // 254 reads as 1/255; under a smaller free_thresh only 255 (occupancy 0) is free.
+  t.free = level_occupancy(kPgmFree) < o.free_thresh - kLevelMargin || o.free_thresh == 0.0 ? kPgmFree : 255;
+  t.unknown = static_cast<uint8_t>(unknown_level(o));
+  return t;
+}
+
+uint8_t map_server_pixel(float value, const MapServerOptions &o) {
   const bool unknown = is_unknown(value);
   const bool offlimits = !unknown && is_offlimits(value);
   const double p = clamp01(value);
-  switch (mode) {
-    case PgmMode::Trinary:
-      if (unknown) return kPgmUnknown;
-      if (offlimits || p > kOccupiedThresh) return kPgmOccupied;
-      if (p < kFreeThresh) return kPgmFree;
-      return kPgmUnknown;
+  uint8_t level = kPgmUnknown;
+  switch (o.mode) {
+    case PgmMode::Trinary: {
+      const TrinaryLevels t = trinary_levels(o);
+      if (unknown) {
+        level = t.unknown;
+      } else if (offlimits || p > o.occupied_thresh) {
+        level = t.occupied;
+      } else if (p < o.free_thresh) {
+        level = t.free;
+      } else {
+        level = t.unknown;
+      }
+      break;
+    }
     case PgmMode::Scale:
-      if (unknown) return kPgmUnknown;
-      if (offlimits) return 0;
-      return static_cast<uint8_t>(std::lround(255.0 * (1.0 - p)));
+      level = unknown ? kPgmUnknown : offlimits ? 0 : static_cast<uint8_t>(std::lround(255.0 * (1.0 - p)));
+      break;
     case PgmMode::Raw:
-      if (unknown) return kPgmRawUnknown;
-      if (offlimits) return 100;
-      return static_cast<uint8_t>(std::lround(100.0 * p));
+      return unknown ? kPgmRawUnknown : offlimits ? 100 : static_cast<uint8_t>(std::lround(100.0 * p));
   }
-  return kPgmUnknown;
+  return o.negate ? static_cast<uint8_t>(255 - level) : level;
+}
+
+uint8_t pgm_pixel(float value, PgmMode mode) {
+  MapServerOptions o;
+  o.mode = mode;
+  return map_server_pixel(value, o);
 }
 
 uint8_t png_pixel(float value) {
@@ -145,10 +211,41 @@ uint8_t png_pixel(float value) {
 }
 
 std::vector<uint8_t> map_to_pgm_pixels(const GridMap &map, PgmMode mode) {
-  return render(map, [mode](float v) { return pgm_pixel(v, mode); });
+  MapServerOptions o;
+  o.mode = mode;
+  return map_to_pgm_pixels(map, o);
 }
 
-std::vector<uint8_t> map_to_png_pixels(const GridMap &map) { return render(map, png_pixel); }
+std::vector<uint8_t> map_to_pgm_pixels(const GridMap &map, const MapServerOptions &o) {
+  if (o.mode != PgmMode::Trinary) return render(map, [&o](float v) { return map_server_pixel(v, o); });
+  // Trinary: the levels once, not a cell at a time.
+  const TrinaryLevels t = trinary_levels(o);
+  const auto neg = [&o](uint8_t v) { return o.negate ? static_cast<uint8_t>(255 - v) : v; };
+  const uint8_t occ = neg(t.occupied), fr = neg(t.free), unk = neg(t.unknown);
+  return render(map, [&](float v) {
+    if (is_unknown(v)) return unk;
+    if (is_offlimits(v) || double(v) > o.occupied_thresh) return occ;
+    return clamp01(v) < o.free_thresh ? fr : unk;
+  });
+}
+
+std::vector<uint8_t> map_to_picture_rgb(const GridMap &map) {
+  const std::vector<uint8_t> grey = render(map, png_pixel);
+  // Which cells are unknown, in the same row order.
+  const std::vector<uint8_t> unknown = render(map, [](float v) { return uint8_t(is_unknown(v) ? 1 : 0); });
+  std::vector<uint8_t> rgb(grey.size() * 3);
+  for (size_t i = 0; i < grey.size(); ++i) {
+    uint8_t *px = rgb.data() + 3 * i;
+    if (unknown[i]) {
+      px[0] = kPictureUnknown.r;
+      px[1] = kPictureUnknown.g;
+      px[2] = kPictureUnknown.b;
+    } else {
+      px[0] = px[1] = px[2] = grey[i];
+    }
+  }
+  return rgb;
+}
 
 std::string yaml_path_for(const std::string &pgm_path) {
   const size_t slash = pgm_path.find_last_of('/');
@@ -181,22 +278,42 @@ std::string yaml_quoted(const std::string &text) {
   return q + "\"";
 }
 
-void write_pgm_with_yaml(AtomicOutput &pgm, AtomicOutput &yaml_out, const GridMap &map,
-                         const GlobalOffset &origin_of_cell00, PgmMode mode) {
-  const std::vector<uint8_t> pixels = map_to_pgm_pixels(map, mode);
-  const std::string header =
-      "P5\n" + std::to_string(map.size_x) + " " + std::to_string(map.size_y) + "\n255\n";
+void write_map_server_pair(AtomicOutput &image, AtomicOutput &yaml_out, const GridMap &map,
+                           const GlobalOffset &origin_of_cell00, const MapServerOptions &o, MapImageKind kind) {
+  const std::string problem = map_server_options_problem(o);
+  if (!problem.empty()) throw std::invalid_argument(yaml_out.final_path() + ": " + problem);
+  const std::vector<uint8_t> pixels = map_to_pgm_pixels(map, o);
   std::string yaml;
-  yaml += "image: " + yaml_quoted(file_name_of(pgm.final_path())) + "\n";
-  yaml += "mode: " + std::string(pgm_mode_name(mode)) + "\n";
+  yaml += "image: " + yaml_quoted(file_name_of(image.final_path())) + "\n";
+  yaml += "mode: " + std::string(pgm_mode_name(o.mode)) + "\n";
   yaml += "resolution: " + number_text(map.resolution) + "\n";
   yaml += "origin: [" + number_text(origin_of_cell00.x) + ", " + number_text(origin_of_cell00.y) + ", " +
           number_text(origin_of_cell00.theta) + "]\n";
-  yaml += "negate: 0\n";
-  yaml += "occupied_thresh: " + number_text(kOccupiedThresh) + "\n";
-  yaml += "free_thresh: " + number_text(kFreeThresh) + "\n";
-  write_all(pgm, header, pixels);
+  yaml += std::string("negate: ") + (o.negate ? "1" : "0") + "\n";
+  yaml += "occupied_thresh: " + number_text(o.occupied_thresh) + "\n";
+  yaml += "free_thresh: " + number_text(o.free_thresh) + "\n";
+  if (kind == MapImageKind::Pgm) {
+    write_all(image, "P5\n" + std::to_string(map.size_x) + " " + std::to_string(map.size_y) + "\n255\n", pixels);
+  } else if (o.mode == PgmMode::Scale) {
+    // Grey + alpha: unknown transparent, every known cell opaque.
+    const std::vector<uint8_t> unknown = render(map, [](float v) { return uint8_t(is_unknown(v) ? 1 : 0); });
+    std::vector<uint8_t> ga(pixels.size() * 2);
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      ga[2 * i] = pixels[i];
+      ga[2 * i + 1] = unknown[i] ? 0 : 255;
+    }
+    write_png_pixels(image, map.size_x, map.size_y, PNG_FORMAT_GA, ga.data());
+  } else {
+    write_png_pixels(image, map.size_x, map.size_y, PNG_FORMAT_GRAY, pixels.data());
+  }
   write_all(yaml_out, yaml, {});
+}
+
+void write_pgm_with_yaml(AtomicOutput &pgm, AtomicOutput &yaml_out, const GridMap &map,
+                         const GlobalOffset &origin_of_cell00, PgmMode mode) {
+  MapServerOptions o;
+  o.mode = mode;
+  write_map_server_pair(pgm, yaml_out, map, origin_of_cell00, o, MapImageKind::Pgm);
 }
 
 void write_pgm_with_yaml(const std::string &pgm_path, const GridMap &map,
@@ -212,8 +329,8 @@ void write_pgm_with_yaml(const std::string &pgm_path, const GridMap &map,
 }
 
 void write_png(AtomicOutput &out, const GridMap &map) {
-  const std::vector<uint8_t> pixels = map_to_png_pixels(map);
-  write_png_pixels(out, map.size_x, map.size_y, PNG_FORMAT_GRAY, pixels.data());
+  const std::vector<uint8_t> rgb = map_to_picture_rgb(map);
+  write_png_pixels(out, map.size_x, map.size_y, PNG_FORMAT_RGB, rgb.data());
 }
 
 void write_rgb_png(AtomicOutput &out, int width, int height, const std::vector<uint8_t> &rgb) {

@@ -34,20 +34,6 @@ void check_image_size(const std::string &path, uint64_t width, uint64_t height) 
                     width * height > kMaxImagePixels ? ErrorCode::TooLarge : ErrorCode::BadInput);
 }
 
-// Cells from rows of grey levels (row 0 at the top; image_io.h's orientation).
-template <typename CellFn>
-GridMap cells_from_rows(const std::vector<uint8_t> &rows, int width, int height, double resolution, CellFn cell) {
-  GridMap g;
-  g.size_x = width;
-  g.size_y = height;
-  g.resolution = resolution;
-  g.cells.resize(size_t(width) * size_t(height));
-  for (size_t x = 0; x < size_t(width); ++x)
-    for (size_t y = 0; y < size_t(height); ++y)
-      g.cells[x * size_t(height) + y] = cell(rows[(size_t(height) - 1 - y) * size_t(width) + x]);
-  return g;
-}
-
 std::string whole_file(const std::string &path, uint64_t limit) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0)
@@ -126,6 +112,83 @@ PgmImage read_pgm(const std::string &path) {
   return img;
 }
 
+// Either image as map_server sees it: per pixel the sum of its three colour
+// channels (a grey pixel v: 3 v) and, when the image has one, its alpha.
+struct MapImage {
+  int width = 0, height = 0;
+  std::vector<uint16_t> rgb_sum;
+  std::vector<uint8_t> alpha;  // empty: no alpha channel
+};
+
+MapImage pgm_as_map_image(PgmImage &&p) {
+  MapImage m{p.width, p.height, std::vector<uint16_t>(p.rows.size()), {}};
+  for (size_t i = 0; i < p.rows.size(); ++i) m.rgb_sum[i] = uint16_t(3 * p.rows[i]);
+  return m;
+}
+
+// Any PNG through libpng's simplified API as 8-bit RGBA (grey expanded to
+// three equal channels, no alpha read as opaque).
+struct Rgba {
+  int width = 0, height = 0;
+  bool has_alpha = false, has_colour = false;
+  std::vector<uint8_t> px;  // 4 bytes a pixel, row 0 at the top
+};
+
+Rgba read_png_file_rgba(const std::string &path) {
+  png_image img;
+  std::memset(&img, 0, sizeof img);
+  img.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&img, path.c_str()))
+    throw FileError(path, std::string("cannot read PNG: ") + img.message);
+  Rgba out;
+  out.has_alpha = (img.format & PNG_FORMAT_FLAG_ALPHA) != 0;
+  out.has_colour = (img.format & PNG_FORMAT_FLAG_COLOR) != 0;
+  img.format = PNG_FORMAT_RGBA;
+  try {
+    check_image_size(path, img.width, img.height);
+  } catch (...) {
+    png_image_free(&img);
+    throw;
+  }
+  out.px.resize(PNG_IMAGE_SIZE(img));
+  if (!png_image_finish_read(&img, nullptr, out.px.data(), 0, nullptr)) {
+    const std::string msg = img.message;
+    png_image_free(&img);
+    throw FileError(path, "cannot read PNG: " + msg);
+  }
+  out.width = int(img.width);
+  out.height = int(img.height);
+  return out;
+}
+
+MapImage read_png_rgba(const std::string &path) {
+  const Rgba r = read_png_file_rgba(path);
+  const size_t n = size_t(r.width) * size_t(r.height);
+  MapImage m{r.width, r.height, std::vector<uint16_t>(n), {}};
+  if (r.has_alpha) m.alpha.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t *p = r.px.data() + 4 * i;
+    m.rgb_sum[i] = uint16_t(p[0] + p[1] + p[2]);
+    if (r.has_alpha) m.alpha[i] = p[3];
+  }
+  return m;
+}
+
+// A PGM or a PNG, told apart by the first bytes.
+MapImage read_map_image(const std::string &path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError(path, std::string("cannot open: ") + std::strerror(errno), ErrorCode::Io);
+  char magic[8] = {};
+  in.read(magic, sizeof magic);
+  const std::streamsize got = in.gcount();
+  in.close();
+  if (got == 8 && std::memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0) return read_png_rgba(path);
+  if (got >= 2 && magic[0] == 'P' && magic[1] == '5') return pgm_as_map_image(read_pgm(path));
+  if (got >= 2 && magic[0] == 'P' && (magic[1] == '2' || magic[1] == '1' || magic[1] == '4'))
+    throw FileError(path, std::string("is a P") + magic[1] + " image: only binary greyscale PGMs (P5) are read");
+  throw FileError(path, "is neither a binary PGM (P5) nor a PNG: the map images this reader takes");
+}
+
 // ---------------------------------------------------------------------------
 // map_server's YAML: flat "key: value" lines.
 // ---------------------------------------------------------------------------
@@ -186,18 +249,67 @@ GlobalOffset yaml_origin(const std::string &path, const YamlValue &v) {
   return GlobalOffset{xyz[0], xyz[1], xyz[2]};
 }
 
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
 struct YamlMeta {
   double resolution = 0;
   GlobalOffset origin;
-  PgmMode mode = PgmMode::Trinary;
-  bool negate = false;
-  double occupied_thresh = kOccupiedThresh, free_thresh = kFreeThresh;
+  MapServerOptions options;
+  std::string image;  // the image key, unquoted; empty when absent
+  long image_line = 0;
 };
 
 const YamlValue &required(const std::string &path, const std::map<std::string, YamlValue> &keys, const char *key) {
   const auto it = keys.find(key);
   if (it == keys.end()) throw FileError(path, std::string("map_server YAML without the \"") + key + "\" key");
   return it->second;
+}
+
+// A YAML scalar without its quotes: "..." with backslash escapes (\" \\ \n
+// \t \xNN, what write_map_server_pair writes), '...' with '' for a quote,
+// or plain.
+std::string yaml_unquoted(const std::string &path, const YamlValue &v, const char *key) {
+  const std::string &t = v.text;
+  if (t.empty() || (t[0] != '"' && t[0] != '\'')) return t;
+  const char q = t[0];
+  std::string out;
+  size_t i = 1;
+  for (; i < t.size(); ++i) {
+    const char c = t[i];
+    if (q == '\'' && c == '\'') {
+      if (i + 1 < t.size() && t[i + 1] == '\'') {
+        out += '\'';
+        ++i;
+        continue;
+      }
+      break;
+    }
+    if (q == '"' && c == '"') break;
+    if (q == '"' && c == '\\' && i + 1 < t.size()) {
+      const char e = t[++i];
+      if (e == 'n') {
+        out += '\n';
+      } else if (e == 't') {
+        out += '\t';
+      } else if (e == 'x' && i + 2 < t.size() && std::isxdigit(static_cast<unsigned char>(t[i + 1])) &&
+                 std::isxdigit(static_cast<unsigned char>(t[i + 2]))) {
+        out += static_cast<char>(std::stoi(t.substr(i + 1, 2), nullptr, 16));
+        i += 2;
+      } else {
+        out += e;
+      }
+      continue;
+    }
+    out += c;
+  }
+  if (i >= t.size()) throw FileError(path, v.line, std::string(key) + ": the quoted string is not closed");
+  if (!trim(t.substr(i + 1)).empty() && trim(t.substr(i + 1))[0] != '#')
+    throw FileError(path, v.line, std::string(key) + ": text after the closing quote");
+  return out;
 }
 
 YamlMeta read_yaml_meta(const std::string &path) {
@@ -207,74 +319,147 @@ YamlMeta read_yaml_meta(const std::string &path) {
   m.resolution = yaml_number(path, res, "resolution");
   if (!(m.resolution > 0)) throw FileError(path, res.line, "resolution must be positive");
   m.origin = yaml_origin(path, required(path, keys, "origin"));
-  if (auto it = keys.find("mode"); it != keys.end() && !parse_pgm_mode(it->second.text, &m.mode))
+  MapServerOptions &o = m.options;
+  if (auto it = keys.find("mode"); it != keys.end() && !parse_pgm_mode(yaml_unquoted(path, it->second, "mode"), &o.mode))
     throw FileError(path, it->second.line, "mode \"" + printable(it->second.text) + "\": expected trinary, scale or raw");
   if (auto it = keys.find("negate"); it != keys.end()) {
-    const double n = yaml_number(path, it->second, "negate");
-    if (n != 0 && n != 1) throw FileError(path, it->second.line, "negate must be 0 or 1");
-    m.negate = n == 1;
+    const std::string &t = it->second.text;
+    if (t == "true" || t == "false") {  // nav2 takes a boolean too
+      o.negate = t == "true";
+    } else {
+      const double n = yaml_number(path, it->second, "negate");
+      if (n != 0 && n != 1) throw FileError(path, it->second.line, "negate must be 0 or 1");
+      o.negate = n == 1;
+    }
   }
-  if (auto it = keys.find("occupied_thresh"); it != keys.end())
-    m.occupied_thresh = yaml_number(path, it->second, "occupied_thresh");
-  if (auto it = keys.find("free_thresh"); it != keys.end()) m.free_thresh = yaml_number(path, it->second, "free_thresh");
+  long thresh_line = 0;
+  if (auto it = keys.find("occupied_thresh"); it != keys.end()) {
+    o.occupied_thresh = yaml_number(path, it->second, "occupied_thresh");
+    thresh_line = it->second.line;
+  }
+  if (auto it = keys.find("free_thresh"); it != keys.end()) {
+    o.free_thresh = yaml_number(path, it->second, "free_thresh");
+    thresh_line = std::max(thresh_line, it->second.line);
+  }
+  if (!(o.free_thresh >= 0 && o.free_thresh < o.occupied_thresh && o.occupied_thresh <= 1))
+    throw FileError(path, thresh_line, "free_thresh " + short_number(o.free_thresh) + " and occupied_thresh " +
+                                           short_number(o.occupied_thresh) +
+                                           ": expected 0 <= free_thresh < occupied_thresh <= 1");
+  if (auto it = keys.find("image"); it != keys.end()) {
+    m.image = yaml_unquoted(path, it->second, "image");
+    m.image_line = it->second.line;
+  }
   return m;
 }
 
-// One grey level as map_server reads it (see image_io.h).
-float pgm_cell(uint8_t v, const YamlMeta &m) {
-  const double occ = m.negate ? v / 255.0 : (255 - v) / 255.0;
-  switch (m.mode) {
-    case PgmMode::Trinary: return occ > m.occupied_thresh ? 1.0f : occ < m.free_thresh ? 0.0f : kUnknownCell;
-    case PgmMode::Scale: return v == kPgmUnknown ? kUnknownCell : static_cast<float>(occ);
-    case PgmMode::Raw: return v == kPgmRawUnknown ? kUnknownCell : static_cast<float>(v / 100.0);
+// One pixel as map_server reads it (see image_io.h).
+float map_cell(const MapImage &img, size_t i, const MapServerOptions &o) {
+  const bool has_alpha = !img.alpha.empty();
+  const double mean = has_alpha && o.mode == PgmMode::Trinary ? (img.rgb_sum[i] + img.alpha[i]) / 4.0
+                                                               : img.rgb_sum[i] / 3.0;
+  const double occ = o.negate ? mean / 255.0 : (255.0 - mean) / 255.0;
+  switch (o.mode) {
+    case PgmMode::Trinary: return occ > o.occupied_thresh ? 1.0f : occ < o.free_thresh ? 0.0f : kUnknownCell;
+    case PgmMode::Scale: {
+      if (has_alpha) return img.alpha[i] != 255 ? kUnknownCell : static_cast<float>(occ);
+      const double level = o.negate ? 255.0 - mean : mean;
+      return level == kPgmUnknown ? kUnknownCell : static_cast<float>(occ);
+    }
+    case PgmMode::Raw: {
+      const long v = std::lround(mean);
+      return v == kPgmRawUnknown ? kUnknownCell : static_cast<float>(double(v) / 100.0);
+    }
   }
   return kUnknownCell;
 }
 
-void check_raw_levels(const std::string &path, const std::vector<uint8_t> &rows) {
-  for (size_t i = 0; i < rows.size(); ++i)
-    if (rows[i] > 100 && rows[i] != kPgmRawUnknown)
-      throw FileError(path, "pixel " + std::to_string(i) + " has level " + std::to_string(rows[i]) +
+void check_raw_levels(const std::string &path, const MapImage &img) {
+  for (size_t i = 0; i < img.rgb_sum.size(); ++i) {
+    const long v = std::lround(img.rgb_sum[i] / 3.0);
+    if (v > 100 && v != kPgmRawUnknown)
+      throw FileError(path, "pixel " + std::to_string(i) + " has level " + std::to_string(v) +
                                 ": a raw-mode map holds 0..100 or 255 (unknown)");
+  }
+}
+
+PgmMap map_from(const std::string &image_path, const MapImage &img, const YamlMeta &meta) {
+  if (meta.options.mode == PgmMode::Raw) check_raw_levels(image_path, img);
+  PgmMap out;
+  GridMap &g = out.grid;
+  g.size_x = img.width;
+  g.size_y = img.height;
+  g.resolution = meta.resolution;
+  g.cells.resize(size_t(img.width) * size_t(img.height));
+  const size_t w = size_t(img.width), h = size_t(img.height);
+  for (size_t x = 0; x < w; ++x)
+    for (size_t y = 0; y < h; ++y) g.cells[x * h + y] = map_cell(img, (h - 1 - y) * w + x, meta.options);
+  out.origin = meta.origin;
+  out.mode = meta.options.mode;
+  out.options = meta.options;
+  out.image_path = image_path;
+  return out;
+}
+
+std::string resolved_image(const std::string &yaml_path, const YamlMeta &meta) {
+  if (meta.image.empty()) throw FileError(yaml_path, "map_server YAML without the \"image\" key");
+  if (meta.image[0] == '/') return meta.image;
+  const size_t slash = yaml_path.find_last_of('/');
+  return slash == std::string::npos ? meta.image : yaml_path.substr(0, slash + 1) + meta.image;
 }
 
 }  // namespace
 
 GridMap read_png(const std::string &path) {
-  png_image img;
-  std::memset(&img, 0, sizeof img);
-  img.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&img, path.c_str()))
-    throw FileError(path, std::string("cannot read PNG: ") + img.message);
-  img.format = PNG_FORMAT_GRAY;
-  try {
-    check_image_size(path, img.width, img.height);
-  } catch (...) {
-    png_image_free(&img);
-    throw;
+  const Rgba img = read_png_file_rgba(path);
+  GridMap g;
+  g.size_x = img.width;
+  g.size_y = img.height;
+  g.resolution = 0.0;
+  g.cells.resize(size_t(img.width) * size_t(img.height));
+  const size_t w = size_t(img.width), h = size_t(img.height);
+  for (size_t x = 0; x < w; ++x) {
+    for (size_t y = 0; y < h; ++y) {
+      const uint8_t *p = img.px.data() + 4 * ((h - 1 - y) * w + x);
+      float cell;
+      if (img.has_colour) {  // a picture: its unknown colour, else the channels' mean
+        const bool unknown = p[0] == kPictureUnknown.r && p[1] == kPictureUnknown.g && p[2] == kPictureUnknown.b;
+        const bool grey = p[0] == p[1] && p[1] == p[2];
+        cell = unknown ? kUnknownCell
+                       : grey ? 1.0f - static_cast<float>(p[0]) / 255.0f
+                              : 1.0f - static_cast<float>((p[0] + p[1] + p[2]) / 3.0 / 255.0);
+      } else {  // grey: the older pictures' rule
+        cell = p[0] == kPngUnknown ? kUnknownCell : 1.0f - static_cast<float>(p[0]) / 255.0f;
+      }
+      g.cells[x * h + y] = cell;
+    }
   }
-  std::vector<uint8_t> px(PNG_IMAGE_SIZE(img));
-  if (!png_image_finish_read(&img, nullptr, px.data(), 0, nullptr)) {
-    const std::string msg = img.message;
-    png_image_free(&img);
-    throw FileError(path, "cannot read PNG: " + msg);
-  }
-  return cells_from_rows(px, int(img.width), int(img.height), 0.0, [](uint8_t v) {
-    return v == kPngUnknown ? kUnknownCell : 1.0f - static_cast<float>(v) / 255.0f;
-  });
+  return g;
+}
+
+PgmMap read_image_with_yaml(const std::string &image_path, const std::string &yaml_path) {
+  const YamlMeta meta = read_yaml_meta(yaml_path);
+  return map_from(image_path, read_map_image(image_path), meta);
 }
 
 PgmMap read_pgm_with_yaml(const std::string &pgm_path) {
   const std::string yaml_path = yaml_path_for(pgm_path);
   const YamlMeta meta = read_yaml_meta(yaml_path);
-  const PgmImage img = read_pgm(pgm_path);
-  if (meta.mode == PgmMode::Raw) check_raw_levels(pgm_path, img.rows);
-  PgmMap out;
-  out.grid = cells_from_rows(img.rows, img.width, img.height, meta.resolution,
-                             [&meta](uint8_t v) { return pgm_cell(v, meta); });
-  out.origin = meta.origin;
-  out.mode = meta.mode;
-  return out;
+  return map_from(pgm_path, pgm_as_map_image(read_pgm(pgm_path)), meta);
+}
+
+std::string map_server_image_of(const std::string &yaml_path) {
+  return resolved_image(yaml_path, read_yaml_meta(yaml_path));
+}
+
+PgmMap read_map_server_yaml(const std::string &yaml_path) {
+  const YamlMeta meta = read_yaml_meta(yaml_path);
+  const std::string image = resolved_image(yaml_path, meta);
+  struct stat st;
+  if (::stat(image.c_str(), &st) != 0)
+    throw FileError(yaml_path, meta.image_line,
+                    "image \"" + printable(meta.image) + "\": cannot open " + printable(image) + ": " +
+                        std::strerror(errno), ErrorCode::Io);
+  return map_from(image, read_map_image(image), meta);
 }
 
 }  // namespace carmen

@@ -1,6 +1,7 @@
 // The map-format table (map_format.h) and its readers and writers.
 #include "carmen_compat/map_format.h"
 
+#include <cstring>
 #include <stdexcept>
 
 #include "carmen_compat/error.h"
@@ -47,11 +48,41 @@ MapRead read_pgm(const std::string &path) {
   return MapRead{std::move(p.grid), p.origin};
 }
 
+// NAME.png+yaml: NAME.png and NAME.yaml.
+std::string png_of_pair(const std::string &path) { return path.substr(0, path.size() - std::strlen("+yaml")); }
+// NAME.yaml written: NAME.yaml and NAME.pgm.
+std::string pgm_of_yaml(const std::string &path) { return path.substr(0, path.size() - std::strlen(".yaml")) + ".pgm"; }
+
+MapRead read_png_pair(const std::string &path) {
+  const std::string png = png_of_pair(path);
+  PgmMap p = read_image_with_yaml(png, yaml_path_for(png));
+  return MapRead{std::move(p.grid), p.origin};
+}
+
+MapRead read_yaml(const std::string &path) {
+  PgmMap p = read_map_server_yaml(path);
+  return MapRead{std::move(p.grid), p.origin};
+}
+
+void write_pair(OutputTransaction &tx, const std::string &image_path, const std::string &yaml_path,
+                const MapToWrite &m, MapImageKind kind) {
+  if (yaml_path == image_path) throw std::invalid_argument(image_path + ": the image and its YAML would be one file");
+  AtomicOutput &image = tx.add(image_path);
+  write_map_server_pair(image, tx.add(yaml_path), m.grid, m.origin.value_or(GlobalOffset{}),
+                        map_server_options_of(m), kind);
+}
+
 void write_pgm(OutputTransaction &tx, const std::string &path, const MapToWrite &m) {
-  const std::string yaml = yaml_path_for(path);
-  if (yaml == path) throw std::invalid_argument(path + ": the image and its YAML would be one file");
-  AtomicOutput &pgm = tx.add(path);
-  write_pgm_with_yaml(pgm, tx.add(yaml), m.grid, m.origin.value_or(GlobalOffset{}), m.pgm_mode);
+  write_pair(tx, path, yaml_path_for(path), m, MapImageKind::Pgm);
+}
+
+void write_png_pair(OutputTransaction &tx, const std::string &path, const MapToWrite &m) {
+  const std::string png = png_of_pair(path);
+  write_pair(tx, png, yaml_path_for(png), m, MapImageKind::Png);
+}
+
+void write_yaml(OutputTransaction &tx, const std::string &path, const MapToWrite &m) {
+  write_pair(tx, pgm_of_yaml(path), path, m, MapImageKind::Pgm);
 }
 
 MapRead read_png_file(const std::string &path) { return MapRead{read_png(path), std::nullopt}; }
@@ -66,8 +97,12 @@ const std::vector<MapFormatEntry> &map_formats() {
   static const std::vector<MapFormatEntry> formats = {
       {MapFormat::CarmenMap, ".map", "CARMEN map", read_carmen, write_carmen},
       {MapFormat::CarmenMapGz, ".map.gz", "CARMEN map, gzipped", read_carmen, write_carmen},
-      {MapFormat::PgmYaml, ".pgm", "ROS map_server image with a .yaml beside it", read_pgm, write_pgm},
-      {MapFormat::Png, ".png", "8-bit grey picture", read_png_file, write_png_file},
+      {MapFormat::PgmYaml, ".pgm", "ROS map_server / nav2 PGM image with a .yaml beside it", read_pgm, write_pgm},
+      {MapFormat::PngYaml, ".png+yaml", "ROS map_server / nav2 pair NAME.png + NAME.yaml", read_png_pair,
+       write_png_pair},
+      {MapFormat::Yaml, ".yaml", "ROS map_server YAML (read: the image it names; written: with NAME.pgm)",
+       read_yaml, write_yaml},
+      {MapFormat::Png, ".png", "picture for people (RGB)", read_png_file, write_png_file},
   };
   return formats;
 }
@@ -91,8 +126,30 @@ const MapFormatEntry &map_format_of(const std::string &path) {
 }
 
 std::vector<std::string> map_output_files(const std::string &path) {
-  if (map_format_of(path).format == MapFormat::PgmYaml) return {path, yaml_path_for(path)};
-  return {path};
+  switch (map_format_of(path).format) {
+    case MapFormat::PgmYaml: return {path, yaml_path_for(path)};
+    case MapFormat::PngYaml: return {png_of_pair(path), yaml_path_for(png_of_pair(path))};
+    case MapFormat::Yaml: return {path, pgm_of_yaml(path)};
+    default: return {path};
+  }
+}
+
+std::vector<std::string> map_input_files(const std::string &path) {
+  if (map_format_of(path).format != MapFormat::Yaml) return map_output_files(path);
+  try {
+    return {path, map_server_image_of(path)};
+  } catch (const FileError &) {
+    return {path};  // reading it will say what is wrong
+  }
+}
+
+MapServerOptions map_server_options_of(const MapToWrite &m) {
+  MapServerOptions o;
+  o.mode = m.pgm_mode;
+  o.occupied_thresh = m.occupied_thresh;
+  o.free_thresh = m.free_thresh;
+  o.negate = m.negate;
+  return o;
 }
 
 MapRead read_map(const std::string &path) { return map_format_of(path).read(path); }

@@ -32,7 +32,8 @@ bool parse_double(const std::string &text, double *out) {
 void add_input_options(CLI::App &app, const ToolSpec &spec, Options &opt) {
   app.add_option(spec.input_name, opt.log, spec.input_help + "; - for standard input")->required();
   app.add_option("OUT", opt.outputs,
-                 "output files: .map, .map.gz, .pgm, .png; - for a CARMEN map on standard output (with --out-dir: "
+                 "output files: .map, .map.gz, .pgm, .png+yaml, .yaml, .png; - for a CARMEN map on standard output "
+                 "(with --out-dir: "
                  "further " + spec.input_name + "s)");
   app.add_option("--param-file", opt.param_file, "carmen.ini with vasco_* keys (default: vasco's defaults)");
   app.add_option("--robot", opt.robot, "robot section of the ini to use");
@@ -52,6 +53,51 @@ void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchT
   app.add_flag("--fail-fast", opt.fail_fast, "batch mode: stop at the first input that fails (default: report it, go on)");
   app.add_option("--jobs", opt.jobs, "batch mode: threads reading inputs and writing maps (default: all cores)")
       ->check(CLI::Range(0, vasco::kMaxThreads));
+}
+
+// The map_server outputs' options; checked after parsing.
+struct MapServerText {
+  std::string mode = "trinary";
+};
+
+void add_map_server_options(CLI::App &app, Options &opt, MapServerText &raw) {
+  carmen::MapServerOptions &o = opt.map_server;
+  app.add_option("--mode", raw.mode,
+                 "grey levels of .pgm, .png+yaml and .yaml outputs: trinary (default), scale (unknown transparent "
+                 "in a PNG; a PGM cannot say unknown in scale mode) or raw")
+      ->check(CLI::IsMember({"trinary", "scale", "raw"}));
+  // 0.196 is what ROS 1's map_saver writes; nav2's map_saver writes 0.25.
+  app.add_option("--free-thresh", o.free_thresh,
+                 "map_server outputs: p below it is free, the YAML's free_thresh (default 0.196, as ROS 1's "
+                 "map_saver writes; nav2's map_saver: 0.25)")
+      ->type_name("P");
+  app.add_option("--occupied-thresh", o.occupied_thresh,
+                 "map_server outputs: p above it is occupied, the YAML's occupied_thresh (default 0.65)")
+      ->type_name("P");
+  app.add_flag("--negate", o.negate, "map_server outputs: negate 1 (black free, white occupied; not with --mode raw)");
+}
+
+// Checks the map_server options: a usage error naming the option, or a
+// warning when no output is a map_server pair.
+void finish_map_server_options(const CLI::App &app, const MapServerText &raw, Options &opt) {
+  carmen::parse_pgm_mode(raw.mode, &opt.map_server.mode);
+  const std::string problem =
+      carmen::map_server_options_problem(opt.map_server, "--free-thresh", "--occupied-thresh", "--negate");
+  if (!problem.empty()) throw Error(ErrorCode::Usage, problem);
+  const bool given = app.count("--mode") || app.count("--free-thresh") || app.count("--occupied-thresh") ||
+                     app.count("--negate");
+  if (!given) return;
+  bool pair = std::find(opt.formats.begin(), opt.formats.end(), "pgm") != opt.formats.end();
+  for (const std::string &out : opt.outputs) {
+    const carmen::MapFormatEntry *f = out == cli::kStdio ? nullptr : carmen::find_map_format(out);
+    pair = pair || (f != nullptr && (f->format == carmen::MapFormat::PgmYaml ||
+                                     f->format == carmen::MapFormat::PngYaml || f->format == carmen::MapFormat::Yaml));
+  }
+  if (pair) return;
+  const std::string w = "--mode, --free-thresh, --occupied-thresh and --negate do nothing without a .pgm, .png+yaml "
+                        "or .yaml output";
+  opt.warnings.push_back(w);
+  std::fprintf(stderr, "%s: warning: %s\n", opt.tool.c_str(), w.c_str());
 }
 
 void add_backend_options(CLI::App &app, Options &opt) {
@@ -251,6 +297,8 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
       ->type_name("MiB");
   PoseText raw_poses;
   add_pose_options(app, *opt, raw_poses);
+  MapServerText raw_map_server;
+  add_map_server_options(app, *opt, raw_map_server);
   std::map<std::string, std::string> raw;
   add_param_options(app, raw);
   try {
@@ -266,6 +314,7 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
   try {
     finish_options(app, spec, raw_poses, max_memory, *opt);
     finish_batch_options(app, raw_batch, *opt);
+    finish_map_server_options(app, raw_map_server, *opt);
   } catch (const carmen::Error &e) {
     std::fprintf(stderr, "%s: %s\n", spec.name.c_str(), carmen::printable(e.what()).c_str());
     return 2;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "carmen_compat/image_io.h"
 #include "log2map_app.h"
 #include "vasco_gpu/internal/log_input.h"
 #include "vasco_gpu/pose_file.h"
@@ -40,6 +41,9 @@ struct Options {
   std::string laser_mount_text;                  // --laser-mount as given
   std::map<std::string, std::string> extra;      // the tool's own options, as given
   std::vector<std::string> warnings;             // options that change nothing here (said at parse time)
+  // --mode, --free-thresh, --occupied-thresh, --negate: the map_server
+  // outputs' (.pgm, .png+yaml, .yaml) grey levels and YAML.
+  carmen::MapServerOptions map_server;
 };
 
 // Parses argv into *opt. Returns -1 to go on, else the exit status to

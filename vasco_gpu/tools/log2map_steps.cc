@@ -200,6 +200,10 @@ void write_outputs(const Options &opt, const std::string &log, const std::vector
   map.source = basename_of(log);
   map.description = "vasco_gpu " + std::string(vasco::version()) + " " + r.backend;
   map.time = static_cast<int64_t>(std::time(nullptr));
+  map.pgm_mode = opt.map_server.mode;  // the map_server outputs' settings
+  map.free_thresh = opt.map_server.free_thresh;
+  map.occupied_thresh = opt.map_server.occupied_thresh;
+  map.negate = opt.map_server.negate;
   carmen::OutputTransaction tx;
   std::unique_ptr<cli::StdoutFile> to_stdout;  // the output "-": a CARMEN map
   for (const std::string &out : outputs) {

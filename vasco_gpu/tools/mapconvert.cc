@@ -1,11 +1,15 @@
-// mapconvert: convert a CARMEN map file, or describe it.
+// mapconvert: convert a map file (CARMEN, or a ROS map_server pair), or
+// describe it.
 //
-//   mapconvert [--mode trinary|scale|raw] IN OUT   convert by OUT's extension
+//   mapconvert [--mode M] [--free-thresh F] [--occupied-thresh O] [--negate] IN OUT
+//                                                  convert by OUT's extension
 //   mapconvert --info IN                           print what the map holds
 //
 // Exit status: 0 ok, 1 a file could not be read or written (the message
 // names it), 2 usage error.
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -24,21 +28,35 @@
 namespace {
 
 const char kUsage[] =
-    "Usage: mapconvert [-q] [--mode trinary|scale|raw] IN OUT\n"
+    "Usage: mapconvert [-q] [--mode trinary|scale|raw] [--free-thresh F] [--occupied-thresh O]\n"
+    "                  [--negate] IN OUT\n"
     "   or: mapconvert --info IN\n"
     "   or: mapconvert --version\n"
     "\n"
-    "Converts the CARMEN map IN (.map or .map.gz) to OUT, chosen by OUT's extension:\n"
-    "  .map     CARMEN map (every chunk it reads; HMAP, unknown and repeated chunks\n"
-    "           are dropped, with a note)\n"
-    "  .map.gz  CARMEN map, gzip-compressed\n"
-    "  .pgm     ROS map_server / nav2 image, with a .yaml beside it (origin from the\n"
-    "           map's OFFSET chunk, else 0 0 0); --mode sets the YAML mode and the\n"
-    "           grey levels (default trinary)\n"
-    "  .png     8-bit grey picture (black occupied, white free, mid grey unknown)\n"
+    "Converts the map IN to OUT, each in the format its extension says:\n"
+    "  .map       CARMEN map (from a CARMEN map: every chunk it reads; HMAP, unknown\n"
+    "             and repeated chunks are dropped, with a note)\n"
+    "  .map.gz    CARMEN map, gzip-compressed\n"
+    "  .pgm       ROS map_server / nav2 PGM image, with a .yaml beside it (origin from\n"
+    "             the map's OFFSET chunk, else 0 0 0)\n"
+    "  .png+yaml  the same pair with a PNG: OUT x.png+yaml writes x.png and x.yaml\n"
+    "             (in scale mode unknown cells are transparent; a PGM cannot say\n"
+    "             unknown in scale mode: it gets grey 205, which map_server reads\n"
+    "             as occupancy 0.196)\n"
+    "  .yaml      map_server YAML: as IN, the map it describes (its image, PGM or\n"
+    "             PNG, read the way map_server reads it); as OUT, x.yaml and x.pgm\n"
+    "  .png       picture for people (black occupied, white free, grey in between,\n"
+    "             unknown grey-green #708986); not an input (no resolution or origin)\n"
+    "Options of the map_server outputs (.pgm, .png+yaml, .yaml), written to the YAML:\n"
+    "  --mode M             trinary (default), scale or raw grey levels\n"
+    "  --free-thresh F      p below F is free (default 0.196, what ROS 1's map_saver\n"
+    "                       writes; nav2's map_saver writes 0.25)\n"
+    "  --occupied-thresh O  p above O is occupied (default 0.65); 0 <= F < O <= 1\n"
+    "  --negate             negate 1: black free, white occupied (not with raw)\n"
     "--info prints the size, resolution, chunks, unknown fraction and value range.\n"
     "-q, --quiet leaves out the notes (chunks not copied); errors are still said.\n"
-    "IN '-' reads standard input; OUT '-' writes a CARMEN map (.map) to standard output.\n"
+    "IN '-' reads a CARMEN map from standard input; OUT '-' writes a CARMEN map\n"
+    "(.map) to standard output.\n"
     "\n"
     "Exit status: 0 ok, 1 a file could not be read or written, 2 usage error.\n";
 
@@ -49,22 +67,38 @@ int usage_error(const std::string &msg) {
 
 // A CARMEN map is copied whole (every chunk); any other format of the
 // map-format table gets the grid and its origin through the table's writer.
-enum class OutKind { None, Map, Pgm, Grid };
+enum class OutKind { None, Map, MapServer, Grid };
 
 // By the map-format table's rule (file_names.h: the extension, any case).
 OutKind kind_of(const std::string &path) {
   const carmen::MapFormatEntry *f = carmen::find_map_format(path);
   if (f == nullptr) return OutKind::None;
-  if (f->format == carmen::MapFormat::CarmenMap || f->format == carmen::MapFormat::CarmenMapGz) return OutKind::Map;
-  return f->format == carmen::MapFormat::PgmYaml ? OutKind::Pgm : OutKind::Grid;
+  switch (f->format) {
+    case carmen::MapFormat::CarmenMap:
+    case carmen::MapFormat::CarmenMapGz: return OutKind::Map;
+    case carmen::MapFormat::PgmYaml:
+    case carmen::MapFormat::PngYaml:
+    case carmen::MapFormat::Yaml: return OutKind::MapServer;
+    case carmen::MapFormat::Png: return OutKind::Grid;
+  }
+  return OutKind::None;
+}
+
+// Whether IN is a CARMEN map (read whole, every chunk) rather than a grid
+// of the table (a map_server pair).
+bool carmen_input(const std::string &path) {
+  return path == cli::kStdio || kind_of(path) == OutKind::Map;
 }
 
 std::string quoted(const std::string &s) { return "\"" + s + "\""; }
 
-void print_info(const std::string &path, const carmen::MapFile &m) {
+// `format`: the table's words for a file that is not a CARMEN map (no
+// comments, no chunks to list), else nullptr.
+void print_info(const std::string &path, const carmen::MapFile &m, const char *format) {
   std::printf("file: %s\n", path.c_str());
-  std::printf("comment lines: %zu\n", m.comments.size());
-  std::printf("chunks: %zu\n", m.chunks.size());
+  if (format != nullptr) std::printf("format: %s\n", format);
+  if (format == nullptr) std::printf("comment lines: %zu\n", m.comments.size());
+  if (format == nullptr) std::printf("chunks: %zu\n", m.chunks.size());
   for (const carmen::ChunkInfo &c : m.chunks) {
     std::printf("  %-10s %10d bytes at byte %lld%s%s\n", carmen::chunk_type_name(c.type).c_str(), c.size,
                 static_cast<long long>(c.offset), c.named() ? (" named " + quoted(c.name)).c_str() : "",
@@ -121,14 +155,48 @@ void print_info(const std::string &path, const carmen::MapFile &m) {
 // The command line, parsed.
 struct Args {
   bool info = false, mode_given = false, help = false, version = false, quiet = false;
-  carmen::PgmMode mode = carmen::PgmMode::Trinary;
+  bool thresholds_given = false;  // --free-thresh, --occupied-thresh or --negate
+  carmen::MapServerOptions map_server;
   std::vector<std::string> files;
 };
+
+// "--name VALUE" or "--name=VALUE" at args[*i]: *value (moving *i past
+// it) and true, or false when args[*i] is not this option. Sets *missing when the
+// value is not there.
+bool option_value(const std::vector<std::string> &args, size_t *i, const std::string &name, std::string *value,
+                  bool *missing) {
+  const std::string &s = args[*i];
+  if (s == name) {
+    if (*i + 1 >= args.size()) {
+      *missing = true;
+      return true;
+    }
+    *value = args[++*i];
+    return true;
+  }
+  if (s.rfind(name + "=", 0) == 0) {
+    *value = s.substr(name.size() + 1);
+    return true;
+  }
+  return false;
+}
+
+// A threshold: one finite number, the whole text.
+bool parse_threshold(const std::string &text, double *out) {
+  char *end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
+}
 
 // Parses argv into *a; returns 0, or usage_error's code.
 int parse_args(const std::vector<std::string> &args, Args *a) {
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string &s = args[i];
+    std::string value;
+    bool missing = false;
     if (s == "--help" || s == "-h") {
       a->help = true;
       return 0;
@@ -139,18 +207,23 @@ int parse_args(const std::vector<std::string> &args, Args *a) {
       a->quiet = true;
     } else if (s == "--info") {
       a->info = true;
-    } else if (s == "--mode" || s.rfind("--mode=", 0) == 0) {
-      std::string value;
-      if (s == "--mode") {
-        if (i + 1 >= args.size()) return usage_error("--mode needs a value");
-        value = args[++i];
-      } else {
-        value = s.substr(7);
-      }
-      if (!carmen::parse_pgm_mode(value, &a->mode)) {
+    } else if (option_value(args, &i, "--mode", &value, &missing)) {
+      if (missing) return usage_error("--mode needs a value");
+      if (!carmen::parse_pgm_mode(value, &a->map_server.mode)) {
         return usage_error("unknown --mode '" + value + "' (trinary, scale or raw)");
       }
       a->mode_given = true;
+    } else if (option_value(args, &i, "--free-thresh", &value, &missing) ||
+               option_value(args, &i, "--occupied-thresh", &value, &missing)) {
+      const bool is_free = s.rfind("--free-thresh", 0) == 0;
+      const char *name = is_free ? "--free-thresh" : "--occupied-thresh";
+      if (missing) return usage_error(std::string(name) + " needs a value");
+      if (!parse_threshold(value, is_free ? &a->map_server.free_thresh : &a->map_server.occupied_thresh))
+        return usage_error(std::string(name) + " '" + value + "': expected a number from 0 to 1");
+      a->thresholds_given = true;
+    } else if (s == "--negate") {
+      a->map_server.negate = true;
+      a->thresholds_given = true;
     } else if (s == "--") {
       a->files.insert(a->files.end(), args.begin() + static_cast<long>(i) + 1, args.end());
       break;
@@ -168,21 +241,53 @@ int parse_args(const std::vector<std::string> &args, Args *a) {
 int check_args(const Args &a, OutKind *kind) {
   if (a.info) {
     if (a.files.size() != 1) return usage_error("--info takes one map file");
-    if (a.mode_given) return usage_error("--mode applies to .pgm output, not --info");
+    if (a.mode_given || a.thresholds_given)
+      return usage_error("--mode, --free-thresh, --occupied-thresh and --negate apply to map_server output, not --info");
     return 0;
   }
   if (a.files.size() != 2) return usage_error(a.files.empty() ? "no files given" : "expected IN and OUT");
   *kind = a.files[1] == cli::kStdio ? OutKind::Map : kind_of(a.files[1]);
   if (*kind == OutKind::None) {
-    return usage_error("cannot tell the output format of '" + a.files[1] + "' (use .map, .map.gz, .pgm or .png)");
+    return usage_error("cannot tell the output format of '" + a.files[1] + "' (use " +
+                       carmen::known_map_extensions() + ")");
   }
-  if (a.mode_given && *kind != OutKind::Pgm) return usage_error("--mode applies to .pgm output only");
+  if (a.files[0] != cli::kStdio && kind_of(a.files[0]) == OutKind::None)
+    return usage_error("cannot tell the format of '" + a.files[0] + "' (use " + carmen::known_map_extensions() + ")");
+  if (kind_of(a.files[0]) == OutKind::Grid && *kind != OutKind::Grid)
+    return usage_error("'" + a.files[0] + "' is a picture (.png): it holds no resolution or origin to make a map of; "
+                       "convert from the .map, or from a .png+yaml or .yaml pair");
+  if ((a.mode_given || a.thresholds_given) && *kind != OutKind::MapServer)
+    return usage_error("--mode, --free-thresh, --occupied-thresh and --negate apply to .pgm, .png+yaml and .yaml "
+                       "output only");
+  const std::string problem =
+      carmen::map_server_options_problem(a.map_server, "--free-thresh", "--occupied-thresh", "--negate");
+  if (!problem.empty()) return usage_error(problem);
   return 0;
+}
+
+// The creator fields of a map made from `in`.
+void describe(carmen::MapToWrite *w, const std::string &in) {
+  const size_t slash = in.find_last_of('/');
+  w->author = "mapconvert";
+  w->source = slash == std::string::npos ? in : in.substr(slash + 1);
+  w->description = "converted by mapconvert (vasco_gpu " + std::string(vasco::version()) + ")";
+  w->time = static_cast<int64_t>(std::time(nullptr));
+}
+
+// Writes `w` to `out` (standard output for "-").
+void write_grid(const carmen::MapToWrite &w, const std::string &out) {
+  if (out == cli::kStdio) {
+    const cli::StdoutFile to_stdout(".map");
+    carmen::write_map(to_stdout.path(), w);
+    to_stdout.send();
+  } else {
+    carmen::write_map(out, w);
+  }
 }
 
 // Writes map m, read from `in`, to `out` in the format `kind`.
 void convert(const std::string &in, const carmen::MapFile &m, const std::string &out, OutKind kind,
-             carmen::PgmMode mode, bool quiet) {
+             const carmen::MapServerOptions &o, bool quiet) {
   if (kind == OutKind::Map && out == cli::kStdio) {
     const cli::StdoutFile to_stdout(".map");
     carmen::write_map_file(to_stdout.path(), m);
@@ -201,8 +306,27 @@ void convert(const std::string &in, const carmen::MapFile &m, const std::string 
   carmen::MapToWrite w;
   w.grid = *m.gridmap;
   w.origin = m.offset;
-  w.pgm_mode = mode;
+  w.pgm_mode = o.mode;
+  w.free_thresh = o.free_thresh;
+  w.occupied_thresh = o.occupied_thresh;
+  w.negate = o.negate;
   carmen::write_map(out, w);
+}
+
+// A map_server pair (or picture) IN: its grid and origin, to any OUT. A
+// CARMEN map OUT gets the standard comments and a CREATOR chunk naming IN,
+// and the YAML's origin as its OFFSET chunk.
+void convert_grid(const std::string &in, const std::string &out, const carmen::MapServerOptions &o) {
+  carmen::MapRead r = carmen::read_map(in);
+  carmen::MapToWrite w;
+  w.grid = std::move(r.grid);
+  w.origin = r.origin;
+  w.pgm_mode = o.mode;
+  w.free_thresh = o.free_thresh;
+  w.occupied_thresh = o.occupied_thresh;
+  w.negate = o.negate;
+  describe(&w, in);
+  write_grid(w, out);
 }
 
 }  // namespace
@@ -221,18 +345,34 @@ int main(int argc, char **argv) {
   OutKind kind = OutKind::None;
   if (const int rc = check_args(a, &kind)) return rc;
   try {
-    // The output (and a .pgm's .yaml) is checked before the map is read: it
-    // must be replaceable and must not be the input.
-    if (!a.info && a.files[1] != cli::kStdio) cli::check_outputs({a.files[0]}, carmen::map_output_files(a.files[1]));
+    // The outputs (a map_server pair's two files) are checked before the map
+    // is read: they must be replaceable and must not be an input.
+    if (!a.info && a.files[1] != cli::kStdio) {
+      const std::vector<std::string> inputs =
+          a.files[0] == cli::kStdio ? std::vector<std::string>{a.files[0]} : carmen::map_input_files(a.files[0]);
+      cli::check_outputs(inputs, carmen::map_output_files(a.files[1]));
+    }
+    if (!carmen_input(a.files[0])) {
+      if (a.info) {
+        carmen::MapRead r = carmen::read_map(a.files[0]);
+        carmen::MapFile m;
+        m.gridmap = std::move(r.grid);
+        m.offset = r.origin;
+        print_info(a.files[0], m, carmen::map_format_of(a.files[0]).what);
+      } else {
+        convert_grid(a.files[0], a.files[1], a.map_server);
+      }
+      return 0;
+    }
     // --info lists named GRIDMAP chunks without parsing them: a file of
     // thousands of them costs their headers, not their cells.
     carmen::MapReadOptions read;
     if (a.info) read.named_chunks = carmen::NamedChunkReading::Index;
     const carmen::MapFile m = carmen::read_map_file(cli::input_path(a.files[0]), read);
     if (a.info) {
-      print_info(a.files[0], m);
+      print_info(a.files[0], m, nullptr);
     } else {
-      convert(a.files[0], m, a.files[1], kind, a.mode, a.quiet);
+      convert(a.files[0], m, a.files[1], kind, a.map_server, a.quiet);
     }
     return 0;
   } catch (const carmen::Error &e) {  // names the file itself

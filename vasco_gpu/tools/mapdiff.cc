@@ -24,6 +24,7 @@
 #include "carmen_compat/image_io.h"
 #include "carmen_compat/map_file.h"
 #include "cli_support.h"
+#include "picture_legend.h"
 #include "carmen_compat/map_compare.h"
 #include "carmen_compat/map_digest.h"
 #include "vasco_gpu/version.h"
@@ -318,15 +319,39 @@ void print_json(const Input &a, const Input &b, bool identical, const Alignment 
 // The picture
 // ---------------------------------------------------------------------------
 
-// Writes the picture of the overlap; false (and a note) when there is none.
+bool unknown_cell(float v) { return std::isnan(v) || v < 0.0f; }
+
+// Writes the picture of the overlap with its legend below; false (and a
+// note) when there is no overlap. Cells unknown in both are drawn in the
+// pictures' unknown colour (carmen::kPictureUnknown), not a grey any p has.
+// Sets *width and *height to the picture's size.
 bool write_picture(const std::string &path, const Input &a, const Input &b, const Alignment &al,
-                   const carmen::GridComparison &c) {
+                   const carmen::GridComparison &c, int *width, int *height) {
   const char *why = !al.compared ? "the resolutions differ" : c.width == 0 ? "the grids do not overlap" : nullptr;
   if (why != nullptr) {
     std::fprintf(stderr, "mapdiff: %s: not written: %s\n", path.c_str(), why);
     return false;
   }
-  carmen::write_rgb_png(path, c.width, c.height, carmen::difference_image_rgb(a.grid, b.grid, c));
+  std::vector<uint8_t> rgb = carmen::difference_image_rgb(a.grid, b.grid, c);
+  for (int row = 0; row < c.height; ++row) {
+    const int y = c.y0 + c.height - 1 - row;  // row 0 is the top: y points up
+    for (int x = c.x0; x < c.x0 + c.width; ++x) {
+      const float va = a.grid.cells[size_t(x) * size_t(a.grid.size_y) + size_t(y)];
+      const float vb = b.grid.cells[size_t((x - c.shift_x) * int64_t(b.grid.size_y) + (y - c.shift_y))];
+      if (!unknown_cell(va) || std::memcmp(&va, &vb, sizeof va) != 0) continue;
+      uint8_t *p = rgb.data() + (size_t(row) * size_t(c.width) + size_t(x - c.x0)) * 3;
+      p[0] = carmen::kPictureUnknown.r;
+      p[1] = carmen::kPictureUnknown.g;
+      p[2] = carmen::kPictureUnknown.b;
+    }
+  }
+  picture::DiffLegend legend;
+  legend.differing = c.differing_cells();
+  legend.identical = legend.differing == 0;
+  const picture::Canvas canvas = picture::with_diff_legend(c.width, c.height, rgb, legend);
+  carmen::write_rgb_png(path, canvas.width, canvas.height, canvas.rgb);
+  *width = canvas.width;
+  *height = canvas.height;
   return true;
 }
 
@@ -343,9 +368,11 @@ const char kFooter[] =
     "cells, and equal OFFSET chunks where both maps have one (unless --no-offset).\n"
     "With any of --tolerance, --max-status-differs, --min-class-agreement:\n"
     "within every limit (an unset --tolerance or --max-status-differs is 0).\n"
-    "PNG: the overlap, y up; A in grey (white free, black occupied, grey unknown);\n"
+    "PNG: the overlap, y up, and a legend below it; where B agrees, A in grey\n"
+    "(white free p = 0 .. black occupied p = 1) and unknown in grey-green #708986;\n"
     "red B higher, blue B lower (pale |dp| <= 1e-6 .. full |dp| >= 1, log scale);\n"
-    "magenta known in A only, green known in B only.\n"
+    "magenta known in A only, green known in B only. When nothing differs the\n"
+    "legend says IDENTICAL. A narrow overlap is widened on the right for the legend.\n"
     "Exit status: 0 same or within tolerance, 1 different, 2 usage error or a file\n"
     "that cannot be read (missing, damaged, no GRIDMAP) or written.";
 
@@ -410,14 +437,17 @@ int run(const Options &o) {
   carmen::GridComparison c;
   if (al.compared) c = carmen::compare_grids(a.grid, b.grid, al.shift_x, al.shift_y, size_t(o.top));
   const Verdict v = judge(a, b, identical, al, c, o);
-  const bool pictured = !o.png.empty() && write_picture(o.png, a, b, al, c);
+  int picture_w = 0, picture_h = 0;
+  const bool pictured = !o.png.empty() && write_picture(o.png, a, b, al, c, &picture_w, &picture_h);
   if (o.json) {
     print_json(a, b, identical, al, c, v);
   } else if (o.quiet) {
     std::printf("%s\n", v.line.c_str());
   } else {
     print_text(a, b, identical, al, c, v);
-    if (pictured) std::printf("picture: %s (%d x %d)\n", o.png.c_str(), c.width, c.height);
+    if (pictured)
+      std::printf("picture: %s (%d x %d: the %d x %d overlap and its legend)\n", o.png.c_str(), picture_w, picture_h,
+                  c.width, c.height);
   }
   return v.exit_status;
 }

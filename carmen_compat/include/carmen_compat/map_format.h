@@ -7,10 +7,16 @@
 // ASCII case, so "x.PNG" is a PNG and "x.Map.Gz" a gzipped CARMEN map. Every
 // tool and binding asks this table, so they all accept the same names.
 //
-//   .map      CARMEN map: comments, id, CREATOR, GRIDMAP, OFFSET (when known)
-//   .map.gz   the same, gzipped
-//   .pgm      map_server / nav2 image plus a .yaml beside it (two files)
-//   .png      8-bit grey picture (lossy; no resolution, no origin)
+//   .map        CARMEN map: comments, id, CREATOR, GRIDMAP, OFFSET (when known)
+//   .map.gz     the same, gzipped
+//   .pgm        map_server / nav2 image plus a .yaml beside it (two files)
+//   .png+yaml   the same with a PNG: "NAME.png+yaml" names the pair
+//               NAME.png + NAME.yaml (no file is called .png+yaml), so that
+//               NAME.png alone stays the picture for people; scale mode
+//               makes unknown cells transparent
+//   .yaml       a map_server YAML: read, the image its "image" key names
+//               (PGM or PNG); written, NAME.yaml + NAME.pgm (as .pgm)
+//   .png        picture for people (lossy; no resolution, no origin)
 #ifndef CARMEN_COMPAT_MAP_FORMAT_H
 #define CARMEN_COMPAT_MAP_FORMAT_H
 
@@ -25,7 +31,7 @@
 
 namespace carmen {
 
-enum class MapFormat { CarmenMap, CarmenMapGz, PgmYaml, Png };
+enum class MapFormat { CarmenMap, CarmenMapGz, PgmYaml, PngYaml, Yaml, Png };
 
 // Everything a writer needs, for every format.
 struct MapToWrite {
@@ -39,7 +45,11 @@ struct MapToWrite {
   std::string creator_origin;        // CREATOR origin; empty: the same as source
   std::string description;           // comments' and CREATOR's description
   int64_t time = 0;                  // seconds since 1970 (0 is written as it is)
+  // A map_server pair's (.pgm, .png+yaml, .yaml) mode, thresholds, negate.
   PgmMode pgm_mode = PgmMode::Trinary;
+  double occupied_thresh = kOccupiedThresh;
+  double free_thresh = kFreeThresh;
+  bool negate = false;
 };
 
 // What a reader gives back.
@@ -58,7 +68,7 @@ struct MapFormatEntry {
 
 // Every format, in the order help texts list them.
 const std::vector<MapFormatEntry> &map_formats();
-// ".map, .map.gz, .pgm, .png": for messages.
+// ".map, .map.gz, .pgm, .png+yaml, .yaml, .png": for messages.
 std::string known_map_extensions();
 
 // The format of `path` by the rule above; nullptr when none matches.
@@ -66,9 +76,16 @@ const MapFormatEntry *find_map_format(const std::string &path);
 // The same, or carmen::Error(Usage) naming the path and the known extensions.
 const MapFormatEntry &map_format_of(const std::string &path);
 
-// Every file writing `path` creates: the path, and for a .pgm its .yaml.
-// Throws like map_format_of.
+// Every file writing `path` creates: the path, for a .pgm its .yaml too;
+// for NAME.png+yaml NAME.png and NAME.yaml; for NAME.yaml NAME.yaml and
+// NAME.pgm. Throws like map_format_of.
 std::vector<std::string> map_output_files(const std::string &path);
+// Every file reading `path` reads, as far as the names tell: the path, a
+// .pgm's .yaml, a .png+yaml's two files, a .yaml and the image it names
+// (when the YAML can be read). Throws like map_format_of.
+std::vector<std::string> map_input_files(const std::string &path);
+// The map_server settings of `m` (its pgm_mode, thresholds, negate).
+MapServerOptions map_server_options_of(const MapToWrite &m);
 
 // Reads the map at `path` in its format. Throws carmen::Error(Usage) for an
 // unknown extension and carmen::FileError naming the file for a bad one.

@@ -116,7 +116,9 @@ def read_map(path: str | os.PathLike) -> Map:
     Images hold less than a CARMEN map: a PGM is read the way map_server reads it (trinary:
     occupied 1.0, free 0.0, unknown -1; scale: ``(255 - v) / 255`` with 205 unknown; raw:
     ``v / 100`` with 255 unknown), with the YAML's resolution and origin; a PNG as written by
-    :func:`write_map` (``1 - v / 255``, 128 unknown), without resolution or origin (0). The
+    :func:`write_map` (grey ``1 - v / 255``, the colour #708986 unknown; an older grey picture's
+    128 too), without resolution or origin (0); ``NAME.png+yaml`` and ``NAME.yaml`` as the
+    map_server pair their YAML describes. The
     format is chosen by the name's extension, in any case (``x.PNG``). Raises
     :class:`FileError` naming the file.
     """
