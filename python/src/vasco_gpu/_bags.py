@@ -168,7 +168,7 @@ def _bag2carmen_parser() -> argparse.ArgumentParser:
     for name, help_text, metavar in BAG_OPTIONS:
         p.add_argument("--" + name, help=help_text, metavar=metavar)
     p.add_argument("--laser-mount", metavar="X,Y,THETA", help="the laser in the robot's frame (for --pose-topic)")
-    p.add_argument("--quiet", action="store_true", help="no progress")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress")
     return p
 
 
