@@ -183,11 +183,14 @@ void launch_float_from_prob(const KernelModel<float> &m, const float *probs, uns
 
 // Adds every beam's log-odds evidence to `sums` (integer atomics: no update
 // is lost, none depends on the order). `increments`: launch_float_tables'
-// tables, or null to compute every update in full. counters: beams used,
+// tables, or null to compute every update in full. `across`: null, or
+// scratch of size_x * size_y cells for the beams that step along x (a
+// y-major accumulator, so that a warp's adds are coalesced), cleared first
+// and added to `sums` at the end: the same sums. counters: beams used,
 // beams skipped, cell updates.
 void launch_float_map(const KernelModel<float> &m, const int2 *increments, const FloatScan *scans, int num_scans,
-                      const float *ranges, unsigned long long *sums, unsigned long long *counters,
-                      cudaStream_t stream);
+                      const float *ranges, unsigned long long *sums, unsigned long long *across,
+                      unsigned long long *counters, cudaStream_t stream);
 
 // Float log-odds sums (the paper's kernels, bench/experiments) ->
 // probability, in place; cells never updated become -1: those still -0.0f,

@@ -112,10 +112,17 @@ __global__ void float_tables_kernel(KernelModel<float> m, int2 *increments) {
 // remainder per 32 steps, so each lane divides once. With tables, an update
 // is a lookup and a comparison (d < r, the sensor model's free test, with the
 // same float distance); without, fixed_increment in full.
+//
+// A beam whose major axis is x (not steep) steps along x from lane to lane:
+// in the x-major sums its 32 lanes' adds are a column apart each, 32 L2
+// sectors per warp. With `across` (a y-major accumulator of the same cells)
+// they go there instead, to consecutive addresses; launch_float_map adds it
+// to the sums afterwards. Integer sums: the same bytes either way.
 __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, const int2 *increments,
                                                  const egrid::LineParams &p, int x1, int y1, float r, int lane,
-                                                 unsigned long long *sums, const NearWindow &near,
-                                                 unsigned *updates) {
+                                                 unsigned long long *sums, unsigned long long *across,
+                                                 const NearWindow &near, unsigned *updates) {
+  unsigned long long *const target = !p.steep && across != nullptr ? across : sums;
   // Cells beyond table_size steps are never updated (see oracle.h); cells
   // with d >= max are skipped, which equals the oracle's stop because d
   // never decreases along the walk.
@@ -146,6 +153,8 @@ __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, co
       if (update) {
         if (i < kNear && j < kNear) {
           atomicAdd(near.cells + (cx - near.x1 + kNear - 1) * kWindow + (cy - near.y1 + kNear - 1), fixed_term(q));
+        } else if (target == across) {
+          add_fixed(across, static_cast<size_t>(cy) * m.size_x + cx, q);
         } else {
           add_fixed(sums, static_cast<size_t>(cx) * m.size_y + cy, q);
         }
@@ -163,7 +172,8 @@ __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, co
 
 __global__ void __launch_bounds__(kWarpsPerBlock * 32)
     float_map_kernel(KernelModel<float> m, const int2 *increments, const FloatScan *scans, int num_scans, int parts,
-                     const float *ranges, unsigned long long *sums, unsigned long long *counters) {
+                     const float *ranges, unsigned long long *sums, unsigned long long *across,
+                     unsigned long long *counters) {
   const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
   unsigned used = 0, skipped = 0, updates = 0;
   __shared__ unsigned long long window[kWindow * kWindow];
@@ -198,7 +208,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
         continue;
       }
       const egrid::LineParams p = egrid::line_params(sc.x1, sc.y1, x2, y2);
-      walk_closed_form(m, increments, p, sc.x1, sc.y1, r, lane, sums, near, &updates);
+      walk_closed_form(m, increments, p, sc.x1, sc.y1, r, lane, sums, across, near, &updates);
     }
     __syncthreads();
     // The window to the sums: only cells of the grid were added to it.
@@ -217,6 +227,25 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
     if (used) atomicAdd(counters + 0, static_cast<unsigned long long>(used));
     if (skipped) atomicAdd(counters + 1, static_cast<unsigned long long>(skipped));
     if (updates) atomicAdd(counters + 2, static_cast<unsigned long long>(updates));
+  }
+}
+
+// sums[x * size_y + y] += across[y * size_x + x]: a 32 x 32 tile through
+// shared memory, so that both the read and the write are coalesced.
+constexpr int kAcrossTile = 32, kAcrossRows = 8;
+
+__global__ void add_across_kernel(int size_x, int size_y, const unsigned long long *across, unsigned long long *sums) {
+  __shared__ unsigned long long tile[kAcrossTile][kAcrossTile + 1];  // +1: no bank conflicts on the transposed read
+  const int x0 = blockIdx.x * kAcrossTile, y0 = blockIdx.y * kAcrossTile;
+  for (int r = threadIdx.y; r < kAcrossTile; r += kAcrossRows) {
+    const int x = x0 + threadIdx.x, y = y0 + r;
+    tile[r][threadIdx.x] = x < size_x && y < size_y ? across[static_cast<size_t>(y) * size_x + x] : 0ull;
+  }
+  __syncthreads();
+  for (int r = threadIdx.y; r < kAcrossTile; r += kAcrossRows) {
+    const int x = x0 + r, y = y0 + threadIdx.x;
+    const unsigned long long v = tile[threadIdx.x][r];
+    if (x < size_x && y < size_y && v != 0) sums[static_cast<size_t>(x) * size_y + y] += v;
   }
 }
 
@@ -292,14 +321,20 @@ void launch_float_tables(const KernelModel<float> &m, int2 *increments, cudaStre
 }
 
 void launch_float_map(const KernelModel<float> &m, const int2 *increments, const FloatScan *scans, int num_scans,
-                      const float *ranges, unsigned long long *sums, unsigned long long *counters,
-                      cudaStream_t stream) {
+                      const float *ranges, unsigned long long *sums, unsigned long long *across,
+                      unsigned long long *counters, cudaStream_t stream) {
   if (num_scans <= 0) return;
+  const size_t cells = static_cast<size_t>(m.size_x) * static_cast<size_t>(m.size_y);
+  if (across != nullptr) VG_CUDA_CHECK(cudaMemsetAsync(across, 0, cells * sizeof(unsigned long long), stream));
   // A full render has thousands of scans: a block each. An insert of a few
   // scans splits each over up to 48 blocks (a warp per beam either way).
   const int parts = num_scans >= 1024 ? 1 : std::min(48, (1024 + num_scans - 1) / num_scans);
   float_map_kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, increments, scans, num_scans, parts, ranges,
-                                                                           sums, counters);
+                                                                           sums, across, counters);
+  VG_CUDA_CHECK_LAUNCH();
+  if (across == nullptr) return;
+  const dim3 tiles((m.size_x + kAcrossTile - 1) / kAcrossTile, (m.size_y + kAcrossTile - 1) / kAcrossTile), threads(kAcrossTile, kAcrossRows);
+  add_across_kernel<<<tiles, threads, 0, stream>>>(m.size_x, m.size_y, across, sums);
   VG_CUDA_CHECK_LAUNCH();
 }
 

@@ -6,6 +6,8 @@
 // without a GPU.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <climits>
 #include <cmath>
 #include <cstdlib>
@@ -242,6 +244,26 @@ TEST_F(MapperCuda, TablesChangeNoBitInEitherMode) {
     testing_support::expect_bit_identical(tabled.read(), computed.read(), geo,
                                           cm == CudaMode::Float ? "float, tables vs none" : "exact, tables vs none");
   }
+}
+
+// Float mode adds the beams that step along x into a y-major accumulator on a
+// render of many scans (VASCO_CUDA_NO_ACROSS forces the x-major sums alone),
+// and one insert at a time never uses it: all three must be the same bytes.
+TEST_F(MapperCuda, FloatAcrossAccumulatorChangesNoBit) {
+  ASSERT_GE(scans_.num_scans(), 256u) << "the test log must be a render of many scans";
+  const GridGeometry geo = size_grid(scans_, params_);
+  Mapper across(params_, geo, "cuda", mode(CudaMode::Float));
+  across.insert(scans_);
+  ASSERT_EQ(setenv("VASCO_CUDA_NO_ACROSS", "1", 1), 0);
+  Mapper plain(params_, geo, "cuda", mode(CudaMode::Float));
+  plain.insert(scans_);
+  unsetenv("VASCO_CUDA_NO_ACROSS");
+  Mapper one_by_one(params_, geo, "cuda", mode(CudaMode::Float));
+  const long n = static_cast<long>(scans_.num_scans());
+  for (long s = 0; s < n; s += 97) one_by_one.insert(scans_.select(s, std::min(97L, n - s)));
+  testing_support::expect_bit_identical(across.read(), plain.read(), geo, "float, across vs x-major only");
+  testing_support::expect_bit_identical(across.read(), one_by_one.read(), geo, "float, one render vs inserts");
+  EXPECT_EQ(across.last_stats().cell_updates, plain.last_stats().cell_updates);
 }
 
 // Float mode sums in fixed point: a log whose beams could push a cell past

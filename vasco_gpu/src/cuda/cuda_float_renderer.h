@@ -26,9 +26,11 @@ class CudaFloatRenderer final : public CudaRenderer {
   cuda::GridCells cells() const override;
   const int2 *tables();
   void stage_scan_records(const ScanBatch &scans, size_t first, size_t last);
-  void launch_map(const int2 *tables, size_t num_scans, MapStats *st);
+  void launch_map(const int2 *tables, unsigned long long *across, size_t num_scans, MapStats *st);
+  unsigned long long *across_scratch(size_t num_scans);
 
   cuda::DeviceBuffer<unsigned long long> sums_;  // fixed-point log-odds sums
+  cuda::DeviceBuffer<unsigned long long> across_;  // a render's y-major accumulator (launch_float_map)
   uint64_t beams_ = 0;                            // applied since the reset
   cuda::DeviceBuffer<int2> increments_;           // launch_float_tables', when small enough
   TableCache increments_key_;

@@ -53,6 +53,14 @@ inline bool tables_disabled() {
   return v != nullptr && *v != '\0' && std::string(v) != "0";
 }
 
+// VASCO_CUDA_NO_ACROSS=1 maps float mode without its y-major accumulator
+// (cuda_float_renderer.cc), as a grid too large for it is: for the tests
+// and benchmarks that compare both ways.
+inline bool across_disabled() {
+  const char *v = std::getenv("VASCO_CUDA_NO_ACROSS");
+  return v != nullptr && *v != '\0' && std::string(v) != "0";
+}
+
 // With VASCO_CUDA_PROFILE set, prints the time of each GPU stage to stderr
 // (events between stages; for tuning, not for the benchmark table).
 class StageTimer {
