@@ -543,3 +543,31 @@ TEST(Log2MapConventions, DashIsStandardInputAndOutput) {
 }
 
 }  // namespace
+
+namespace {
+
+// --json is UTF-8 whatever the file names: a byte that is not (a Latin-1
+// name) comes out as \u00XX.
+TEST(Log2MapConventions, JsonEscapesBytesThatAreNotUtf8) {
+  TempDir dir;
+  const ToolRun r = log2map({"--json", dir.file("caf\xe9.log"), dir.file("a.map")}, false);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(contains(r.output, "caf\\u00e9.log")) << r.output;
+  EXPECT_FALSE(contains(r.output, "caf\xe9")) << r.output;
+}
+
+// The output "-" leaves nothing in the temporary directory, whether standard
+// output takes the map, closes early (SIGPIPE) or a later output fails.
+TEST(Log2MapConventions, DashLeavesNoTemporaryWhateverHappens) {
+  TempDir dir, tmp;
+  const std::string env = "TMPDIR=" + tooltest::quote(tmp.path()) + " ";
+  const std::string tool = tooltest::quote(std::string(VASCO_BIN_DIR) + "/log2map");
+  const std::string log = tooltest::quote(kIntel);
+  EXPECT_EQ(std::system((env + tool + " -q --backend cpu_threads " + log + " - > /dev/null").c_str()), 0);
+  std::system((env + tool + " -q --backend cpu_threads " + log + " - | head -c 10 > /dev/null").c_str());
+  std::system((env + tool + " -q " + log + " - " + tooltest::quote(dir.file("no/such/dir.map")) + " > /dev/null 2>&1")
+                  .c_str());
+  EXPECT_TRUE(tmp.entries().empty());
+}
+
+}  // namespace

@@ -18,19 +18,57 @@ namespace cli {
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+namespace {
+
+// The length of the well-formed UTF-8 sequence at text[i] (RFC 3629: no
+// overlong forms, no surrogates, nothing past U+10FFFF), 0 if there is none.
+size_t utf8_length(const std::string &text, size_t i) {
+  const auto at = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char c = at(i);
+  size_t n;
+  unsigned lo = 0x80, hi = 0xbf;  // the range of the second byte
+  if (c < 0x80) return 1;
+  if (c >= 0xc2 && c <= 0xdf) {
+    n = 2;
+  } else if (c >= 0xe0 && c <= 0xef) {
+    n = 3;
+    if (c == 0xe0) lo = 0xa0;
+    if (c == 0xed) hi = 0x9f;
+  } else if (c >= 0xf0 && c <= 0xf4) {
+    n = 4;
+    if (c == 0xf0) lo = 0x90;
+    if (c == 0xf4) hi = 0x8f;
+  } else {
+    return 0;
+  }
+  if (i + n > text.size() || at(i + 1) < lo || at(i + 1) > hi) return 0;
+  for (size_t k = 2; k < n; ++k)
+    if (at(i + k) < 0x80 || at(i + k) > 0xbf) return 0;
+  return n;
+}
+
+}  // namespace
+
 std::string json_string(const std::string &text) {
   std::string out = "\"";
-  for (unsigned char c : text) {
+  for (size_t i = 0; i < text.size();) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    const size_t n = utf8_length(text, i);
     if (c == '"' || c == '\\') {
       out += '\\';
       out += static_cast<char>(c);
-    } else if (c < 0x20) {
+    } else if (c < 0x20 || c == 0x7f || n == 0) {
+      // Control characters, and bytes that are not UTF-8 (a file name in
+      // Latin-1, say), as \u00XX: JSON must be UTF-8.
       char buf[8];
       std::snprintf(buf, sizeof buf, "\\u%04x", c);
       out += buf;
     } else {
-      out += static_cast<char>(c);
+      out.append(text, i, n);
+      i += n;
+      continue;
     }
+    ++i;
   }
   return out + "\"";
 }
@@ -101,11 +139,16 @@ StdoutFile::~StdoutFile() {
 
 void StdoutFile::send() const {
   FILE *in = std::fopen(path_.c_str(), "rb");
+  // Open, the file and its directory can go at once: whatever ends the copy
+  // (a closed pipe's SIGPIPE, a signal) leaves nothing behind.
+  ::unlink(path_.c_str());
+  ::rmdir(dir_.c_str());
   if (in == nullptr) throw carmen::Error(carmen::ErrorCode::Io, "the output '-' was not made");
   char buf[1 << 16];
   size_t n;
   bool ok = true;
   while (ok && (n = std::fread(buf, 1, sizeof buf, in)) > 0) ok = std::fwrite(buf, 1, n, stdout) == n;
+  ok = ok && !std::ferror(in);
   std::fclose(in);
   if (!ok || std::fflush(stdout) != 0)
     throw carmen::Error(carmen::ErrorCode::Io, "standard output refused the map: " + std::string(std::strerror(errno)));

@@ -187,6 +187,8 @@ void check_before_work(const Options &opt) {
   for (const vasco::SessionInput &more : opt.more) inputs.push_back(more.path);
   cli::check_outputs(inputs, files_written(opt.outputs));
   if (opt.json) cli::check_stdout_writable("--json");
+  for (const std::string &out : opt.outputs)
+    if (out == cli::kStdio) cli::check_stdout_writable("the output '-'");
 }
 
 // --backend auto for one input: the backend expected to finish first, and

@@ -204,8 +204,11 @@ void write_outputs(const Options &opt, const std::string &log, const std::vector
   map.free_thresh = opt.map_server.free_thresh;
   map.occupied_thresh = opt.map_server.occupied_thresh;
   map.negate = opt.map_server.negate;
+  // The output "-" (a CARMEN map) before the transaction, so that the
+  // transaction, destroyed first, takes its temporary out of the directory
+  // before the directory goes.
+  std::unique_ptr<cli::StdoutFile> to_stdout;
   carmen::OutputTransaction tx;
-  std::unique_ptr<cli::StdoutFile> to_stdout;  // the output "-": a CARMEN map
   for (const std::string &out : outputs) {
     if (out == cli::kStdio) {
       to_stdout = std::make_unique<cli::StdoutFile>(".map");

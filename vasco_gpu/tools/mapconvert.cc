@@ -352,6 +352,7 @@ int main(int argc, char **argv) {
           a.files[0] == cli::kStdio ? std::vector<std::string>{a.files[0]} : carmen::map_input_files(a.files[0]);
       cli::check_outputs(inputs, carmen::map_output_files(a.files[1]));
     }
+    if (!a.info && a.files[1] == cli::kStdio) cli::check_stdout_writable("the output '-'");
     if (!carmen_input(a.files[0])) {
       if (a.info) {
         carmen::MapRead r = carmen::read_map(a.files[0]);
