@@ -12,6 +12,7 @@
 #include <new>
 #include <random>
 
+#include "carmen/map_io.h"
 #include "carmen_compat/error.h"
 #include "map_test_support.h"
 
@@ -873,7 +874,77 @@ TEST(MapFileLimits, ChunkDataBeyondTheBudgetIsRefused) {
   } catch (const carmen::FileError &e) {
     EXPECT_EQ(e.file(), path);
     EXPECT_NE(std::string(e.what()).find("max_kept_bytes"), std::string::npos) << e.what();
+    EXPECT_EQ(e.code(), carmen::ErrorCode::TooLarge);
   }
+}
+
+// read_chunk_body (the C API's HMAP reader and carmen_map_name_chunk use
+// it): a .gz chunk's size is not checked against the file, so one claiming
+// more than max_kept_bytes is refused before it is read; a plain file's is
+// checked against what the file holds.
+TEST(MapFileLimits, ChunkBodiesBeyondTheBudgetAreRefusedBeforeTheyAreRead) {
+  maptest::TempDir dir;
+  const std::string bytes = maptest::kId + std::string(1, '\x66') + maptest::i32(0x7ffffff0) + "JUNK      " +
+                            std::string(4000, 'a');
+  carmen::ChunkInfo c;
+  c.type = 0x66;
+  c.offset = int64_t(maptest::kId.size());
+  c.size = 0x7ffffff0;
+  const std::string gz = dir.file("claims.map.gz");
+  maptest::gzip_to_file(gz, bytes);
+  try {
+    carmen::read_chunk_body(gz, c);
+    ADD_FAILURE() << "no error";
+  } catch (const carmen::FileError &e) {
+    EXPECT_EQ(e.file(), gz);
+    EXPECT_EQ(e.code(), carmen::ErrorCode::TooLarge) << e.what();
+    EXPECT_NE(std::string(e.what()).find("claims 2147483632 bytes, more than the 1024 MiB"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("gunzip"), std::string::npos) << e.what();
+  }
+  const std::string plain = dir.file("claims.map");
+  maptest::write_bytes(plain, bytes);
+  try {
+    carmen::read_chunk_body(plain, c);
+    ADD_FAILURE() << "no error";
+  } catch (const carmen::FileError &e) {
+    EXPECT_NE(std::string(e.what()).find("only 4010 remain in the file"), std::string::npos) << e.what();
+  }
+  c.size = 4010;  // what is there reads
+  EXPECT_EQ(carmen::read_chunk_body(plain, c), "JUNK      " + std::string(4000, 'a'));
+  EXPECT_EQ(carmen::read_chunk_body(gz, c), "JUNK      " + std::string(4000, 'a'));
+}
+
+// CARMEN's C gridmap readers: a C caller cannot raise max_kept_bytes. A
+// plain map's chunk sizes are checked against the file, so there is no
+// limit (CARMEN reads maps above 16384 x 16384); a .gz keeps the limit, and
+// the message says what to do. (A map over 1 GiB would make a slow test:
+// the header of one is enough, the reader refusing before the cells.)
+TEST(MapFileLimits, TheCGridmapReaderTellsToGunzipAGzipMapOverTheLimit) {
+  maptest::TempDir dir;
+  const int32_t side = 16500;  // 1089 MB of cells
+  const std::string header = maptest::kId + std::string(1, '\x01') +
+                             maptest::i32(int32_t(10 + 12 + int64_t(side) * side * 4)) + "GRIDMAP   " +
+                             maptest::i32(side) + maptest::i32(side) + maptest::f32(0.05f) +
+                             std::string(4096, '\0');
+  const std::string gz = dir.file("large.map.gz");
+  maptest::gzip_to_file(gz, header);
+  carmen_map_t map;
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(carmen_map_read_gridmap_chunk(gz.c_str(), &map), -1);
+  std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find(gz + ": its GRIDMAP chunk would take more than 1024 MiB"), std::string::npos) << err;
+  EXPECT_NE(err.find("gunzip the map"), std::string::npos) << err;
+  EXPECT_EQ(err.find("MapReadOptions"), std::string::npos) << err;  // nothing a C caller can set
+  EXPECT_EQ(map.complete_map, nullptr);
+  // The same header in a plain file: only the file's size limits it.
+  const std::string plain = dir.file("large.map");
+  maptest::write_bytes(plain, header);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(carmen_map_read_gridmap_chunk(plain.c_str(), &map), -1);
+  err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("remain in the file: it is truncated or damaged"), std::string::npos) << err;
+  EXPECT_EQ(err.find("max_kept_bytes"), std::string::npos) << err;
 }
 
 }  // namespace

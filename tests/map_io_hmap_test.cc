@@ -3,9 +3,15 @@
 // names, link count, then per link type, degree, keys and float x y theta
 // points: two per key for a door, one for an elevator).
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <string>
 
 #include "carmen/map_io.h"
@@ -179,6 +185,127 @@ TEST_P(MapIoHmap, TheFirstHmapIsReadNamedOrNot) {
   EXPECT_EQ(back.links[1].points[2].theta, 0.75);
   free_hmap(back);
   EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_HMAP_CHUNK), int(10 + 6 + s.payload().size()));
+}
+
+// What a forked child saw calling `read`: its result, its stderr, how much
+// its peak RSS grew (ru_maxrss) and how long the call took. The child's
+// address space is capped at 1 GiB more than it starts with, so that a
+// reader that allocates what a file claims fails there, not on the machine.
+struct ChildRun {
+  int rc = -2;  // -2: the child died
+  long rss_growth_mib = -1;
+  double seconds = -1;
+  std::string err;
+};
+
+long vm_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  long pages = 0;
+  statm >> pages;
+  return pages * sysconf(_SC_PAGESIZE);
+}
+
+template <typename F>
+ChildRun run_in_child(F read) {
+  int fds[2];
+  if (pipe(fds) != 0) return {};
+  std::fflush(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    const long vm = vm_bytes();
+    if (vm > 0) {
+      const rlimit cap{rlim_t(vm) + (rlim_t(1) << 30), rlim_t(vm) + (rlim_t(1) << 30)};
+      setrlimit(RLIMIT_AS, &cap);
+    }
+    testing::internal::CaptureStderr();
+    rusage before{}, after{};
+    getrusage(RUSAGE_SELF, &before);
+    const auto t0 = std::chrono::steady_clock::now();
+    const int rc = read();
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    getrusage(RUSAGE_SELF, &after);
+    const std::string err = testing::internal::GetCapturedStderr();
+    const std::string out = std::to_string(rc) + " " + std::to_string((after.ru_maxrss - before.ru_maxrss) / 1024) +
+                            " " + std::to_string(secs) + "\n" + err;
+    const ssize_t wrote = write(fds[1], out.data(), out.size());
+    _exit(wrote == ssize_t(out.size()) ? 0 : 1);
+  }
+  close(fds[1]);
+  std::string got;
+  char buf[4096];
+  for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) > 0;) got.append(buf, size_t(n));
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ChildRun r;
+  const size_t nl = got.find('\n');
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || nl == std::string::npos) return r;
+  std::sscanf(got.c_str(), "%d %ld %lf", &r.rc, &r.rss_growth_mib, &r.seconds);
+  r.err = got.substr(nl + 1);
+  return r;
+}
+
+// 16 MiB of NULs claim 16.7 million empty zone names: a 16 KB .map.gz once
+// made the reader build 1.2 GB of them. What the C structure would keep is
+// counted as the payload is walked, and refused at the HMAP reader's limit
+// before anything is allocated for it.
+TEST_P(MapIoHmap, MillionsOfEmptyZoneNamesAreRefusedNotAllocated) {
+  const std::string file = path("zones");
+  const int32_t claimed = 1 << 24;
+  write(file, kId + chunk(3, "HMAP", i32(claimed) + std::string(size_t(claimed), '\0') + i32(0)));
+  const ChildRun r = run_in_child([&] {
+    carmen_hmap_t back;
+    const int rc = carmen_map_read_hmap_chunk(file.c_str(), &back);
+    if (rc == 0) free_hmap(back);
+    return rc;
+  });
+  EXPECT_EQ(r.rc, -1) << r.err;
+  EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("more than 64 MiB"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("refused rather than allocated"), std::string::npos) << r.err;
+  EXPECT_GE(r.rss_growth_mib, 0);
+  EXPECT_LT(r.rss_growth_mib, 128) << "the payload is 16 MiB; nothing more should have been allocated";
+  EXPECT_LT(r.seconds, 5.0);
+}
+
+// A chunk claiming more than the limit is refused before its bytes are read
+// (a .gz chunk's size is not checked against the file's; a plain file's is).
+TEST_P(MapIoHmap, AChunkOverTheLimitIsRefusedBeforeItIsRead) {
+  const std::string file = path("big_chunk");
+  write(file, kId + std::string(1, '\3') + i32(0x7ffffff0) + "HMAP      " + i32(1000) + std::string(4000, 'a'));
+  testing::internal::CaptureStderr();
+  carmen_hmap_t back;
+  EXPECT_EQ(carmen_map_read_hmap_chunk(file.c_str(), &back), -1);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find(file), std::string::npos) << err;
+  if (std::string(GetParam()).size() > 4) {
+    EXPECT_NE(err.find("2147483632 bytes, more than the 64 MiB"), std::string::npos) << err;
+  } else {
+    EXPECT_NE(err.find("truncated or damaged"), std::string::npos) << err;
+  }
+  EXPECT_EQ(back.zone_names, nullptr);
+}
+
+// Many zones within the limit still read, each name its own allocation.
+TEST_P(MapIoHmap, ManyZonesWithinTheLimitRead) {
+  const int n = 100000;
+  std::string names;
+  for (int i = 0; i < n; ++i) names += "zone" + std::to_string(i) + '\0';
+  const std::string file = path("many");
+  write(file, kId + chunk(3, "HMAP", i32(n) + names + i32(1) + i32(CARMEN_HMAP_LINK_ELEVATOR) + i32(2) +
+                                         i32(0) + i32(n - 1) + f32(1) + f32(2) + f32(3) + f32(4) + f32(5) +
+                                         f32(6)));
+  carmen_hmap_t back;
+  ASSERT_EQ(carmen_map_read_hmap_chunk(file.c_str(), &back), 0);
+  ASSERT_EQ(back.num_zones, n);
+  EXPECT_STREQ(back.zone_names[0], "zone0");
+  EXPECT_STREQ(back.zone_names[n - 1], ("zone" + std::to_string(n - 1)).c_str());
+  ASSERT_EQ(back.num_links, 1);
+  EXPECT_EQ(back.links[0].keys[1], n - 1);
+  EXPECT_EQ(back.links[0].num_points, 2);
+  EXPECT_EQ(back.links[0].points[1].theta, 6);
+  free_hmap(back);
 }
 
 INSTANTIATE_TEST_SUITE_P(PlainAndGzip, MapIoHmap, ::testing::Values(".map", ".map.gz"), [](const auto &info) {

@@ -25,6 +25,7 @@ namespace {
 int g_calls = 0;                 // proves these replaced ours
 long long g_fail_after = -1;     // a plain read past this many bytes fails with (size_t)-1
 long long g_plain_read = 0;
+bool g_seek_fails_once = false;  // the next seek gets 3 bytes short of its offset, then fails
 
 gzFile gz(carmen_FILE *fp) { return reinterpret_cast<gzFile>(fp->comp_fp); }
 
@@ -78,6 +79,16 @@ size_t carmen_fwrite(const void *ptr, size_t size, size_t nmemb, carmen_FILE *fp
 
 int carmen_fseek(carmen_FILE *fp, off_t offset, int whence) {
   ++g_calls;
+  if (g_seek_fails_once) {  // as gzseek when the data goes bad part way: moved, and -1
+    g_seek_fails_once = false;
+    const off_t part = offset > 3 ? offset - 3 : 0;
+    if (fp->compressed) {
+      gzseek(gz(fp), part, whence);
+    } else {
+      fseeko(fp->fp, part, whence);
+    }
+    return -1;
+  }
   if (fp->compressed) return static_cast<int>(gzseek(gz(fp), offset, whence));  // the new offset
   g_plain_read = offset;
   return fseeko(fp->fp, offset, whence);
@@ -163,6 +174,34 @@ TEST(ReadlogUnderCarmensStdio, SeeksThatReturnTheOffsetAreSuccesses) {
         << carmen_readlog_last_error();
     EXPECT_EQ(std::string(line), lines[i]);
   }
+  carmen_logfile_free_index(&idx);
+  carmen_fclose(fp);
+}
+
+// A seek that fails after moving the file leaves it somewhere the index
+// does not know: the next read must not read from there.
+TEST(ReadlogUnderCarmensStdio, AFailedSeekIsNotFollowedByAReadFromTheWrongPlace) {
+  const std::string path = log_path("two_members.log.gz");
+  const std::vector<std::string> lines = gz_lines(path);
+  ASSERT_GT(lines.size(), 8u);
+  carmen_FILE *fp = carmen_fopen(path.c_str(), "r");
+  ASSERT_NE(fp, nullptr);
+  carmen_logfile_index_p idx = carmen_logfile_index_messages(fp);
+  ASSERT_NE(idx, nullptr);
+  ASSERT_EQ(idx->num_messages, static_cast<int>(lines.size()));
+  char line[1 << 16];
+  ASSERT_EQ(carmen_logfile_read_line(idx, fp, 0, sizeof line, line), static_cast<int>(lines[0].size()));
+  g_seek_fails_once = true;
+  EXPECT_EQ(carmen_logfile_read_line(idx, fp, 5, sizeof line, line), -1);
+  EXPECT_FALSE(g_seek_fails_once);
+  EXPECT_NE(std::string(carmen_readlog_last_error()).find("seek"), std::string::npos)
+      << carmen_readlog_last_error();
+  // Message 5 was not delivered; the next one is read from its own offset.
+  ASSERT_EQ(carmen_logfile_read_next_line(idx, fp, sizeof line, line), static_cast<int>(lines[6].size()))
+      << carmen_readlog_last_error();
+  EXPECT_EQ(std::string(line), lines[6]);
+  ASSERT_EQ(carmen_logfile_read_line(idx, fp, 2, sizeof line, line), static_cast<int>(lines[2].size()));
+  EXPECT_EQ(std::string(line), lines[2]);
   carmen_logfile_free_index(&idx);
   carmen_fclose(fp);
 }

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <new>
 #include <sstream>
 #include <string>
 
@@ -26,21 +27,47 @@ namespace {
 constexpr uint64_t kMaxImagePixels = uint64_t(1) << 30;
 constexpr uint64_t kMaxYamlBytes = 1 << 20;
 
+// Deflate's largest expansion: a compressed stream of n bytes inflates to at
+// most about 1032 n (zlib's figure), so a PNG's pixel data cannot outgrow
+// its file by more than that.
+constexpr uint64_t kMaxDeflateRatio = 1032;
+
 void check_image_size(const std::string &path, uint64_t width, uint64_t height) {
-  if (width == 0 || height == 0 || width > uint64_t(std::numeric_limits<int>::max()) ||
-      height > uint64_t(std::numeric_limits<int>::max()) || width * height > kMaxImagePixels)
+  // width * height > 2^30, without the product (a PGM's dimensions go up to
+  // 10^12 - 1 each, so it could wrap).
+  const bool empty = width == 0 || height == 0;
+  const bool too_many = !empty && (width > kMaxImagePixels || height > kMaxImagePixels / width);
+  if (empty || too_many || width > uint64_t(std::numeric_limits<int>::max()) ||
+      height > uint64_t(std::numeric_limits<int>::max()))
     throw FileError(path, "image of " + std::to_string(width) + " x " + std::to_string(height) +
                               " pixels: not a map this reader takes (1 to 2^30 pixels)",
-                    width * height > kMaxImagePixels ? ErrorCode::TooLarge : ErrorCode::BadInput);
+                    too_many ? ErrorCode::TooLarge : ErrorCode::BadInput);
 }
 
-std::string whole_file(const std::string &path, uint64_t limit) {
+// The size of a file to be read, which must be a regular one (a FIFO or a
+// device would block or never end). Throws FileError (Io).
+uint64_t regular_file_size(const std::string &path) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0)
     throw FileError(path, std::string("cannot open: ") + std::strerror(errno), ErrorCode::Io);
   if (!S_ISREG(st.st_mode)) throw FileError(path, "is not a regular file", ErrorCode::Io);
-  if (uint64_t(st.st_size) > limit)
-    throw FileError(path, "is " + std::to_string(st.st_size) + " bytes, more than a map's " +
+  return uint64_t(st.st_size);
+}
+
+// std::bad_alloc from `read` as a FileError naming the file.
+template <typename F>
+auto with_memory_error(const std::string &path, F &&read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const std::bad_alloc &) {
+    throw FileError(path, "out of memory while reading the image", ErrorCode::OutOfMemory);
+  }
+}
+
+std::string whole_file(const std::string &path, uint64_t limit) {
+  const uint64_t size = regular_file_size(path);
+  if (size > limit)
+    throw FileError(path, "is " + std::to_string(size) + " bytes, more than a map's " +
                               std::to_string(limit) + " allow");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FileError(path, std::string("cannot open: ") + std::strerror(errno), ErrorCode::Io);
@@ -134,7 +161,26 @@ struct Rgba {
   std::vector<uint8_t> px;  // 4 bytes a pixel, row 0 at the top
 };
 
+// The bits a pixel takes in the file, from its IHDR (bit depth and colour
+// type, bytes 24 and 25); 1, the least, when they cannot be read.
+uint64_t png_file_bits_per_pixel(const std::string &path) {
+  unsigned char h[26] = {};
+  std::ifstream in(path, std::ios::binary);
+  in.read(reinterpret_cast<char *>(h), sizeof h);
+  if (in.gcount() != std::streamsize(sizeof h) || std::memcmp(h + 12, "IHDR", 4) != 0) return 1;
+  const uint64_t depth = h[24];
+  switch (h[25]) {
+    case 0: return depth;      // grey
+    case 2: return 3 * depth;  // RGB
+    case 3: return depth;      // palette index
+    case 4: return 2 * depth;  // grey and alpha
+    case 6: return 4 * depth;  // RGBA
+    default: return 1;
+  }
+}
+
 Rgba read_png_file_rgba(const std::string &path) {
+  const uint64_t file_size = regular_file_size(path);
   png_image img;
   std::memset(&img, 0, sizeof img);
   img.version = PNG_IMAGE_VERSION;
@@ -146,11 +192,22 @@ Rgba read_png_file_rgba(const std::string &path) {
   img.format = PNG_FORMAT_RGBA;
   try {
     check_image_size(path, img.width, img.height);
+    // The pixel data inflated from the file's IDAT chunks holds at least
+    // width * height * bits-per-pixel / 8 bytes: more than the file's bytes
+    // could inflate to is a damaged or hostile header, refused before the
+    // 4 bytes a pixel are allocated.
+    const uint64_t bits = std::max<uint64_t>(1, png_file_bits_per_pixel(path));
+    const uint64_t min_data = uint64_t(img.width) * img.height * bits / 8;
+    if (min_data / kMaxDeflateRatio > file_size)
+      throw FileError(path, "PNG of " + std::to_string(img.width) + " x " + std::to_string(img.height) +
+                                " pixels in only " + std::to_string(file_size) +
+                                " bytes: more than its compressed data can hold (the header is damaged)",
+                      ErrorCode::BadInput);
+    out.px.resize(size_t(img.width) * size_t(img.height) * 4);  // PNG_IMAGE_SIZE is 32-bit: wraps at 2^30
   } catch (...) {
     png_image_free(&img);
     throw;
   }
-  out.px.resize(PNG_IMAGE_SIZE(img));
   if (!png_image_finish_read(&img, nullptr, out.px.data(), 0, nullptr)) {
     const std::string msg = img.message;
     png_image_free(&img);
@@ -176,6 +233,7 @@ MapImage read_png_rgba(const std::string &path) {
 
 // A PGM or a PNG, told apart by the first bytes.
 MapImage read_map_image(const std::string &path) {
+  regular_file_size(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FileError(path, std::string("cannot open: ") + std::strerror(errno), ErrorCode::Io);
   char magic[8] = {};
@@ -213,7 +271,9 @@ std::string value_text(const std::string &raw) {
 
 std::map<std::string, YamlValue> parse_flat_yaml(const std::string &path, const std::string &text) {
   std::map<std::string, YamlValue> keys;
-  std::istringstream in(text);
+  // A UTF-8 byte order mark (some Windows editors write one) is no part of the first key.
+  const bool bom = text.compare(0, 3, "\xEF\xBB\xBF") == 0;
+  std::istringstream in(bom ? text.substr(3) : text);
   std::string line;
   for (long n = 1; std::getline(in, line); ++n) {
     const std::string t = trim(line);
@@ -407,9 +467,7 @@ std::string resolved_image(const std::string &yaml_path, const YamlMeta &meta) {
   return slash == std::string::npos ? meta.image : yaml_path.substr(0, slash + 1) + meta.image;
 }
 
-}  // namespace
-
-GridMap read_png(const std::string &path) {
+GridMap png_grid(const std::string &path) {
   const Rgba img = read_png_file_rgba(path);
   GridMap g;
   g.size_x = img.width;
@@ -436,15 +494,22 @@ GridMap read_png(const std::string &path) {
   return g;
 }
 
+}  // namespace
+
+GridMap read_png(const std::string &path) {
+  return with_memory_error(path, [&] { return png_grid(path); });
+}
+
 PgmMap read_image_with_yaml(const std::string &image_path, const std::string &yaml_path) {
   const YamlMeta meta = read_yaml_meta(yaml_path);
-  return map_from(image_path, read_map_image(image_path), meta);
+  return with_memory_error(image_path, [&] { return map_from(image_path, read_map_image(image_path), meta); });
 }
 
 PgmMap read_pgm_with_yaml(const std::string &pgm_path) {
   const std::string yaml_path = yaml_path_for(pgm_path);
   const YamlMeta meta = read_yaml_meta(yaml_path);
-  return map_from(pgm_path, pgm_as_map_image(read_pgm(pgm_path)), meta);
+  return with_memory_error(pgm_path,
+                           [&] { return map_from(pgm_path, pgm_as_map_image(read_pgm(pgm_path)), meta); });
 }
 
 std::string map_server_image_of(const std::string &yaml_path) {
@@ -459,7 +524,7 @@ PgmMap read_map_server_yaml(const std::string &yaml_path) {
     throw FileError(yaml_path, meta.image_line,
                     "image \"" + printable(meta.image) + "\": cannot open " + printable(image) + ": " +
                         std::strerror(errno), ErrorCode::Io);
-  return map_from(image, read_map_image(image), meta);
+  return with_memory_error(image, [&] { return map_from(image, read_map_image(image), meta); });
 }
 
 }  // namespace carmen

@@ -378,14 +378,14 @@ class Reader {
     chunk_ = nullptr;
   }
 
-  [[noreturn]] void fail(const std::string &msg) const {
+  [[noreturn]] void fail(const std::string &msg, ErrorCode code = ErrorCode::BadInput) const {
     std::string where = "the file ";
     if (chunk_ != nullptr) {
       where = "the " + chunk_type_name(chunk_->type) + " chunk at byte " + std::to_string(chunk_->offset) +
               (chunk_->named() && !chunk_->name.empty() ? " (named \"" + printable(chunk_->name) + "\")" : "") +
               " ";
     }
-    throw FileError(in_.path(), where + msg);
+    throw FileError(in_.path(), where + msg, code);
   }
 
   // Called when fewer bytes came than were needed.
@@ -524,7 +524,8 @@ class Reader {
     kept_ += bytes;
     if (kept_ > opts_.max_kept_bytes)
       fail("makes the map hold more than " + std::to_string(opts_.max_kept_bytes >> 20) +
-           " MiB of chunk data (MapReadOptions::max_kept_bytes): refused rather than allocated");
+           " MiB of chunk data (MapReadOptions::max_kept_bytes): refused rather than allocated",
+           ErrorCode::TooLarge);
   }
 
   // The size and resolution, checked against the chunk size; the cells are
@@ -657,10 +658,30 @@ std::string read_chunk_body(const std::string &path, const ChunkInfo &chunk) {
   Input in(path);
   const uint64_t start = static_cast<uint64_t>(chunk.offset) + 5;  // type byte and size field
   if (in.skip(start) != start) throw FileError(path, "ends before the chunk at " + std::to_string(chunk.offset));
-  // Read in pieces: the size was checked by the listing, but a gzip stream
-  // can still end early.
-  std::string body;
   const size_t want = static_cast<size_t>(chunk.size);
+  // A plain file's size bounds what it can hold; a gzip stream's (or a
+  // pipe's) does not, so there the size is held to MapReadOptions'
+  // max_kept_bytes, as read_map_file holds it.
+  const int64_t rem = in.remaining();
+  if (rem >= 0 && uint64_t(chunk.size) > uint64_t(rem)) {
+    throw FileError(path, "the chunk at offset " + std::to_string(chunk.offset) + " claims " +
+                              std::to_string(chunk.size) + " bytes but only " + std::to_string(rem) +
+                              " remain in the file: it is truncated or damaged");
+  }
+  const uint64_t limit = MapReadOptions{}.max_kept_bytes;
+  if (rem < 0 && uint64_t(chunk.size) > limit) {
+    throw FileError(path, "the chunk at offset " + std::to_string(chunk.offset) + " claims " +
+                              std::to_string(chunk.size) + " bytes, more than the " +
+                              std::to_string(limit >> 20) + " MiB read from a " +
+                              (in.compressed() ? "gzip file" : "stream") +
+                              " whose size cannot vouch for it: refused rather than allocated" +
+                              (in.compressed() ? " (gunzip the map to read it)" : ""),
+                    ErrorCode::TooLarge);
+  }
+  // Read in pieces when the size is not known: a gzip stream can still end
+  // early, and then only what it held was allocated.
+  std::string body;
+  if (rem >= 0) body.reserve(want);
   while (body.size() < want) {
     const size_t k = std::min(want - body.size(), kReadPiece);
     const size_t old = body.size();

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <ctime>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <new>
 #include <optional>
@@ -17,6 +18,7 @@
 #include <variant>
 
 #include "carmen_compat/error.h"
+#include "carmen_compat/file_names.h"
 #include "carmen_compat/map_file.h"
 #include "map_io_support.h"
 
@@ -532,8 +534,25 @@ static int read_gridmap(const char *fn, const char *filename, const char *chunk_
     carmen::map_io_detail::need_name(filename);
     carmen::MapReadOptions opts;
     opts.check_cells = false;  // checked below, as a warning
+    // A C caller cannot raise max_kept_bytes, and CARMEN reads any map. A
+    // plain file's chunk sizes are checked against its size (and a pipe is
+    // read in bounded pieces), so what is allocated is what the file holds:
+    // no limit. A .gz can claim gigabytes in a few kilobytes: the limit
+    // stays, and its message says what to do.
+    const bool gzip = carmen::is_gzip_name(filename);
+    if (!gzip) opts.max_kept_bytes = std::numeric_limits<uint64_t>::max();
     const std::string name = chunk_name ? chunk_name : "";
-    const auto c = carmen::read_first_chunk(filename, CARMEN_MAP_GRIDMAP_CHUNK, chunk_name ? &name : nullptr, opts);
+    std::optional<carmen::FoundChunk> c;
+    try {
+      c = carmen::read_first_chunk(filename, CARMEN_MAP_GRIDMAP_CHUNK, chunk_name ? &name : nullptr, opts);
+    } catch (const carmen::FileError &e) {
+      if (!gzip || e.code() != carmen::ErrorCode::TooLarge) throw;
+      throw carmen::FileError(filename,
+                              "its GRIDMAP chunk would take more than " + std::to_string(opts.max_kept_bytes >> 20) +
+                                  " MiB, more than is read from a gzip file (whose size cannot vouch for the "
+                                  "sizes it claims): gunzip the map and read the plain file, which has no such limit",
+                              carmen::ErrorCode::TooLarge);
+    }
     if (!c) missing_chunk(filename, "GRIDMAP", chunk_name);
     warn_invalid_cells(fn, filename, *c);
     fill_map(payload_of<carmen::GridMap>(*c), chunk_name ? chunk_name : filename, map);

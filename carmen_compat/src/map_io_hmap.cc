@@ -9,7 +9,6 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include "carmen/map_io.h"
 #include "carmen_compat/error.h"
@@ -86,13 +85,25 @@ std::string hmap_payload(const carmen_hmap_t *h) {
 }
 
 // ---- Reading -----------------------------------------------------------------
-// Bounds-checked little-endian reads of a payload; errors name the file.
+// What a read may keep: the chunk's bytes, then for the C structure each
+// zone's name, NUL and pointer and each link's structure, keys and points,
+// every allocation counted with kAllocOverhead more (malloc's header and
+// minimum). CARMEN's hierarchies name a handful of zones (the named gridmap
+// chunks of the same file) and the doors between them; the budget is far
+// above that and bounds what a few kilobytes of .gz claiming millions of
+// zones could make us allocate. Nothing is allocated before a whole payload
+// was walked and found inside it.
+constexpr uint64_t kMaxHmapKeptBytes = uint64_t(64) << 20;
+constexpr uint64_t kAllocOverhead = 16;
+
+// Bounds-checked little-endian reads of a payload (a view into the chunk's
+// bytes); errors name the file.
 class Cursor {
  public:
-  Cursor(const std::string &bytes, const char *file) : b_(bytes), file_(file) {}
+  Cursor(const char *bytes, size_t size, const char *file) : b_(bytes), n_(size), file_(file) {}
   int32_t i32() {
     need(4);
-    const auto *p = reinterpret_cast<const unsigned char *>(b_.data() + pos_);
+    const auto *p = reinterpret_cast<const unsigned char *>(b_ + pos_);
     pos_ += 4;
     const uint32_t u = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
     int32_t v;
@@ -105,12 +116,14 @@ class Cursor {
     std::memcpy(&v, &i, 4);
     return v;
   }
-  std::string name() {
-    const size_t end = b_.find('\0', pos_);
-    if (end == std::string::npos) fail("a zone name has no terminating NUL");
-    if (end - pos_ > kMaxZoneName) fail("a zone name is over 127 characters");
-    std::string s = b_.substr(pos_, end - pos_);
-    pos_ = end + 1;
+  // The next NUL-terminated name: its first byte, its length in *len.
+  const char *name(size_t *len) {
+    const void *nul = left() == 0 ? nullptr : std::memchr(b_ + pos_, '\0', left());
+    if (nul == nullptr) fail("a zone name has no terminating NUL");
+    const char *s = b_ + pos_;
+    *len = static_cast<size_t>(static_cast<const char *>(nul) - s);
+    if (*len > kMaxZoneName) fail("a zone name is over 127 characters");
+    pos_ += *len + 1;
     return s;
   }
   // A count of items of at least min_bytes each that the payload can hold.
@@ -120,42 +133,20 @@ class Cursor {
       fail(std::string("invalid ") + what + " count " + std::to_string(n));
     return n;
   }
-  size_t left() const { return b_.size() - pos_; }
-  [[noreturn]] void fail(const std::string &what) const {
-    throw carmen::FileError(file_, "HMAP chunk: " + what + " (payload byte " + std::to_string(pos_) + ")");
+  size_t left() const { return n_ - pos_; }
+  [[noreturn]] void fail(const std::string &what, carmen::ErrorCode code = carmen::ErrorCode::BadInput) const {
+    throw carmen::FileError(file_, "HMAP chunk: " + what + " (payload byte " + std::to_string(pos_) + ")", code);
   }
 
  private:
   void need(size_t n) const {
     if (left() < n) fail("payload ends early");
   }
-  const std::string &b_;
+  const char *b_;
+  size_t n_;
   const char *file_;
   size_t pos_ = 0;
 };
-
-struct Link {
-  int type = 0, degree = 0;
-  std::vector<int> keys;
-  std::vector<carmen_point_t> points;
-};
-
-Link parse_link(Cursor &in, int num_zones) {
-  Link l;
-  l.type = in.i32();
-  const int n = points_per_key(l.type);
-  if (n == 0) in.fail("unknown link type " + std::to_string(l.type));
-  l.degree = in.count("link degree", 4 + 12 * size_t(n));
-  for (int j = 0; j < l.degree; ++j) {
-    l.keys.push_back(in.i32());
-    if (l.keys.back() < 0 || l.keys.back() >= num_zones) in.fail("link key out of range");
-  }
-  for (int k = 0; k < n * l.degree; ++k) {
-    const double x = in.f32(), y = in.f32(), theta = in.f32();
-    l.points.push_back({x, y, theta});
-  }
-  return l;
-}
 
 void free_hmap(carmen_hmap_t &h) {
   for (int i = 0; h.zone_names != nullptr && i < h.num_zones; ++i) std::free(h.zone_names[i]);
@@ -167,7 +158,7 @@ void free_hmap(carmen_hmap_t &h) {
   std::free(h.links);
 }
 
-// malloc() of n items (at least one byte); throws std::bad_alloc.
+// calloc() of n items (at least one byte); throws std::bad_alloc.
 template <typename T>
 T *c_array(size_t n) {
   void *p = std::calloc(n == 0 ? 1 : n, sizeof(T));
@@ -175,44 +166,84 @@ T *c_array(size_t n) {
   return static_cast<T *>(p);
 }
 
-void fill_link(carmen_hmap_link_t &out, const Link &l) {
-  out.type = l.type;
-  out.degree = l.degree;
-  out.num_points = static_cast<int>(l.points.size());
-  out.keys = c_array<int>(l.keys.size());
-  out.points = c_array<carmen_point_t>(l.points.size());
-  if (!l.keys.empty()) std::memcpy(out.keys, l.keys.data(), l.keys.size() * sizeof(int));
-  if (!l.points.empty()) std::memcpy(out.points, l.points.data(), l.points.size() * sizeof(carmen_point_t));
+// Walks a payload, counting what the C structure of it keeps (added to
+// *kept, refused past kMaxHmapKeptBytes). With `out` (a walk already passed
+// without), fills *out as it goes; out's counts are set as soon as its
+// arrays exist, so that free_hmap frees whatever was made.
+void walk_hmap(Cursor &in, uint64_t *kept, carmen_hmap_t *out) {
+  const auto keep = [&](uint64_t bytes) {
+    *kept += bytes;
+    if (*kept > kMaxHmapKeptBytes)
+      in.fail("its zones and links would take more than " + std::to_string(kMaxHmapKeptBytes >> 20) +
+              " MiB (the HMAP reader's limit): refused rather than allocated",
+              carmen::ErrorCode::TooLarge);
+  };
+  const int32_t num_zones = in.count("zone", 1);
+  keep(uint64_t(num_zones) * sizeof(char *) + kAllocOverhead);
+  if (out != nullptr) {
+    out->zone_names = c_array<char *>(size_t(num_zones));
+    out->num_zones = num_zones;
+  }
+  for (int32_t i = 0; i < num_zones; ++i) {
+    size_t len = 0;
+    const char *name = in.name(&len);
+    keep(len + 1 + kAllocOverhead);
+    if (out != nullptr) {
+      out->zone_names[i] = c_array<char>(len + 1);
+      std::memcpy(out->zone_names[i], name, len);
+    }
+  }
+  const int32_t num_links = in.count("link", 8);
+  keep(uint64_t(num_links) * sizeof(carmen_hmap_link_t) + kAllocOverhead);
+  if (out != nullptr) {
+    out->links = c_array<carmen_hmap_link_t>(size_t(num_links));
+    out->num_links = num_links;
+  }
+  for (int32_t i = 0; i < num_links; ++i) {
+    const int type = in.i32();
+    const int n = points_per_key(type);
+    if (n == 0) in.fail("unknown link type " + std::to_string(type));
+    const int32_t degree = in.count("link degree", 4 + 12 * size_t(n));
+    const size_t num_points = size_t(n) * size_t(degree);
+    keep(uint64_t(degree) * sizeof(int) + num_points * sizeof(carmen_point_t) + 2 * kAllocOverhead);
+    carmen_hmap_link_t *l = out != nullptr ? &out->links[i] : nullptr;
+    if (l != nullptr) {
+      l->type = type;
+      l->degree = degree;
+      l->num_points = static_cast<int>(num_points);
+      l->keys = c_array<int>(size_t(degree));
+      l->points = c_array<carmen_point_t>(num_points);
+    }
+    for (int32_t j = 0; j < degree; ++j) {
+      const int32_t key = in.i32();
+      if (key < 0 || key >= num_zones) in.fail("link key out of range");
+      if (l != nullptr) l->keys[j] = key;
+    }
+    for (size_t k = 0; k < num_points; ++k) {
+      const double x = in.f32(), y = in.f32(), theta = in.f32();
+      if (l != nullptr) l->points[k] = carmen_point_t{x, y, theta};
+    }
+  }
+  if (in.left() != 0) in.fail(std::to_string(in.left()) + " bytes left over after the last link");
 }
 
-// Builds the C structure; frees what it made if an allocation fails.
-carmen_hmap_t to_c(const std::vector<std::string> &zones, const std::vector<Link> &links) {
+// The payload checked whole (and its cost counted) first, then built; a
+// failed allocation frees what was made.
+carmen_hmap_t parse_hmap(const char *payload, size_t size, uint64_t kept, const char *file) {
+  {
+    Cursor check(payload, size, file);
+    uint64_t counted = kept;
+    walk_hmap(check, &counted, nullptr);
+  }
   carmen_hmap_t h{};
   try {
-    h.zone_names = c_array<char *>(zones.size());
-    h.num_zones = static_cast<int>(zones.size());
-    for (size_t i = 0; i < zones.size(); ++i) {
-      h.zone_names[i] = c_array<char>(zones[i].size() + 1);
-      std::memcpy(h.zone_names[i], zones[i].c_str(), zones[i].size() + 1);
-    }
-    h.links = c_array<carmen_hmap_link_t>(links.size());
-    h.num_links = static_cast<int>(links.size());
-    for (size_t i = 0; i < links.size(); ++i) fill_link(h.links[i], links[i]);
+    Cursor in(payload, size, file);
+    walk_hmap(in, &kept, &h);
   } catch (...) {
     free_hmap(h);
     throw;
   }
   return h;
-}
-
-carmen_hmap_t parse_hmap(const std::string &payload, const char *file) {
-  Cursor in(payload, file);
-  std::vector<std::string> zones(static_cast<size_t>(in.count("zone", 1)));
-  for (std::string &z : zones) z = in.name();
-  std::vector<Link> links(static_cast<size_t>(in.count("link", 8)));
-  for (Link &l : links) l = parse_link(in, static_cast<int>(zones.size()));
-  if (in.left() != 0) in.fail(std::to_string(in.left()) + " bytes left over after the last link");
-  return to_c(zones, links);
 }
 
 // The first HMAP chunk, named or not, as CARMEN's advance finds it.
@@ -239,10 +270,19 @@ int carmen_map_read_hmap_chunk(const char *filename, carmen_hmap_p hmap) {
     carmen::map_io_detail::need_name(filename);
     if (hmap == nullptr) throw std::invalid_argument("no hmap given (NULL)");
     const carmen::ChunkInfo c = first_hmap(filename);
+    // The chunk's bytes count too: a size past the budget is refused before
+    // they are read (a .gz chunk's size is not checked against the file).
+    if (uint64_t(c.size) > kMaxHmapKeptBytes)
+      throw carmen::FileError(filename, "the HMAP chunk at byte " + std::to_string(c.offset) + " claims " +
+                                            std::to_string(c.size) + " bytes, more than the " +
+                                            std::to_string(kMaxHmapKeptBytes >> 20) +
+                                            " MiB the HMAP reader takes: refused rather than read",
+                              carmen::ErrorCode::TooLarge);
     const std::string body = carmen::read_chunk_body(filename, c);
     // A named chunk's name and NUL come between the description and the payload.
     const size_t skip = 10 + (c.named() ? c.name.size() + 1 : 0);
-    *hmap = parse_hmap(body.substr(skip), filename);
+    if (skip > body.size()) throw carmen::FileError(filename, "HMAP chunk: its name runs past its end");
+    *hmap = parse_hmap(body.data() + skip, body.size() - skip, body.size(), filename);
     return 0;
   });
 }

@@ -274,7 +274,12 @@ int carmen_logfile_read_line(carmen_logfile_index_p index, carmen_FILE *infile, 
   line[0] = '\0';
   if (message_num != index->current_position) {
     if (!seek_to(infile, start)) {
+      // The file may have moved part way (gzseek can fail after skipping
+      // some data): current_position no longer says where it is. Seek to
+      // the next message (or the end), as after a short read, so that the
+      // next read starts where the index says.
       set_error("seek failed");
+      skip_to(index, infile, message_num + 1);
       return -1;
     }
     index->current_position = message_num;
