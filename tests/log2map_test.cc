@@ -151,8 +151,9 @@ TEST(Log2Map, CudaWithoutAGpuIsAClearError) {
   EXPECT_TRUE(contains(v.output, "backend cuda")) << v.output;
   // A CUDA build on a machine without a GPU (or driver) says so in plain
   // words, not in the runtime's "driver version is insufficient".
-  if (!contains(v.output, "this build has no CUDA backend"))
+  if (!contains(v.output, "this build has no CUDA backend")) {
     EXPECT_TRUE(contains(v.output, "no GPU found")) << v.output;
+  }
   EXPECT_TRUE(dir.entries().empty());
 }
 
