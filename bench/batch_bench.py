@@ -94,6 +94,23 @@ def cost_model(log2map: str, backends: list[str], tmp: str, repeat: int) -> list
     return lines
 
 
+def gpu_count() -> int:
+    try:
+        p = subprocess.run(["nvidia-smi", "-L"], capture_output=True, text=True)
+    except OSError:
+        return 0
+    return sum(1 for line in p.stdout.splitlines() if line.startswith("GPU ")) if p.returncode == 0 else 0
+
+
+def device_sets(gpus: int) -> list[str]:
+    """The --devices of the scaling table: 1, 2, 4, 8 GPUs where there are
+    that many, and two mappers on each GPU (0,0 on one GPU)."""
+    sets = [",".join(str(d) for d in range(n)) for n in (1, 2, 4, 8) if n <= gpus]
+    if gpus >= 1:
+        sets.append(",".join(str(d) for d in range(gpus) for _ in range(2)))
+    return sets
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
@@ -135,6 +152,12 @@ def main() -> int:
                  for b in ["auto"] + backends}
             one.append((log, t))
         model = cost_model(log2map, backends, tmp, a.repeat)
+        scaling = []
+        if "cuda" in backends:
+            for devices in device_sets(gpu_count()):
+                s = best([log2map, "--backend", "cuda", "--quiet", "--devices", devices, "--out-dir", out,
+                          "--formats", a.formats] + logs, a.repeat)
+                scaling.append((devices, len(logs) / s))
 
     print(f"batch_bench: {a.copies} copies of {os.path.basename(a.log)}, outputs {a.formats}, "
           f"{os.cpu_count()} cores, best of {a.repeat}")
@@ -148,6 +171,11 @@ def main() -> int:
     for log, t in one:
         fastest = min(t[b] for b in backends)
         print(f"{log:30} " + " ".join(f"{t[b]:14.3f}" for b in ["auto"] + backends) + f" {t['auto'] / fastest:15.2f}")
+    if scaling:
+        print()
+        print(f"{'cuda batch --devices':22} {'mappers':>8} {'logs/s':>8} {'/ one mapper':>13}")
+        for devices, rate in scaling:
+            print(f"{devices:22} {devices.count(',') + 1:8d} {rate:8.1f} {rate / scaling[0][1]:12.2f}x")
     print()
     print("auto's cost model measured here (compare vasco_gpu/tools/backend_choice.cc):")
     for line in model:

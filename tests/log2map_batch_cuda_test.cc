@@ -59,6 +59,28 @@ TEST_F(Log2MapBatchCuda, FloatModeGivesEachLogsOneRunMap) {
   }
 }
 
+// Several mappers share a batch (one per GPU, or two on one GPU with
+// --devices 0,0): each log is mapped whole by one of them, so the outputs are
+// those of one mapper, in either mode.
+TEST_F(Log2MapBatchCuda, SeveralMappersGiveTheOneMappersMaps) {
+  TempDir dir;
+  const std::vector<std::string> logs = {kIntel, kFr079, kLogs + "/fr101.carmen.log.gz"};
+  for (const char *mode : {"float", "exact"}) {
+    const std::string one = dir.file(std::string("one_") + mode), two = dir.file(std::string("two_") + mode);
+    std::vector<std::string> a = {"--backend", "cuda", "--cuda-mode", mode, "--device", "0", "--out-dir", one};
+    std::vector<std::string> b = {"--backend", "cuda", "--cuda-mode", mode, "--devices", "0,0", "--out-dir", two};
+    a.insert(a.end(), logs.begin(), logs.end());
+    b.insert(b.end(), logs.begin(), logs.end());
+    const ToolRun r1 = log2map(a), r2 = log2map(b);
+    ASSERT_EQ(r1.status, 0) << r1.output;
+    ASSERT_EQ(r2.status, 0) << r2.output;
+    EXPECT_TRUE(contains(r2.output, "on GPUs 0,0")) << r2.output;
+    for (const std::string stem : {"intel.gfs", "fr079-complete.gfs", "fr101.carmen"})
+      EXPECT_EQ(map_file_digest(one + "/" + stem + ".map.gz"), map_file_digest(two + "/" + stem + ".map.gz"))
+          << mode << " " << stem;
+  }
+}
+
 TEST_F(Log2MapBatchCuda, ADeviceThatDoesNotExistIsRefusedNamingIt) {
   TempDir dir;
   const ToolRun r = log2map({"--backend", "cuda", "--device", "999", kIntel, dir.file("a.map")});

@@ -53,6 +53,22 @@ std::unique_ptr<Renderer> automatic(const BackendOptions &o) {
 
 }  // namespace
 
+int cuda_device_count() {
+#if defined(VASCO_HAVE_CUDA)
+  return cuda_visible_device_count();
+#else
+  return 0;
+#endif
+}
+
+bool gpu_usable(int device, std::string *why) {
+  BackendOptions o;
+  o.cuda_device = device;
+  const std::string reason = cuda_unusable_reason(o);
+  if (!reason.empty() && why != nullptr) *why = reason;
+  return reason.empty();
+}
+
 const std::vector<BackendInfo> &backend_registry() {
   static const std::vector<BackendInfo> rows = {
       {"cpu_double", {}, Exactness::Exact, false, true,

@@ -122,20 +122,36 @@ class BatchRun {
     for (size_t i = 0; i < std::min(ahead_, read_.size()); ++i) submit_read(i);
   }
 
+  // Maps inputs until none is left, each on `mapper`; several callers (one
+  // thread and mapper per GPU) share the inputs, each taking the next.
   void map_all(vasco::Mapper &mapper) {
     const size_t n = read_.size();
-    for (size_t i = 0; i < n && !stop_; ++i) {
+    size_t i;
+    while (!stop_ && (i = take_next()) < n) {
       std::unique_ptr<RunResult> r;
       try {
         r = read_[i].get();
       } catch (...) {
         fail(i, std::current_exception());
       }
-      if (i + ahead_ < n && !stop_) submit_read(i + ahead_);
       if (r) map_one(mapper, i, std::move(r));
     }
-    if (stop_)
-      for (size_t i = 0; i < n; ++i) report_.not_run(i);
+  }
+
+  // After every map_all has returned.
+  void report_not_run() {
+    if (!stop_) return;
+    for (size_t i = 0; i < read_.size(); ++i) report_.not_run(i);
+  }
+
+  // The next input to map, its read queued `ahead_` inputs in advance: the
+  // read of an input is submitted when the one ahead_ before it is taken,
+  // so it exists before anyone can take it.
+  size_t take_next() {
+    std::lock_guard<std::mutex> lock(next_mutex_);
+    const size_t i = next_++;
+    if (i + ahead_ < read_.size() && !stop_) submit_read(i + ahead_);
+    return i;
   }
 
  private:
@@ -192,11 +208,50 @@ class BatchRun {
   const size_t ahead_;
   Slots writes_;
   std::atomic<bool> stop_{false};
+  std::mutex next_mutex_;
+  size_t next_ = 0;
   cli::TaskPool pool_;  // after what its tasks use: joined first
   std::vector<std::future<std::unique_ptr<RunResult>>> read_;
 };
 
 int all_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+
+// The GPUs a batch maps on: --device's alone when given; else, for cuda and
+// auto, every visible GPU that is usable (none: the one backend as before,
+// auto then on the CPU).
+std::vector<int> batch_devices(const Options &opt) {
+  if (!opt.devices.empty()) return opt.devices;
+  if (opt.device_given || (opt.backend != "cuda" && opt.backend != "auto")) return {opt.device};
+  std::vector<int> usable;
+  for (int d = 0; d < vasco::cuda_device_count(); ++d)
+    if (vasco::gpu_usable(d)) usable.push_back(d);
+  if (usable.empty()) return {opt.device};
+  return usable;
+}
+
+// The GPUs after the first, a thread and a mapper each, sharing the inputs
+// with the first's (run.map_all on the calling thread): each log is mapped
+// whole by one mapper (start_over between logs), so its bytes are those of a
+// one-GPU batch. A GPU whose mapper cannot start is said and left out: the
+// others map its share.
+std::thread map_on_other_devices(BatchRun &run, const Options &opt, std::vector<int> devices) {
+  return std::thread([&run, &opt, devices] {
+    std::vector<std::thread> workers;
+    for (int d : devices) {
+      workers.emplace_back([&run, &opt, d] {
+        try {
+          vasco::BackendOptions b = backend_options(opt);
+          b.cuda_device = d;
+          vasco::Mapper mapper(vasco::MapperParams{}, opt.backend, b);
+          run.map_all(mapper);
+        } catch (const std::exception &e) {
+          std::fprintf(stderr, "%s: GPU %d left out: %s\n", opt.tool.c_str(), d, carmen::printable(e.what()).c_str());
+        }
+      });
+    }
+    for (std::thread &w : workers) w.join();
+  });
+}
 
 }  // namespace
 
@@ -216,14 +271,27 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
   {
     BatchRun run(opt, spec, report, opt.jobs > 0 ? opt.jobs : all_cores());
     run.start_reads();  // while the backend starts
-    // One mapper for every input: its backend (a GPU's context and
-    // scratch) starts once. auto is the GPU when one is usable: its
+    const std::vector<int> devices = batch_devices(opt);
+    // One mapper for every input (per GPU): its backend (a GPU's context
+    // and scratch) starts once. auto is the GPU when one is usable: its
     // start-up is paid once for the whole batch.
-    vasco::Mapper mapper(vasco::MapperParams{}, opt.backend, backend_options(opt));
+    vasco::BackendOptions first = backend_options(opt);
+    first.cuda_device = devices.front();
+    vasco::Mapper mapper(vasco::MapperParams{}, opt.backend, first);
     report.set_backend(mapper.backend_name());
     if (opt.backend == "auto" && !mapper.backend_traits().grid_on_device && !opt.quiet)
       std::fprintf(stderr, "%s: --backend auto: no usable GPU: using %s\n", opt.tool.c_str(), mapper.backend_name().c_str());
-    run.map_all(mapper);
+    if (devices.size() > 1 && mapper.backend_traits().grid_on_device) {
+      std::string list;
+      for (int d : devices) list += (list.empty() ? "" : ",") + std::to_string(d);
+      report.set_backend(mapper.backend_name() + " on GPUs " + list);
+      std::thread others = map_on_other_devices(run, opt, std::vector<int>(devices.begin() + 1, devices.end()));
+      run.map_all(mapper);
+      others.join();
+    } else {
+      run.map_all(mapper);
+    }
+    run.report_not_run();
   }  // every write done
   report.print_end(cli::seconds_since(t_start));
   return report.failures() > 0 ? 1 : 0;

@@ -42,6 +42,7 @@ void add_input_options(CLI::App &app, const ToolSpec &spec, Options &opt) {
 // What --out-dir takes along; checked after parsing.
 struct BatchText {
   std::string formats = "map.gz";
+  std::string devices;
 };
 
 void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchText &raw) {
@@ -53,6 +54,27 @@ void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchT
   app.add_flag("--fail-fast", opt.fail_fast, "batch mode: stop at the first input that fails (default: report it, go on)");
   app.add_option("--jobs", opt.jobs, "batch mode: threads reading inputs and writing maps (default: all cores)")
       ->check(CLI::Range(0, vasco::kMaxThreads));
+  app.add_option("--devices", raw.devices,
+                 "batch mode: the GPUs to map on, a mapper each, e.g. 0,1 (a GPU named twice runs two mappers on it; "
+                 "default: every usable GPU)")
+      ->type_name("LIST");
+}
+
+// "0,1,1": the GPUs of --devices, each a whole number (repeats allowed).
+std::vector<int> parse_devices(const std::string &text) {
+  std::vector<int> devices;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = std::min(text.find(',', start), text.size());
+    const std::string d = text.substr(start, comma - start);
+    int v = -1;
+    const auto r = std::from_chars(d.data(), d.data() + d.size(), v);
+    if (d.empty() || r.ec != std::errc() || r.ptr != d.data() + d.size() || v < 0 || devices.size() >= 64)
+      throw Error(ErrorCode::Usage, "--devices '" + text + "': expected GPU numbers such as 0,1 (at most 64)");
+    devices.push_back(v);
+    start = comma + 1;
+  }
+  return devices;
 }
 
 // The map_server outputs' options; checked after parsing.
@@ -108,7 +130,7 @@ void add_backend_options(CLI::App &app, Options &opt) {
   app.add_option("--threads", opt.threads,
                  "threads of cpu_threads, 1 to " + std::to_string(vasco::kMaxThreads) + " (default: all cores)")
       ->check(CLI::Range(0, vasco::kMaxThreads));
-  app.add_option("--device", opt.device, "the CUDA device of the cuda backend (default 0)")->check(CLI::NonNegativeNumber);
+  app.add_option("--device", opt.device, "the CUDA device of the cuda backend (default 0; a batch: every usable GPU)")->check(CLI::NonNegativeNumber);
   app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
       ->check(CLI::IsMember({"float", "exact"}));
   app.add_flag("--lenient", opt.lenient, "skip bad log lines (and report them) instead of stopping");
@@ -180,15 +202,21 @@ std::vector<std::string> parse_formats(const std::string &text) {
 
 // Batch mode: every positional is an input; the one-input options refused.
 void finish_batch_options(const CLI::App &app, const BatchText &raw, Options &opt) {
-  const bool batch_only = app.count("--formats") || app.count("--fail-fast") || app.count("--jobs");
+  const bool batch_only = app.count("--formats") || app.count("--fail-fast") || app.count("--jobs") ||
+                          app.count("--devices");
   if (opt.out_dir.empty()) {
-    if (batch_only) throw Error(ErrorCode::Usage, "--formats, --fail-fast and --jobs go with --out-dir DIR");
+    if (batch_only)
+      throw Error(ErrorCode::Usage, "--formats, --fail-fast, --jobs and --devices go with --out-dir DIR");
     if (opt.outputs.empty()) throw Error(ErrorCode::Usage, "no output named: give OUT [OUT...], or --out-dir DIR for a batch");
     return;
   }
   for (const char *one : {"--poses", "--add", "--transform"})
     if (app.count(one)) throw Error(ErrorCode::Usage, std::string(one) + " is for one input: not with --out-dir");
   opt.formats = parse_formats(raw.formats);
+  if (app.count("--devices")) {
+    if (opt.device_given) throw Error(ErrorCode::Usage, "--device and --devices: give one of them");
+    opt.devices = parse_devices(raw.devices);
+  }
   opt.inputs.push_back(opt.log);
   opt.inputs.insert(opt.inputs.end(), opt.outputs.begin(), opt.outputs.end());
   opt.outputs.clear();
@@ -219,6 +247,7 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
   }
   if (!raw.transform.empty()) opt.transform = parse_pose_triple(raw.transform, "--transform");
   for (const std::string &a : raw.adds) opt.more.push_back(parse_session(a));
+  opt.device_given = app.count("--device") > 0;
   // A bag reader takes --laser-mount (a pose topic's mount) and --skip-unposed
   // (scans outside the poses' time span) without --poses too.
   const bool pose_options = app.count("--pose-format") || app.count("--pose-match") || app.count("--pose-ids") ||
@@ -237,6 +266,8 @@ void warn_about_idle_options(const CLI::App &app, Options &opt) {
     opt.warnings.push_back("--cuda-mode does nothing with --backend " + opt.backend + " (only cuda has modes)");
   if (app.count("--device") && cpu)
     opt.warnings.push_back("--device does nothing with --backend " + opt.backend);
+  if (app.count("--devices") && cpu)
+    opt.warnings.push_back("--devices does nothing with --backend " + opt.backend);
   if (app.count("--threads") && (opt.backend == "cpu_double" || opt.backend == "cpu_float" || opt.backend == "cuda"))
     opt.warnings.push_back("--threads does nothing with --backend " + opt.backend + " (only cpu_threads and auto use it)");
   if (app.count("--robot") && opt.param_file.empty())

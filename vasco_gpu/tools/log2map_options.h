@@ -27,6 +27,8 @@ struct Options {
   bool fail_fast = false;
   int jobs = 0;  // batch threads reading and writing logs (0: all cores)
   int device = 0;
+  bool device_given = false;  // --device N: that GPU alone, also in a batch
+  std::vector<int> devices;   // --devices LIST (batch): a mapper on each; empty: every usable GPU
   std::string param_file;
   std::string robot;
   std::string backend = "auto";

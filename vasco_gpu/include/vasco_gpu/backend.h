@@ -98,6 +98,14 @@ std::vector<std::string> backend_names();
 // compiled backend.
 std::string backend_help();
 
+// How many CUDA devices this process sees (CUDA_VISIBLE_DEVICES applies): 0
+// without a driver, a device or a CUDA build. Usable or not is cuda_usable's.
+int cuda_device_count();
+
+// Whether the cuda backend can run on `device` (false in a build without
+// CUDA); `why` (optional) says why not.
+bool gpu_usable(int device, std::string *why = nullptr);
+
 }  // namespace vasco
 
 #endif  // VASCO_GPU_BACKEND_H

@@ -18,6 +18,9 @@ namespace vasco {
 // return the cached answer. `why` (optional) receives the reason when it cannot.
 bool cuda_usable(int device, std::string *why);
 
+// cudaGetDeviceCount's count, 0 when it fails (no driver, no device).
+int cuda_visible_device_count();
+
 // The device's name and memory, for messages ("NVIDIA H100 80GB HBM3, 79 GiB").
 std::string cuda_device_description(int device);
 

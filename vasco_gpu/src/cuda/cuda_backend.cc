@@ -74,6 +74,15 @@ std::string unusable_reason(int device) {
 
 }  // namespace
 
+int cuda_visible_device_count() {
+  int count = 0;
+  if (cudaGetDeviceCount(&count) != cudaSuccess) {
+    (void)cudaGetLastError();
+    return 0;
+  }
+  return count;
+}
+
 bool cuda_usable(int device, std::string *why) {
   std::lock_guard<std::mutex> lock(usable_mutex());
   auto found = usable_states().find(device);
