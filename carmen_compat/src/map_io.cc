@@ -3,7 +3,6 @@
 
 #include <unistd.h>
 
-#include <climits>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -20,6 +19,7 @@
 #include "carmen_compat/error.h"
 #include "carmen_compat/file_names.h"
 #include "carmen_compat/map_file.h"
+#include "carmen_stdio_results.h"
 #include "map_io_support.h"
 
 static_assert(CARMEN_MAP_GRIDMAP_CHUNK == carmen::kGridmapChunk, "chunk code");
@@ -253,24 +253,9 @@ bool read_i32(carmen_FILE *fp, int32_t *v) {
   return true;
 }
 
-// carmen_fseek, its result taken as CARMEN's libglobal may give it (a
-// program can link it ahead of ours): for a .gz file CARMEN's returns
-// gzseek's new offset, not 0, and a plain one fseek's 0. So success is the
-// file being where it was asked to go, as carmen_ftell says.
-bool seek(carmen_FILE *fp, long offset, int whence) {
-  long target = offset;
-  if (whence == SEEK_CUR) {
-    const long here = carmen_ftell(fp);
-    if (here < 0 || offset > LONG_MAX - here) return false;
-    target = here + offset;
-  }
-  if (carmen_fseek(fp, offset, whence) == -1) return false;
-  return whence == SEEK_END || carmen_ftell(fp) == target;
-}
-
 // Rewinds and reads past the comments and the id; false if they are not there.
 bool skip_to_first_chunk(carmen_FILE *fp) {
-  if (!seek(fp, 0, SEEK_SET)) return false;
+  if (!carmen::checked_seek(fp, 0, SEEK_SET)) return false;
   int c;
   while ((c = carmen_fgetc(fp)) == '#') {
     while ((c = carmen_fgetc(fp)) != EOF && c != '\n') {
@@ -296,7 +281,7 @@ int advance(carmen_FILE *fp, int specific_chunk, const char *chunk_name) {
     if (!read_i32(fp, &size) || size < 10) return -1;
     long skip = size;
     if ((type & ~CARMEN_MAP_NAMED_CHUNK_FLAG) == specific_chunk) {
-      if (chunk_name == nullptr) return seek(fp, at_type, SEEK_SET) ? 0 : -1;
+      if (chunk_name == nullptr) return carmen::checked_seek(fp, at_type, SEEK_SET) ? 0 : -1;
       if (type & CARMEN_MAP_NAMED_CHUNK_FLAG) {
         char desc[10];
         if (carmen_fread(desc, 1, 10, fp) != 10) return -1;
@@ -309,10 +294,10 @@ int advance(carmen_FILE *fp, int specific_chunk, const char *chunk_name) {
           name.push_back(static_cast<char>(c));
           if (name.size() > 4096) return -1;
         }
-        if (name == chunk_name) return seek(fp, at_type, SEEK_SET) ? 0 : -1;
+        if (name == chunk_name) return carmen::checked_seek(fp, at_type, SEEK_SET) ? 0 : -1;
       }
     }
-    if (!seek(fp, skip, SEEK_CUR)) return -1;
+    if (!carmen::checked_seek(fp, skip, SEEK_CUR)) return -1;
   }
 }
 

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "carmen_stdio_results.h"
 #include "readlog_error.h"
 
 namespace {
@@ -49,15 +50,6 @@ struct Offsets {
     return true;
   }
 };
-
-// carmen_fseek to an absolute offset. CARMEN's returns gzseek's result (the
-// new offset) on a compressed stream, where ours returns 0: any result but 0
-// is checked with carmen_ftell.
-bool seek_to(carmen_FILE *fp, off_t offset) {
-  const off_t rc = carmen_fseek(fp, offset, SEEK_SET);
-  if (rc == 0) return true;
-  return carmen_ftell(fp) == offset;
-}
 
 // carmen_fread as CARMEN's may return it: gzread's -1 becomes (size_t)-1,
 // and nothing but 0..n is a count. Returns false for a read error.
@@ -201,14 +193,14 @@ carmen_logfile_index_p carmen_logfile_index_messages(carmen_FILE *infile) {
     set_error("NULL file");
     return nullptr;
   }
-  if (!seek_to(infile, 0)) {
+  if (!carmen::checked_seek(infile, 0, SEEK_SET)) {
     set_error("cannot rewind the log");
     return nullptr;
   }
   Offsets offsets;
   if (!find_messages(infile, offsets)) return nullptr;
   carmen_logfile_index_t *index = make_index(offsets);
-  if (index && !seek_to(infile, 0)) {
+  if (index && !carmen::checked_seek(infile, 0, SEEK_SET)) {
     carmen_logfile_free_index(&index);
     set_error("cannot rewind the log");
   }
@@ -241,7 +233,7 @@ float carmen_logfile_percent_read(carmen_logfile_index_p index) {
 // Positions the index (and the file) at message `next`; when the file cannot
 // get there, at the end, so that carmen_logfile_eof() ends a reading loop.
 static void skip_to(carmen_logfile_index_p index, carmen_FILE *infile, int next) {
-  if (next < index->num_messages && seek_to(infile, index->offset[next])) {
+  if (next < index->num_messages && carmen::checked_seek(infile, index->offset[next], SEEK_SET)) {
     index->current_position = next;
   } else {
     index->current_position = index->num_messages;
@@ -273,7 +265,7 @@ int carmen_logfile_read_line(carmen_logfile_index_p index, carmen_FILE *infile, 
   }
   line[0] = '\0';
   if (message_num != index->current_position) {
-    if (!seek_to(infile, start)) {
+    if (!carmen::checked_seek(infile, start, SEEK_SET)) {
       // The file may have moved part way (gzseek can fail after skipping
       // some data): current_position no longer says where it is. Seek to
       // the next message (or the end), as after a short read, so that the
