@@ -490,18 +490,24 @@ void print_table(const std::vector<Row> &rows) {
               "octree, one z layer used), one end voxel, clamped log-odds.\n");
 }
 
-// The target: cpu_float (one core) builds its map faster than MRPT (one core) on every log and parameter
-// set measured.
+// The target (issue: "beat MRPT on one core"): cpu_float (one core) builds its map at least 1.25x as fast
+// as MRPT (one core) on every log and parameter set measured; a miss says by how much.
+constexpr double kTargetOverMrpt = 1.25;
+
 void print_target(const std::vector<Row> &rows) {
   bool header = false;
   for (const Row &r : rows) {
     if (r.mapper != "cpu_float" || r.map_s <= 0) continue;
     const double mrpt = time_of(rows, r, kMrptLabel);
     if (mrpt <= 0) continue;
-    if (!header) std::printf("\nTarget: cpu_float faster than MRPT, one core each:\n");
+    if (!header) std::printf("\nTarget: cpu_float at least %.2fx MRPT's speed, one core each:\n", kTargetOverMrpt);
     header = true;
-    std::printf("  %s / %s: cpu_float %s ms, MRPT %s ms: %s (%.2fx)\n", r.data.c_str(), r.params.c_str(),
-                ms(r.map_s).c_str(), ms(mrpt).c_str(), r.map_s < mrpt ? "met" : "missed", mrpt / r.map_s);
+    const double x = mrpt / r.map_s;
+    std::printf("  %s / %s: cpu_float %s ms, MRPT %s ms: %.2fx: %s", r.data.c_str(), r.params.c_str(),
+                ms(r.map_s).c_str(), ms(mrpt).c_str(), x, x >= kTargetOverMrpt ? "met\n" : "missed");
+    if (x < kTargetOverMrpt)
+      std::printf(" (needs %s ms, %.0f%% less)\n", ms(mrpt / kTargetOverMrpt).c_str(),
+                  100.0 * (1.0 - mrpt / kTargetOverMrpt / r.map_s));
   }
 }
 
