@@ -57,6 +57,7 @@ const char *const kOctomapLabel = "OctoMap OcTree";
 struct Options {
   int runs = 3;
   std::string dataset = "all";
+  bool octomap = true;  // --no-octomap: leave out its rows (minutes per log on one core)
 };
 
 // Cells of a map on either side of even odds; unknown cells (and any exactly at 0.5) are in neither.
@@ -381,6 +382,7 @@ void bench_peers(Bench *b, const Job &job, const CellCounts &ours) {
   b->rows.push_back(missing_row(job, kMrptLabel, "libmrpt-maps-dev"));
 #endif
 #if defined(VASCO_HAVE_OCTOMAP)
+  if (!b->opt.octomap) return;
   std::fprintf(stderr, "  %s ...\n", kOctomapLabel);
   CellCounts octo_cells;
   b->rows.push_back(run_octomap(job, &octo_cells));
@@ -418,8 +420,10 @@ bool parse_options(int argc, char **argv, Options *o) {
       o->runs = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--dataset" && i + 1 < argc) {
       o->dataset = argv[++i];
+    } else if (a == "--no-octomap") {
+      o->octomap = false;
     } else {
-      std::fprintf(stderr, "usage: peer_bench [--runs N] [--dataset fr079|fr101|all]\n");
+      std::fprintf(stderr, "usage: peer_bench [--runs N] [--dataset fr079|fr101|all] [--no-octomap]\n");
       return false;
     }
   }
