@@ -91,6 +91,7 @@ bench: all
 	$(BUILD)/bin/parse_bench
 	$(BUILD)/bin/oracle_o2_bench
 	$(BUILD)/bin/mapping_bench
+	$(BUILD)/bin/mapping_bench --large
 	$(BUILD)/bin/session_bench
 	python3 bench/batch_bench.py --bin $(BUILD)/bin
 

@@ -15,7 +15,15 @@
 // the same run. A second table is the ablation of the paper's kernel design.
 // Without a usable GPU it runs the CPU rows and says so.
 //
+// --large instead maps a synthetic large site (bench/large_site.h: a square
+// loop of corridors, the robot starting in a corner, so that the grid passes
+// 2^31 cells at vasco's 2.5 cm) with every backend at each --large-res, and
+// prints grid cells, scans, map and finish time and peak host and device
+// memory per backend (bench/large_bench.h).
+//
 //   mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset NAME]
+//   mapping_bench --large [--large-scans N] [--large-site M] [--large-res R,R..]
+//                 [--large-backends cpu_double,cpu_threads,cpu_float,cuda_float,cuda_exact] [--threads N]
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -32,6 +40,7 @@
 #include <vector>
 
 #include "bench_support.h"
+#include "large_bench.h"
 #include "carmen_compat/map_file.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/internal/cpu_threads_backend.h"
@@ -185,7 +194,13 @@ struct Options {
   int runs = 5, threads = 0;
   bool ablation = true;
   std::string only;  // --dataset: only this one
+  bench::LargeOptions large;  // --large and its options
 };
+
+constexpr const char *kUsage =
+    "usage: mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset fr079|fr101]\n"
+    "       mapping_bench --large [--large-scans N] [--large-site METRES] [--large-res R[,R...]]\n"
+    "                     [--large-backends cpu_double,cpu_threads,cpu_float,cuda_float,cuda_exact] [--threads N]\n";
 
 // Parses the command line into *o (threads 0 or less: all cores); false, after the usage line on stderr,
 // for anything it does not know.
@@ -197,12 +212,27 @@ bool parse_options(int argc, char **argv, Options *o) {
     else if (a == "--threads" && i + 1 < argc) o->threads = std::atoi(argv[++i]);
     else if (a == "--no-ablation") o->ablation = false;
     else if (a == "--dataset" && i + 1 < argc) o->only = argv[++i];
+    else if (a == "--large") o->large.on = true;
+    else if (a == "--large-scans" && i + 1 < argc) o->large.site.scans = std::max(1L, std::atol(argv[++i]));
+    else if (a == "--large-site" && i + 1 < argc) {
+      o->large.site.side = std::atof(argv[++i]);
+      if (!(o->large.site.side > 2 * o->large.site.corridor)) {
+        std::fprintf(stderr, "mapping_bench: --large-site must be more than %g m\n", 2 * o->large.site.corridor);
+        return false;
+      }
+    } else if (a == "--large-res" && i + 1 < argc) {
+      if (!bench::parse_number_list(argv[++i], &o->large.resolutions)) {
+        std::fprintf(stderr, "mapping_bench: --large-res takes positive numbers, comma-separated\n%s", kUsage);
+        return false;
+      }
+    } else if (a == "--large-backends" && i + 1 < argc) o->large.backends = bench::split_names(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset fr079|fr101]\n");
+      std::fprintf(stderr, "%s", kUsage);
       return false;
     }
   }
   if (o->threads <= 0) o->threads = vasco::hardware_threads();
+  o->large.threads = o->threads;
   return true;
 }
 
@@ -457,6 +487,7 @@ void print_end_to_end(const char *argv0, const std::string &fr079, const Options
 int main(int argc, char **argv) {
   Bench b;
   if (!parse_options(argc, argv, &b.opt)) return 2;
+  if (b.opt.large.on) return bench::run_large_bench(b.opt.large);
   const std::vector<Dataset> datasets = bench_datasets();
   const GpuInfo gpu = probe_gpu();
   b.gpu = gpu.usable;

@@ -63,6 +63,13 @@ constexpr int kSteep = 1, kFlipped = 2, kBackward = 4, kDegenerate = 8;
 // often) short: a tile's blocks run its list sequentially, so the longest list
 // bounds the kernel.
 constexpr int kTile = 8;
+// The most tiles an exact-mode grid may have: tile ids are int in the kernels
+// and uint32 in the pairs (kNoTile, 2^32 - 1, sorts after every real one,
+// and the sort's tile_bits stay <= 31), and the tiles kernel runs a block per
+// tile (gridDim.x <= 2^31 - 1). 2^31 - 1 tiles are 2^37 cells, 512 GiB of
+// floats: beyond every GPU's memory, but refused by name (the host's
+// reserve_grid) rather than left to wrap.
+constexpr size_t kMaxExactTiles = 0x7fffffff;
 
 // Scratch sizes for the CUB calls of exact mode.
 size_t exact_scan_temp_bytes(size_t num_beams);

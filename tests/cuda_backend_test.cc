@@ -5,11 +5,17 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <unordered_map>
+#include <vector>
 
 #include "test_seed.h"
 #include "test_support.h"
 #include "carmen_compat/map_compare.h"
 #include "vasco_gpu/error.h"
+#include "vasco_gpu/grid.h"
+#include "vasco_gpu/internal/egrid_math.h"
+#include "vasco_gpu/internal/oracle.h"
+#include "vasco_gpu/internal/sensor_params.h"
 #include "vasco_gpu/renderer.h"
 #if defined(VASCO_HAVE_CUDA)
 #include "vasco_gpu/cuda_backend.h"
@@ -180,6 +186,118 @@ TEST(CudaExact, RandomScansWithOddRangesMatchTheOracle) {
   SCOPED_TRACE("random seed " + std::to_string(seed));
   expect_bit_identical(ref, got, geo);
   EXPECT_EQ(rs.cell_updates, gs.cell_updates);
+}
+
+// Exact mode counts tiles in 31 bits (tile ids, the tiles kernel's blocks):
+// a grid of more tiles is refused by name before anything is allocated.
+TEST(CudaExact, AGridPastItsTileIdsIsRefusedByName) {
+  REQUIRE_GPU();
+  MapperParams params;
+  GridGeometry geo;
+  geo.size_x = geo.size_y = 400000;  // 2.5e9 tiles of 8 x 8
+  geo.resolution = params.resolution;
+  BackendOptions o;
+  o.cuda_mode = CudaMode::Exact;
+  auto r = make_renderer("cuda", o);
+  try {
+    r->reset(geo, params);
+    ADD_FAILURE() << "a grid of 2.5e9 tiles was accepted";
+  } catch (const Error &e) {
+    EXPECT_EQ(e.code(), ErrorCode::TooLarge) << e.what();
+    EXPECT_NE(std::string(e.what()).find("2500000000 tiles"), std::string::npos) << e.what();
+  }
+}
+
+// The oracle's cells of a window of a grid too large to hold on the host in
+// a test: the beams of `batch` in a grid of `geo` (frame fixed by scan 0),
+// walked and updated with the oracle's own functions, kept by 64-bit index.
+std::vector<float> sparse_oracle_window(const ScanBatch &batch, const MapperParams &p, const GridGeometry &geo,
+                                        const GridWindow &w) {
+  std::unordered_map<int64_t, float> cells;
+  oracle::GridFrame frame = start_frame(geo, batch);
+  const egrid::SensorModel<double> model = sensor_model_of(p);
+  for (size_t s = 0; s < batch.num_scans(); ++s) {
+    const oracle::ScanStart start = oracle::scan_start(frame, batch.x[s], batch.y[s], batch.theta[s]);
+    oracle::SteppedAngles angle_of{batch.first_angle[s], batch.angle_step[s]};
+    double angle = 0;
+    const float *range = batch.ranges_of(s);
+    for (int i = 0; i < batch.beams_in(s); ++i) {
+      angle_of(i, start.theta, &angle);
+      if (!oracle::beam_used(range[i])) continue;
+      int x2, y2;
+      oracle::beam_end(start, angle, range[i], p.wall_size, p.resolution, &x2, &y2);
+      egrid::walk_beam_cells(start.x1, start.y1, x2, y2, p.table_size(), geo.size_x, geo.size_y,
+                             [&](int cx, int cy, int bi, int bj) {
+                               double prob;
+                               const double d = oracle::table_distance(bi, bj, p.table_size(), nullptr, p.resolution);
+                               if (!egrid::sensor_model(model, d, range[i], &prob)) return false;
+                               const int64_t c = egrid::cell_index(cx, cy, geo.size_y);
+                               const auto it = cells.find(c);
+                               cells[c] = egrid::odds_update(it == cells.end() ? egrid::kUnknown : it->second,
+                                                             model.prior, prob);
+                               return true;
+                             });
+    }
+  }
+  std::vector<float> out(static_cast<size_t>(w.width) * w.height, egrid::kUnknown);
+  for (int x = 0; x < w.width; ++x)
+    for (int y = 0; y < w.height; ++y) {
+      const auto it = cells.find(egrid::cell_index(w.x0 + x, w.y0 + y, geo.size_y));
+      if (it != cells.end()) out[static_cast<size_t>(x) * w.height + y] = it->second;
+    }
+  return out;
+}
+
+// A grid of 2.5e9 cells (past 2^31) on the GPU, mapped where its cells'
+// indices pass 2^31: exact mode gives the oracle's bytes there, float mode
+// updates the same cells. Skips when the GPU has not the memory free
+// (exact 4.5 bytes a cell, float 8 to 16).
+TEST(CudaLargeGrid, AGridPast2To31CellsMapsWhereItsIndicesPass2To31) {
+  REQUIRE_GPU();
+  MapperParams params;
+  GridGeometry geo;
+  geo.size_x = geo.size_y = 50000;
+  geo.resolution = params.resolution;
+  ScanBatch batch;
+  std::vector<float> r(361);
+  for (int s = 0; s < 40; ++s) {
+    for (int i = 0; i < 361; ++i) r[i] = static_cast<float>(2.0 + 6.0 * std::fabs(std::sin(0.05 * i + 0.3 * s)));
+    // Scan 0 fixes the frame's centre; the others 550 m away in x and y: cells
+    // x ~ 47000 of 50000, indices ~2.35e9.
+    const double x = s == 0 ? 0 : 550 + 0.1 * s, y = s == 0 ? 0 : 550 - 0.07 * s;
+    batch.add_scan(x, y, 0.01 * s, -M_PI / 2, M_PI / 360, r.data(), 361, s + 1);
+  }
+  const GridWindow w{47000 - 450, 47000 - 450, 900, 900};
+  ASSERT_GT(egrid::cell_index(w.x0, w.y0, geo.size_y), int64_t(1) << 31);
+  const std::vector<float> want = sparse_oracle_window(batch, params, geo, w);
+  size_t known = 0;
+  for (float v : want) known += v != egrid::kUnknown;
+  ASSERT_GT(known, 10000u);
+  size_t free_b = 0;
+#if defined(VASCO_HAVE_CUDA)
+  ASSERT_TRUE(cuda_memory_info(0, &free_b, nullptr));
+#endif
+  for (CudaMode md : {CudaMode::Exact, CudaMode::Float}) {
+    BackendOptions o;
+    o.cuda_mode = md;
+    auto rend = make_renderer("cuda", o);
+    const double need = rend->traits().device_bytes_per_cell * static_cast<double>(geo.num_cells());
+    if (need + (1u << 30) > static_cast<double>(free_b)) {
+      std::printf("skipped %s: %.1f GiB needed, %.1f GiB free\n", rend->name().c_str(), need / (1 << 30),
+                  static_cast<double>(free_b) / (1 << 30));
+      continue;
+    }
+    SCOPED_TRACE(rend->name());
+    rend->reset(geo, params);
+    rend->apply(batch, 0, batch.num_scans(), nullptr);
+    const std::vector<float> got = rend->read(w);
+    if (md == CudaMode::Exact) {
+      testing_support::expect_bit_identical(want, got, GridGeometry{w.width, w.height}, "cuda exact past 2^31");
+    } else {
+      const carmen::Agreement a = carmen::compare_maps(want, got);
+      EXPECT_LT(a.status_differs, known / 100) << "float mode's cells are the oracle's, up to its float placement";
+    }
+  }
 }
 
 }  // namespace

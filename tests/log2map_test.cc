@@ -245,8 +245,9 @@ TEST(Log2Map, SigtermLeavesNoTemporary) {
 }
 
 
-// Two scans 399 m apart (diagonally) ask for a grid of 10^9 cells, 4 GiB:
-// refused by the default memory budget before anything is allocated.
+// Two scans 399 m apart (diagonally) ask for a grid of 10^9 cells, 4.5 GiB
+// on cpu_double: refused by the default memory budget before anything is
+// allocated, naming the need, the bytes a cell and the scans that stretch it.
 TEST(Log2Map, AGridBeyondTheMemoryBudgetIsRefusedNamingTheLog) {
   TempDir dir;
   const std::string log = write_text(dir, "far.log",
@@ -254,7 +255,9 @@ TEST(Log2Map, AGridBeyondTheMemoryBudgetIsRefusedNamingTheLog) {
                                      "FLASER 3 1.0 2.0 3.0 399 399 0 0 0 0 2 t 0\n");
   const ToolRun r = log2map({"--backend", "cpu_double", log, dir.file("out.map")});
   EXPECT_EQ(r.status, 1);
-  EXPECT_TRUE(contains(r.output, log + ": the map needs about")) << r.output;
+  EXPECT_TRUE(contains(r.output, log + ": the map needs about 4")) << r.output;
+  EXPECT_TRUE(contains(r.output, "4.5 bytes a cell on cpu_double")) << r.output;
+  EXPECT_TRUE(contains(r.output, "the poses span 798 m x 798 m (from the scan at line 1 to line 2 in x")) << r.output;
   EXPECT_TRUE(contains(r.output, "--max-memory")) << r.output;
   const ToolRun small = log2map({"--backend", "cpu_double", "--max-memory", "1", kIntel, dir.file("out.map")});
   EXPECT_EQ(small.status, 1);

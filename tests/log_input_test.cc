@@ -105,11 +105,14 @@ TEST(LogInput, ABadValueInTheLogNamesItsLine) {
   }
 }
 
+// A side past kMaxGridSide (2^31 - 1024 cells: 53,687 km at 2.5 cm) is refused
+// while the frame is sized; a grid of many cells with sides below it is the
+// memory budget's to refuse (Log2Map.AGridBeyondTheMemoryBudgetIsRefusedNamingTheLog).
 TEST(LogInput, PosesTooFarApartNameTheLogAndTheExtremeScans) {
   TempDir dir;
-  // Line 1: the first scan; line 2: near; line 3: 10^7 m away in x; line 4: 10^6 m in y.
+  // Line 1: the first scan; line 2: near; line 3: 10^9 m away in x; line 4: 10^6 m in y.
   const std::string log =
-      write(dir, "far.log", flaser(0, 0, 1) + flaser(1, 1, 2) + flaser(1e7, 0, 3) + flaser(0, 1e6, 4));
+      write(dir, "far.log", flaser(0, 0, 1) + flaser(1, 1, 2) + flaser(1e9, 0, 3) + flaser(0, 1e6, 4));
   try {
     load(log);
     FAIL() << "no error";
@@ -117,8 +120,12 @@ TEST(LogInput, PosesTooFarApartNameTheLogAndTheExtremeScans) {
     const std::string what = e.what();
     EXPECT_EQ(e.file(), log);
     EXPECT_NE(what.find("from the scan at line 1 to line 3 in x and line 4 in y"), std::string::npos) << what;
-    EXPECT_NE(what.find("too large"), std::string::npos) << what;
+    EXPECT_NE(what.find("too large (each side at most 2147482624 cells)"), std::string::npos) << what;
   }
+  // 10^7 m: sides of 8 * 10^8 and 8 * 10^7 cells, which an int holds: sized.
+  const std::string far = write(dir, "far7.log", flaser(0, 0, 1) + flaser(1e7, 0, 2) + flaser(0, 1e6, 3));
+  const LogInput in = load(far);
+  EXPECT_GT(in.geo.num_cells(), uint64_t(1) << 55);
 }
 
 }  // namespace

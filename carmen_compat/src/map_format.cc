@@ -1,6 +1,8 @@
 // The map-format table (map_format.h) and its readers and writers.
 #include "carmen_compat/map_format.h"
 
+#include <climits>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 
@@ -39,7 +41,22 @@ MapFile carmen_file_of(const MapToWrite &m) {
   return mf;
 }
 
+// The most cells a GRIDMAP chunk holds: its size field is an int32 counting
+// the 10-byte description, the 12-byte header (sizes, resolution) and 4
+// bytes a cell, so a chunk stops short of 2 GiB: 536870906 cells (about
+// 23170 x 23170). A larger map is refused, naming the file, before any of it
+// is written.
+constexpr uint64_t kMaxCarmenMapCells = (static_cast<uint64_t>(INT32_MAX) - 10 - 12) / 4;
+
 void write_carmen(OutputTransaction &tx, const std::string &path, const MapToWrite &m) {
+  const uint64_t cells = static_cast<uint64_t>(m.grid.size_x) * static_cast<uint64_t>(m.grid.size_y);
+  if (cells > kMaxCarmenMapCells)
+    throw FileError(path,
+                    "a map of " + std::to_string(m.grid.size_x) + " x " + std::to_string(m.grid.size_y) + " = " +
+                        std::to_string(cells) + " cells does not fit a CARMEN map: its GRIDMAP chunk holds at most " +
+                        std::to_string(kMaxCarmenMapCells) +
+                        " cells (2 GiB); write a .pgm instead, or finish at a larger vasco_downsample",
+                    ErrorCode::TooLarge);
   write_map_file(tx.add(path), carmen_file_of(m));
 }
 

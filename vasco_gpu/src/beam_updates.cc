@@ -97,7 +97,7 @@ Walker::Walker(const egrid::LineParams &p, int k_max, const Box &box, int size_y
   rem_ = two_b_ * k_ + a_minus_c_ - two_a_ * m_;
   int cx, cy;
   egrid::line_cell(p, static_cast<int>(k_lo), &cx, &cy);
-  index_ = static_cast<int64_t>(cx) * size_y + cy;
+  index_ = egrid::cell_index(cx, cy, size_y);
   major_step_ = p.steep ? p.inc : static_cast<int64_t>(p.inc) * size_y;
   diagonal_step_ = major_step_ + (p.steep ? static_cast<int64_t>(minor_sign) * size_y : minor_sign);
 }

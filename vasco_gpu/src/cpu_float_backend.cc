@@ -307,7 +307,9 @@ uint64_t add_walked_beam(const EvidenceTable &ev, int x1, int y1, int x2, int y2
 
 class CpuFloatRenderer : public HostGridRenderer {
  public:
-  CpuFloatRenderer() : HostGridRenderer("cpu_float", false) {}
+  // The call's sums cover the cells its scans reach, about the whole grid for
+  // a full render: sizeof(Sum) a cell besides the grid, for the budget.
+  CpuFloatRenderer() : HostGridRenderer("cpu_float", false, sizeof(Sum)) {}
 
   void apply_to(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
                 const GridGeometry &geo, float *cells, MapStats *stats) override {

@@ -131,7 +131,7 @@ uint64_t walk_degenerate(const Context &c, const Beam &b, const oracle::ScanStar
     const double d = oracle::table_distance(i, j, c.table_size, nullptr, c.resolution);
     if (!egrid::sensor_model(c.model, d, b.range, &p)) return false;
     if (cx >= xa && cx < xb) {
-      float &cell = c.cells[static_cast<size_t>(cx) * static_cast<size_t>(c.size_y) + cy];
+      float &cell = c.cells[egrid::cell_index(cx, cy, c.size_y)];
       cell = egrid::odds_update(cell, c.model.prior, p);
       ++updates;
     }

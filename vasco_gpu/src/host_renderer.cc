@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "vasco_gpu/internal/egrid_math.h"
+
 namespace vasco {
 
 void HostGridRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
@@ -21,7 +23,7 @@ FinishedMap HostGridRenderer::finish(int downsample, int border) {
 std::vector<float> HostGridRenderer::read(const GridWindow &w) {
   std::vector<float> out(static_cast<size_t>(w.width) * static_cast<size_t>(w.height));
   for (int x = 0; x < w.width; ++x) {
-    const float *col = cells_.data() + static_cast<size_t>(w.x0 + x) * geo_.size_y + w.y0;
+    const float *col = cells_.data() + egrid::cell_index(w.x0 + x, w.y0, geo_.size_y);
     std::copy(col, col + w.height, out.begin() + static_cast<size_t>(x) * w.height);
   }
   return out;

@@ -4,7 +4,9 @@
 #ifndef VASCO_GPU_SRC_HOST_RENDERER_H
 #define VASCO_GPU_SRC_HOST_RENDERER_H
 
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vasco_gpu/backend.h"
@@ -14,10 +16,14 @@ namespace vasco {
 
 class HostGridRenderer : public Renderer {
  public:
-  HostGridRenderer(std::string name, bool exact) : name_(std::move(name)), exact_(exact) {}
+  // `scratch_bytes_per_cell`: what the backend keeps per cell of the grid
+  // besides the grid's own 4-byte floats (cpu_float's sums), for the
+  // session's memory budget.
+  HostGridRenderer(std::string name, bool exact, double scratch_bytes_per_cell = 0)
+      : name_(std::move(name)), exact_(exact), scratch_bytes_per_cell_(scratch_bytes_per_cell) {}
 
   std::string name() const override { return name_; }
-  RendererTraits traits() const override { return {exact_, false}; }
+  RendererTraits traits() const override { return {exact_, false, sizeof(float) + scratch_bytes_per_cell_, 0}; }
 
   void reset(const GridGeometry &geo, const MapperParams &params) override;
   void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) override;
@@ -33,6 +39,7 @@ class HostGridRenderer : public Renderer {
  private:
   std::string name_;
   bool exact_;
+  const double scratch_bytes_per_cell_;
   GridGeometry geo_;
   MapperParams params_;
   std::vector<float> cells_;

@@ -26,10 +26,10 @@ void check_window(const GridWindow &w, const GridGeometry &geo) {
 void check_fixed_frame(const GridGeometry &frame, const MapperParams &params) {
   if (frame.size_x <= 0 || frame.size_y <= 0)
     throw Error(ErrorCode::Usage, "Mapper: a fixed frame needs a size of at least 1 x 1 cells");
-  if (frame.num_cells() > kMaxGridCells)
+  if (frame.size_x > kMaxGridSide || frame.size_y > kMaxGridSide)
     throw Error(ErrorCode::TooLarge, "Mapper: a fixed frame of " + std::to_string(frame.size_x) + " x " +
                                          std::to_string(frame.size_y) + " cells is beyond the limit of " +
-                                         std::to_string(kMaxGridCells) + " cells");
+                                         std::to_string(kMaxGridSide) + " cells a side");
   if (frame.resolution != params.resolution)
     throw Error(ErrorCode::Usage, "Mapper: the frame's resolution differs from vasco_resolution");
   if (!std::isfinite(frame.theta_offset))
@@ -70,13 +70,27 @@ int64_t grown_size(int need, int current) {
   return 2 * std::max(half_need, half_now + half_now / 2) + 2;
 }
 
-// What the session keeps in host memory, estimated before it is allocated:
-// the grid (4 bytes a cell; CPU renderers), the stored scans (4 bytes a beam)
-// and a renderer's per-beam scratch (placement and stripe lists of the CPU
-// backends, the CUDA renderer's pinned staging: 64 bytes a beam at most).
-double memory_need(const GridGeometry &geo, uint64_t beams, bool grid_on_device) {
-  return (grid_on_device ? 0.0 : 4.0 * static_cast<double>(geo.num_cells())) + 68.0 * static_cast<double>(beams);
+// What the session keeps in host memory at most, estimated before it is
+// allocated (DESIGN §8, the README's table of bytes a cell):
+//  - per cell of the renderer's grid, what the renderer says it keeps in host
+//    memory (RendererTraits::host_bytes_per_cell: a host grid's 4-byte
+//    floats, cpu_float's 8-byte sums over the cells a call reaches; 0 for a
+//    grid on a GPU);
+//  - per cell, the finish at the session's downsample ds: the block means and
+//    the finished map, 4 bytes a block each (8 / ds^2 a cell; for a grid on a
+//    GPU, the pinned copy the map is downloaded into and the map);
+//  - per beam, the stored range (4 bytes) and a renderer's per-beam scratch
+//    (placement and stripe lists of the CPU backends, the CUDA renderers'
+//    pinned staging: 64 bytes at most).
+double session_memory_need(const GridGeometry &geo, uint64_t beams, const RendererTraits &traits, double downsample) {
+  const double ds = std::max(downsample, 1.0);
+  const double per_cell = std::max(traits.host_bytes_per_cell, 0.0) + 8.0 / (ds * ds);
+  return per_cell * static_cast<double>(geo.num_cells()) + 68.0 * static_cast<double>(beams);
 }
+
+// Cells a strip of a grown grid's finish reads at a time (finish_grid_by_columns):
+// 64 MiB of floats, or one block column when that is more.
+constexpr uint64_t kFinishStripCells = uint64_t(16) << 20;
 
 }  // namespace
 
@@ -110,8 +124,7 @@ GridGeometry Mapper::frame_for(const PoseExtent &extent, const ScanBatch &scans)
 // the size limit and the memory budget, else `need` itself.
 GridGeometry Mapper::grown_frame(const GridGeometry &need, uint64_t beams) const {
   const int64_t sx = grown_size(need.size_x, grid_.size_x), sy = grown_size(need.size_y, grid_.size_y);
-  if (sx >= INT32_MAX || sy >= INT32_MAX || static_cast<uint64_t>(sx) * static_cast<uint64_t>(sy) > kMaxGridCells)
-    return need;
+  if (sx > kMaxGridSide || sy > kMaxGridSide) return need;
   GridGeometry g = need;
   g.size_x = static_cast<int>(sx);
   g.size_y = static_cast<int>(sy);
@@ -144,20 +157,25 @@ std::string need_above(double need, double budget, int budget_decimals) {
 
 }  // namespace
 
+double Mapper::memory_need(const GridGeometry &geo, uint64_t beams) const {
+  return session_memory_need(geo, beams, renderer_->traits(), params_.downsample);
+}
+
 bool Mapper::fits_memory(const GridGeometry &geo, uint64_t beams) const {
-  return options_.max_memory_bytes == 0 ||
-         memory_need(geo, beams, renderer_->traits().grid_on_device) <= static_cast<double>(options_.max_memory_bytes);
+  return options_.max_memory_bytes == 0 || memory_need(geo, beams) <= static_cast<double>(options_.max_memory_bytes);
 }
 
 void Mapper::check_memory(const GridGeometry &geo, uint64_t beams) const {
   if (fits_memory(geo, beams)) return;
-  const double need = memory_need(geo, beams, renderer_->traits().grid_on_device);
+  const double need = memory_need(geo, beams);
   const uint64_t b = options_.max_memory_bytes;
   const int budget_decimals = b % (1 << 20) == 0 ? 0 : 2;
   const std::string budget = mebibytes(static_cast<double>(b), false, budget_decimals);
   std::ostringstream m;
-  m << "the map needs about " << need_above(need, static_cast<double>(b), budget_decimals) << " MiB of memory (a grid of " << geo.size_x
-    << " x " << geo.size_y << " cells at " << geo.resolution << " m and " << beams
+  const double per_cell = (need - 68.0 * static_cast<double>(beams)) / std::max(1.0, static_cast<double>(geo.num_cells()));
+  m << "the map needs about " << need_above(need, static_cast<double>(b), budget_decimals) << " MiB of memory (a grid of "
+    << geo.size_x << " x " << geo.size_y << " = " << geo.num_cells() << " cells at " << geo.resolution << " m, "
+    << std::setprecision(3) << per_cell << " bytes a cell on " << renderer_->name() << ", and " << beams
     << " beams), more than the budget of " << budget << " MiB: ";
   if (!options_.budget_hint.empty()) m << "raise it (" << options_.budget_hint << "), or ";
   m << "use a coarser vasco_resolution";
@@ -323,9 +341,16 @@ FinishedMap Mapper::finish(int downsample, int border) const {
   if (downsample < 1) throw Error(ErrorCode::Usage, "Mapper::finish: downsample must be at least 1");
   if (border < 0) throw Error(ErrorCode::Usage, "Mapper::finish: border must not be negative");
   if (grid_.size_x == geo_.size_x && grid_.size_y == geo_.size_y) return renderer_->finish(downsample, border);
-  // A grown grid: CARMEN's finish of the frame()'s window of it.
-  const std::vector<float> cells = read();
-  return finish_grid(cells.data(), geo_.size_x, geo_.size_y, geo_.resolution, downsample, border);
+  // A grown grid: CARMEN's finish of the frame()'s window of it, read a strip
+  // of columns at a time (no copy of the whole window in host memory).
+  const int dx = (grid_.size_x - geo_.size_x) / 2, dy = (grid_.size_y - geo_.size_y) / 2;
+  std::vector<float> strip;
+  const ColumnStrip columns = [&](int x0, int width) {
+    strip = renderer_->read(GridWindow{x0 + dx, dy, width, geo_.size_y});
+    return strip.data();
+  };
+  return finish_grid_by_columns(columns, geo_.size_x, geo_.size_y, geo_.resolution, downsample, border,
+                                kFinishStripCells);
 }
 
 std::vector<float> Mapper::read(const GridWindow &window) const {

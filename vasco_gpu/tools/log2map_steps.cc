@@ -178,8 +178,15 @@ void map_input(vasco::Mapper &mapper, const std::string &log, RunResult &r) {
   try {
     mapper.insert(std::move(r.input.batch));
   } catch (const carmen::Error &e) {
-    // Over the memory budget: the log's poses decide the grid, so name it.
-    if (e.code() == carmen::ErrorCode::OutOfMemory) throw carmen::FileError(log, e.what(), e.code());
+    // Over the memory budget (the host's, or a GPU's free memory): the log's
+    // poses decide the grid, so name it and the scans that stretch it (a bad
+    // pose far away reads as a grid no budget holds).
+    if (e.code() == carmen::ErrorCode::OutOfMemory) {
+      vasco::PoseExtent extent;
+      extent.add(r.input.batch, 0, r.input.batch.num_scans());  // given back by the failed insert
+      const std::string span = extent.scans > 0 ? "; " + vasco::pose_span_text(extent, r.input.batch) : "";
+      throw carmen::FileError(log, e.what() + span, e.code());
+    }
     throw;
   }
   r.stats = mapper.last_stats();

@@ -30,9 +30,17 @@ struct MapStats {
 enum class CudaMode { Float, Exact };
 
 // The host-memory budget of a mapping session by default: 2 GiB, which a
-// laptop has to spare (a 580 m square at 2.5 cm cells); a grid of 10^9 cells
-// (two scans 400 m apart) does not fit it and is refused before anything is
-// allocated.
+// laptop has to spare. There is no cap on a grid's cells: the budget is what
+// bounds a host grid (4.5 bytes a cell on cpu_double and cpu_threads at
+// vasco_downsample 4, 12.5 on cpu_float: a 546 m or a 327 m square at 2.5
+// cm), and a grid of 10^9 cells (two scans 400 m apart) is refused before
+// anything is allocated, naming the need and how to raise the budget. It
+// stays 2 GiB rather than a share of the machine's memory because what it
+// catches most is a bad pose (a scan kilometres off), where a refusal in
+// well under a second beats minutes of paging; a large site is mapped by
+// asking for it (log2map --max-memory, max_memory_bytes). A GPU's grid is
+// bounded by the device's free memory instead; the host then holds only
+// the finished map (0.5 bytes a cell at downsample 4).
 constexpr uint64_t kDefaultMaxMemoryBytes = uint64_t(2) << 30;
 
 // The most threads a session's cpu_threads may use (BackendOptions::threads,

@@ -2,6 +2,7 @@
 #ifndef VASCO_GPU_CUDA_BACKEND_H
 #define VASCO_GPU_CUDA_BACKEND_H
 
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -23,6 +24,10 @@ int cuda_visible_device_count();
 
 // The device's name and memory, for messages ("NVIDIA H100 80GB HBM3, 79 GiB").
 std::string cuda_device_description(int device);
+
+// The device's free and total memory now (cudaMemGetInfo on `device`, which
+// becomes the current device); false, and nothing set, when CUDA cannot say.
+bool cuda_memory_info(int device, size_t *free_bytes, size_t *total_bytes);
 
 class Renderer;
 // A mapping session's renderer on the GPU (vasco::Mapper with backend "cuda"):

@@ -3,8 +3,11 @@
 #ifndef VASCO_GPU_GRID_H
 #define VASCO_GPU_GRID_H
 
+#include <climits>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
 namespace vasco {
@@ -30,9 +33,16 @@ struct GridGeometry {
   double world_y(double gy) const { return (gy - size_y / 2.0) * resolution + y0; }
 };
 
-// Grids larger than this many cells are refused with a clear error rather
-// than allocated (4 GiB of floats).
-constexpr uint64_t kMaxGridCells = uint64_t(1) << 30;
+// The largest side of an evidence grid, in cells: 2^31 - 1024. Sizes are
+// int (CARMEN's map format has int sizes), and the GPU kernels round a side
+// up to whole tiles in int (side + 31), which this leaves room for. There is
+// no cap on the number of cells: every cell index and count is 64-bit
+// (size_x * size_y < 2^62), and a grid is limited by the memory it needs —
+// the session's host budget (BackendOptions::max_memory_bytes, checked by the
+// Mapper before anything is allocated) and, for a grid on a GPU, the
+// device's free memory when the grid is allocated. Both refusals name the
+// need.
+constexpr int kMaxGridSide = INT32_MAX - 1023;
 
 // How far the scans of a batch lie from its first scan: what the PROTOCOL
 // frame is sized by, kept up to date scan by scan by a mapping session.
@@ -48,11 +58,16 @@ struct PoseExtent {
   void add_pose(double x, double y, double theta, size_t index);
 };
 
+// How far a batch's poses spread, for messages about the grid they need:
+// "the poses span 798 m x 12 m (from the scan at line 1 to line 9 in x and
+// line 4 in y)", lines from batch.line (scan indices where it has none).
+std::string pose_span_text(const PoseExtent &extent, const ScanBatch &batch);
+
 // Sizes the grid for a batch (DESIGN §3 step 2): the PROTOCOL frame, the one
 // function log2map's input and every Mapper size their grid with. Throws
-// vasco::Error(BadInput) when the batch is empty, Error(TooLarge) when the
-// grid would be absurdly large (naming the source lines of the first and the
-// farthest scans).
+// vasco::Error(BadInput) when the batch is empty, Error(TooLarge) when a side
+// would pass kMaxGridSide (naming the source lines of the first and the
+// farthest scans). Whether the grid fits in memory is the Mapper's check.
 GridGeometry size_grid(const ScanBatch &batch, const MapperParams &params);
 GridGeometry size_grid(const PoseExtent &extent, const ScanBatch &batch, const MapperParams &params);
 
@@ -79,6 +94,16 @@ struct FinishedMap {
 // vasco::Error(Usage) for a downsample < 1 or border < 0.
 FinishedMap finish_grid(const float *cells, int size_x, int size_y, double resolution,
                         int downsample, int border);
+
+// The same finish of a grid read a strip of whole columns at a time:
+// columns(x0, width) returns columns [x0, x0 + width) (x-major, width *
+// size_y cells), valid until its next call. Asks for strips of about
+// `strip_cells` cells (at least one block column, downsample * size_y), so
+// that a grid kept elsewhere (a GPU, a grown session's window) is finished
+// without a copy of it in host memory. The same bytes as finish_grid.
+using ColumnStrip = std::function<const float *(int x0, int width)>;
+FinishedMap finish_grid_by_columns(const ColumnStrip &columns, int size_x, int size_y, double resolution,
+                                   int downsample, int border, uint64_t strip_cells);
 
 }  // namespace vasco
 

@@ -21,7 +21,7 @@
 // grid is that frame on the first insert and after every render(); an insert
 // whose scans leave the grid grows it, in each axis that must grow, to the
 // larger of what they need and 1.5 times the current half-width (falling back
-// to what they need where the margin would pass kMaxGridCells or the memory
+// to what they need where the margin would pass kMaxGridSide or the memory
 // budget), so n inserts of a robot driving away cost O(log n) full renders,
 // not n. Not in a session holding a beam whose end cell is 2^29 cells away or
 // more (a -inf or huge negative range: CARMEN's wrapping end cell depends on
@@ -79,7 +79,8 @@ class Mapper {
   // Fixed frame: `frame.size_x`, `size_y`, `resolution` (must equal
   // params.resolution) and `theta_offset` (finite) are used; x0 and y0 are
   // taken from the first scan. Error(Usage) for a bad frame, Error(TooLarge)
-  // beyond kMaxGridCells.
+  // for a side beyond kMaxGridSide (the memory it needs is checked by the
+  // first insert, against the budget then in force).
   Mapper(const MapperParams &params, const GridGeometry &frame, const std::string &backend,
          const BackendOptions &options = {});
   // PROTOCOL frame on a renderer of the caller's (a backend of its own).
@@ -90,7 +91,8 @@ class Mapper {
   // Error(BadInput) for a batch whose arrays disagree or a non-finite pose
   // (ScanBatch::validate_for_mapping, naming the scan), Error(TooLarge) when
   // the frame would be too large, Error(OutOfMemory) when the session would
-  // need more host memory than the budget. The && form takes the batch's
+  // need more host memory than the budget (memory_need()), or a GPU's grid
+  // more than the device has free. The && form takes the batch's
   // arrays instead of copying them into an empty session (given back on a
   // failure).
   void insert(const ScanBatch &scans);
@@ -118,6 +120,12 @@ class Mapper {
   // A new host-memory budget (0: none). Error(OutOfMemory), keeping the old
   // one, when the session already needs more.
   void set_max_memory_bytes(uint64_t bytes);
+  // The host memory, in bytes, the session needs at most with a grid of
+  // `geo` and `beams` stored beams: what inserts and renders check against
+  // the budget (the renderer's bytes a cell, RendererTraits, the finish at
+  // vasco_downsample, 68 bytes a beam). memory_need() is the current one.
+  double memory_need(const GridGeometry &geo, uint64_t beams) const;
+  double memory_need() const { return memory_need(grid_, scans_.num_beams()); }
 
   size_t num_scans() const { return scans_.num_scans(); }
   const ScanBatch &scans() const { return scans_; }

@@ -30,11 +30,16 @@ struct GridWindow {
 };
 
 // What a renderer is, for its users: whether its grid is CARMEN's bytes
-// (cpu_double's), and whether the grid lives in device memory (so the host
-// memory budget does not count it).
+// (cpu_double's), whether the grid lives in device memory (so the host
+// memory budget does not count it), and what it keeps per cell of its grid
+// at most, in host memory (what the Mapper's budget counts, with the finish
+// and the scans: Mapper::memory_need) and in device memory (what the GPU's
+// free memory must hold; checked when the grid is allocated).
 struct RendererTraits {
   bool exact = false;
   bool grid_on_device = false;
+  double host_bytes_per_cell = 4;    // a host grid's floats, and any per-cell scratch
+  double device_bytes_per_cell = 0;  // the grid and per-cell scratch on the device (the finish adds 8 / ds^2)
 };
 
 // Owns one evidence grid and applies scans to it with one backend.

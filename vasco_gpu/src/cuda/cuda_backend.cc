@@ -105,6 +105,17 @@ std::string cuda_device_description(int device) {
   return o.str();
 }
 
+bool cuda_memory_info(int device, size_t *free_bytes, size_t *total_bytes) {
+  size_t f = 0, t = 0;
+  if (cudaSetDevice(device) != cudaSuccess || cudaMemGetInfo(&f, &t) != cudaSuccess) {
+    (void)cudaGetLastError();
+    return false;
+  }
+  if (free_bytes != nullptr) *free_bytes = f;
+  if (total_bytes != nullptr) *total_bytes = t;
+  return true;
+}
+
 std::unique_ptr<Renderer> make_cuda_renderer(const BackendOptions &options, CUstream_st *stream) {
   std::string why;
   if (!cuda_usable(options.cuda_device, &why)) throw Error(ErrorCode::NoGpu, "no usable GPU: " + why);

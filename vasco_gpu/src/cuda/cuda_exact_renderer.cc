@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <string>
 
 #include "exact_pair_bound.h"
 #include "vasco_gpu/internal/beam_placement.h"
@@ -17,7 +18,37 @@ namespace vasco {
 
 using cuda_host::reserve;
 
-void CudaExactRenderer::reserve_grid(const GridGeometry &geo) { grow_grid(grid_, geo.num_cells()); }
+// kTile x kTile tiles of a grid, in 64 bits (sides up to kMaxGridSide).
+size_t CudaExactRenderer::tiles_of(const GridGeometry &geo) {
+  const int64_t tx = (static_cast<int64_t>(geo.size_x) + cuda::kTile - 1) / cuda::kTile;
+  const int64_t ty = (static_cast<int64_t>(geo.size_y) + cuda::kTile - 1) / cuda::kTile;
+  return static_cast<size_t>(tx) * static_cast<size_t>(ty);
+}
+
+// The grid's floats and, per tile, its list's bounds, the run order and the
+// order's sort keys and ids (six uint32) and the sort's scratch: about 4.5
+// bytes a cell. They are checked together against the device's free memory
+// and allocated with the grid, so that an apply never runs out of them.
+double CudaExactRenderer::device_bytes_per_cell() const {
+  return sizeof(float) + (6.0 * sizeof(uint32_t) + 2.0 * sizeof(uint32_t)) / (cuda::kTile * cuda::kTile);
+}
+
+void CudaExactRenderer::reserve_grid(const GridGeometry &geo) {
+  const size_t tiles = tiles_of(geo);
+  if (tiles > cuda::kMaxExactTiles)
+    throw Error(ErrorCode::TooLarge,
+                "cuda exact mode: a grid of " + std::to_string(geo.size_x) + " x " + std::to_string(geo.size_y) +
+                    " cells has " + std::to_string(tiles) + " tiles of " + std::to_string(cuda::kTile) + " x " +
+                    std::to_string(cuda::kTile) + " cells, more than the " + std::to_string(cuda::kMaxExactTiles) +
+                    " its tile ids and its launch can count; use cuda float mode or a CPU backend");
+  const size_t order_tmp = std::max<size_t>(cuda::exact_order_temp_bytes(tiles), 1);
+  const auto per_tile = {&tile_begin_, &tile_end_, &order_, &order_keys_, &order_keys_out_, &order_ids_};
+  size_t scratch = cuda_host::growth_bytes(order_tmp_, order_tmp);
+  for (auto *b : per_tile) scratch += cuda_host::growth_bytes(*b, tiles);
+  grow_grid(grid_, geo, scratch);
+  for (auto *b : per_tile) reserve(*b, tiles);
+  reserve(order_tmp_, order_tmp);
+}
 
 void CudaExactRenderer::clear_grid() {
   cuda::launch_fill(grid_.get(), geo().num_cells(), egrid::kUnknown, stream());
@@ -80,11 +111,6 @@ uint64_t CudaExactRenderer::place_beams(const ScanBatch &scans, size_t first, si
   place_laid_out_beams(scans, geo(), params(), layout, 0, beams);
   for (size_t s = 0; s < scans_; ++s) staging_starts_[s] = {layout.starts[s].x1, layout.starts[s].y1};
   return cuda_host::exact_pair_bound(beams, beams_, layout.starts, params().table_size());
-}
-
-size_t CudaExactRenderer::num_tiles() const {
-  return static_cast<size_t>((geo().size_x + cuda::kTile - 1) / cuda::kTile) *
-         ((geo().size_y + cuda::kTile - 1) / cuda::kTile);
 }
 
 void CudaExactRenderer::reserve_scratch(uint64_t pair_bound, size_t tiles) {

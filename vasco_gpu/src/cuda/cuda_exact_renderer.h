@@ -20,10 +20,12 @@ class CudaExactRenderer final : public CudaRenderer {
   void clear_grid() override;
   void apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) override;
   cuda::GridCells cells() const override;
+  double device_bytes_per_cell() const override;
   void ensure_tables();
   void apply_launch(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
   uint64_t place_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
-  size_t num_tiles() const;
+  size_t num_tiles() const { return tiles_of(geo()); }
+  static size_t tiles_of(const GridGeometry &geo);
   void reserve_scratch(uint64_t pair_bound, size_t tiles);
   void launch_tile_lists(const cuda::KernelModel<double> &m, uint64_t pair_bound, size_t tiles, cudaStream_t s,
                          cuda_host::StageTimer &timer);

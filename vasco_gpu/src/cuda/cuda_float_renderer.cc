@@ -11,7 +11,11 @@ namespace vasco {
 
 using cuda_host::reserve;
 
-void CudaFloatRenderer::reserve_grid(const GridGeometry &geo) { grow_grid(sums_, geo.num_cells()); }
+// The sums are what the grid needs (8 bytes a cell); the y-major accumulator
+// (8 more) is taken only where it fits (across_scratch).
+void CudaFloatRenderer::reserve_grid(const GridGeometry &geo) { grow_grid(sums_, geo); }
+
+double CudaFloatRenderer::device_bytes_per_cell() const { return 2 * sizeof(unsigned long long); }
 
 void CudaFloatRenderer::clear_grid() {
   cuda::launch_float_clear(sums_.get(), geo().num_cells(), stream());
@@ -60,9 +64,15 @@ const int2 *CudaFloatRenderer::tables() {
 // render goes without it (the same sums), never refused for it.
 constexpr size_t kAcrossMinScans = 256;
 
+// The transpose that adds it to the sums is launched with a block per 32 x 32
+// cells and the y tiles in gridDim.y, which CUDA caps at 65535: a grid taller
+// than that goes without (float_kernels.cu's add_across launch would fail).
+constexpr int64_t kAcrossMaxSizeY = int64_t(65535) * 32;
+
 unsigned long long *CudaFloatRenderer::across_scratch(size_t num_scans) {
   const size_t cells = geo().num_cells();
   if (num_scans < kAcrossMinScans || cells == 0 || cuda_host::across_disabled()) return nullptr;
+  if (geo().size_y > kAcrossMaxSizeY) return nullptr;
   if (cells > across_.size()) {
     size_t free_b = 0, total_b = 0;
     VG_CUDA_CHECK(cudaMemGetInfo(&free_b, &total_b));

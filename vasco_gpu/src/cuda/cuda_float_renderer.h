@@ -24,6 +24,7 @@ class CudaFloatRenderer final : public CudaRenderer {
   void clear_grid() override;
   void apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) override;
   cuda::GridCells cells() const override;
+  double device_bytes_per_cell() const override;
   const int2 *tables();
   void stage_scan_records(const ScanBatch &scans, size_t first, size_t last);
   void launch_map(const int2 *tables, unsigned long long *across, size_t num_scans, MapStats *st);

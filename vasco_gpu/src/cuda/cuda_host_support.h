@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iomanip>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -44,6 +45,14 @@ inline void check_fits(size_t bytes, const char *what) {
     throw Error(ErrorCode::OutOfMemory, std::string("the map does not fit in GPU memory: ") + what + " needs " +
                                             mib(bytes) + ", " + mib(free_b) + " free of " + mib(total_b) +
                                             " (use a coarser vasco_resolution or a CPU backend)");
+}
+
+// "the evidence grid of 20000 x 20000 cells (8 bytes a cell)", for check_fits.
+inline std::string grid_description(const GridGeometry &geo, double bytes_per_cell) {
+  std::ostringstream s;
+  s << "the evidence grid of " << geo.size_x << " x " << geo.size_y << " cells (" << std::setprecision(3)
+    << bytes_per_cell << " bytes a cell)";
+  return s.str();
 }
 
 // VASCO_CUDA_NO_TABLES=1 computes every update in full, as grids too large
@@ -89,6 +98,13 @@ class StageTimer {
 // The size a buffer of `have` elements grows to for `n` (half as much again,
 // so that a session appending scans reallocates rarely).
 inline size_t grown_size(size_t have, size_t n) { return n > have ? std::max(n, have + have / 2) : have; }
+
+// The device memory reserve(b, n) would take beyond what b holds (it frees
+// the old buffer before allocating the grown one); 0 when b holds n already.
+template <class T>
+size_t growth_bytes(const cuda::DeviceBuffer<T> &b, size_t n) {
+  return n > b.size() ? (grown_size(b.size(), n) - b.size()) * sizeof(T) : 0;
+}
 
 // Grows a buffer to at least n elements; its contents are dropped.
 template <class Buffer>

@@ -77,7 +77,8 @@ FinishedMap CudaRenderer::finish(int downsample, int border) {
   require_grid("finish");
   select_device();
   const finish::Blocks blocks = finish::blocks_of(geo_.size_x, geo_.size_y, downsample);
-  reserve(blocks_, std::max<size_t>(static_cast<size_t>(blocks.count()), 1));
+  cuda_host::reserve_checked(blocks_, std::max<size_t>(static_cast<size_t>(blocks.count()), 1),
+                             "the finish's block means");
   reserve(known_, 1);
   reserve(staging_known_, 1);
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
@@ -91,7 +92,7 @@ FinishedMap CudaRenderer::finish(int downsample, int border) {
   const finish::Crop crop = finish::crop_of(staging_known_[0], blocks, border);
   FinishedMap m = finish::finished_frame(crop, geo_.resolution, downsample);
   const size_t n = static_cast<size_t>(crop.count());
-  reserve(finished_, std::max<size_t>(n, 1));
+  cuda_host::reserve_checked(finished_, std::max<size_t>(n, 1), "the finished map");
   cuda::launch_crop(blocks_.get(), blocks, crop, finished_.get(), stream_);
   const cuda::PinnedBuffer<float> &out = download(finished_.get(), n);
   m.cells.assign(out.get(), out.get() + n);
@@ -102,7 +103,7 @@ std::vector<float> CudaRenderer::read(const GridWindow &w) {
   require_grid("read");
   select_device();
   const size_t n = static_cast<size_t>(w.width) * static_cast<size_t>(w.height);
-  reserve(window_, std::max<size_t>(n, 1));
+  cuda_host::reserve_checked(window_, std::max<size_t>(n, 1), "the window read");
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
   cuda::launch_read_window(cells(), geo_.size_y, w.x0, w.y0, w.width, w.height, window_.get(), stream_);
   const cuda::PinnedBuffer<float> &out = download(window_.get(), n);

@@ -14,6 +14,7 @@
 #ifndef VASCO_GPU_SRC_CUDA_RENDERER_H
 #define VASCO_GPU_SRC_CUDA_RENDERER_H
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,7 +30,7 @@ namespace vasco {
 class CudaRenderer : public Renderer {
  public:
   ~CudaRenderer() override;
-  RendererTraits traits() const override { return {exact_, true}; }
+  RendererTraits traits() const override { return {exact_, true, 0, device_bytes_per_cell()}; }
   void reset(const GridGeometry &geo, const MapperParams &params) final;
   void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) final;
   FinishedMap finish(int downsample, int border) final;
@@ -53,12 +54,22 @@ class CudaRenderer : public Renderer {
   virtual void apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) = 0;
   // The grid as finish and read see it.
   virtual cuda::GridCells cells() const = 0;
+  // Device memory the mode keeps per cell of its grid at most (the grid and
+  // its per-cell scratch; the README's table of bytes a cell).
+  virtual double device_bytes_per_cell() const = 0;
 
+  // Grows the grid to `cells` (dropping its contents), refused first by
+  // check_fits when the growth and `extra_bytes` (the mode's per-cell scratch
+  // allocated with it) would not fit in the device's free memory: the
+  // refusal names the grid, the bytes needed and the bytes free.
   template <class T>
-  void grow_grid(cuda::DeviceBuffer<T> &grid, size_t cells) {
+  void grow_grid(cuda::DeviceBuffer<T> &grid, const GridGeometry &geo, size_t extra_bytes = 0) {
+    const size_t cells = static_cast<size_t>(geo.num_cells());
+    const size_t growth = cuda_host::growth_bytes(grid, cells);
+    if (growth + extra_bytes == 0) return;
+    const double per_cell = sizeof(T) + static_cast<double>(extra_bytes) / std::max(1.0, static_cast<double>(cells));
+    cuda_host::check_fits(growth + extra_bytes, cuda_host::grid_description(geo, per_cell).c_str());
     if (cells <= grid.size()) return;
-    cuda_host::check_fits((cuda_host::grown_size(grid.size(), cells) - grid.size()) * sizeof(T),
-                          "the evidence grid");
     state_ = GridState::Lost;  // the reallocation drops the old grid
     cuda_host::reserve(grid, cells);
   }

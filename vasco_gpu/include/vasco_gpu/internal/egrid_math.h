@@ -35,6 +35,13 @@ constexpr double kFarDistance = 1e6;
 // Cell value meaning "unknown".
 constexpr float kUnknown = -1.0f;
 
+// Where cell (x, y) of an x-major grid of columns of size_y cells is:
+// x * size_y + y, in 64 bits (a grid may pass 2^31 cells; its sides are
+// ints, so the index is below 2^62). Every backend addresses its grid with it.
+VG_HD int64_t cell_index(int x, int y, int size_y) {
+  return static_cast<int64_t>(x) * static_cast<int64_t>(size_y) + static_cast<int64_t>(y);
+}
+
 // ---------------------------------------------------------------------------
 // Integer helpers with x86-64 semantics. CARMEN's C relies on them for
 // degenerate input (e.g. a range of -inf gives an end cell of INT_MIN, and

@@ -6,6 +6,7 @@
 #define VASCO_GPU_ORACLE_H
 
 #include <cmath>
+#include <cstdint>
 
 #include "vasco_gpu/internal/egrid_math.h"
 
@@ -106,7 +107,7 @@ inline long trace_beam(float *cells, int size_x, int size_y, int x1, int y1, int
     double p;
     if (!egrid::sensor_model(model, table_distance(i, j, table_size, distance_table, resolution), range, &p))
       return false;
-    float &cell = cells[static_cast<long>(cx) * size_y + cy];
+    float &cell = cells[egrid::cell_index(cx, cy, size_y)];
     cell = egrid::odds_update(cell, model.prior, p);
     ++updates;
     return true;
