@@ -80,6 +80,7 @@ struct LargeBackend {
   std::string factory;
   vasco::CudaMode mode = vasco::CudaMode::Float;
   bool gpu = false;
+  int split = 0;  // 2: each render split in two bands (GPUs 0 and 1, or twice GPU 0)
 };
 
 inline const std::vector<LargeBackend> &large_backends() {
@@ -88,7 +89,9 @@ inline const std::vector<LargeBackend> &large_backends() {
       {"cpu_threads", "cpu_threads", vasco::CudaMode::Float, false},
       {"cpu_float", "cpu_float", vasco::CudaMode::Float, false},
       {"cuda_float", "cuda", vasco::CudaMode::Float, true},
-      {"cuda_exact", "cuda", vasco::CudaMode::Exact, true}};
+      {"cuda_exact", "cuda", vasco::CudaMode::Exact, true},
+      {"cuda_float/2", "cuda", vasco::CudaMode::Float, true, 2},
+      {"cuda_exact/2", "cuda", vasco::CudaMode::Exact, true, 2}};
   return all;
 }
 
@@ -181,6 +184,7 @@ inline LargeRow run_large(const LargeBackend &b, const vasco::ScanBatch &scans, 
   try {
     vasco::BackendOptions o;
     o.cuda_mode = b.mode;
+    for (int i = 0; i < b.split; ++i) o.split_devices.push_back(i % std::max(vasco::cuda_device_count(), 1));
     o.threads = threads;
     vasco::Mapper m(params, b.factory, o);
     row.host_need = m.memory_need(geo, scans.num_beams());
@@ -274,15 +278,15 @@ inline int run_large_bench(const LargeOptions &opt) {
   std::vector<LargeBackend> chosen;
   const bool gpu = vasco::gpu_usable(0);
   if (opt.backends.empty()) {
-    for (const LargeBackend &b : large_backends())
-      if (!b.gpu || gpu) chosen.push_back(b);
+    for (const LargeBackend &b : large_backends())  // split rows by default where there are two GPUs
+      if ((!b.gpu || gpu) && (b.split == 0 || vasco::cuda_device_count() >= 2)) chosen.push_back(b);
   } else {
     for (const std::string &name : opt.backends) {
       const auto it = std::find_if(large_backends().begin(), large_backends().end(),
                                    [&](const LargeBackend &b) { return b.label == name; });
       if (it == large_backends().end()) {
         std::fprintf(stderr, "mapping_bench: --large-backends: unknown backend '%s' (known: cpu_double, "
-                             "cpu_threads, cpu_float, cuda_float, cuda_exact)\n", name.c_str());
+                             "cpu_threads, cpu_float, cuda_float, cuda_exact, cuda_float/2, cuda_exact/2)\n", name.c_str());
         return 2;
       }
       chosen.push_back(*it);

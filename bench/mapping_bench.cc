@@ -21,7 +21,10 @@
 // prints grid cells, scans, map and finish time and peak host and device
 // memory per backend (bench/large_bench.h).
 //
-//   mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset NAME]
+//   mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset NAME] [--split N]
+//
+// --split N adds the CUDA rows again with each render split in N bands of
+// columns over the GPUs there are (split_renderer.h; band i on GPU i % count).
 //   mapping_bench --large [--large-scans N] [--large-site M] [--large-res R,R..]
 //                 [--large-backends cpu_double,cpu_threads,cpu_float,cuda_float,cuda_exact] [--threads N]
 #include <sys/wait.h>
@@ -194,11 +197,12 @@ struct Options {
   int runs = 5, threads = 0;
   bool ablation = true;
   std::string only;  // --dataset: only this one
+  int split = 0;     // --split N: the CUDA rows again, each render split in N bands over the GPUs
   bench::LargeOptions large;  // --large and its options
 };
 
 constexpr const char *kUsage =
-    "usage: mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset fr079|fr101]\n"
+    "usage: mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset fr079|fr101] [--split N]\n"
     "       mapping_bench --large [--large-scans N] [--large-site METRES] [--large-res R[,R...]]\n"
     "                     [--large-backends cpu_double,cpu_threads,cpu_float,cuda_float,cuda_exact] [--threads N]\n";
 
@@ -212,6 +216,7 @@ bool parse_options(int argc, char **argv, Options *o) {
     else if (a == "--threads" && i + 1 < argc) o->threads = std::atoi(argv[++i]);
     else if (a == "--no-ablation") o->ablation = false;
     else if (a == "--dataset" && i + 1 < argc) o->only = argv[++i];
+    else if (a == "--split" && i + 1 < argc) o->split = std::max(0, std::min(64, std::atoi(argv[++i])));
     else if (a == "--large") o->large.on = true;
     else if (a == "--large-scans" && i + 1 < argc) o->large.site.scans = std::max(1L, std::atol(argv[++i]));
     else if (a == "--large-site" && i + 1 < argc) {
@@ -258,8 +263,17 @@ GpuInfo probe_gpu() {
   return g;
 }
 
-// The backends measured: the CPU ones, and both CUDA modes when a GPU is usable.
-std::vector<BackendSpec> backend_specs(bool gpu) {
+// Band i of a split render on GPU i % (the GPUs there are).
+std::vector<int> split_devices(int parts) {
+  const int count = std::max(vasco::cuda_device_count(), 1);
+  std::vector<int> devices;
+  for (int i = 0; i < parts; ++i) devices.push_back(i % count);
+  return devices;
+}
+
+// The backends measured: the CPU ones, and both CUDA modes when a GPU is
+// usable (again split in `split` bands, "cuda float/N", for split >= 2).
+std::vector<BackendSpec> backend_specs(bool gpu, int split) {
   std::vector<BackendSpec> specs = {{"cpu_double", "cpu_double", {}, false},
                                     {"cpu_threads", "cpu_threads", {}, false},
                                     {"cpu_float", "cpu_float", {}, false}};
@@ -268,6 +282,11 @@ std::vector<BackendSpec> backend_specs(bool gpu) {
     e.cuda_mode = vasco::CudaMode::Exact;
     specs.push_back({"cuda float", "cuda", f, true});
     specs.push_back({"cuda exact", "cuda", e, true});
+    if (split >= 2) {
+      f.split_devices = e.split_devices = split_devices(split);
+      specs.push_back({"cuda float/" + std::to_string(split), "cuda", f, true});
+      specs.push_back({"cuda exact/" + std::to_string(split), "cuda", e, true});
+    }
   }
   return specs;
 }
@@ -279,6 +298,13 @@ void print_header(const Options &opt, const GpuInfo &gpu) {
   if (gpu.usable) std::printf(" (CUDA context start-up %.0f ms, not in the rows)", gpu.init_s * 1e3);
   std::printf("\n");
   if (!gpu.usable) std::printf("No usable GPU: CPU rows only.\n");
+  if (gpu.usable && opt.split >= 2) {
+    const int count = std::max(vasco::cuda_device_count(), 1);
+    std::printf("cuda float/%d, cuda exact/%d: each render split in %d bands of columns over %d GPU%s%s\n", opt.split,
+                opt.split, opt.split, std::min(count, opt.split), std::min(count, opt.split) > 1 ? "s" : "",
+                count < opt.split ? " (bands sharing a GPU run one after another on it: the split's cost, not its gain)"
+                                  : "");
+  }
 }
 
 // Ablation results: "dataset / params" -> (variant, median map time) in the order run.
@@ -400,9 +426,9 @@ void bench_dataset(Bench *b, const Dataset &ds) {
 // The main table, one line per row, with the speed-ups over cpu_double and cpu_threads of the same data,
 // and its legend.
 void print_table(const std::vector<Row> &rows) {
-  const int width = 176;
+  const int width = 179;
   print_rule(width);
-  std::printf("%-6s %-17s %-11s %5s %8s %10s %7s %7s %7s %8s %8s %7s %6s %8s %9s %8s %8s\n", "data",
+  std::printf("%-6s %-17s %-14s %5s %8s %10s %7s %7s %7s %8s %8s %7s %6s %8s %9s %8s %8s\n", "data",
               "params", "backend", "scans", "beams", "updates", "parse", "prep", "upload", "map",
               "download", "finish", "write", "total", "Mupd/s", "x1core", "xthreads");
   print_rule(width);
@@ -413,7 +439,7 @@ void print_table(const std::vector<Row> &rows) {
         if (o.backend == "cpu_double") base = o.map;
         if (o.backend == "cpu_threads") threads_map = o.map;
       }
-    std::printf("%-6s %-17s %-11s %5llu %8llu %10llu %7s %7s %7s %8s %8s %7s %6s %8s %9.0f %8.1f %8.1f\n",
+    std::printf("%-6s %-17s %-14s %5llu %8llu %10llu %7s %7s %7s %8s %8s %7s %6s %8s %9.0f %8.1f %8.1f\n",
                 r.dataset.c_str(), r.params.c_str(), r.backend.c_str(), (unsigned long long)r.scans,
                 (unsigned long long)r.beams, (unsigned long long)r.updates, ms(r.parse).c_str(),
                 ms(r.prep).c_str(), ms(r.upload).c_str(), ms(r.map).c_str(), ms(r.download).c_str(),
@@ -491,7 +517,7 @@ int main(int argc, char **argv) {
   const std::vector<Dataset> datasets = bench_datasets();
   const GpuInfo gpu = probe_gpu();
   b.gpu = gpu.usable;
-  b.specs = backend_specs(gpu.usable);
+  b.specs = backend_specs(gpu.usable, b.opt.split);
   print_header(b.opt, gpu);
   for (const Dataset &ds : datasets) bench_dataset(&b, ds);
   print_table(b.rows);

@@ -26,6 +26,9 @@ struct KernelModel {
   Real resolution, wall;
   int table_size;      // (int)(max_range / resolution)
   int size_x, size_y;  // grid size in cells
+  // The grid holds columns [x_begin, x_begin + size_x) of the frame the
+  // scans are placed in (a band of a split render; 0 for a whole grid).
+  int x_begin;
   // Exact mode: within max_sure_range the evidence is occ or emp itself, so
   // cells with i*i + j*j < n_sure take one of these two factors, no table.
   int n_sure;

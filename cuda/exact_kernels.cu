@@ -25,12 +25,17 @@ namespace vasco {
 namespace cuda {
 namespace {
 
+// Whether (cx, cy) is one of the grid's cells: columns [x_begin, x_begin +
+// size_x) of the frame (a band of a split render, or all of them). In
+// unsigned arithmetic, defined for any cx: below size_x exactly for them.
 __device__ __forceinline__ bool inside(int cx, int cy, const KernelModel<double> &m) {
-  return cx >= 0 && cx < m.size_x && cy >= 0 && cy < m.size_y;
+  return static_cast<unsigned>(cx) - static_cast<unsigned>(m.x_begin) < static_cast<unsigned>(m.size_x) && cy >= 0 &&
+         cy < m.size_y;
 }
 
-__device__ __forceinline__ int tile_of(int cx, int cy, int tiles_y) {
-  return (cx / kTile) * tiles_y + cy / kTile;
+// The tile of a cell inside the grid; the grid's tiles start at x_begin.
+__device__ __forceinline__ int tile_of(int cx, int cy, const KernelModel<double> &m, int tiles_y) {
+  return ((cx - m.x_begin) / kTile) * tiles_y + cy / kTile;
 }
 
 // Calls visit(tile) once per tile whose cells inside the grid the walk visits
@@ -50,7 +55,7 @@ __device__ void for_each_tile(const LineRec &L, const KernelModel<double> &m, Vi
     int prev = -1;
     egrid::walk_line(L.x1, L.y1, L.x2, L.y2, L.k_max + 1, [&](int cx, int cy, int) {
       if (inside(cx, cy, m)) {
-        const int t = tile_of(cx, cy, tiles_y);
+        const int t = tile_of(cx, cy, m, tiles_y);
         if (t != prev) {
           visit(t);
           prev = t;
@@ -61,17 +66,22 @@ __device__ void for_each_tile(const LineRec &L, const KernelModel<double> &m, Vi
     return;
   }
   const bool steep = L.flags & kSteep, backward = L.flags & kBackward, flipped = L.flags & kFlipped;
+  // The grid's range of each coordinate: x from x_begin, y from 0.
+  const int maj_lo = steep ? 0 : m.x_begin, min_lo = steep ? m.x_begin : 0;
   const int size_maj = steep ? m.size_y : m.size_x, size_min = steep ? m.size_x : m.size_y;
-  // Steps whose major coordinate (sx1 +- k) is inside the grid.
-  const int k_lo = backward ? max(0, L.sx1 - (size_maj - 1)) : max(0, -L.sx1);
-  const int k_hi = backward ? min(L.k_max, L.sx1) : min(L.k_max, size_maj - 1 - L.sx1);
-  auto minor_at = [&](int k) {  // grid minor coordinate at step k (egrid_math.h line_cell)
+  // Steps whose major coordinate (sx1 +- k) is inside the grid (in 64 bits:
+  // a start cell can be anywhere an int reaches).
+  const int64_t to_lo = static_cast<int64_t>(L.sx1) - maj_lo, to_hi = maj_lo + int64_t(size_maj) - 1 - L.sx1;
+  const int64_t k_max = L.k_max, lo = backward ? -to_hi : -to_lo, hi = backward ? to_lo : to_hi;
+  const int k_lo = static_cast<int>(lo < 0 ? 0 : lo > k_max + 1 ? k_max + 1 : lo);
+  const int k_hi = static_cast<int>(hi > k_max ? k_max : hi < -1 ? -1 : hi);
+  auto minor_at = [&](int k) {  // the minor coordinate at step k (egrid_math.h line_cell), from min_lo
     const int off = (L.two_b * k + L.bias) / L.two_a;
     const int mn = backward ? L.sy1 - off : L.sy1 + off;
-    return flipped ? -mn : mn;
+    return (flipped ? -mn : mn) - min_lo;
   };
   for (int k = k_lo; k <= k_hi;) {
-    const int maj = backward ? L.sx1 - k : L.sx1 + k;
+    const int maj = (backward ? L.sx1 - k : L.sx1 + k) - maj_lo;
     const int tmaj = maj / kTile;
     const int k_end = min(k_hi, backward ? maj - tmaj * kTile + k : tmaj * kTile + kTile - 1 - maj + k);
     const int a = minor_at(k), b = minor_at(k_end);
@@ -203,7 +213,7 @@ __device__ void mark_chunk(const LineRec *sh, int n, int tx0, int ty0, unsigned 
   }
   if (mine && !closed) {  // rare (see kClosedFormLimit): the oracle's walk
     egrid::walk_line(L.x1, L.y1, L.x2, L.y2, L.k_max + 1, [&](int x, int y, int) {
-      const int u = x - tx0, v = y - ty0;
+      const int u = egrid::wrap_sub(x, tx0), v = egrid::wrap_sub(y, ty0);  // x, y: anywhere an int reaches
       if (u >= 0 && u < kTile && v >= 0 && v < kTile) atomicOr(&hit[2 * (u * kTile + v) + w], 1u << lane);
       return true;
     });
@@ -363,13 +373,14 @@ __global__ void __launch_bounds__(kTileThreads)
   }
   const int tiles_y = (m.size_y + kTile - 1) / kTile;
   const int tile = static_cast<int>(order[blockIdx.x]);
-  const int tx0 = (tile / tiles_y) * kTile, ty0 = (tile % tiles_y) * kTile;
+  const int tx0 = m.x_begin + (tile / tiles_y) * kTile, ty0 = (tile % tiles_y) * kTile;  // in the frame
   const int cx = tx0 + threadIdx.x / kTile;
   const int cy = ty0 + threadIdx.x % kTile;
   const bool active = inside(cx, cy, m);
+  const size_t index = static_cast<size_t>(cx - m.x_begin) * m.size_y + cy;  // active cells only
   // The grid holds the result of earlier scans (all unknown for a fresh map):
   // this launch's updates come after theirs, as in the oracle's order.
-  float cell = active ? grid[static_cast<size_t>(cx) * m.size_y + cy] : egrid::kUnknown;
+  float cell = active ? grid[index] : egrid::kUnknown;
   unsigned count = 0;
   FixedPoints fixed;
   StartFactors known;
@@ -386,7 +397,7 @@ __global__ void __launch_bounds__(kTileThreads)
     if (active) count += drain_hits(m, sh, mine, cx, cy, reach, factors, &fixed, &known, &cell);
     __syncthreads();
   }
-  if (active) grid[static_cast<size_t>(cx) * m.size_y + cy] = cell;
+  if (active) grid[index] = cell;
   const unsigned in_warp = warp_sum(count);
   if ((threadIdx.x & 31) == 0 && in_warp) atomicAdd(updates, static_cast<unsigned long long>(in_warp));
 }

@@ -6,8 +6,10 @@
 // Exact paths (cpu_double, cpu_threads/1, /2, /7, egrid_c_api, a mapping
 // session fed the scans in pieces then rendered again with its poses
 // (mapper/cpu_threads), egrid.h on a
-// cpu_threads session, and cuda_exact, mapper/cuda and egrid_c_api/cuda_exact
-// in exact mode when a GPU is usable) must give CARMEN's GRIDMAP payload
+// cpu_threads session, and cuda_exact, the same split in two bands
+// (cuda_exact/split: GPUs 0 and 1, or twice GPU 0), mapper/cuda,
+// mapper/cuda_split and egrid_c_api/cuda_exact in exact mode when a GPU is
+// usable) must give CARMEN's GRIDMAP payload
 // digest.
 // Float paths (cpu_float, cuda_float) and the session fed in pieces as it is
 // (mapper-grown/..., whose grown grid may round a boundary cell the other
@@ -69,6 +71,12 @@ std::vector<golden::Path> select_paths(const Options &opt, std::vector<golden::P
     all.emplace("mapper/cuda", golden::mapper_path("cuda", exact));
     float_names.push_back("mapper-grown/cuda");
     all.emplace("mapper-grown/cuda", golden::mapper_grown_path("cuda", exact));
+    exact_names.push_back("cuda_exact/split");
+    all.emplace("cuda_exact/split", golden::cuda_split_path());
+    exact_names.push_back("mapper/cuda_split");
+    golden::Path split_session = golden::mapper_path("cuda", golden::split_exact_options());
+    split_session.name = "mapper/cuda_split";
+    all.emplace("mapper/cuda_split", split_session);
     exact_names.push_back("egrid_c_api/cuda_exact");
     all.emplace("egrid_c_api/cuda_exact", golden::egrid_path("cuda_exact"));
   }
@@ -171,7 +179,8 @@ int main(int argc, char **argv) {
       std::fprintf(stderr,
                    "usage: golden_check [--golden DIR] [--data DIR] [--paths a,b,...] [--case SUBSTRING]\n"
                    "paths: cpu_double cpu_threads/1 cpu_threads/2 cpu_threads/7 egrid_c_api mapper/cpu_threads "
-                   "egrid_c_api/cpu_threads cuda_exact mapper/cuda egrid_c_api/cuda_exact cpu_float cuda_float "
+                   "egrid_c_api/cpu_threads cuda_exact cuda_exact/split mapper/cuda mapper/cuda_split "
+                   "egrid_c_api/cuda_exact cpu_float cuda_float "
                    "mapper-grown/cpu_threads mapper-grown/cuda\n");
       return 2;
     }

@@ -28,6 +28,15 @@ TEST_P(GoldenCuda, ExactModeMapperSessionMatchesCarmen) {
   golden::expect_golden(GetParam(), golden::mapper_path("cuda", exact));
 }
 
+TEST_P(GoldenCuda, ExactModeSplitInBandsMatchesCarmen) {
+  golden::expect_golden(GetParam(), golden::cuda_split_path());
+}
+
+TEST_P(GoldenCuda, ExactModeMapperSessionSplitInBandsMatchesCarmen) {
+  golden::Path p = golden::mapper_path("cuda", golden::split_exact_options());
+  golden::expect_golden(GetParam(), p);
+}
+
 TEST_P(GoldenCuda, ExactModeUnderCarmensApiMatchesCarmen) {
   golden::expect_golden(GetParam(), golden::egrid_path("cuda_exact"));
 }

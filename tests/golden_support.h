@@ -162,6 +162,17 @@ inline Path cuda_path(CudaMode mode) {
   return backend_path(mode == CudaMode::Exact ? "cuda_exact" : "cuda_float", "cuda", o);
 }
 
+// CUDA exact mode split in two bands (BackendOptions::split_devices): on
+// GPUs 0 and 1 where there are two, else both on GPU 0.
+inline BackendOptions split_exact_options() {
+  BackendOptions o;
+  o.cuda_mode = CudaMode::Exact;
+  o.split_devices = {0, cuda_device_count() >= 2 ? 1 : 0};
+  return o;
+}
+
+inline Path cuda_split_path() { return backend_path("cuda_exact/split", "cuda", split_exact_options()); }
+
 // Whether the CUDA backend can run here; `why` says why not.
 inline bool cuda_available(std::string *why) {
 #if defined(VASCO_HAVE_CUDA)

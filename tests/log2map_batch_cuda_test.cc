@@ -1,8 +1,8 @@
 // log2map's batch mode and --device on the GPU, run as a program: exact
 // mode's outputs are CARMEN's maps (the golden digests the project
 // carries), float mode's the same GRIDMAP as a one-log cuda run (float mode
-// is deterministic), and a --device that does not exist is refused naming
-// it. Skips without a usable GPU.
+// is deterministic), a render split across GPUs (--split-devices) writes the
+// one GPU's map, and a --device that does not exist is refused naming it. Skips without a usable GPU.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -79,6 +79,23 @@ TEST_F(Log2MapBatchCuda, SeveralMappersGiveTheOneMappersMaps) {
       EXPECT_EQ(map_file_digest(one + "/" + stem + ".map.gz"), map_file_digest(two + "/" + stem + ".map.gz"))
           << mode << " " << stem;
   }
+}
+
+// One render split in bands (--split-devices 0,0: two bands on GPU 0 where
+// there is one): exact mode writes CARMEN's map, float mode one GPU's.
+TEST_F(Log2MapBatchCuda, ASplitRenderWritesTheOneGpuMap) {
+  TempDir dir;
+  const std::string params = vasco::golden::carried_dir() + "/params/vasco_default_ds4.ini";
+  const ToolRun exact = log2map({"--backend", "cuda", "--cuda-mode", "exact", "--split-devices", "0,0", "--param-file",
+                                 params, "--quiet", kFr079, dir.file("exact.map.gz")});
+  ASSERT_EQ(exact.status, 0) << exact.output;
+  EXPECT_EQ(map_file_digest(dir.file("exact.map.gz")), carried_digest("fr079-complete.gfs__vasco_default_ds4"));
+  const ToolRun one = log2map({"--backend", "cuda", "--quiet", kFr079, dir.file("one.map.gz")});
+  const ToolRun split = log2map({"--backend", "cuda", "--split-devices", "0,0,0", "--quiet", kFr079,
+                                 dir.file("split.map.gz")});
+  ASSERT_EQ(one.status, 0) << one.output;
+  ASSERT_EQ(split.status, 0) << split.output;
+  EXPECT_EQ(map_file_digest(dir.file("one.map.gz")), map_file_digest(dir.file("split.map.gz")));
 }
 
 TEST_F(Log2MapBatchCuda, ADeviceThatDoesNotExistIsRefusedNamingIt) {

@@ -50,6 +50,12 @@ TEST(Log2Map, UsageErrorsExitTwo) {
   EXPECT_EQ(log2map({kIntel}).status, 2);
   EXPECT_EQ(log2map({"--no-such-flag", kIntel, dir.file("a.map")}).status, 2);
   EXPECT_EQ(log2map({"--backend", "gpu9000", kIntel, dir.file("a.map")}).status, 2);
+  // --split-devices: GPU numbers, one render (not a batch), not with --device.
+  const ToolRun split = log2map({"--split-devices", "0,x", kIntel, dir.file("a.map")});
+  EXPECT_EQ(split.status, 2);
+  EXPECT_TRUE(contains(split.output, "--split-devices '0,x'")) << split.output;
+  EXPECT_EQ(log2map({"--split-devices", "0,1", "--out-dir", dir.file("maps"), kIntel}).status, 2);
+  EXPECT_EQ(log2map({"--split-devices", "0,1", "--device", "0", kIntel, dir.file("a.map")}).status, 2);
   const ToolRun ext = log2map({kIntel, dir.file("a.jpeg")});
   EXPECT_EQ(ext.status, 2);
   EXPECT_TRUE(contains(ext.output, "a.jpeg")) << ext.output;

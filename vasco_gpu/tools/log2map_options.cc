@@ -43,6 +43,7 @@ void add_input_options(CLI::App &app, const ToolSpec &spec, Options &opt) {
 struct BatchText {
   std::string formats = "map.gz";
   std::string devices;
+  std::string split_devices;  // not batch mode: one render's GPUs
 };
 
 void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchText &raw) {
@@ -58,10 +59,15 @@ void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchT
                  "batch mode: the GPUs to map on, a mapper each, e.g. 0,1 (a GPU named twice runs two mappers on it; "
                  "default: every usable GPU)")
       ->type_name("LIST");
+  app.add_option("--split-devices", raw.split_devices,
+                 "one map rendered across GPUs, the grid's columns in a band on each, e.g. 0,1: the same bytes as one "
+                 "GPU (a GPU named twice holds two bands; cuda only, not with --out-dir)")
+      ->type_name("LIST");
 }
 
-// "0,1,1": the GPUs of --devices, each a whole number (repeats allowed).
-std::vector<int> parse_devices(const std::string &text) {
+// "0,1,1": the GPUs of --devices or --split-devices (`option`), each a
+// whole number (repeats allowed).
+std::vector<int> parse_devices(const std::string &text, const char *option) {
   std::vector<int> devices;
   size_t start = 0;
   while (start <= text.size()) {
@@ -70,7 +76,8 @@ std::vector<int> parse_devices(const std::string &text) {
     int v = -1;
     const auto r = std::from_chars(d.data(), d.data() + d.size(), v);
     if (d.empty() || r.ec != std::errc() || r.ptr != d.data() + d.size() || v < 0 || devices.size() >= 64)
-      throw Error(ErrorCode::Usage, "--devices '" + text + "': expected GPU numbers such as 0,1 (at most 64)");
+      throw Error(ErrorCode::Usage,
+                  std::string(option) + " '" + text + "': expected GPU numbers such as 0,1 (at most 64)");
     devices.push_back(v);
     start = comma + 1;
   }
@@ -204,6 +211,12 @@ std::vector<std::string> parse_formats(const std::string &text) {
 void finish_batch_options(const CLI::App &app, const BatchText &raw, Options &opt) {
   const bool batch_only = app.count("--formats") || app.count("--fail-fast") || app.count("--jobs") ||
                           app.count("--devices");
+  if (app.count("--split-devices")) {
+    if (!opt.out_dir.empty())
+      throw Error(ErrorCode::Usage, "--split-devices splits one render: not with --out-dir (--devices spreads a batch)");
+    if (app.count("--device")) throw Error(ErrorCode::Usage, "--device and --split-devices: give one of them");
+    opt.split_devices = parse_devices(raw.split_devices, "--split-devices");
+  }
   if (opt.out_dir.empty()) {
     if (batch_only)
       throw Error(ErrorCode::Usage, "--formats, --fail-fast, --jobs and --devices go with --out-dir DIR");
@@ -215,7 +228,7 @@ void finish_batch_options(const CLI::App &app, const BatchText &raw, Options &op
   opt.formats = parse_formats(raw.formats);
   if (app.count("--devices")) {
     if (opt.device_given) throw Error(ErrorCode::Usage, "--device and --devices: give one of them");
-    opt.devices = parse_devices(raw.devices);
+    opt.devices = parse_devices(raw.devices, "--devices");
   }
   opt.inputs.push_back(opt.log);
   opt.inputs.insert(opt.inputs.end(), opt.outputs.begin(), opt.outputs.end());
@@ -268,6 +281,8 @@ void warn_about_idle_options(const CLI::App &app, Options &opt) {
     opt.warnings.push_back("--device does nothing with --backend " + opt.backend);
   if (app.count("--devices") && cpu)
     opt.warnings.push_back("--devices does nothing with --backend " + opt.backend);
+  if (app.count("--split-devices") && cpu)
+    opt.warnings.push_back("--split-devices does nothing with --backend " + opt.backend);
   if (app.count("--threads") && (opt.backend == "cpu_double" || opt.backend == "cpu_float" || opt.backend == "cuda"))
     opt.warnings.push_back("--threads does nothing with --backend " + opt.backend + " (only cpu_threads and auto use it)");
   if (app.count("--robot") && opt.param_file.empty())

@@ -29,6 +29,7 @@ struct Options {
   int device = 0;
   bool device_given = false;  // --device N: that GPU alone, also in a batch
   std::vector<int> devices;   // --devices LIST (batch): a mapper on each; empty: every usable GPU
+  std::vector<int> split_devices;  // --split-devices LIST: one render in bands across them
   std::string param_file;
   std::string robot;
   std::string backend = "auto";

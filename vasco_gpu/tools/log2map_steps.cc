@@ -85,7 +85,8 @@ vasco::BackendOptions backend_options(const Options &opt) {
   vasco::BackendOptions bopt;
   bopt.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
   bopt.threads = opt.threads;
-  bopt.cuda_device = opt.device;
+  bopt.cuda_device = opt.split_devices.empty() ? opt.device : opt.split_devices[0];
+  bopt.split_devices = opt.split_devices;
   bopt.max_memory_bytes = opt.max_memory_bytes;
   bopt.budget_hint = "--max-memory MiB";
   return bopt;

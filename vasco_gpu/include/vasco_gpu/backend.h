@@ -53,6 +53,10 @@ struct BackendOptions {
   CudaMode cuda_mode = CudaMode::Float;
   int threads = 0;   // cpu_threads: 0 = all cores, at most kMaxThreads
   int cuda_device = 0;
+  // cuda: one render split across these devices, two or more (the grid's
+  // columns in bands, one a device; a device may repeat). Bit-identical to
+  // one device's render in both modes. Empty: one device, cuda_device.
+  std::vector<int> split_devices;
   uint64_t max_memory_bytes = kDefaultMaxMemoryBytes;  // host memory a Mapper may use (0: no limit)
   // How the caller raises max_memory_bytes, as a refusal names it ("log2map
   // --max-memory MiB", "vasco_mapper_set_max_memory"); empty: not named.

@@ -13,6 +13,7 @@
 #include "cuda_exact_renderer.h"
 #include "cuda_float_renderer.h"
 #include "egrid_kernels.h"
+#include "split_renderer.h"
 #include "vasco_gpu/error.h"
 
 namespace vasco {
@@ -117,10 +118,18 @@ bool cuda_memory_info(int device, size_t *free_bytes, size_t *total_bytes) {
 }
 
 std::unique_ptr<Renderer> make_cuda_renderer(const BackendOptions &options, CUstream_st *stream) {
+  if (options.split_devices.size() > 1) {
+    if (stream != nullptr)
+      throw Error(ErrorCode::Usage, "a split render has a stream per device: it takes no caller's stream");
+    return make_split_renderer(options);
+  }
+  BackendOptions one = options;
+  if (one.split_devices.size() == 1) one.cuda_device = one.split_devices[0];
+  one.split_devices.clear();
   std::string why;
-  if (!cuda_usable(options.cuda_device, &why)) throw Error(ErrorCode::NoGpu, "no usable GPU: " + why);
-  if (options.cuda_mode == CudaMode::Exact) return std::make_unique<CudaExactRenderer>(options, stream);
-  return std::make_unique<CudaFloatRenderer>(options, stream);
+  if (!cuda_usable(one.cuda_device, &why)) throw Error(ErrorCode::NoGpu, "no usable GPU: " + why);
+  if (one.cuda_mode == CudaMode::Exact) return std::make_unique<CudaExactRenderer>(one, stream);
+  return std::make_unique<CudaFloatRenderer>(one, stream);
 }
 
 }  // namespace vasco

@@ -51,7 +51,7 @@ void CudaExactRenderer::reserve_grid(const GridGeometry &geo) {
 }
 
 void CudaExactRenderer::clear_grid() {
-  cuda::launch_fill(grid_.get(), geo().num_cells(), egrid::kUnknown, stream());
+  cuda::launch_fill(grid_.get(), grid_geo().num_cells(), egrid::kUnknown, stream());
 }
 
 cuda::GridCells CudaExactRenderer::cells() const {
@@ -68,7 +68,7 @@ void CudaExactRenderer::ensure_tables() {
   tables_key_.ensure(params(), [&] {
     reserve(factors_, static_cast<size_t>(T) * static_cast<size_t>(T));
     reserve(reach_, static_cast<size_t>(T));
-    cuda::launch_exact_tables(kernel_model_of<double>(params(), geo()), factors_.get(), reach_.get(), stream());
+    cuda::launch_exact_tables(kernel_model_of<double>(params(), grid_geo()), factors_.get(), reach_.get(), stream());
   });
 }
 
@@ -110,6 +110,8 @@ uint64_t CudaExactRenderer::place_beams(const ScanBatch &scans, size_t first, si
   PlacedBeam *beams = staging_beams_.get();
   place_laid_out_beams(scans, geo(), params(), layout, 0, beams);
   for (size_t s = 0; s < scans_; ++s) staging_starts_[s] = {layout.starts[s].x1, layout.starts[s].y1};
+  // The bound counts tile borders crossed in the frame; a band starts on a
+  // tile border (split_renderer.h), so it holds for a band's tiles too.
   return cuda_host::exact_pair_bound(beams, beams_, layout.starts, params().table_size());
 }
 
@@ -163,7 +165,7 @@ void CudaExactRenderer::launch_tile_lists(const cuda::KernelModel<double> &m, ui
 // Allocates every scratch buffer first; the grid changes only in the tiles
 // kernel.
 void CudaExactRenderer::launch_apply(uint64_t pair_bound, MapStats *st) {
-  const cuda::KernelModel<double> m = kernel_model_of<double>(params(), geo());
+  const cuda::KernelModel<double> m = kernel_model_of<double>(params(), grid_geo(), band_x0());
   const size_t tiles = num_tiles();
   reserve_scratch(pair_bound, tiles);
   PhaseEvents &ev = events();

@@ -24,7 +24,7 @@ class CudaExactRenderer final : public CudaRenderer {
   void ensure_tables();
   void apply_launch(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
   uint64_t place_beams(const ScanBatch &scans, size_t first, size_t last, MapStats *st);
-  size_t num_tiles() const { return tiles_of(geo()); }
+  size_t num_tiles() const { return tiles_of(grid_geo()); }
   static size_t tiles_of(const GridGeometry &geo);
   void reserve_scratch(uint64_t pair_bound, size_t tiles);
   void launch_tile_lists(const cuda::KernelModel<double> &m, uint64_t pair_bound, size_t tiles, cudaStream_t s,

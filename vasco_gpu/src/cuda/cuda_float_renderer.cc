@@ -18,7 +18,7 @@ void CudaFloatRenderer::reserve_grid(const GridGeometry &geo) { grow_grid(sums_,
 double CudaFloatRenderer::device_bytes_per_cell() const { return 2 * sizeof(unsigned long long); }
 
 void CudaFloatRenderer::clear_grid() {
-  cuda::launch_float_clear(sums_.get(), geo().num_cells(), stream());
+  cuda::launch_float_clear(sums_.get(), grid_geo().num_cells(), stream());
   beams_ = 0;
 }
 
@@ -36,10 +36,16 @@ void CudaFloatRenderer::check_capacity(uint64_t beams) const {
                                          "use the exact mode or a CPU backend for this log");
 }
 
+// The kernels' model of the grid: the band's cells, the scans placed in the
+// whole frame.
+cuda::KernelModel<float> CudaFloatRenderer::model() const {
+  return kernel_model_of<float>(params(), grid_geo(), band_x0());
+}
+
 cuda::GridCells CudaFloatRenderer::cells() const {
   cuda::GridCells c;
   c.sums = sums_.get();
-  c.logodds_prior = kernel_model_of<float>(params(), geo()).logodds_prior;
+  c.logodds_prior = model().logodds_prior;
   return c;
 }
 
@@ -50,7 +56,7 @@ const int2 *CudaFloatRenderer::tables() {
   if (T <= 0 || T > cuda::kMaxFloatTable || cuda_host::tables_disabled()) return nullptr;
   increments_key_.ensure(params(), [&] {
     reserve(increments_, static_cast<size_t>(T) * static_cast<size_t>(T));
-    cuda::launch_float_tables(kernel_model_of<float>(params(), geo()), increments_.get(), stream());
+    cuda::launch_float_tables(model(), increments_.get(), stream());
   });
   return increments_.get();
 }
@@ -70,9 +76,9 @@ constexpr size_t kAcrossMinScans = 256;
 constexpr int64_t kAcrossMaxSizeY = int64_t(65535) * 32;
 
 unsigned long long *CudaFloatRenderer::across_scratch(size_t num_scans) {
-  const size_t cells = geo().num_cells();
+  const size_t cells = grid_geo().num_cells();
   if (num_scans < kAcrossMinScans || cells == 0 || cuda_host::across_disabled()) return nullptr;
-  if (geo().size_y > kAcrossMaxSizeY) return nullptr;
+  if (grid_geo().size_y > kAcrossMaxSizeY) return nullptr;
   if (cells > across_.size()) {
     size_t free_b = 0, total_b = 0;
     VG_CUDA_CHECK(cudaMemGetInfo(&free_b, &total_b));
@@ -138,7 +144,7 @@ void CudaFloatRenderer::launch_map(const int2 *increments, unsigned long long *a
                                 cudaMemcpyHostToDevice, s));
   VG_CUDA_CHECK(cudaMemsetAsync(counters_.get(), 0, 3 * sizeof(unsigned long long), s));
   ev.uploaded.record(s);
-  cuda::launch_float_map(kernel_model_of<float>(params(), geo()), increments, scan_records_.get(),
+  cuda::launch_float_map(model(), increments, scan_records_.get(),
                          static_cast<int>(n), ranges_.get(), sums_.get(), across, counters_.get(), s);
   ev.mapped.record(s);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), counters_.get(), 3 * sizeof(unsigned long long),

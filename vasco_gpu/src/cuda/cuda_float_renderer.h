@@ -24,6 +24,7 @@ class CudaFloatRenderer final : public CudaRenderer {
   void clear_grid() override;
   void apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) override;
   cuda::GridCells cells() const override;
+  cuda::KernelModel<float> model() const;
   double device_bytes_per_cell() const override;
   const int2 *tables();
   void stage_scan_records(const ScanBatch &scans, size_t first, size_t last);

@@ -126,8 +126,9 @@ void reserve_checked(cuda::DeviceBuffer<T> &b, size_t n, const char *what) {
 // The kernels' model for a grid in their mode's precision (double: exact
 // mode, float: float mode), with both modes' derived constants.
 template <class Real>
-cuda::KernelModel<Real> kernel_model_of(const MapperParams &p, const GridGeometry &geo) {
+cuda::KernelModel<Real> kernel_model_of(const MapperParams &p, const GridGeometry &geo, int x_begin = 0) {
   cuda::KernelModel<Real> m{};
+  m.x_begin = x_begin;
   m.sensor = sensor_model_of<Real>(p);
   m.resolution = static_cast<Real>(p.resolution);
   m.wall = static_cast<Real>(p.wall_size);

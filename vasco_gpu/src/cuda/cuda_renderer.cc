@@ -37,11 +37,26 @@ void CudaRenderer::require_grid(const char *call) const {
 // Check and allocate (the mode's reserve_grid), then commit: a refusal
 // changes neither the frame nor the grid.
 void CudaRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
+  reset_band(geo, params, ColumnBand{0, geo.size_x});
+}
+
+void CudaRenderer::reset_band(const GridGeometry &geo, const MapperParams &params, ColumnBand band) {
+  const bool whole = band.x0 == 0 && band.width == geo.size_x;
+  if (band.x0 < 0 || band.width < 0 || band.width > geo.size_x - band.x0 ||
+      (!whole && geo.size_x > kMaxBandedSide))
+    throw Error(ErrorCode::Internal, "a band of columns [" + std::to_string(band.x0) + ", +" +
+                                         std::to_string(band.width) + ") of a grid " + std::to_string(geo.size_x) +
+                                         " cells wide (a bug)");
   select_device();
-  reserve_grid(geo);
+  GridGeometry grid = geo;
+  grid.size_x = band.width;
+  reserve_grid(grid);
   geo_ = geo;
+  grid_geo_ = grid;
+  band_x0_ = band.x0;
   params_ = params;
   state_ = GridState::Lost;  // until it is cleared
+  blocks_ds_ = 0;
   clear_grid();
   state_ = GridState::Valid;
 }
@@ -75,8 +90,18 @@ cuda::PinnedBuffer<float> &CudaRenderer::download(const float *device, size_t n)
 FinishedMap CudaRenderer::finish(int downsample, int border) {
   finish::check_arguments(downsample, border);
   require_grid("finish");
+  const finish::KnownBox known = finish_blocks(downsample);
+  const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, downsample);
+  const finish::Crop crop = finish::crop_of(known, blocks, border);
+  FinishedMap m = finish::finished_frame(crop, grid_geo_.resolution, downsample);
+  m.cells = read_blocks(crop);
+  return m;
+}
+
+finish::KnownBox CudaRenderer::finish_blocks(int downsample) {
+  require_grid("finish");
   select_device();
-  const finish::Blocks blocks = finish::blocks_of(geo_.size_x, geo_.size_y, downsample);
+  const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, downsample);
   cuda_host::reserve_checked(blocks_, std::max<size_t>(static_cast<size_t>(blocks.count()), 1),
                              "the finish's block means");
   reserve(known_, 1);
@@ -85,18 +110,25 @@ FinishedMap CudaRenderer::finish(int downsample, int border) {
   staging_known_[0] = finish::KnownBox{};
   VG_CUDA_CHECK(cudaMemcpyAsync(known_.get(), staging_known_.get(), sizeof(finish::KnownBox),
                                 cudaMemcpyHostToDevice, stream_));
-  cuda::launch_finish_blocks(cells(), geo_.size_x, geo_.size_y, downsample, blocks_.get(), known_.get(), stream_);
+  cuda::launch_finish_blocks(cells(), grid_geo_.size_x, grid_geo_.size_y, downsample, blocks_.get(), known_.get(),
+                             stream_);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_known_.get(), known_.get(), sizeof(finish::KnownBox),
                                 cudaMemcpyDeviceToHost, stream_));
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
-  const finish::Crop crop = finish::crop_of(staging_known_[0], blocks, border);
-  FinishedMap m = finish::finished_frame(crop, geo_.resolution, downsample);
+  blocks_ds_ = downsample;
+  return staging_known_[0];
+}
+
+std::vector<float> CudaRenderer::read_blocks(const finish::Crop &crop) {
+  require_grid("finish");
+  if (blocks_ds_ < 1) throw Error(ErrorCode::Internal, "read_blocks before finish_blocks (a bug)");
+  select_device();
+  const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, blocks_ds_);
   const size_t n = static_cast<size_t>(crop.count());
   cuda_host::reserve_checked(finished_, std::max<size_t>(n, 1), "the finished map");
   cuda::launch_crop(blocks_.get(), blocks, crop, finished_.get(), stream_);
   const cuda::PinnedBuffer<float> &out = download(finished_.get(), n);
-  m.cells.assign(out.get(), out.get() + n);
-  return m;
+  return std::vector<float>(out.get(), out.get() + n);
 }
 
 std::vector<float> CudaRenderer::read(const GridWindow &w) {
@@ -105,7 +137,7 @@ std::vector<float> CudaRenderer::read(const GridWindow &w) {
   const size_t n = static_cast<size_t>(w.width) * static_cast<size_t>(w.height);
   cuda_host::reserve_checked(window_, std::max<size_t>(n, 1), "the window read");
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
-  cuda::launch_read_window(cells(), geo_.size_y, w.x0, w.y0, w.width, w.height, window_.get(), stream_);
+  cuda::launch_read_window(cells(), grid_geo_.size_y, w.x0, w.y0, w.width, w.height, window_.get(), stream_);
   const cuda::PinnedBuffer<float> &out = download(window_.get(), n);
   return std::vector<float>(out.get(), out.get() + n);
 }

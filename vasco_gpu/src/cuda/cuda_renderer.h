@@ -1,8 +1,10 @@
 // cuda_renderer.h — what the CUDA renderers of float and exact mode share
 // (private to the library: make_cuda_renderer in cuda_backend.h creates
 // one): the device, the stream (the caller's, or one of its own), the phase
-// events, the frame and parameters of the last reset, CARMEN's finish and
-// the window read on the device, and the grid's state.
+// events, the frame and parameters of the last reset, the band of the
+// frame's columns the grid holds (all of them, or one GPU's share of a split
+// render: split_renderer.h), CARMEN's finish and the window read on the
+// device, and the grid's state.
 //
 // Every call is strongly exception-safe where the device allows it: a mode
 // checks (GPU memory, fixed-point range) and allocates before it changes
@@ -27,11 +29,40 @@
 
 namespace vasco {
 
+// The columns [x0, x0 + width) of a frame: what a renderer's grid holds.
+struct ColumnBand {
+  int x0 = 0, width = 0;
+};
+
+// The widest frame a render may be split in bands of: 2^30 columns. A band
+// walks every beam in the frame's cell numbers (CARMEN's walk compares end
+// points, so a moved line is not the same walk when a move wraps one past
+// INT_MIN) and keeps the cells of its columns; the kernels subtract the
+// band's first column from a cell's x, which this keeps well inside an int
+// for every cell a closed-form line visits.
+constexpr int kMaxBandedSide = 1 << 30;
+
 class CudaRenderer : public Renderer {
  public:
   ~CudaRenderer() override;
   RendererTraits traits() const override { return {exact_, true, 0, device_bytes_per_cell()}; }
   void reset(const GridGeometry &geo, const MapperParams &params) final;
+  // reset, for a grid that holds only the columns of `band` of the frame
+  // `geo`: the beams are placed in `geo` (the cells the whole grid's render
+  // would update), and only the band's cells are kept and updated, with the
+  // same values. finish and read see the band as a grid of band.width x
+  // geo.size_y cells. A band must lie inside the frame, and a frame split in
+  // bands must be at most kMaxBandedSide columns wide (split_renderer.h says
+  // why).
+  void reset_band(const GridGeometry &geo, const MapperParams &params, ColumnBand band);
+  // The device the renderer's grid is on.
+  int device() const { return options_.cuda_device; }
+  // finish in two steps, for a split render's bands: the block means at
+  // `downsample` into device scratch, returning the known blocks' box (in
+  // this grid's blocks); then a window of those blocks (crop: its first block
+  // column and row, its size) to the host, x-major. finish is the two.
+  finish::KnownBox finish_blocks(int downsample);
+  std::vector<float> read_blocks(const finish::Crop &crop);
   void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) final;
   FinishedMap finish(int downsample, int border) final;
   std::vector<float> read(const GridWindow &window) final;
@@ -78,7 +109,12 @@ class CudaRenderer : public Renderer {
 
   void select_device() const;
   cudaStream_t stream() const { return stream_; }
+  // The frame the beams are placed in (the whole grid's).
   const GridGeometry &geo() const { return geo_; }
+  // The cells the grid holds: the band's columns of the frame, band_x0()
+  // its first.
+  const GridGeometry &grid_geo() const { return grid_geo_; }
+  int band_x0() const { return band_x0_; }
   const MapperParams &params() const { return params_; }
 
   // The phase times of an apply: start, uploaded, mapped.
@@ -98,11 +134,13 @@ class CudaRenderer : public Renderer {
   std::unique_ptr<cuda::Stream> own_stream_;  // null when the caller gave one
   cudaStream_t stream_ = nullptr;
   std::unique_ptr<PhaseEvents> events_;
-  GridGeometry geo_;
+  GridGeometry geo_, grid_geo_;
+  int band_x0_ = 0;
   MapperParams params_;
   GridState state_ = GridState::None;
   // Finish and read.
   cuda::DeviceBuffer<float> blocks_, finished_, window_;
+  int blocks_ds_ = 0;  // the downsample blocks_ holds the means of (0: none since the reset)
   cuda::DeviceBuffer<finish::KnownBox> known_;
   cuda::PinnedBuffer<finish::KnownBox> staging_known_;
   cuda::PinnedBuffer<float> staging_out_;
