@@ -41,14 +41,19 @@ void on_band_threads(size_t n, Body body) {
   std::vector<std::exception_ptr> failed(n);
   std::vector<std::thread> threads;
   threads.reserve(n);
-  for (size_t i = 0; i < n; ++i)
-    threads.emplace_back([&, i] {
-      try {
-        body(i);
-      } catch (...) {
-        failed[i] = std::current_exception();
-      }
-    });
+  try {
+    for (size_t i = 0; i < n; ++i)
+      threads.emplace_back([&, i] {
+        try {
+          body(i);
+        } catch (...) {
+          failed[i] = std::current_exception();
+        }
+      });
+  } catch (...) {  // no thread for a band: join those started, then report it
+    for (auto &t : threads) t.join();
+    throw;
+  }
   for (auto &t : threads) t.join();
   for (auto &f : failed)
     if (f) std::rethrow_exception(f);
@@ -82,7 +87,15 @@ void SplitRenderer::apply(const ScanBatch &scans, size_t first, size_t last, Map
   require_grid("apply");
   std::vector<MapStats> st(bands_.size());
   valid_ = false;  // until every band has applied the scans
-  on_band_threads(bands_.size(), [&](size_t i) { parts_[i]->apply(scans, first, last, &st[i]); });
+  try {
+    on_band_threads(bands_.size(), [&](size_t i) { parts_[i]->apply(scans, first, last, &st[i]); });
+  } catch (...) {
+    // A band that succeeded keeps the scans' ranges (float mode's device
+    // copy) as sent, though the caller takes the scans back: every band
+    // sends them all again next time.
+    forget_scans();
+    throw;
+  }
   valid_ = true;
   // Every band sees every beam; each updates its own cells; they run at once.
   MapStats sum = st[0];
