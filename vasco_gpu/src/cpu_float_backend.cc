@@ -76,6 +76,8 @@ class EvidenceTable {
     const int64_t n_max = t > 0 ? 2 * (t - 1) * (t - 1) : 0;
     n_stop_ = egrid::first_square_not_below(std::max(model_.sure, model_.max), res_, n_max);
     n_sure_ = std::min(egrid::first_square_not_below(model_.sure, res_, n_max), n_stop_);
+    root_sure_ = std::sqrt(static_cast<double>(n_sure_));
+    root_stop_ = std::sqrt(static_cast<double>(n_stop_));
     free_near_ = increment(0, true);
     occ_near_ = increment(0, false);
     if (t <= 0 || t * t > kMaxEntries) return;
@@ -104,6 +106,12 @@ class EvidenceTable {
   // The smallest n whose distance is not below `range` (at most n_stop):
   // the oracle's free test d < range is n < n_free(range).
   int64_t n_free(double range) const { return beam_updates::first_square_near(range, res_, n_stop_ - 1); }
+  // The same test at one n (first_square_near's, so n_free's).
+  bool closer_than(int64_t n, double range) const { return std::sqrt(static_cast<double>(n)) * res_ < range; }
+  // Estimates: sqrt(n_sure), sqrt(n_stop), and a distance in cells.
+  double root_sure() const { return root_sure_; }
+  double root_stop() const { return root_stop_; }
+  double cells(double distance) const { return distance / res_; }
 
   // The increment at n < n_stop, computed.
   float increment(int64_t n, bool free) const {
@@ -124,6 +132,7 @@ class EvidenceTable {
   double res_, logit_prior_;
   int size_;
   int64_t n_stop_ = 0, n_sure_ = 0;
+  double root_sure_ = 0, root_stop_ = 0;
   float free_near_ = 0, occ_near_ = 0;
   std::vector<float> free_, occ_;
 };
@@ -161,129 +170,174 @@ Box reach_of(const PlacedBeams &placed, int table_size, const GridGeometry &geo)
 }
 
 // A closed-form walk (egrid::LineParams) in box-relative terms: the steps
-// whose cell lies in the box are [k_first, k_last] (both coordinates move
-// monotonically), the minor coordinate's fixed-point slope, and how the
-// scratch index moves per major and per minor step. Measured on fr079 (one
-// core of a 2-core EPYC): this walk 2.4 ns per update against 2.7 for the
-// remainder walk it replaced, with perf's samples now on the scratch's load;
-// a float scratch (half the bytes) measured no faster.
-struct WalkFrame {
-  int64_t k_first, k_last;
-  uint64_t y0, slope;  // the minor offset at step 0 and its growth per step, fixed point (kMinorFracBits)
-  double slope2;       // 1 + (b / a)^2: n grows about as k^2 times this
-  ptrdiff_t major_step, minor_stride;
-};
-
+// whose cell lies in the box are [k_first, k_end) (both coordinates move
+// monotonically), the minor offset as a fixed-point value, how the scratch
+// index moves per step without and with a minor step, and the factor that
+// turns a distance in cells into an estimate of the steps that cover it.
+//
 // The minor offset m(k) = floor((2bk + c) / 2a), c = a - [inc < 0]
-// (egrid::line_minor_offset), as the integer part of a fixed-point value
-// y(k) = y0 + k * slope with y0 = ceil(c 2^F / 2a) and slope = ceil(2b 2^F /
-// 2a): one add a step and no branch, where the remainder's compare-and-
-// subtract mispredicted at every other minor step. Why it is the same m:
-// y(k) is the exact (2bk + c) / 2a plus an error e in [0, (k + 1) 2^-F). The
-// exact value is an integer plus a fraction that is a multiple of 1 / 2a, so
-// adding less than 1 / 2a cannot reach the next integer: floor(y(k)) = m(k)
-// whenever (k + 1) 2a < 2^F. Here k < table_size <= 1448 (tabulated tables,
-// EvidenceTable::kMaxEntries) and a < 2^29 (is_closed_form_line), so
-// (k + 1) 2a < 2^41, and y(k) < (k + 2) 2^F < 2^62 does not overflow.
-constexpr int kMinorFracBits = 46;
-
-uint64_t fixed_ceil_div(uint64_t num, uint64_t den) {  // ceil(num 2^F / den)
-  const unsigned __int128 n = static_cast<unsigned __int128>(num) << kMinorFracBits;
-  return static_cast<uint64_t>((n + den - 1) / den);
-}
-
-// The walk at step k: the cell's scratch index (its table index is m *
-// table_size + k).
-struct WalkState {
-  int64_t k;
-  ptrdiff_t idx;
+// (egrid::line_minor_offset), is the integer part of y(k) = y0 + k * slope,
+// both with 64 fraction bits: y0 = ceil(c 2^64 / 2a), slope = ceil(2b 2^64 /
+// 2a). A step adds slope's fraction to y's, and the carry out is the minor
+// step (slope's integer part is 1 only where b = a, and then every step is
+// diagonal): an add and a select a step, with no chain through the integer
+// part and no branch to mispredict. Why it is the same m: y(k) is the exact
+// (2bk + c) / 2a plus an error e in [0, (k + 1) 2^-64). The exact value is
+// an integer plus a multiple of 1 / 2a, so adding less than 1 / 2a cannot
+// reach the next integer: floor(y(k)) = m(k) whenever (k + 1) 2a < 2^64,
+// and here k < table_size <= 1448 (EvidenceTable::kMaxEntries) and a < 2^29
+// (is_closed_form_line).
+struct WalkFrame {
+  int64_t k_first, k_end;
+  uint64_t y0, slope;        // fractions of m at step 0 and of its growth a step
+  int64_t slope_int;         // 1 where b = a, else 0
+  ptrdiff_t major_step, minor_step;  // scratch index moves
+  ptrdiff_t axial, diagonal;          // a step's move without and with the minor step
+  ptrdiff_t origin;                   // the scratch index of step 0's cell
+  double steps_per_cell;      // a / sqrt(a^2 + b^2): steps to a distance, per cell of distance
 };
 
-int64_t minor_at(const WalkFrame &f, int64_t k) {
-  return static_cast<int64_t>((f.y0 + static_cast<uint64_t>(k) * f.slope) >> kMinorFracBits);
+// y(k), split into its integer part (the minor offset) and its fraction.
+struct Fixed {
+  int64_t m;
+  uint64_t frac;
+};
+
+Fixed fixed_at(const WalkFrame &f, int64_t k) {
+  const unsigned __int128 y = static_cast<unsigned __int128>(static_cast<uint64_t>(k)) * f.slope + f.y0;
+  return {k * f.slope_int + static_cast<int64_t>(y >> 64), static_cast<uint64_t>(y)};
 }
 
 int64_t square_at(const WalkFrame &f, int64_t k) {
-  const int64_t m = minor_at(f, k);
+  const int64_t m = fixed_at(f, k).m;
   return k * k + m * m;
 }
 
-WalkFrame frame_of(const egrid::LineParams &p, int table_size, const Box &box, WalkState *w) {
-  const int minor_inc = p.flipped ? -p.inc : p.inc;
-  const int64_t bx = int64_t(p.x1) - box.x_lo, by = int64_t(p.y1) - box.y_lo;
+// The fixed point's start and step: y0 = ceil(c 2^64 / 2a) with c = a or
+// a - 1, and slope = ceil(2b 2^64 / 2a) = ceil(b 2^64 / a) for b < a, from
+// q = floor(2^63 / a) and r = 2^63 mod a: y0 = 2^63, or 2^63 - q (c = a - 1:
+// ceil(2^63 - 2^63 / a)); slope = 2bq + ceil(2br / a), where 2br < 2a^2 <
+// 2^59. Two 64-bit divisions instead of two 128-bit ones.
+void fixed_point_of(uint64_t a, uint64_t b, bool c_is_a, WalkFrame *f) {
+  constexpr uint64_t kHalf = uint64_t(1) << 63;
+  f->slope_int = a != 0 && b == a ? 1 : 0;
+  f->slope = 0;
+  f->y0 = 0;
+  if (a == 0) return;
+  const uint64_t q = kHalf / a, r = kHalf % a;
+  f->y0 = c_is_a ? kHalf : kHalf - q;
+  if (b < a) f->slope = 2 * b * q + (2 * b * r + a - 1) / a;
+}
+
+bool in_box(const Box &box, int64_t x, int64_t y) {
+  return x >= box.x_lo && x < box.x_hi && y >= box.y_lo && y < box.y_hi;
+}
+
+// The frame of the line from (x1, y1) to (x2, y2) (p), walked for at most
+// table_size steps. A line whose two ends lie in the box lies in it (the box
+// is convex, and the walk's cells stay between the ends), which spares most
+// beams steps_in_box's divisions.
+WalkFrame frame_of(const egrid::LineParams &p, int x2, int y2, int table_size, const Box &box) {
   WalkFrame f;
+  const int64_t k_max = std::min(p.major_len, table_size - 1);
+  if (in_box(box, p.x1, p.y1) && in_box(box, x2, y2)) {
+    f.k_first = 0, f.k_end = k_max + 1;
+  } else {
+    int64_t k_last;
+    beam_updates::steps_in_box(p, static_cast<int>(k_max), box, &f.k_first, &k_last);
+    f.k_end = k_last + 1;
+  }
+  const uint64_t a = static_cast<uint64_t>(p.a), b = static_cast<uint64_t>(p.b);
+  fixed_point_of(a, b, p.inc > 0, &f);
+  const int minor_inc = p.flipped ? -p.inc : p.inc;
   const ptrdiff_t h = box.height();  // the scratch is [x][y], as the grid
   f.major_step = p.steep ? p.inc : p.inc * h;
-  f.minor_stride = p.steep ? minor_inc * h : minor_inc;
-  const uint64_t two_a = 2 * static_cast<uint64_t>(p.a), two_b = 2 * static_cast<uint64_t>(p.b);
-  const uint64_t c = static_cast<uint64_t>(p.a) - (p.inc < 0 ? 1 : 0);
-  f.slope = two_a == 0 ? 0 : fixed_ceil_div(two_b, two_a);
-  f.y0 = two_a == 0 ? 0 : fixed_ceil_div(c, two_a);
-  const double s = p.a == 0 ? 0.0 : static_cast<double>(p.b) / p.a;
-  f.slope2 = 1.0 + s * s;
-  beam_updates::steps_in_box(p, std::min(p.major_len, table_size - 1), box, &f.k_first, &f.k_last);
-  const int64_t k = f.k_first, m = minor_at(f, k);
-  w->k = k;
-  w->idx = bx * h + by + k * f.major_step + m * f.minor_stride;
+  f.minor_step = p.steep ? minor_inc * h : minor_inc;
+  f.diagonal = f.major_step + f.minor_step;
+  f.axial = f.slope_int != 0 ? f.diagonal : f.major_step;
+  f.origin = (int64_t(p.x1) - box.x_lo) * h + (int64_t(p.y1) - box.y_lo);
+  f.steps_per_cell = a == 0 ? 0.0 : static_cast<double>(a) / std::sqrt(static_cast<double>(a * a + b * b));
   return f;
 }
 
-// The first step from `k` on (at most k_last + 1) whose n = k*k + m*m is not
-// below `limit`: n grows strictly with k, so it is found from the estimate
-// k ~ sqrt(limit / (1 + (b/a)^2)) by stepping to where n crosses the limit.
-int64_t end_of_run(const WalkFrame &f, int64_t k, int64_t limit) {
-  const int64_t hi = f.k_last + 1;
-  if (k >= hi || square_at(f, k) >= limit) return k;
-  int64_t e = static_cast<int64_t>(std::sqrt(static_cast<double>(limit) / f.slope2));
-  e = std::clamp<int64_t>(e, k + 1, hi);
-  while (e > k + 1 && square_at(f, e - 1) >= limit) --e;
-  while (e < hi && square_at(f, e) < limit) ++e;
-  return e;
+// The first step in [lo, hi] where `below` turns false (it is true up to a
+// step and false from there on: n = k*k + m*m grows strictly with k), found
+// from an estimate by stepping. Along a line sqrt(n) is within half a cell
+// of k / steps_per_cell, so an estimate from the distance is at most a step
+// off, and this takes two or three tests.
+template <class Below>
+int64_t first_not_below(int64_t lo, int64_t hi, double estimate, Below &&below) {
+  int64_t k = lo;
+  if (estimate >= static_cast<double>(hi)) k = hi;
+  else if (estimate > static_cast<double>(lo)) k = static_cast<int64_t>(estimate);
+  while (k > lo && !below(k - 1)) --k;
+  while (k < hi && below(k)) ++k;
+  return k;
 }
 
-// Adds increments to the cells of steps [state->k, k_end): from `column`
-// (free or occupied) at the cell's (i, j), or the constant `near` where
+// The walk at step k: the fixed point's fraction and the cell.
+struct Cursor {
+  int64_t k;
+  uint64_t frac;
+  Sum *cell;
+};
+
+Cursor cursor_at(const WalkFrame &f, Sum *acc, int64_t k) {
+  const Fixed y = fixed_at(f, k);
+  return {k, y.frac, acc + f.origin + k * f.major_step + y.m * f.minor_step};
+}
+
+// Adds increments to the cells of steps [c->k, k_end): from `column` (free
+// or occupied) at the cell's (i, j) = (k, m), or the constant `near` where
 // kTabled is false. The hot loop: a table load (none below range_sure: most
-// updates), a float add, and integer steps whose chains from one step to the
-// next are one add each (y, the pointers): the minor step dm (0 or 1) comes
-// from y alone, and the run's end was found before (end_of_run).
+// updates), a float add, and the step: the fraction's add, whose carry
+// selects the scratch's (and the table's) move.
 template <bool kTabled>
-void walk_run(const WalkFrame &f, int table_size, int64_t k_end, const float *column, float near, Sum *acc,
-              WalkState *state) {
+void walk_run(const WalkFrame &f, int64_t k_end, const float *column, int row, float near, Cursor *c) {
+  if (k_end <= c->k) return;
   const uint64_t slope = f.slope;
-  const ptrdiff_t major_step = f.major_step, minor_stride = f.minor_stride, row = table_size;
-  int64_t k = state->k;
-  uint64_t y = f.y0 + static_cast<uint64_t>(k) * slope;
-  int64_t m = static_cast<int64_t>(y >> kMinorFracBits);
-  Sum *cell = acc + state->idx;
-  const float *inc = kTabled ? column + m * row + k : nullptr;
-  for (; k < k_end; ++k) {
+  const ptrdiff_t axial = f.axial, turn = f.diagonal - f.axial;
+  const ptrdiff_t table_axial = 1 + f.slope_int * row, table_turn = row - f.slope_int * row;
+  uint64_t frac = c->frac;
+  Sum *cell = c->cell;
+  const float *inc = kTabled ? column + fixed_at(f, c->k).m * row + c->k : nullptr;
+  for (int64_t n = k_end - c->k; n > 0; --n) {
     *cell += kTabled ? *inc : near;
-    y += slope;
-    const int64_t m_next = static_cast<int64_t>(y >> kMinorFracBits);
-    const int64_t dm = m_next - m;
-    cell += major_step + dm * minor_stride;
-    if (kTabled) inc += 1 + dm * row;
-    m = m_next;
+    // The carry as a mask, not a select: a compiler may turn a select into
+    // a branch, which mispredicts at every other minor step.
+    const ptrdiff_t mask = -static_cast<ptrdiff_t>(__builtin_add_overflow(frac, slope, &frac));
+    cell += axial + (turn & mask);
+    if (kTabled) inc += table_axial + (table_turn & mask);
   }
-  *state = {k, cell - acc};
+  *c = {k_end, frac, cell};
 }
 
 // Adds one closed-form beam's evidence to the scratch; returns its number of
-// updates: the free cells (n < n_free), then the occupied ones (n < n_stop),
-// each with the constant increment below n_sure and the table's beyond.
-uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &p, const Box &box, int64_t n_free,
-                              Sum *acc) {
-  WalkState w;
-  const WalkFrame f = frame_of(p, ev.size(), box, &w);
-  if (f.k_first > f.k_last) return 0;
+// updates. Its steps fall in four runs by n = k*k + m*m, which grows along
+// the walk: free cells (n < n_free, the oracle's d < range) with the
+// constant increment below n_sure and the table's beyond, then occupied ones
+// likewise up to n_stop. The runs' ends are three steps: k_sure (n reaches
+// n_sure), k_stop (n_stop) and k_free (d reaches the range, at most k_stop),
+// each found from an estimate unless the walk ends before it.
+uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &p, int x2, int y2, const Box &box,
+                              double range, Sum *acc) {
+  const WalkFrame f = frame_of(p, x2, y2, ev.size(), box);
+  const int64_t lo = f.k_first, hi = f.k_end;
+  if (lo >= hi) return 0;
+  const int64_t n_last = square_at(f, hi - 1), n_sure = ev.n_sure(), n_stop = ev.n_stop();
+  auto below = [&f](int64_t limit) { return [&f, limit](int64_t k) { return square_at(f, k) < limit; }; };
+  const double spc = f.steps_per_cell;
+  const int64_t k_stop = n_last < n_stop ? hi : first_not_below(lo, hi, ev.root_stop() * spc, below(n_stop));
+  const int64_t k_sure = n_last < n_sure ? hi : first_not_below(lo, k_stop, ev.root_sure() * spc, below(n_sure));
+  const int64_t k_free = first_not_below(lo, k_stop, ev.cells(range) * spc,
+                                         [&](int64_t k) { return ev.closer_than(square_at(f, k), range); });
   const int t = ev.size();
-  const int64_t n_sure = ev.n_sure(), n_stop = ev.n_stop();
-  walk_run<false>(f, t, end_of_run(f, w.k, std::min(n_free, n_sure)), nullptr, ev.near_increment(true), acc, &w);
-  walk_run<true>(f, t, end_of_run(f, w.k, n_free), ev.column(true), 0, acc, &w);
-  walk_run<false>(f, t, end_of_run(f, w.k, std::min(n_stop, n_sure)), nullptr, ev.near_increment(false), acc, &w);
-  walk_run<true>(f, t, end_of_run(f, w.k, n_stop), ev.column(false), 0, acc, &w);
-  return static_cast<uint64_t>(w.k - f.k_first);
+  Cursor c = cursor_at(f, acc, lo);
+  walk_run<false>(f, std::min(k_free, k_sure), nullptr, t, ev.near_increment(true), &c);
+  walk_run<true>(f, k_free, ev.column(true), t, 0, &c);
+  walk_run<false>(f, std::max(k_free, k_sure), nullptr, t, ev.near_increment(false), &c);
+  walk_run<true>(f, k_stop, ev.column(false), t, 0, &c);
+  return static_cast<uint64_t>(k_stop - lo);
 }
 
 // A line the closed form does not cover (e.g. from a range of -inf), or a
@@ -343,11 +397,11 @@ class CpuFloatRenderer : public HostGridRenderer {
     Sum *acc = scratch_.data();
     for (const PlacedBeam &b : placed.beams) {
       const oracle::ScanStart &s = placed.starts[b.scan];
-      const int64_t n_free = ev.n_free(static_cast<double>(b.range));
       if (ev.tabulated() && egrid::is_closed_form_line(s.x1, s.y1, b.x2, b.y2)) {
-        updates += add_closed_form_beam(ev, egrid::line_params(s.x1, s.y1, b.x2, b.y2), box, n_free, acc);
+        updates += add_closed_form_beam(ev, egrid::line_params(s.x1, s.y1, b.x2, b.y2), b.x2, b.y2, box,
+                                        static_cast<double>(b.range), acc);
       } else {
-        updates += add_walked_beam(ev, s.x1, s.y1, b.x2, b.y2, geo, box, n_free, acc);
+        updates += add_walked_beam(ev, s.x1, s.y1, b.x2, b.y2, geo, box, ev.n_free(static_cast<double>(b.range)), acc);
       }
     }
     return updates;
