@@ -287,29 +287,74 @@ Cursor cursor_at(const WalkFrame &f, Sum *acc, int64_t k) {
   return {k, y.frac, acc + f.origin + k * f.major_step + y.m * f.minor_step};
 }
 
-// Adds increments to the cells of steps [c->k, k_end): from `column` (free
-// or occupied) at the cell's (i, j) = (k, m), or the constant `near` where
-// kTabled is false. The hot loop: a table load (none below range_sure: most
-// updates), a float add, and the step: the fraction's add, whose carry
-// selects the scratch's (and the table's) move.
-template <bool kTabled>
-void walk_run(const WalkFrame &f, int64_t k_end, const float *column, int row, float near, Cursor *c) {
-  if (k_end <= c->k) return;
+// Adds the table's increments (free or occupied `column`, at the cell's
+// (i, j) = (k, m)) to the cells of steps [c->k, k_end). A step adds the
+// slope to the fraction, and the carry, as a mask (a select may compile to
+// a branch, which mispredicts at every other minor step), adds the minor
+// step to the cell and a row to the table entry.
+void add_tabled_run(const WalkFrame &f, int64_t k_end, const float *column, int row, Cursor *c) {
   const uint64_t slope = f.slope;
   const ptrdiff_t axial = f.axial, turn = f.diagonal - f.axial;
   const ptrdiff_t table_axial = 1 + f.slope_int * row, table_turn = row - f.slope_int * row;
   uint64_t frac = c->frac;
   Sum *cell = c->cell;
-  const float *inc = kTabled ? column + fixed_at(f, c->k).m * row + c->k : nullptr;
+  const float *inc = column + fixed_at(f, c->k).m * row + c->k;
   for (int64_t n = k_end - c->k; n > 0; --n) {
-    *cell += kTabled ? *inc : near;
-    // The carry as a mask, not a select: a compiler may turn a select into
-    // a branch, which mispredicts at every other minor step.
+    *cell += *inc;
     const ptrdiff_t mask = -static_cast<ptrdiff_t>(__builtin_add_overflow(frac, slope, &frac));
     cell += axial + (turn & mask);
-    if (kTabled) inc += table_axial + (table_turn & mask);
+    inc += table_axial + (table_turn & mask);
   }
   *c = {k_end, frac, cell};
+}
+
+// Adds the constant `near` to the cells of steps [c->k, k_end): most of the
+// updates (all below range_sure). Where the minor step is one cell in the
+// scratch (kMinor = +1 or -1: x-major lines), the cell's index and the
+// fraction are one 128-bit number, and a step is one 128-bit add (or
+// subtract: with the fraction complemented, its borrow is the original's
+// carry), the carry going straight into the index; elsewhere (kMinor = 0)
+// the carry is a mask, as above.
+template <int kMinor>
+void add_near_run(const WalkFrame &f, int64_t k_end, float near, Sum *acc, Cursor *c) {
+  using U128 = unsigned __int128;
+  const int64_t n = k_end - c->k;
+  if (kMinor == 0) {
+    const uint64_t slope = f.slope;
+    const ptrdiff_t axial = f.axial, turn = f.diagonal - f.axial;
+    uint64_t frac = c->frac;
+    Sum *cell = c->cell;
+    for (int64_t i = n; i > 0; --i) {
+      *cell += near;
+      const ptrdiff_t mask = -static_cast<ptrdiff_t>(__builtin_add_overflow(frac, slope, &frac));
+      cell += axial + (turn & mask);
+    }
+    *c = {k_end, frac, cell};
+    return;
+  }
+  const uint64_t idx = static_cast<uint64_t>(c->cell - acc);
+  const uint64_t axial = static_cast<uint64_t>(kMinor > 0 ? f.axial : -f.axial);
+  const U128 step = (U128(axial) << 64) | f.slope;
+  U128 pos = (U128(idx) << 64) | (kMinor > 0 ? c->frac : ~c->frac);
+  for (int64_t i = n; i > 0; --i) {
+    acc[static_cast<ptrdiff_t>(pos >> 64)] += near;
+    if (kMinor > 0) pos += step;
+    else pos -= step;
+  }
+  const uint64_t low = static_cast<uint64_t>(pos);
+  *c = {k_end, kMinor > 0 ? low : ~low, acc + static_cast<ptrdiff_t>(pos >> 64)};
+}
+
+// The near run for this frame's minor step.
+void add_near(const WalkFrame &f, int64_t k_end, float near, Sum *acc, Cursor *c) {
+  if (k_end <= c->k) return;
+  if (f.minor_step == 1) add_near_run<1>(f, k_end, near, acc, c);
+  else if (f.minor_step == -1) add_near_run<-1>(f, k_end, near, acc, c);
+  else add_near_run<0>(f, k_end, near, acc, c);
+}
+
+void add_tabled(const WalkFrame &f, int64_t k_end, const float *column, int row, Cursor *c) {
+  if (k_end > c->k) add_tabled_run(f, k_end, column, row, c);
 }
 
 // Adds one closed-form beam's evidence to the scratch; returns its number of
@@ -333,10 +378,10 @@ uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &
                                          [&](int64_t k) { return ev.closer_than(square_at(f, k), range); });
   const int t = ev.size();
   Cursor c = cursor_at(f, acc, lo);
-  walk_run<false>(f, std::min(k_free, k_sure), nullptr, t, ev.near_increment(true), &c);
-  walk_run<true>(f, k_free, ev.column(true), t, 0, &c);
-  walk_run<false>(f, std::max(k_free, k_sure), nullptr, t, ev.near_increment(false), &c);
-  walk_run<true>(f, k_stop, ev.column(false), t, 0, &c);
+  add_near(f, std::min(k_free, k_sure), ev.near_increment(true), acc, &c);
+  add_tabled(f, k_free, ev.column(true), t, &c);
+  add_near(f, std::max(k_free, k_sure), ev.near_increment(false), acc, &c);
+  add_tabled(f, k_stop, ev.column(false), t, &c);
   return static_cast<uint64_t>(k_stop - lo);
 }
 
