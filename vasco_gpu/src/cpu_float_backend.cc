@@ -308,7 +308,7 @@ void add_tabled_run(const WalkFrame &f, int64_t k_end, const float *column, int 
   *c = {k_end, frac, cell};
 }
 
-// Adds the constant `near` to the cells of steps [c->k, k_end): most of the
+// Adds the constant `near` to the cells of steps [c.k, k_end): most of the
 // updates (all below range_sure). Where the minor step is one cell in the
 // scratch (kMinor = +1 or -1: x-major lines), the cell's index and the
 // fraction are one 128-bit number, and a step is one 128-bit add (or
@@ -316,45 +316,48 @@ void add_tabled_run(const WalkFrame &f, int64_t k_end, const float *column, int 
 // carry), the carry going straight into the index; elsewhere (kMinor = 0)
 // the carry is a mask, as above.
 template <int kMinor>
-void add_near_run(const WalkFrame &f, int64_t k_end, float near, Sum *acc, Cursor *c) {
+Cursor add_near_run(const WalkFrame &f, int64_t k_end, float near, Sum *acc, Cursor c) {
   using U128 = unsigned __int128;
-  const int64_t n = k_end - c->k;
+  if (k_end <= c.k) return c;
+  const int64_t n = k_end - c.k;
   if (kMinor == 0) {
     const uint64_t slope = f.slope;
     const ptrdiff_t axial = f.axial, turn = f.diagonal - f.axial;
-    uint64_t frac = c->frac;
-    Sum *cell = c->cell;
+    uint64_t frac = c.frac;
+    Sum *cell = c.cell;
     for (int64_t i = n; i > 0; --i) {
       *cell += near;
       const ptrdiff_t mask = -static_cast<ptrdiff_t>(__builtin_add_overflow(frac, slope, &frac));
       cell += axial + (turn & mask);
     }
-    *c = {k_end, frac, cell};
-    return;
+    return {k_end, frac, cell};
   }
-  const uint64_t idx = static_cast<uint64_t>(c->cell - acc);
+  const uint64_t idx = static_cast<uint64_t>(c.cell - acc);
   const uint64_t axial = static_cast<uint64_t>(kMinor > 0 ? f.axial : -f.axial);
   const U128 step = (U128(axial) << 64) | f.slope;
-  U128 pos = (U128(idx) << 64) | (kMinor > 0 ? c->frac : ~c->frac);
+  U128 pos = (U128(idx) << 64) | (kMinor > 0 ? c.frac : ~c.frac);
   for (int64_t i = n; i > 0; --i) {
     acc[static_cast<ptrdiff_t>(pos >> 64)] += near;
     if (kMinor > 0) pos += step;
     else pos -= step;
   }
   const uint64_t low = static_cast<uint64_t>(pos);
-  *c = {k_end, kMinor > 0 ? low : ~low, acc + static_cast<ptrdiff_t>(pos >> 64)};
+  return {k_end, kMinor > 0 ? low : ~low, acc + static_cast<ptrdiff_t>(pos >> 64)};
 }
 
-// The near run for this frame's minor step.
-void add_near(const WalkFrame &f, int64_t k_end, float near, Sum *acc, Cursor *c) {
-  if (k_end <= c->k) return;
-  if (f.minor_step == 1) add_near_run<1>(f, k_end, near, acc, c);
-  else if (f.minor_step == -1) add_near_run<-1>(f, k_end, near, acc, c);
-  else add_near_run<0>(f, k_end, near, acc, c);
-}
+// Where a beam's four runs end (see add_closed_form_beam).
+struct RunEnds {
+  int64_t near_free, free, near_occupied, stop;
+};
 
-void add_tabled(const WalkFrame &f, int64_t k_end, const float *column, int row, Cursor *c) {
-  if (k_end > c->k) add_tabled_run(f, k_end, column, row, c);
+// A beam's four runs from `c`, for one kind of minor step (one dispatch a
+// beam, the runs inlined).
+template <int kMinor>
+void walk_runs(const WalkFrame &f, const RunEnds &e, const EvidenceTable &ev, Sum *acc, Cursor c) {
+  c = add_near_run<kMinor>(f, e.near_free, ev.near_increment(true), acc, c);
+  if (e.free > c.k) add_tabled_run(f, e.free, ev.column(true), ev.size(), &c);
+  c = add_near_run<kMinor>(f, e.near_occupied, ev.near_increment(false), acc, c);
+  if (e.stop > c.k) add_tabled_run(f, e.stop, ev.column(false), ev.size(), &c);
 }
 
 // Adds one closed-form beam's evidence to the scratch; returns its number of
@@ -376,12 +379,11 @@ uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &
   const int64_t k_sure = n_last < n_sure ? hi : first_not_below(lo, k_stop, ev.root_sure() * spc, below(n_sure));
   const int64_t k_free = first_not_below(lo, k_stop, ev.cells(range) * spc,
                                          [&](int64_t k) { return ev.closer_than(square_at(f, k), range); });
-  const int t = ev.size();
-  Cursor c = cursor_at(f, acc, lo);
-  add_near(f, std::min(k_free, k_sure), ev.near_increment(true), acc, &c);
-  add_tabled(f, k_free, ev.column(true), t, &c);
-  add_near(f, std::max(k_free, k_sure), ev.near_increment(false), acc, &c);
-  add_tabled(f, k_stop, ev.column(false), t, &c);
+  const RunEnds e{std::min(k_free, k_sure), k_free, std::max(k_free, k_sure), k_stop};
+  const Cursor c = cursor_at(f, acc, lo);
+  if (f.minor_step == 1) walk_runs<1>(f, e, ev, acc, c);
+  else if (f.minor_step == -1) walk_runs<-1>(f, e, ev, acc, c);
+  else walk_runs<0>(f, e, ev, acc, c);
   return static_cast<uint64_t>(k_stop - lo);
 }
 
