@@ -76,6 +76,7 @@ class EvidenceTable {
     const int64_t n_max = t > 0 ? 2 * (t - 1) * (t - 1) : 0;
     n_stop_ = egrid::first_square_not_below(std::max(model_.sure, model_.max), res_, n_max);
     n_sure_ = std::min(egrid::first_square_not_below(model_.sure, res_, n_max), n_stop_);
+    inv_res_ = 1.0 / res_;
     root_sure_ = std::sqrt(static_cast<double>(n_sure_));
     root_stop_ = std::sqrt(static_cast<double>(n_stop_));
     free_near_ = increment(0, true);
@@ -111,7 +112,7 @@ class EvidenceTable {
   // Estimates: sqrt(n_sure), sqrt(n_stop), and a distance in cells.
   double root_sure() const { return root_sure_; }
   double root_stop() const { return root_stop_; }
-  double cells(double distance) const { return distance / res_; }
+  double cells(double distance) const { return distance * inv_res_; }
 
   // The increment at n < n_stop, computed.
   float increment(int64_t n, bool free) const {
@@ -132,7 +133,7 @@ class EvidenceTable {
   double res_, logit_prior_;
   int size_;
   int64_t n_stop_ = 0, n_sure_ = 0;
-  double root_sure_ = 0, root_stop_ = 0;
+  double root_sure_ = 0, root_stop_ = 0, inv_res_ = 0;
   float free_near_ = 0, occ_near_ = 0;
   std::vector<float> free_, occ_;
 };
@@ -229,8 +230,9 @@ void fixed_point_of(uint64_t a, uint64_t b, bool c_is_a, WalkFrame *f) {
   if (b < a) f->slope = 2 * b * q + (2 * b * r + a - 1) / a;
 }
 
-bool in_box(const Box &box, int64_t x, int64_t y) {
-  return x >= box.x_lo && x < box.x_hi && y >= box.y_lo && y < box.y_hi;
+bool in_box(const Box &box, int64_t x, int64_t y) {  // one unsigned compare an axis
+  return static_cast<uint64_t>(x - box.x_lo) < static_cast<uint64_t>(box.width()) &&
+         static_cast<uint64_t>(y - box.y_lo) < static_cast<uint64_t>(box.height());
 }
 
 // The frame of the line from (x1, y1) to (x2, y2) (p), walked for at most
@@ -372,11 +374,14 @@ uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &
   const WalkFrame f = frame_of(p, x2, y2, ev.size(), box);
   const int64_t lo = f.k_first, hi = f.k_end;
   if (lo >= hi) return 0;
-  const int64_t n_last = square_at(f, hi - 1), n_sure = ev.n_sure(), n_stop = ev.n_stop();
+  // n at the last step is at most (hi - 1)^2 + b^2 (m <= b): when that is
+  // below a limit, the walk ends before reaching it, with no search.
+  const int64_t n_bound = (hi - 1) * (hi - 1) + int64_t(p.b) * p.b;
+  const int64_t n_sure = ev.n_sure(), n_stop = ev.n_stop();
   auto below = [&f](int64_t limit) { return [&f, limit](int64_t k) { return square_at(f, k) < limit; }; };
   const double spc = f.steps_per_cell;
-  const int64_t k_stop = n_last < n_stop ? hi : first_not_below(lo, hi, ev.root_stop() * spc, below(n_stop));
-  const int64_t k_sure = n_last < n_sure ? hi : first_not_below(lo, k_stop, ev.root_sure() * spc, below(n_sure));
+  const int64_t k_stop = n_bound < n_stop ? hi : first_not_below(lo, hi, ev.root_stop() * spc, below(n_stop));
+  const int64_t k_sure = n_bound < n_sure ? hi : first_not_below(lo, k_stop, ev.root_sure() * spc, below(n_sure));
   const int64_t k_free = first_not_below(lo, k_stop, ev.cells(range) * spc,
                                          [&](int64_t k) { return ev.closer_than(square_at(f, k), range); });
   const RunEnds e{std::min(k_free, k_sure), k_free, std::max(k_free, k_sure), k_stop};
