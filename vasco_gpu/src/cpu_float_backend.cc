@@ -181,7 +181,7 @@ Box reach_of(const PlacedBeams &placed, int table_size, const GridGeometry &geo)
 // both with 64 fraction bits: y0 = ceil(c 2^64 / 2a), slope = ceil(2b 2^64 /
 // 2a). A step adds slope's fraction to y's, and the carry out is the minor
 // step (slope's integer part is 1 only where b = a, and then every step is
-// diagonal): an add and a select a step, with no chain through the integer
+// diagonal): an add and a mask a step, with no chain through the integer
 // part and no branch to mispredict. Why it is the same m: y(k) is the exact
 // (2bk + c) / 2a plus an error e in [0, (k + 1) 2^-64). The exact value is
 // an integer plus a multiple of 1 / 2a, so adding less than 1 / 2a cannot
@@ -316,15 +316,17 @@ void add_tabled_run(const WalkFrame &f, int64_t k_end, const float *column, int 
 // fraction are one 128-bit number, and a step is one 128-bit add (or
 // subtract: with the fraction complemented, its borrow is the original's
 // carry), the carry going straight into the index; elsewhere (kMinor = 0)
-// the carry is a mask, as above.
-template <int kMinor>
+// the carry is a mask, as above, and where the major step is one cell
+// (kAxial = +1 or -1: y-major lines, but for diagonals) it is a constant
+// the address arithmetic absorbs.
+template <int kMinor, int kAxial>
 Cursor add_near_run(const WalkFrame &f, int64_t k_end, float near, Sum *acc, Cursor c) {
   using U128 = unsigned __int128;
   if (k_end <= c.k) return c;
   const int64_t n = k_end - c.k;
   if (kMinor == 0) {
     const uint64_t slope = f.slope;
-    const ptrdiff_t axial = f.axial, turn = f.diagonal - f.axial;
+    const ptrdiff_t axial = kAxial != 0 ? kAxial : f.axial, turn = f.diagonal - axial;
     uint64_t frac = c.frac;
     Sum *cell = c.cell;
     for (int64_t i = n; i > 0; --i) {
@@ -354,11 +356,11 @@ struct RunEnds {
 
 // A beam's four runs from `c`, for one kind of minor step (one dispatch a
 // beam, the runs inlined).
-template <int kMinor>
+template <int kMinor, int kAxial>
 void walk_runs(const WalkFrame &f, const RunEnds &e, const EvidenceTable &ev, Sum *acc, Cursor c) {
-  c = add_near_run<kMinor>(f, e.near_free, ev.near_increment(true), acc, c);
+  c = add_near_run<kMinor, kAxial>(f, e.near_free, ev.near_increment(true), acc, c);
   if (e.free > c.k) add_tabled_run(f, e.free, ev.column(true), ev.size(), &c);
-  c = add_near_run<kMinor>(f, e.near_occupied, ev.near_increment(false), acc, c);
+  c = add_near_run<kMinor, kAxial>(f, e.near_occupied, ev.near_increment(false), acc, c);
   if (e.stop > c.k) add_tabled_run(f, e.stop, ev.column(false), ev.size(), &c);
 }
 
@@ -386,9 +388,11 @@ uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &
                                          [&](int64_t k) { return ev.closer_than(square_at(f, k), range); });
   const RunEnds e{std::min(k_free, k_sure), k_free, std::max(k_free, k_sure), k_stop};
   const Cursor c = cursor_at(f, acc, lo);
-  if (f.minor_step == 1) walk_runs<1>(f, e, ev, acc, c);
-  else if (f.minor_step == -1) walk_runs<-1>(f, e, ev, acc, c);
-  else walk_runs<0>(f, e, ev, acc, c);
+  if (f.minor_step == 1) walk_runs<1, 0>(f, e, ev, acc, c);
+  else if (f.minor_step == -1) walk_runs<-1, 0>(f, e, ev, acc, c);
+  else if (f.axial == 1) walk_runs<0, 1>(f, e, ev, acc, c);
+  else if (f.axial == -1) walk_runs<0, -1>(f, e, ev, acc, c);
+  else walk_runs<0, 0>(f, e, ev, acc, c);
   return static_cast<uint64_t>(k_stop - lo);
 }
 
