@@ -384,8 +384,18 @@ uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &
   const double spc = f.steps_per_cell;
   const int64_t k_stop = n_bound < n_stop ? hi : first_not_below(lo, hi, ev.root_stop() * spc, below(n_stop));
   const int64_t k_sure = n_bound < n_sure ? hi : first_not_below(lo, k_stop, ev.root_sure() * spc, below(n_sure));
-  const int64_t k_free = first_not_below(lo, k_stop, ev.cells(range) * spc,
-                                         [&](int64_t k) { return ev.closer_than(square_at(f, k), range); });
+  const double cells = ev.cells(range);
+  // The oracle's test d(n) < range without a square root where n is clearly
+  // on one side: n against (range / res)^2 with a relative margin of 1e-9,
+  // a million times the roundings of the test and of the bound.
+  const double sq = cells * cells, n_lo = range > 0 ? sq * (1 - 1e-9) : -1, n_hi = range > 0 ? sq * (1 + 1e-9) : -1;
+  const int64_t k_free = first_not_below(lo, k_stop, cells * spc, [&](int64_t k) {
+    const int64_t n = square_at(f, k);
+    const double dn = static_cast<double>(n);
+    if (dn < n_lo) return true;
+    if (dn > n_hi) return false;
+    return ev.closer_than(n, range);
+  });
   const RunEnds e{std::min(k_free, k_sure), k_free, std::max(k_free, k_sure), k_stop};
   const Cursor c = cursor_at(f, acc, lo);
   if (f.minor_step == 1) walk_runs<1, 0>(f, e, ev, acc, c);
