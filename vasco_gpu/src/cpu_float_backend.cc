@@ -141,25 +141,22 @@ class EvidenceTable {
 // The cells a call's scans can reach: a beam's updated cells lie within
 // min(max(|dx|, |dy|), table_size - 1) steps of its scan's start cell (the
 // walk stops at its end cell and before table_size steps), so the box is the
-// union over scans of the start cell widened by its longest beam's reach.
+// union over scans of the start cell widened by its longest beam's reach:
+// the union over beams of their start cell widened by their own reach
+// (squares about one centre nest), kept in registers as it goes.
 using beam_updates::Box;
 
 Box reach_of(const PlacedBeams &placed, int table_size, const GridGeometry &geo) {
   const int64_t t = std::max(table_size - 1, 0);
-  std::vector<int64_t> reach(placed.starts.size(), -1);  // -1: a scan without beams
+  int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
   for (const PlacedBeam &b : placed.beams) {
     const oracle::ScanStart &s = placed.starts[b.scan];
     const int64_t dx = std::abs(int64_t(b.x2) - s.x1), dy = std::abs(int64_t(b.y2) - s.y1);
-    reach[b.scan] = std::max(reach[b.scan], std::min(std::max(dx, dy), t));
-  }
-  int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
-  for (size_t i = 0; i < placed.starts.size(); ++i) {
-    if (reach[i] < 0) continue;
-    const oracle::ScanStart &s = placed.starts[i];
-    x0 = std::min<int64_t>(x0, int64_t(s.x1) - reach[i]);
-    x1 = std::max<int64_t>(x1, int64_t(s.x1) + reach[i]);
-    y0 = std::min<int64_t>(y0, int64_t(s.y1) - reach[i]);
-    y1 = std::max<int64_t>(y1, int64_t(s.y1) + reach[i]);
+    const int64_t r = std::min(std::max(dx, dy), t);
+    x0 = std::min<int64_t>(x0, s.x1 - r);
+    x1 = std::max<int64_t>(x1, s.x1 + r);
+    y0 = std::min<int64_t>(y0, s.y1 - r);
+    y1 = std::max<int64_t>(y1, s.y1 + r);
   }
   Box b;
   x0 = std::max<int64_t>(x0, 0), y0 = std::max<int64_t>(y0, 0);
