@@ -115,21 +115,33 @@ void launch_exact_tile_ranges(const uint32_t *sorted_tile, size_t num_pairs, uin
                               uint32_t *tile_end, size_t num_tiles, cudaStream_t stream);
 
 // The order in which to run the tiles: longest list first (so that the
-// longest ones do not start last and make the tail), as tile ids in `order`.
-// Scratch: three arrays of num_tiles and exact_order_temp_bytes(num_tiles) bytes.
+// longest ones do not start last and make the tail), as tile ids in `order`,
+// and in *heavy_count how many of the first run as heavy tiles (a block of
+// their own; see launch_exact_tiles). Scratch: three arrays of num_tiles and
+// exact_order_temp_bytes(num_tiles) bytes.
 size_t exact_order_temp_bytes(size_t num_tiles);
 void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size_t num_tiles,
                       uint32_t *order, uint32_t *scratch_keys, uint32_t *scratch_keys_out,
-                      uint32_t *scratch_ids, void *temp, size_t temp_bytes, cudaStream_t stream);
+                      uint32_t *scratch_ids, uint32_t *heavy_count, void *temp, size_t temp_bytes,
+                      cudaStream_t stream);
 
-// One block per tile (block i runs tile order[i]), one thread per cell:
-// applies every beam of the tile's list, in order, to the thread's own cell,
-// and writes the final grid (x-major floats, -1 unknown). The tables are all
-// null above kMaxExactTable (distances on the fly).
+// The streams of the tiles kernels: the light tiles run on `main`, the
+// heavy ones on `side` at the same time; `fork` and `join` (events) order
+// `side` after what `main` queued before and `main`'s later work after it.
+struct TileStreams {
+  cudaStream_t main, side;
+  cudaEvent_t fork, join;
+};
+
+// One thread per cell of each tile, in the order of exact_tile_order: a
+// heavy tile (its first *heavy_count) in a block of 256 threads, the others
+// in blocks of 64. Applies every beam of the tile's list, in order, to the
+// thread's own cell, and writes the final grid (x-major floats, -1 unknown).
+// The tables are all null above kMaxExactTable (distances on the fly).
 void launch_exact_tiles(const KernelModel<double> &m, const LineRec *lines, const uint32_t *sorted_beam,
-                        const uint32_t *order, const uint32_t *tile_begin,
-                        const uint32_t *tile_end, const double2 *factors, const int *reach,
-                        float *grid, unsigned long long *cell_updates, cudaStream_t stream);
+                        const uint32_t *order, const uint32_t *tile_begin, const uint32_t *tile_end,
+                        const uint32_t *heavy_count, const double2 *factors, const int *reach, float *grid,
+                        unsigned long long *cell_updates, const TileStreams &streams);
 
 // ---------------------------------------------------------------------------
 // Float mode: single precision, all scans fused into one launch.

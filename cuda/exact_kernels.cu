@@ -38,63 +38,101 @@ __device__ __forceinline__ int tile_of(int cx, int cy, const KernelModel<double>
   return ((cx - m.x_begin) / kTile) * tiles_y + cy / kTile;
 }
 
-// Calls visit(tile) once per tile whose cells inside the grid the walk visits
-// at a step that can update a cell (k <= k_max). A straight line's cells are
-// monotone in x and in y, so a tile, once left, is never re-entered.
-//
-// Closed-form lines go a tile column at a time: along the major axis the k of
-// a column of tiles is an interval, and over it the minor coordinate moves
-// monotonically by at most one cell a step, so the walk visits exactly the
-// tiles between the minor coordinates at the interval's ends (both clipped
-// to the grid). About 2 * table_size / kTile iterations instead of table_size.
-template <class Visit>
-__device__ void for_each_tile(const LineRec &L, const KernelModel<double> &m, Visit visit) {
-  if (L.k_max < 0) return;
-  const int tiles_y = (m.size_y + kTile - 1) / kTile;
-  if (L.flags & kDegenerate) {  // the oracle's walker, step by step
-    int prev = -1;
-    egrid::walk_line(L.x1, L.y1, L.x2, L.y2, L.k_max + 1, [&](int cx, int cy, int) {
-      if (inside(cx, cy, m)) {
-        const int t = tile_of(cx, cy, m, tiles_y);
-        if (t != prev) {
-          visit(t);
-          prev = t;
-        }
-      }
-      return true;
-    });
-    return;
+// A closed-form line's walk through the grid's tiles, a column of tiles at a
+// time: along the major axis the k of a column of tiles (kTile steps) is an
+// interval, and over it the minor coordinate moves monotonically by at most
+// one cell a step, so the walk visits exactly the tiles between the minor
+// coordinates at the interval's ends (both clipped to the grid): one or two.
+// Columns are numbered from the start; each can be taken on its own, so a
+// warp can take a line's columns a lane each (pairs_kernel).
+struct TileColumns {
+  bool steep, backward, flipped;
+  int maj_lo, min_lo, size_min, tiles_y;
+  int k_lo, k_hi;  // the steps whose major coordinate is inside the grid (none when k_lo > k_hi)
+  int k_end0;      // the last step of the first column
+
+  __device__ TileColumns(const LineRec &L, const KernelModel<double> &m) {
+    steep = L.flags & kSteep;
+    backward = L.flags & kBackward;
+    flipped = L.flags & kFlipped;
+    tiles_y = (m.size_y + kTile - 1) / kTile;
+    // The grid's range of each coordinate: x from x_begin, y from 0.
+    maj_lo = steep ? 0 : m.x_begin;
+    min_lo = steep ? m.x_begin : 0;
+    const int size_maj = steep ? m.size_y : m.size_x;
+    size_min = steep ? m.size_x : m.size_y;
+    // Steps whose major coordinate (sx1 +- k) is inside the grid (in 64 bits:
+    // a start cell can be anywhere an int reaches).
+    const int64_t to_lo = static_cast<int64_t>(L.sx1) - maj_lo, to_hi = maj_lo + int64_t(size_maj) - 1 - L.sx1;
+    const int64_t k_max = L.k_max, lo = backward ? -to_hi : -to_lo, hi = backward ? to_lo : to_hi;
+    k_lo = static_cast<int>(lo < 0 ? 0 : lo > k_max + 1 ? k_max + 1 : lo);
+    k_hi = static_cast<int>(hi > k_max ? k_max : hi < -1 ? -1 : hi);
+    k_end0 = k_hi;
+    if (k_lo <= k_hi) {  // then the major coordinate at k_lo is in the grid
+      const int maj = major_at(L, k_lo);
+      k_end0 = min(k_hi, backward ? maj % kTile + k_lo : kTile - 1 - maj % kTile + k_lo);
+    }
   }
-  const bool steep = L.flags & kSteep, backward = L.flags & kBackward, flipped = L.flags & kFlipped;
-  // The grid's range of each coordinate: x from x_begin, y from 0.
-  const int maj_lo = steep ? 0 : m.x_begin, min_lo = steep ? m.x_begin : 0;
-  const int size_maj = steep ? m.size_y : m.size_x, size_min = steep ? m.size_x : m.size_y;
-  // Steps whose major coordinate (sx1 +- k) is inside the grid (in 64 bits:
-  // a start cell can be anywhere an int reaches).
-  const int64_t to_lo = static_cast<int64_t>(L.sx1) - maj_lo, to_hi = maj_lo + int64_t(size_maj) - 1 - L.sx1;
-  const int64_t k_max = L.k_max, lo = backward ? -to_hi : -to_lo, hi = backward ? to_lo : to_hi;
-  const int k_lo = static_cast<int>(lo < 0 ? 0 : lo > k_max + 1 ? k_max + 1 : lo);
-  const int k_hi = static_cast<int>(hi > k_max ? k_max : hi < -1 ? -1 : hi);
-  auto minor_at = [&](int k) {  // the minor coordinate at step k (egrid_math.h line_cell), from min_lo
+  __device__ int count() const { return k_lo > k_hi ? 0 : 1 + (k_hi - k_end0 + kTile - 1) / kTile; }
+  // The major coordinate at step k, from maj_lo (>= 0 for k in [k_lo, k_hi]).
+  __device__ int major_at(const LineRec &L, int k) const { return (backward ? L.sx1 - k : L.sx1 + k) - maj_lo; }
+  // The minor coordinate at step k (egrid_math.h line_cell), from min_lo.
+  __device__ int minor_at(const LineRec &L, int k) const {
     const int off = (L.two_b * k + L.bias) / L.two_a;
     const int mn = backward ? L.sy1 - off : L.sy1 + off;
     return (flipped ? -mn : mn) - min_lo;
-  };
-  for (int k = k_lo; k <= k_hi;) {
-    const int maj = (backward ? L.sx1 - k : L.sx1 + k) - maj_lo;
-    const int tmaj = maj / kTile;
-    const int k_end = min(k_hi, backward ? maj - tmaj * kTile + k : tmaj * kTile + kTile - 1 - maj + k);
-    const int a = minor_at(k), b = minor_at(k_end);
-    if (max(a, b) >= 0 && min(a, b) < size_min) {
-      const int t_from = min(max(a, 0), size_min - 1) / kTile, t_to = min(max(b, 0), size_min - 1) / kTile;
-      const int step = t_to >= t_from ? 1 : -1;
-      for (int t = t_from;; t += step) {
-        visit(steep ? t * tiles_y + tmaj : tmaj * tiles_y + t);
-        if (t == t_to) break;
+  }
+  // Calls visit(tile) for the tiles of column c < count(), in walk order.
+  template <class Visit>
+  __device__ void visit_column(const LineRec &L, int c, Visit &&visit) const {
+    // After the first column, each starts on a tile border: kTile steps, or to k_hi.
+    const int k = c == 0 ? k_lo : k_end0 + 1 + (c - 1) * kTile;
+    const int k_end = c == 0 ? k_end0 : min(k_hi, k + kTile - 1);
+    const int tmaj = major_at(L, k) / kTile;
+    const int a = minor_at(L, k), b = minor_at(L, k_end);
+    if (max(a, b) < 0 || min(a, b) >= size_min) return;
+    const int t_from = min(max(a, 0), size_min - 1) / kTile, t_to = min(max(b, 0), size_min - 1) / kTile;
+    const int step = t_to >= t_from ? 1 : -1;
+    for (int t = t_from;; t += step) {
+      visit(steep ? t * tiles_y + tmaj : tmaj * tiles_y + t);
+      if (t == t_to) break;
+    }
+  }
+};
+
+// The oracle's walker, step by step, for the rare degenerate line (see
+// kClosedFormLimit): visit(tile) once per tile whose cells inside the grid it
+// passes at a step that can update a cell (k <= k_max).
+template <class Visit>
+__device__ void for_each_tile_walked(const LineRec &L, const KernelModel<double> &m, Visit &&visit) {
+  const int tiles_y = (m.size_y + kTile - 1) / kTile;
+  int prev = -1;
+  egrid::walk_line(L.x1, L.y1, L.x2, L.y2, L.k_max + 1, [&](int cx, int cy, int) {
+    if (inside(cx, cy, m)) {
+      const int t = tile_of(cx, cy, m, tiles_y);
+      if (t != prev) {
+        visit(t);
+        prev = t;
       }
     }
-    k = k_end + 1;
+    return true;
+  });
+}
+
+// Calls visit(tile) once per tile whose cells inside the grid the walk visits
+// at a step that can update a cell (k <= k_max). A straight line's cells are
+// monotone in x and in y, so a tile, once left, is never re-entered. Closed-
+// form lines go a tile column at a time: about 2 * table_size / kTile
+// iterations instead of table_size.
+template <class Visit>
+__device__ void for_each_tile(const LineRec &L, const KernelModel<double> &m, Visit visit) {
+  if (L.k_max < 0) return;
+  if (L.flags & kDegenerate) {
+    for_each_tile_walked(L, m, visit);
+    return;
   }
+  const TileColumns columns(L, m);
+  for (int c = 0, n = columns.count(); c < n; ++c) columns.visit_column(L, c, visit);
 }
 
 __global__ void tables_kernel(KernelModel<double> m, double2 *factors) {
@@ -135,21 +173,73 @@ __global__ void lines_kernel(KernelModel<double> m, const PlacedBeam *beams, con
   counts[i] = c;
 }
 
+// Each group of kPairLanes lanes writes one beam's (tile, beam) pairs at its
+// offset, a tile column a lane: the group's pairs are consecutive, so its
+// stores are too (a thread per beam, each writing its own run, scattered
+// every store of a warp over 32 lines: 0.99 ms of fr079's 5.8 ms). A beam
+// whose pairs do not come to what lines_kernel counted (a bug) is reported
+// like an overflow, never written past its run.
+constexpr int kPairLanes = 8;
+
 __global__ void pairs_kernel(KernelModel<double> m, const LineRec *lines, const uint32_t *offsets, size_t n,
                              size_t capacity, uint32_t *pair_tile, uint32_t *pair_beam,
                              unsigned long long *overflow) {
-  const size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
+  const size_t thread = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
+  const size_t i = thread / kPairLanes;
+  const int sub = static_cast<int>(thread % kPairLanes);
   if (i >= n) return;
   if (offsets[n] > capacity) {  // the host's bound was wrong: write nothing, report
-    if (i == 0) atomicAdd(overflow, 1ull);
+    if (i == 0 && sub == 0) atomicAdd(overflow, 1ull);
     return;
   }
-  uint32_t o = offsets[i];
-  for_each_tile(lines[i], m, [&](int t) {
-    pair_tile[o] = static_cast<uint32_t>(t);
-    pair_beam[o] = static_cast<uint32_t>(i);
-    ++o;
-  });
+  const LineRec L = lines[i];
+  const uint32_t begin = offsets[i], end = offsets[i + 1];
+  if (L.k_max < 0) return;
+  if (L.flags & kDegenerate) {
+    uint32_t o = begin;
+    if (sub == 0) {
+      for_each_tile_walked(L, m, [&](int t) {
+        if (o < end) {
+          pair_tile[o] = static_cast<uint32_t>(t);
+          pair_beam[o] = static_cast<uint32_t>(i);
+        }
+        ++o;
+      });
+      if (o != end) atomicAdd(overflow, 1ull);
+    }
+    return;
+  }
+  const unsigned group = ((1u << kPairLanes) - 1) << ((threadIdx.x & 31) / kPairLanes * kPairLanes);
+  const TileColumns columns(L, m);
+  const int n_columns = columns.count();
+  uint32_t o = begin;
+  for (int c0 = 0; c0 < n_columns; c0 += kPairLanes) {
+    int t0 = -1, t1 = -1, got = 0;  // this lane's column: one or two tiles
+    if (c0 + sub < n_columns) columns.visit_column(L, c0 + sub, [&](int t) {
+      (got == 0 ? t0 : t1) = t;
+      ++got;
+    });
+    int before = got;  // inclusive prefix over the group's lanes
+    for (int d = 1; d < kPairLanes; d <<= 1) {
+      const int v = __shfl_up_sync(group, before, d, kPairLanes);
+      if (sub >= d) before += v;
+    }
+    const uint32_t at = o + before - got;
+    if (got > 2 || at + got > end) {
+      atomicAdd(overflow, 1ull);  // cannot happen: |minor change| < kTile within a column
+    } else {
+      if (got > 0) {
+        pair_tile[at] = static_cast<uint32_t>(t0);
+        pair_beam[at] = static_cast<uint32_t>(i);
+      }
+      if (got > 1) {
+        pair_tile[at + 1] = static_cast<uint32_t>(t1);
+        pair_beam[at + 1] = static_cast<uint32_t>(i);
+      }
+    }
+    o += __shfl_sync(group, before, kPairLanes - 1, kPairLanes);
+  }
+  if (sub == 0 && o != end) atomicAdd(overflow, 1ull);
 }
 
 __global__ void tile_ranges_kernel(const uint32_t *key, size_t n, size_t num_tiles, uint32_t *begin,
@@ -163,23 +253,53 @@ __global__ void tile_ranges_kernel(const uint32_t *key, size_t n, size_t num_til
 }
 
 constexpr int kTileThreads = kTile * kTile;
-static_assert(kTileThreads == 64, "a chunk's hit marks are one 64-bit word per cell");
+static_assert(kTileThreads == 64, "a tile's cells are the threads of two warps");
 
-// Marks, for every cell of the tile, which beams of the chunk visit it: beam
-// e = 32 * w + lane sets bit `lane` of hit[2 * cell + w]. Each thread takes
-// one beam. A closed-form line visits one cell per step and its major
-// coordinate is sx1 + inc*k, so only the (at most kTile) steps whose major
-// coordinate lies in the tile need looking at; the marked set is exactly
-// { c in tile : step_of_cell(L, c) >= 0 }.
+// A chunk of a tile's list is taken as words of 32 beams, a warp each. What
+// a word's beams have in common: with tables, a beam's update of a cell
+// depends on its start cell and on whether i*i + j*j < free_below, so when
+// every beam of the word starts in one cell a thread can tell from these
+// alone whether any of them changes its cell (drain_word).
+struct WordSummary {
+  int x1, y1;                          // the start cell of the word's first beam
+  int min_free_below, max_free_below;  // over the word's beams
+  int uniform;                         // every beam of the word starts at (x1, y1)
+};
+
+__device__ __forceinline__ int warp_min(int v) {
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 800
+  return __reduce_min_sync(0xffffffffu, v);
+#else
+  for (int offset = 16; offset > 0; offset >>= 1) v = min(v, __shfl_xor_sync(0xffffffffu, v, offset));
+  return v;
+#endif
+}
+__device__ __forceinline__ int warp_max(int v) {
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 800
+  return __reduce_max_sync(0xffffffffu, v);
+#else
+  for (int offset = 16; offset > 0; offset >>= 1) v = max(v, __shfl_xor_sync(0xffffffffu, v, offset));
+  return v;
+#endif
+}
+
+// Marks, for every cell of the tile, which beams of the word visit it: the
+// word's beam `lane` sets bit `lane` of hit[cell * stride]. Called by a whole
+// warp, lane l taking beam l (those past n mark nothing). A closed-form line
+// visits one cell per step and its major coordinate is sx1 + inc*k, so only
+// the (at most kTile) steps whose major coordinate lies in the tile need
+// looking at; the marked set is exactly { c in tile : step_of_cell(L, c) >= 0 }.
 //
 // The warp goes through those steps together and merges the lanes that mark
 // the same cell (__match_any_sync) into one plain write by one lane: in the
 // tiles where the robot stood still every beam starts in the same cell, and
-// per-lane atomics on that one word would serialise the whole warp.
-__device__ void mark_chunk(const LineRec *sh, int n, int tx0, int ty0, unsigned *hit) {
-  const int lane = threadIdx.x & 31, w = threadIdx.x >> 5, e = threadIdx.x;
-  const bool mine = e < n;
-  const LineRec &L = sh[mine ? e : 0];
+// per-lane atomics on that one word would serialise the whole warp. Only this
+// warp writes its word of each cell.
+__device__ void mark_word(const LineRec *sh, int n, int tx0, int ty0, unsigned *hit, int stride,
+                          WordSummary *summary) {
+  const int lane = threadIdx.x & 31;
+  const bool mine = lane < n;
+  const LineRec &L = sh[mine ? lane : 0];
   const bool closed = mine && !(L.flags & kDegenerate);
   const bool steep = L.flags & kSteep, backward = L.flags & kBackward, flipped = L.flags & kFlipped;
   const int maj0 = steep ? ty0 : tx0, min0 = steep ? tx0 : ty0;
@@ -208,16 +328,23 @@ __device__ void mark_chunk(const LineRec *sh, int n, int tx0, int ty0, unsigned 
       if (dv >= 0 && dv < kTile) cell = steep ? dv * kTile + du : du * kTile + dv;
     }
     const unsigned peers = __match_any_sync(0xffffffffu, cell);
-    if (cell >= 0 && lane == __ffs(peers) - 1) hit[2 * cell + w] |= peers;
+    if (cell >= 0 && lane == __ffs(peers) - 1) hit[cell * stride] |= peers;
     __syncwarp();
   }
   if (mine && !closed) {  // rare (see kClosedFormLimit): the oracle's walk
     egrid::walk_line(L.x1, L.y1, L.x2, L.y2, L.k_max + 1, [&](int x, int y, int) {
       const int u = egrid::wrap_sub(x, tx0), v = egrid::wrap_sub(y, ty0);  // x, y: anywhere an int reaches
-      if (u >= 0 && u < kTile && v >= 0 && v < kTile) atomicOr(&hit[2 * (u * kTile + v) + w], 1u << lane);
+      if (u >= 0 && u < kTile && v >= 0 && v < kTile) atomicOr(&hit[(u * kTile + v) * stride], 1u << lane);
       return true;
     });
   }
+  if (summary == nullptr) return;
+  // Lanes past n repeat the first beam, which changes neither the start nor the bounds.
+  const long long start = (static_cast<long long>(L.x1) << 32) | static_cast<unsigned>(L.y1);
+  int same = 0;
+  __match_all_sync(0xffffffffu, start, &same);
+  const int lo = warp_min(L.free_below), hi = warp_max(L.free_below);
+  if (lane == 0) *summary = WordSummary{L.x1, L.y1, lo, hi, same};
 }
 
 // The (value, factor) pairs a thread has seen leave its cell's value
@@ -353,30 +480,56 @@ __device__ __forceinline__ unsigned drain_hits(const KernelModel<double> &m, con
   return count;
 }
 
-// One block per tile, one thread per cell. The tile's list is taken in
-// chunks of 64 beams: the chunk's beams mark the cells they visit (one
-// thread per beam), then every thread applies its marked beams lowest bit
-// first — the list's order, which is (scan, beam) order. A warp thus runs as
-// many update rounds as its busiest cell has hits, not as many as there are
-// beams touching any of its cells.
-__global__ void __launch_bounds__(kTileThreads)
-    tiles_kernel(KernelModel<double> m, const LineRec *lines, const uint32_t *sorted_beam,
-                 const uint32_t *order, const uint32_t *tile_begin, const uint32_t *tile_end,
-                 const double2 *factors, const int *reach_global, float *grid, unsigned long long *updates) {
-  __shared__ LineRec sh[kTileThreads];
-  __shared__ unsigned hit[2 * kTileThreads];  // per cell: beams 0-31, beams 32-63
-  extern __shared__ int reach_shared[];  // the reach table, when tables are used
-  const int *reach = nullptr;
-  if (reach_global) {
-    for (int i = threadIdx.x; i < m.table_size; i += kTileThreads) reach_shared[i] = reach_global[i];
-    reach = reach_shared;
+// A word's hits on the thread's cell (bit e: the word's beam e), in order.
+// When the word's beams all start in one cell (tables only), each of them
+// multiplies the cell by the free or the occupied factor of that start, and
+// where the cell is already a fixed point of every factor that can occur the
+// whole word changes nothing: counted, not walked. This is the common case
+// on the longest tile lists — the cells around where the robot stood, hit
+// by thousands of beams from the same start after they settled.
+__device__ __forceinline__ unsigned drain_word(const KernelModel<double> &m, const LineRec *sh, unsigned h,
+                                               const WordSummary &s, int cx, int cy, const int *reach,
+                                               const double2 *factors, FixedPoints *fixed, StartFactors *known,
+                                               float *cell) {
+  if (h == 0) return 0;
+  if (reach != nullptr && s.uniform) {
+    if (known->x1 != s.x1 || known->y1 != s.y1) *known = start_factors(m, sh[0], cx, cy, reach, factors);
+    if (!known->update) return 0;  // the oracle stops these beams before the cell
+    const bool all_free = known->n < s.min_free_below, all_occupied = known->n >= s.max_free_below;
+    if ((all_free || fixed->holds(*cell, known->occ)) && (all_occupied || fixed->holds(*cell, known->free)))
+      return __popc(h);
   }
+  return drain_hits(m, sh, h, cx, cy, reach, factors, fixed, known, cell);
+}
+
+// The shared memory of one tile's run, chunks of 32 * kWords beams.
+template <int kWords>
+struct TileShared {
+  LineRec beams[32 * kWords];
+  unsigned hit[kTileThreads * kWords];  // per cell, kWords words of 32 beams
+  WordSummary words[kWords];
+};
+
+// One tile's list, run by 32 * kWords threads (t = 0, 1, ...), the first 64
+// of which own the tile's cells: the list is taken in chunks of 32 * kWords
+// beams; the chunk's beams mark the cells they visit (a warp per word), then
+// every cell's thread applies its marked beams word by word, lowest bit first
+// — the list's order, which is (scan, beam) order. A warp thus runs as many
+// update rounds as its busiest cell has hits, not as many as there are beams
+// touching any of its cells. The next chunk's beams are fetched while this
+// one is marked and applied. Returns the thread's cell updates.
+template <int kWords>
+__device__ unsigned run_tile(const KernelModel<double> &m, uint32_t tile, int t, TileShared<kWords> &S,
+                             const LineRec *lines, const uint32_t *sorted_beam, const uint32_t *tile_begin,
+                             const uint32_t *tile_end, const double2 *factors, const int *reach, float *grid) {
+  constexpr int kThreads = 32 * kWords;
+  constexpr bool kHeavy = kWords > 2;
+  static_assert(kWords == 2 || kWords == 8, "a light tile's 64 threads or a heavy tile's 256");
   const int tiles_y = (m.size_y + kTile - 1) / kTile;
-  const int tile = static_cast<int>(order[blockIdx.x]);
-  const int tx0 = m.x_begin + (tile / tiles_y) * kTile, ty0 = (tile % tiles_y) * kTile;  // in the frame
-  const int cx = tx0 + threadIdx.x / kTile;
-  const int cy = ty0 + threadIdx.x % kTile;
-  const bool active = inside(cx, cy, m);
+  const int tx0 = m.x_begin + (static_cast<int>(tile) / tiles_y) * kTile;  // in the frame
+  const int ty0 = (static_cast<int>(tile) % tiles_y) * kTile;
+  const int cx = tx0 + t / kTile, cy = ty0 + t % kTile;
+  const bool active = t < kTileThreads && inside(cx, cy, m);
   const size_t index = static_cast<size_t>(cx - m.x_begin) * m.size_y + cy;  // active cells only
   // The grid holds the result of earlier scans (all unknown for a fresh map):
   // this launch's updates come after theirs, as in the oracle's order.
@@ -384,22 +537,97 @@ __global__ void __launch_bounds__(kTileThreads)
   unsigned count = 0;
   FixedPoints fixed;
   StartFactors known;
-  const uint32_t begin = tile_begin[tile], end = tile_end[tile];
-  for (uint32_t base = begin; base < end; base += kTileThreads) {
-    const int n = static_cast<int>(min(static_cast<uint32_t>(kTileThreads), end - base));
-    hit[2 * threadIdx.x] = hit[2 * threadIdx.x + 1] = 0;
-    if (static_cast<int>(threadIdx.x) < n) sh[threadIdx.x] = lines[sorted_beam[base + threadIdx.x]];
+  const int w = t / 32;
+  // 64-bit positions: a list can end near 2^32 (pairs are counted in 32 bits).
+  const uint64_t begin = tile_begin[tile], end = tile_end[tile];
+  // A heavy tile's thread fetches its beam of the next chunk, and the id of
+  // its beam two chunks ahead: each load is issued a chunk before its value
+  // is needed, so no round waits for the list's two dependent loads. (A
+  // light tile has few rounds; the registers would cost it occupancy.)
+  LineRec next;
+  uint32_t ahead = 0;
+  if (kHeavy) {
+    if (begin + t < end) next = lines[sorted_beam[begin + t]];
+    if (begin + kThreads + t < end) ahead = sorted_beam[begin + kThreads + t];
+  }
+  for (uint64_t base = begin; base < end; base += kThreads) {
+    const int n = static_cast<int>(min(static_cast<uint64_t>(kThreads), end - base));
+    for (int i = t; i < kTileThreads * kWords; i += kThreads) S.hit[i] = 0;
+    if (t < n) S.beams[t] = kHeavy ? next : lines[sorted_beam[base + t]];
     __syncthreads();
-    mark_chunk(sh, n, tx0, ty0, hit);
+    if (kHeavy) {
+      if (base + kThreads + t < end) next = lines[ahead];
+      if (base + 2 * kThreads + t < end) ahead = sorted_beam[base + 2 * kThreads + t];
+    }
+    if (32 * w < n)
+      mark_word(S.beams + 32 * w, n - 32 * w, tx0, ty0, S.hit + w, kWords, kHeavy ? &S.words[w] : nullptr);
     __syncthreads();
-    const unsigned long long mine =
-        (static_cast<unsigned long long>(hit[2 * threadIdx.x + 1]) << 32) | hit[2 * threadIdx.x];
-    if (active) count += drain_hits(m, sh, mine, cx, cy, reach, factors, &fixed, &known, &cell);
+    if (active && kHeavy) {
+      for (int v = 0; v < kWords && 32 * v < n; ++v)
+        count += drain_word(m, S.beams + 32 * v, S.hit[t * kWords + v], S.words[v], cx, cy, reach, factors, &fixed,
+                            &known, &cell);
+    } else if (active) {  // a light tile's two words as one mask of 64 beams
+      const unsigned long long h = (static_cast<unsigned long long>(S.hit[2 * t + 1]) << 32) | S.hit[2 * t];
+      count += drain_hits(m, S.beams, h, cx, cy, reach, factors, &fixed, &known, &cell);
+    }
     __syncthreads();
   }
   if (active) grid[index] = cell;
+  return count;
+}
+
+// Tiles whose lists are longer than this run as heavy tiles: a block of 256
+// threads (chunks of 256 beams, 8 warps marking) each, in a launch of their
+// own beside the light tiles' (a block of 64 threads each). A tile's list
+// runs in order, so the longest lists (where the robot stood: fr079 has one
+// of 25560 beams) bounded the kernel: a quarter of the rounds, marking and
+// fetching spread over four times the warps, the next chunk fetched during
+// this one, and words of beams with one start counted without walking once
+// the cell settled take them out of the way. Measured on the H200 (fr079,
+// vasco's defaults, tiles kernel): every tile 64 threads, one launch,
+// 5.07 ms (the SMs busy 54 % of it); heavy tiles above 512 beams in the
+// same launch (four light tiles a block) 3.92; apart on a second stream,
+// above 4096 beams (at most 132) 3.89, above 2048 (at most 264) 3.81; at
+// most 4096 heavy tiles in one launch, 5.4. The light tiles' total work
+// bounds it now.
+constexpr uint32_t kHeavyList = 2048;
+// At most this many tiles run heavy: the longest lists, a block each.
+constexpr uint32_t kHeavyBlocks = 264;
+constexpr int kLightWords = kTileThreads / 32, kHeavyWords = 8;
+
+// Block b runs tile order[b] when it is a heavy one (b < *heavy_count, for the
+// heavy launch) or a light one (b >= *heavy_count, for the light launch).
+template <int kWords>
+__global__ void __launch_bounds__(32 * kWords)
+    tiles_kernel(KernelModel<double> m, const LineRec *lines, const uint32_t *sorted_beam, const uint32_t *order,
+                 const uint32_t *tile_begin, const uint32_t *tile_end, const uint32_t *heavy_count,
+                 const double2 *factors, const int *reach_global, float *grid, unsigned long long *updates) {
+  constexpr bool kHeavy = kWords == kHeavyWords;
+  if ((blockIdx.x < *heavy_count) != kHeavy) return;  // the other launch's tile
+  __shared__ TileShared<kWords> S;
+  extern __shared__ int reach_shared[];  // the reach table, when tables are used
+  const int *reach = nullptr;
+  if (reach_global) {
+    for (int i = threadIdx.x; i < m.table_size; i += 32 * kWords) reach_shared[i] = reach_global[i];
+    reach = reach_shared;
+  }
+  __syncthreads();
+  const unsigned count = run_tile<kWords>(m, order[blockIdx.x], threadIdx.x, S, lines, sorted_beam, tile_begin,
+                                          tile_end, factors, reach, grid);
   const unsigned in_warp = warp_sum(count);
   if ((threadIdx.x & 31) == 0 && in_warp) atomicAdd(updates, static_cast<unsigned long long>(in_warp));
+}
+
+// *count = the number of leading entries of `lengths` (sorted, longest first)
+// above kHeavyList, at most kHeavyBlocks.
+__global__ void heavy_count_kernel(const uint32_t *lengths, size_t n, uint32_t *count) {
+  size_t lo = 0, hi = n < kHeavyBlocks ? n : kHeavyBlocks;
+  while (lo < hi) {
+    const size_t mid = lo + (hi - lo) / 2;
+    if (lengths[mid] > kHeavyList) lo = mid + 1;
+    else hi = mid;
+  }
+  *count = static_cast<uint32_t>(lo);
 }
 
 __global__ void tile_keys_kernel(const uint32_t *begin, const uint32_t *end, size_t n,
@@ -463,8 +691,8 @@ void launch_exact_pairs(const KernelModel<double> &m, const LineRec *lines, cons
   // Slots past the real pairs keep kNoTile and sort last.
   VG_CUDA_CHECK(cudaMemsetAsync(pair_tile, 0xff, capacity * sizeof(uint32_t), stream));
   if (num_beams == 0) return;
-  pairs_kernel<<<blocks_for(num_beams, 128), 128, 0, stream>>>(m, lines, offsets, num_beams, capacity,
-                                                                pair_tile, pair_beam, overflow);
+  pairs_kernel<<<blocks_for(num_beams * kPairLanes, 128), 128, 0, stream>>>(m, lines, offsets, num_beams, capacity,
+                                                                             pair_tile, pair_beam, overflow);
   VG_CUDA_CHECK_LAUNCH();
 }
 
@@ -496,8 +724,8 @@ size_t exact_order_temp_bytes(size_t num_tiles) {
 }
 
 void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size_t num_tiles,
-                      uint32_t *order, uint32_t *keys, uint32_t *keys_out, uint32_t *ids, void *temp,
-                      size_t temp_bytes, cudaStream_t stream) {
+                      uint32_t *order, uint32_t *keys, uint32_t *keys_out, uint32_t *ids, uint32_t *heavy_count,
+                      void *temp, size_t temp_bytes, cudaStream_t stream) {
   if (num_tiles == 0) return;
   tile_keys_kernel<<<blocks_for(num_tiles, 256), 256, 0, stream>>>(tile_begin, tile_end, num_tiles,
                                                                    keys, ids);
@@ -505,19 +733,32 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
   VG_CUDA_CHECK(cub::DeviceRadixSort::SortPairsDescending(temp, temp_bytes, keys, keys_out, ids, order,
                                                           static_cast<int64_t>(num_tiles), 0, 32,
                                                           stream));
+  heavy_count_kernel<<<1, 1, 0, stream>>>(keys_out, num_tiles, heavy_count);
+  VG_CUDA_CHECK_LAUNCH();
 }
 
 void launch_exact_tiles(const KernelModel<double> &m, const LineRec *lines, const uint32_t *sorted_beam,
-                        const uint32_t *order, const uint32_t *tile_begin,
-                        const uint32_t *tile_end, const double2 *factors, const int *reach, float *grid,
-                        unsigned long long *updates, cudaStream_t stream) {
+                        const uint32_t *order, const uint32_t *tile_begin, const uint32_t *tile_end,
+                        const uint32_t *heavy_count, const double2 *factors, const int *reach, float *grid,
+                        unsigned long long *updates, const TileStreams &streams) {
   const size_t tiles = static_cast<size_t>((m.size_x + kTile - 1) / kTile) *
                        ((m.size_y + kTile - 1) / kTile);
   if (tiles == 0) return;
   const size_t shared = reach ? static_cast<size_t>(m.table_size) * sizeof(int) : 0;
-  tiles_kernel<<<static_cast<unsigned>(tiles), kTileThreads, shared, stream>>>(
-      m, lines, sorted_beam, order, tile_begin, tile_end, factors, reach, grid, updates);
+  // The heavy tiles on the side stream, beside the light ones: forked after
+  // everything queued so far, joined before anything queued later.
+  VG_CUDA_CHECK(cudaEventRecord(streams.fork, streams.main));
+  VG_CUDA_CHECK(cudaStreamWaitEvent(streams.side, streams.fork, 0));
+  const unsigned heavy_blocks = static_cast<unsigned>(tiles < kHeavyBlocks ? tiles : kHeavyBlocks);
+  tiles_kernel<kHeavyWords><<<heavy_blocks, 32 * kHeavyWords, shared, streams.side>>>(
+      m, lines, sorted_beam, order, tile_begin, tile_end, heavy_count, factors, reach, grid, updates);
   VG_CUDA_CHECK_LAUNCH();
+  // kMaxExactTiles keeps this below 2^31 blocks.
+  tiles_kernel<kLightWords><<<static_cast<unsigned>(tiles), 32 * kLightWords, shared, streams.main>>>(
+      m, lines, sorted_beam, order, tile_begin, tile_end, heavy_count, factors, reach, grid, updates);
+  VG_CUDA_CHECK_LAUNCH();
+  VG_CUDA_CHECK(cudaEventRecord(streams.join, streams.side));
+  VG_CUDA_CHECK(cudaStreamWaitEvent(streams.main, streams.join, 0));
 }
 
 }  // namespace cuda

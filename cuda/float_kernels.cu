@@ -37,8 +37,11 @@ constexpr int kWarpsPerBlock = 8;
 // atomics contend in L2: they go to a block-private window in shared memory
 // instead, and the window to the sums once per scan. Integer sums: the same
 // bytes as adding each to the sums. Measured on the H200 (map phase, fr079 /
-// fr101): no window 1.93 / 3.35 ms, kNear 8 1.81 / 3.23, kNear 16 1.66 / 3.24.
-constexpr int kNear = 16;
+// fr101): no window 1.93 / 3.35 ms, kNear 8 1.81 / 3.23, kNear 16 1.66 / 3.24;
+// with the beams planned a lane each (fr079 paper / defaults): kNear 16
+// 1.14 / 1.19 ms, 24 1.05 / 1.11, 32 0.95 / 1.01 (a warp's first 32 steps
+// all in shared memory), 39 1.09 / 1.15 (the window's 47 KB cost blocks).
+constexpr int kNear = 32;
 constexpr int kWindow = 2 * kNear - 1;  // cells per side, centred on the start cell
 
 struct NearWindow {
@@ -108,11 +111,122 @@ __global__ void float_tables_kernel(KernelModel<float> m, int2 *increments) {
   }
 }
 
+// A beam's closed-form walk, as every lane of the warp that walks it needs
+// it. One lane plans each beam (plan_beam) and the warp shares the plans
+// (share_plan): the set-up — the angle's sine and cosine, the end cell, the
+// line's parameters, three divisions and a search — then costs a lane's work
+// instead of a warp's, where an average fr079 beam gives each lane only 3 or
+// 4 cells to update. Measured on the H200 (fr079, vasco's defaults, map
+// phase): 1.38 -> 1.19 ms, 1.11 G -> 0.68 G instructions.
+struct BeamPlan {
+  int kind;        // kSkipBeam, kDegenerateBeam or kClosedBeam
+  int flags;       // kPlanSteep | kPlanFlipped | kPlanBackward (closed only)
+  int sx1, sy1;    // the start in the swapped/flipped frame (major, minor)
+  int k_end;       // last step that can update a cell
+  int two_a, bias; // minor offset m(k) = (two_b * k + bias) / two_a
+  int two_b;
+  int dq, dr;      // m(k + 32) = m(k) + dq, or + dq + 1 when the remainder passes two_a (dr < two_a)
+  int n_free;      // i*i + j*j < n_free exactly where the beam's float distance is below its range
+  int x2, y2;      // the end cell (degenerate lines)
+  float r;
+};
+constexpr int kSkipBeam = 0, kDegenerateBeam = 1, kClosedBeam = 2;
+constexpr int kPlanSteep = 1, kPlanFlipped = 2, kPlanBackward = 4;
+
+// The first n in [0, n_max] with !(float distance of n < r), n_max + 1 if
+// none: the free test of every update in one comparison of integers. The
+// float distance sqrtf((float)n) * resolution never decreases as n grows
+// (each operation is correctly rounded, so monotone), so walking from any
+// guess to where the test turns gives it exactly; (r / resolution)^2 is
+// within a few units of it. Tables only: n = i*i + j*j < 2 * 2048^2 is exact
+// in a float.
+__device__ __forceinline__ int first_not_free(const KernelModel<float> &m, float r) {
+  const int n_max = 2 * (m.table_size - 1) * (m.table_size - 1);
+  auto is_free = [&](int n) { return sqrtf(static_cast<float>(n)) * m.resolution < r; };
+  const float x = r / m.resolution, guess = x * x;
+  int n = !(r > 0.0f) ? 0 : guess >= static_cast<float>(n_max) ? n_max + 1 : static_cast<int>(guess);
+  while (n > 0 && !is_free(n - 1)) --n;
+  while (n <= n_max && is_free(n)) ++n;
+  return n;
+}
+
+__device__ BeamPlan plan_beam(const KernelModel<float> &m, const FloatScan &sc, const float *ranges, int b,
+                              bool tables) {
+  BeamPlan w{};
+  w.kind = kSkipBeam;
+  if (b >= sc.beam_count) return w;
+  w.r = ranges[sc.beam_begin + b];
+  if (!(w.r < 50.0f)) return w;
+  float sn, cs;
+  sincosf(sc.theta + sc.first + static_cast<float>(b) * sc.step, &sn, &cs);
+  w.x2 = egrid::trunc_to_int(sc.lx + (w.r + m.wall) * cs / m.resolution);
+  w.y2 = egrid::trunc_to_int(sc.ly + (w.r + m.wall) * sn / m.resolution);
+  if (!egrid::is_closed_form_line(sc.x1, sc.y1, w.x2, w.y2)) {
+    w.kind = kDegenerateBeam;  // a range of -inf: walked sequentially
+    return w;
+  }
+  w.kind = kClosedBeam;
+  const egrid::LineParams p = egrid::line_params(sc.x1, sc.y1, w.x2, w.y2);
+  w.flags = (p.steep ? kPlanSteep : 0) | (p.flipped ? kPlanFlipped : 0) | (p.inc < 0 ? kPlanBackward : 0);
+  w.sx1 = p.steep ? p.y1 : p.x1;
+  w.sy1 = p.flipped ? -(p.steep ? p.x1 : p.y1) : (p.steep ? p.x1 : p.y1);
+  // Cells beyond table_size steps are never updated (see oracle.h); cells
+  // with d >= max are skipped, which equals the oracle's stop because d
+  // never decreases along the walk.
+  w.k_end = min(p.major_len, m.table_size - 1);
+  // a, b < 2^29 (is_closed_form_line): 2a and 2b fit an int; 32 steps of 2b may not.
+  w.two_a = p.a ? 2 * p.a : 1;
+  w.two_b = p.a ? 2 * p.b : 0;
+  w.bias = p.a ? p.a - (p.inc < 0 ? 1 : 0) : 0;
+  const int64_t stride = 32 * static_cast<int64_t>(w.two_b);
+  w.dq = static_cast<int>(stride / w.two_a);
+  w.dr = static_cast<int>(stride % w.two_a);
+  w.n_free = tables ? first_not_free(m, w.r) : 0;
+  return w;
+}
+
+__device__ __forceinline__ BeamPlan share_plan(const BeamPlan &w, int src) {
+  constexpr unsigned kAll = 0xffffffffu;
+  BeamPlan s;
+  s.kind = __shfl_sync(kAll, w.kind, src);
+  s.flags = __shfl_sync(kAll, w.flags, src);
+  s.sx1 = __shfl_sync(kAll, w.sx1, src);
+  s.sy1 = __shfl_sync(kAll, w.sy1, src);
+  s.k_end = __shfl_sync(kAll, w.k_end, src);
+  s.two_a = __shfl_sync(kAll, w.two_a, src);
+  s.bias = __shfl_sync(kAll, w.bias, src);
+  s.two_b = __shfl_sync(kAll, w.two_b, src);
+  s.dq = __shfl_sync(kAll, w.dq, src);
+  s.dr = __shfl_sync(kAll, w.dr, src);
+  s.n_free = __shfl_sync(kAll, w.n_free, src);
+  s.x2 = __shfl_sync(kAll, w.x2, src);
+  s.y2 = __shfl_sync(kAll, w.y2, src);
+  s.r = __shfl_sync(kAll, w.r, src);
+  return s;
+}
+
+// The minor offset at step k <= k_end: (two_b * k + bias) / two_a, and its
+// remainder, in 32 bits when they fit (every beam of a table-sized walk at
+// ordinary resolutions), else in 64.
+__device__ __forceinline__ void minor_offset(const BeamPlan &w, int k, int *mm, int *rem) {
+  const int64_t num = static_cast<int64_t>(w.two_b) * k + w.bias;
+  if (num <= INT32_MAX) {
+    const unsigned n32 = static_cast<unsigned>(num), q = n32 / static_cast<unsigned>(w.two_a);
+    *mm = static_cast<int>(q);
+    *rem = static_cast<int>(n32 - q * static_cast<unsigned>(w.two_a));
+  } else {
+    *mm = static_cast<int>(num / w.two_a);
+    *rem = static_cast<int>(num % w.two_a);
+  }
+}
+
 // The closed-form walk of one beam, lane by lane: lane l takes steps l, l+32,
-// ... The minor offset (2b·k + bias) / 2a advances by a constant quotient and
-// remainder per 32 steps, so each lane divides once. With tables, an update
-// is a lookup and a comparison (d < r, the sensor model's free test, with the
-// same float distance); without, fixed_increment in full.
+// ... The minor offset advances by a constant quotient and remainder per 32
+// steps, so each lane divides once. With tables, an update is a lookup and a
+// comparison of integers (n < n_free: the free test d < r, see
+// first_not_free); without, fixed_increment in full. The tables depend on
+// i*i + j*j only, so they are symmetric: looking up (minor offset, step)
+// makes the lanes' loads consecutive whatever the beam's direction.
 //
 // A beam whose major axis is x (not steep) steps along x from lane to lane:
 // in the x-major sums its 32 lanes' adds are a column apart each, 32 L2
@@ -121,43 +235,36 @@ __global__ void float_tables_kernel(KernelModel<float> m, int2 *increments) {
 // to the sums afterwards. Integer sums: the same bytes either way.
 template <bool kBanded>
 __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, const int2 *increments,
-                                                 const egrid::LineParams &p, int x1, int y1, float r, int lane,
+                                                 const BeamPlan &w, int x1, int y1, int lane,
                                                  unsigned long long *sums, unsigned long long *across,
                                                  const NearWindow &near, unsigned *updates) {
-  unsigned long long *const target = !p.steep && across != nullptr ? across : sums;
-  // Cells beyond table_size steps are never updated (see oracle.h); cells
-  // with d >= max are skipped, which equals the oracle's stop because d
-  // never decreases along the walk.
-  const int k_end = min(p.major_len, m.table_size - 1);
-  if (lane > k_end) return;
-  const int64_t two_a = p.a ? 2 * static_cast<int64_t>(p.a) : 1, two_b = p.a ? 2 * static_cast<int64_t>(p.b) : 0;
-  const int64_t num = two_b * lane + (p.a ? p.a - (p.inc < 0 ? 1 : 0) : 0), stride = two_b * 32;
-  int mm = static_cast<int>(num / two_a);
-  int64_t rem = num % two_a;
-  const int dq = static_cast<int>(stride / two_a);
-  const int64_t dr = stride % two_a;
-  const int sx1 = p.steep ? p.y1 : p.x1, sy1 = p.flipped ? -(p.steep ? p.x1 : p.y1) : (p.steep ? p.x1 : p.y1);
-  for (int k = lane; k <= k_end; k += 32) {
-    const int maj = sx1 + p.inc * k;
-    const int mn = p.flipped ? -(sy1 + p.inc * mm) : sy1 + p.inc * mm;
-    const int cx = p.steep ? mn : maj, cy = p.steep ? maj : mn;
+  if (lane > w.k_end) return;
+  const bool steep = w.flags & kPlanSteep, flipped = w.flags & kPlanFlipped;
+  const int inc = w.flags & kPlanBackward ? -1 : 1;
+  unsigned long long *const target = !steep && across != nullptr ? across : sums;
+  int mm, rem;
+  minor_offset(w, lane, &mm, &rem);
+  for (int k = lane; k <= w.k_end; k += 32) {
+    const int maj = w.sx1 + inc * k;
+    const int mn = flipped ? -(w.sy1 + inc * mm) : w.sy1 + inc * mm;
+    const int cx = steep ? mn : maj, cy = steep ? maj : mn;
     // The column in the grid (x_begin: a band's first; a session's start
     // cells lie in its frame, so this stays well inside an int). A whole
     // grid's kernel goes without the subtraction (measured: 2 % of its time).
     const int bx = kBanded ? cx - m.x_begin : cx;
     if (bx >= 0 && bx < m.size_x && cy >= 0 && cy < m.size_y) {
-      const int i = p.steep ? mm : k, j = p.steep ? k : mm;  // |cx - x1|, |cy - y1|
       long long q;
       bool update;
       if (increments) {
-        const int2 e = increments[i * m.table_size + j];
+        // mm <= k < table_size (the minor offset never outruns the step).
+        const int2 e = increments[mm * m.table_size + k];
         update = e.x != kFloatStops;
-        q = float_distance(m, i, j) < r ? e.x : e.y;
+        q = mm * mm + k * k < w.n_free ? e.x : e.y;
       } else {
-        update = fixed_increment(m, float_distance(m, abs(cx - x1), abs(cy - y1)), r, &q);
+        update = fixed_increment(m, float_distance(m, abs(cx - x1), abs(cy - y1)), w.r, &q);
       }
       if (update) {
-        if (i < kNear && j < kNear) {
+        if (k < kNear) {  // then mm < kNear too: inside the window
           atomicAdd(near.cells + (cx - near.x1 + kNear - 1) * kWindow + (cy - near.y1 + kNear - 1), fixed_term(q));
         } else if (target == across) {
           add_fixed(across, static_cast<size_t>(cy) * m.size_x + bx, q);
@@ -167,17 +274,17 @@ __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, co
         ++*updates;
       }
     }
-    mm += dq;
-    rem += dr;
-    if (rem >= two_a) {
-      rem -= two_a;
+    mm += w.dq;
+    rem += w.dr;
+    if (rem >= w.two_a) {
+      rem -= w.two_a;
       ++mm;
     }
   }
 }
 
 template <bool kBanded>
-__global__ void __launch_bounds__(kWarpsPerBlock * 32)
+__global__ void __launch_bounds__(kWarpsPerBlock * 32, 5)
     float_map_kernel(KernelModel<float> m, const int2 *increments, const FloatScan *scans, int num_scans, int parts,
                      const float *ranges, unsigned long long *sums, unsigned long long *across,
                      unsigned long long *counters) {
@@ -192,30 +299,26 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32)
     const NearWindow near{window, sc.x1, sc.y1};
     for (int c = threadIdx.x; c < kWindow * kWindow; c += blockDim.x) window[c] = 0;
     __syncthreads();
-    for (int b = part * kWarpsPerBlock + warp; b < sc.beam_count; b += kWarpsPerBlock * parts) {
-      const float r = ranges[sc.beam_begin + b];
-      if (!(r < 50.0f)) {
-        skipped += lane == 0;
-        continue;
-      }
-      used += lane == 0;
-      float sn, cs;
-      sincosf(sc.theta + sc.first + static_cast<float>(b) * sc.step, &sn, &cs);
-      const int x2 = egrid::trunc_to_int(sc.lx + (r + m.wall) * cs / m.resolution);
-      const int y2 = egrid::trunc_to_int(sc.ly + (r + m.wall) * sn / m.resolution);
-      if (!egrid::is_closed_form_line(sc.x1, sc.y1, x2, y2)) {
-        // Degenerate line (a range of -inf): one lane walks it sequentially.
-        if (lane == 0) {
+    // The warp's beams are first + l * stride; a round plans 32 of them, a
+    // lane each, and walks them one after the other.
+    const int first = part * kWarpsPerBlock + warp, stride = kWarpsPerBlock * parts;
+    for (int round = first; round < sc.beam_count; round += 32 * stride) {
+      const int b = round + lane * stride;
+      const BeamPlan mine = plan_beam(m, sc, ranges, b, increments != nullptr);
+      used += mine.kind != kSkipBeam;
+      skipped += mine.kind == kSkipBeam && b < sc.beam_count;
+      for (unsigned todo = __ballot_sync(0xffffffffu, mine.kind != kSkipBeam); todo != 0; todo &= todo - 1) {
+        const BeamPlan w = share_plan(mine, __ffs(todo) - 1);
+        if (w.kind == kClosedBeam) {
+          walk_closed_form<kBanded>(m, increments, w, sc.x1, sc.y1, lane, sums, across, near, &updates);
+        } else if (lane == 0) {  // degenerate line (a range of -inf): one lane walks it sequentially
           bool stop = false;
-          egrid::walk_line(sc.x1, sc.y1, x2, y2, m.table_size, [&](int cx, int cy, int) {
-            add_evidence(m, cx, cy, sc.x1, sc.y1, r, sums, &updates, &stop);
+          egrid::walk_line(sc.x1, sc.y1, w.x2, w.y2, m.table_size, [&](int cx, int cy, int) {
+            add_evidence(m, cx, cy, sc.x1, sc.y1, w.r, sums, &updates, &stop);
             return !stop;
           });
         }
-        continue;
       }
-      const egrid::LineParams p = egrid::line_params(sc.x1, sc.y1, x2, y2);
-      walk_closed_form<kBanded>(m, increments, p, sc.x1, sc.y1, r, lane, sums, across, near, &updates);
     }
     __syncthreads();
     // The window to the sums: only cells of the grid were added to it.

@@ -188,6 +188,40 @@ TEST(CudaExact, RandomScansWithOddRangesMatchTheOracle) {
   EXPECT_EQ(rs.cell_updates, gs.cell_updates);
 }
 
+// A robot that stands still: thousands of beams from one start cell cross
+// the tiles around it, so those tiles run as heavy tiles (exact_kernels.cu
+// kHeavyList: their own launch, 256 threads, words of beams with one start
+// counted without walking once their cells settle). A second pose in the
+// same tile mixes two start cells in a word; soft evidence (0.499 / 0.501)
+// keeps cells from settling, vasco's defaults let them settle. Both must be
+// the oracle's bits and counts.
+TEST(CudaExact, TilesWhereTheRobotStoodMatchTheOracle) {
+  REQUIRE_GPU();
+  for (const bool soft : {false, true}) {
+    SCOPED_TRACE(soft ? "soft evidence" : "vasco's defaults");
+    MapperParams params;
+    if (soft) {
+      params.p_emp = 0.499;
+      params.p_occ = 0.501;
+    }
+    ScanBatch batch;
+    std::vector<float> r(720);
+    for (int s = 0; s < 16; ++s) {
+      for (size_t i = 0; i < r.size(); ++i) r[i] = 1.0f + 0.25f * s + 0.5f * std::sin(0.05f * i + s);
+      r[s * 7] = -1.0f;  // an odd range or two on the way
+      r[s * 11 + 3] = 60.0f;
+      const double x = s % 3 == 2 ? 1.04 : 1.0;  // two start cells in one tile
+      batch.add_scan(x, 2.0, 0.01 * s, -M_PI, 2 * M_PI / 720, r.data(), 720, s);
+    }
+    const GridGeometry geo = size_grid(batch, params);
+    MapStats rs, gs;
+    const auto ref = map_on("cpu_double", batch, params, geo, &rs);
+    const auto got = map_on("cuda", batch, params, geo, &gs, CudaMode::Exact);
+    expect_bit_identical(ref, got, geo);
+    EXPECT_EQ(rs.cell_updates, gs.cell_updates);
+  }
+}
+
 // Exact mode counts tiles in 31 bits (tile ids, the tiles kernel's blocks):
 // a grid of more tiles is refused by name before anything is allocated.
 TEST(CudaExact, AGridPastItsTileIdsIsRefusedByName) {

@@ -126,6 +126,7 @@ void CudaExactRenderer::reserve_scratch(uint64_t pair_bound, size_t tiles) {
   reserve(scan_tmp_, std::max<size_t>(cuda::exact_scan_temp_bytes(nb), 1));
   reserve(order_tmp_, std::max<size_t>(cuda::exact_order_temp_bytes(tiles), 1));
   reserve(updates_, 2);
+  reserve(heavy_count_, 1);
   reserve(staging_counters_, 2);
   const size_t pairs = std::max<size_t>(pair_bound, 1);
   if (pairs > pair_tile_.size())
@@ -158,7 +159,8 @@ void CudaExactRenderer::launch_tile_lists(const cuda::KernelModel<double> &m, ui
   timer.mark("sort");
   cuda::launch_exact_tile_ranges(sorted_tile_.get(), pair_bound, tile_begin_.get(), tile_end_.get(), tiles, s);
   cuda::exact_tile_order(tile_begin_.get(), tile_end_.get(), tiles, order_.get(), order_keys_.get(),
-                         order_keys_out_.get(), order_ids_.get(), order_tmp_.get(), order_tmp_.size(), s);
+                         order_keys_out_.get(), order_ids_.get(), heavy_count_.get(), order_tmp_.get(),
+                         order_tmp_.size(), s);
   timer.mark("tile order");
 }
 
@@ -168,6 +170,11 @@ void CudaExactRenderer::launch_apply(uint64_t pair_bound, MapStats *st) {
   const cuda::KernelModel<double> m = kernel_model_of<double>(params(), grid_geo(), band_x0());
   const size_t tiles = num_tiles();
   reserve_scratch(pair_bound, tiles);
+  if (!side_stream_) {
+    side_stream_ = std::make_unique<cuda::Stream>();
+    fork_ = std::make_unique<cuda::Event>();
+    join_ = std::make_unique<cuda::Event>();
+  }
   PhaseEvents &ev = events();
   cudaStream_t s = stream();
   ev.start.record(s);
@@ -181,15 +188,15 @@ void CudaExactRenderer::launch_apply(uint64_t pair_bound, MapStats *st) {
   launch_tile_lists(m, pair_bound, tiles, s, timer);
   begin_update();
   cuda::launch_exact_tiles(m, lines_.get(), sorted_beam_.get(), order_.get(), tile_begin_.get(), tile_end_.get(),
-                           use_tables_ ? factors_.get() : nullptr, use_tables_ ? reach_.get() : nullptr,
-                           grid_.get(), updates_.get(), s);
+                           heavy_count_.get(), use_tables_ ? factors_.get() : nullptr, use_tables_ ? reach_.get() : nullptr,
+                           grid_.get(), updates_.get(), {s, side_stream_->get(), fork_->get(), join_->get()});
   timer.mark("tiles");
   ev.mapped.record(s);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), updates_.get(), 2 * sizeof(unsigned long long),
                                 cudaMemcpyDeviceToHost, s));
   VG_CUDA_CHECK(cudaStreamSynchronize(s));  // the call's result is complete
   if (staging_counters_[1] != 0)
-    throw Error(ErrorCode::Internal, "cuda exact mode: more (tile, beam) pairs than the host's bound (a bug)");
+    throw Error(ErrorCode::Internal, "cuda exact mode: (tile, beam) pairs past the host's bound, or not as counted (a bug)");
   timer.report();
   if (std::getenv("VASCO_CUDA_PROFILE")) report_tile_lists(pair_bound, tiles);
   st->cell_updates += staging_counters_[0];

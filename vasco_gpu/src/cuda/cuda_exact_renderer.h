@@ -50,6 +50,11 @@ class CudaExactRenderer final : public CudaRenderer {
       order_ids_, pair_tile_, pair_beam_, sorted_tile_, sorted_beam_;
   cuda::DeviceBuffer<unsigned char> scan_tmp_, order_tmp_, sort_tmp_;
   cuda::DeviceBuffer<unsigned long long> updates_;
+  cuda::DeviceBuffer<uint32_t> heavy_count_;  // how many tiles of order_ run heavy (exact_tile_order)
+  // The heavy tiles' stream beside the renderer's, and its fork and join
+  // (launch_exact_tiles); made on the first apply, on the renderer's device.
+  std::unique_ptr<cuda::Stream> side_stream_;
+  std::unique_ptr<cuda::Event> fork_, join_;
   cuda::PinnedBuffer<PlacedBeam> staging_beams_;
   cuda::PinnedBuffer<cuda::StartCell> staging_starts_;
   cuda::PinnedBuffer<unsigned long long> staging_counters_;
