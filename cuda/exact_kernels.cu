@@ -587,9 +587,9 @@ __device__ unsigned run_tile(const KernelModel<double> &m, uint32_t tile, int t,
 // vasco's defaults, tiles kernel): every tile 64 threads, one launch,
 // 5.07 ms (the SMs busy 54 % of it); heavy tiles above 512 beams in the
 // same launch (four light tiles a block) 3.92; apart on a second stream,
-// above 4096 beams (at most 132) 3.89, above 2048 (at most 264) 3.81; at
-// most 4096 heavy tiles in one launch, 5.4. The light tiles' total work
-// bounds it now.
+// above 4096 beams (at most 132) 3.89, above 2048 (at most 264) 3.81; with
+// at most 4096 heavy tiles in one launch the map phase went 5.84 -> 7.28 ms.
+// The light tiles' total work bounds it now.
 constexpr uint32_t kHeavyList = 2048;
 // At most this many tiles run heavy: the longest lists, a block each.
 constexpr uint32_t kHeavyBlocks = 264;
