@@ -92,6 +92,7 @@ bench: all
 	$(BUILD)/bin/oracle_o2_bench
 	$(BUILD)/bin/mapping_bench
 	$(BUILD)/bin/mapping_bench --large
+	$(BUILD)/bin/mapping_bench --thread-scaling
 	$(BUILD)/bin/session_bench
 	python3 bench/batch_bench.py --bin $(BUILD)/bin
 

@@ -31,6 +31,11 @@
 // columns over the GPUs there are (split_renderer.h; band i on GPU i % count).
 //   mapping_bench --large [--large-scans N] [--large-site M] [--large-res R,R..]
 //                 [--large-backends cpu_double,cpu_threads,cpu_float,cuda_float,cuda_exact] [--threads N]
+//
+// --thread-scaling instead times cpu_threads' map phase at 1, 2, 4, ... threads
+// up to the cores there are (or --scaling-threads LIST) beside cpu_double and
+// cpu_float on one core (bench/thread_scaling.h).
+//   mapping_bench --thread-scaling [--scaling-threads N,N..] [--runs N] [--dataset NAME]
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -48,6 +53,7 @@
 
 #include "bench_support.h"
 #include "large_bench.h"
+#include "thread_scaling.h"
 #include "carmen_compat/map_file.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/internal/cpu_threads_backend.h"
@@ -204,13 +210,15 @@ struct Options {
   int split = 0;     // --split N: the CUDA rows again, each render split in N bands over the GPUs
   std::vector<std::string> backends;  // --backends: only these rows (empty: all)
   bench::LargeOptions large;  // --large and its options
+  bench::ScalingOptions scaling;  // --thread-scaling and its options
 };
 
 constexpr const char *kUsage =
     "usage: mapping_bench [--runs N] [--quick] [--threads N] [--no-ablation] [--dataset fr079|fr101] [--split N]\n"
     "                     [--backends cpu_double,cpu_threads,cpu_float,cuda_float,cuda_exact]\n"
     "       mapping_bench --large [--large-scans N] [--large-site METRES] [--large-res R[,R...]]\n"
-    "                     [--large-backends cpu_double,cpu_threads,cpu_float,cuda_float,cuda_exact] [--threads N]\n";
+    "                     [--large-backends cpu_double,cpu_threads,cpu_float,cuda_float,cuda_exact] [--threads N]\n"
+    "       mapping_bench --thread-scaling [--scaling-threads N[,N...]] [--runs N] [--dataset fr079|fr101]\n";
 
 // Parses the command line into *o (threads 0 or less: all cores); false, after the usage line on stderr,
 // for anything it does not know.
@@ -238,13 +246,22 @@ bool parse_options(int argc, char **argv, Options *o) {
         return false;
       }
     } else if (a == "--large-backends" && i + 1 < argc) o->large.backends = bench::split_names(argv[++i]);
-    else {
+    else if (a == "--thread-scaling") o->scaling.on = true;
+    else if (a == "--scaling-threads" && i + 1 < argc) {
+      if (!bench::parse_int_list(argv[++i], &o->scaling.threads)) {
+        std::fprintf(stderr, "mapping_bench: --scaling-threads takes thread counts from 1, comma-separated\n%s",
+                     kUsage);
+        return false;
+      }
+    } else {
       std::fprintf(stderr, "%s", kUsage);
       return false;
     }
   }
   if (o->threads <= 0) o->threads = vasco::hardware_threads();
   o->large.threads = o->threads;
+  o->scaling.runs = o->runs;
+  o->scaling.only = o->only;
   return true;
 }
 
@@ -542,6 +559,7 @@ int main(int argc, char **argv) {
   Bench b;
   if (!parse_options(argc, argv, &b.opt)) return 2;
   if (b.opt.large.on) return bench::run_large_bench(b.opt.large);
+  if (b.opt.scaling.on) return bench::run_thread_scaling(b.opt.scaling);
   const std::vector<Dataset> datasets = bench_datasets();
   const GpuInfo gpu = probe_gpu();
   b.gpu = gpu.usable;
