@@ -298,6 +298,10 @@ void add_tabled_run(const WalkFrame &f, int64_t k_end, const float *column, int 
   uint64_t frac = c->frac;
   Sum *cell = c->cell;
   const float *inc = column + fixed_at(f, c->k).m * row + c->k;
+  // Unrolled by four (GCC keeps the remainder loop): the loop's own count and
+  // branch are a quarter of an update's instructions. fr079 paper 190 -> 186
+  // ms, fr101 defaults 356 -> 335 (min of 15 renders; by two: no faster).
+#pragma GCC unroll 4
   for (int64_t n = k_end - c->k; n > 0; --n) {
     *cell += *inc;
     const ptrdiff_t mask = -static_cast<ptrdiff_t>(__builtin_add_overflow(frac, slope, &frac));
@@ -326,6 +330,7 @@ Cursor add_near_run(const WalkFrame &f, int64_t k_end, float near, Sum *acc, Cur
     const ptrdiff_t axial = kAxial != 0 ? kAxial : f.axial, turn = f.diagonal - axial;
     uint64_t frac = c.frac;
     Sum *cell = c.cell;
+#pragma GCC unroll 4
     for (int64_t i = n; i > 0; --i) {
       *cell += near;
       const ptrdiff_t mask = -static_cast<ptrdiff_t>(__builtin_add_overflow(frac, slope, &frac));
@@ -337,6 +342,7 @@ Cursor add_near_run(const WalkFrame &f, int64_t k_end, float near, Sum *acc, Cur
   const uint64_t axial = static_cast<uint64_t>(kMinor > 0 ? f.axial : -f.axial);
   const U128 step = (U128(axial) << 64) | f.slope;
   U128 pos = (U128(idx) << 64) | (kMinor > 0 ? c.frac : ~c.frac);
+#pragma GCC unroll 4
   for (int64_t i = n; i > 0; --i) {
     acc[static_cast<ptrdiff_t>(pos >> 64)] += near;
     if (kMinor > 0) pos += step;
