@@ -138,26 +138,17 @@ class EvidenceTable {
   std::vector<float> free_, occ_;
 };
 
-// The cells a call's scans can reach: a beam's updated cells lie within
+// The cells a call's scans can reach. A beam's updated cells lie within
 // min(max(|dx|, |dy|), table_size - 1) steps of its scan's start cell (the
-// walk stops at its end cell and before table_size steps), so the box is the
-// union over scans of the start cell widened by its longest beam's reach:
-// the union over beams of their start cell widened by their own reach
-// (squares about one centre nest), kept in registers as it goes.
+// walk stops at its end cell and before table_size steps; a step moves each
+// coordinate by at most one). The box from the start cells alone, widened by
+// table_size - 1, is a pass over the scans; the one from every beam's own
+// reach is tighter but a pass over the beams (2-3 % of a full render), worth
+// it only where the start box is large next to the beams (a few scans
+// inserted: clearing and merging the box would cost more than the pass).
 using beam_updates::Box;
 
-Box reach_of(const PlacedBeams &placed, int table_size, const GridGeometry &geo) {
-  const int64_t t = std::max(table_size - 1, 0);
-  int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
-  for (const PlacedBeam &b : placed.beams) {
-    const oracle::ScanStart &s = placed.starts[b.scan];
-    const int64_t dx = std::abs(int64_t(b.x2) - s.x1), dy = std::abs(int64_t(b.y2) - s.y1);
-    const int64_t r = std::min(std::max(dx, dy), t);
-    x0 = std::min<int64_t>(x0, s.x1 - r);
-    x1 = std::max<int64_t>(x1, s.x1 + r);
-    y0 = std::min<int64_t>(y0, s.y1 - r);
-    y1 = std::max<int64_t>(y1, s.y1 + r);
-  }
+Box clipped_box(int64_t x0, int64_t x1, int64_t y0, int64_t y1, const GridGeometry &geo) {
   Box b;
   x0 = std::max<int64_t>(x0, 0), y0 = std::max<int64_t>(y0, 0);
   x1 = std::min<int64_t>(x1, geo.size_x - 1), y1 = std::min<int64_t>(y1, geo.size_y - 1);
@@ -165,6 +156,26 @@ Box reach_of(const PlacedBeams &placed, int table_size, const GridGeometry &geo)
   b.x_lo = static_cast<int>(x0), b.y_lo = static_cast<int>(y0);
   b.x_hi = static_cast<int>(x1 + 1), b.y_hi = static_cast<int>(y1 + 1);
   return b;
+}
+
+Box reach_of(const PlacedBeams &placed, int table_size, const GridGeometry &geo) {
+  const int64_t t = std::max(table_size - 1, 0);
+  int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
+  for (const oracle::ScanStart &s : placed.starts) {
+    x0 = std::min<int64_t>(x0, s.x1 - t), x1 = std::max<int64_t>(x1, s.x1 + t);
+    y0 = std::min<int64_t>(y0, s.y1 - t), y1 = std::max<int64_t>(y1, s.y1 + t);
+  }
+  const Box starts = clipped_box(x0, x1, y0, y1, geo);
+  if (starts.cells() <= 4 * placed.beams.size()) return starts;
+  x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
+  for (const PlacedBeam &b : placed.beams) {
+    const oracle::ScanStart &s = placed.starts[b.scan];
+    const int64_t dx = std::abs(int64_t(b.x2) - s.x1), dy = std::abs(int64_t(b.y2) - s.y1);
+    const int64_t r = std::min(std::max(dx, dy), t);
+    x0 = std::min<int64_t>(x0, s.x1 - r), x1 = std::max<int64_t>(x1, s.x1 + r);
+    y0 = std::min<int64_t>(y0, s.y1 - r), y1 = std::max<int64_t>(y1, s.y1 + r);
+  }
+  return clipped_box(x0, x1, y0, y1, geo);
 }
 
 // A closed-form walk (egrid::LineParams) in box-relative terms: the steps
