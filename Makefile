@@ -84,8 +84,9 @@ demo: configure
 	cmake --build $(BUILD) -j $(JOBS) --target log2map
 	$(BUILD)/bin/log2map logs/fr079-complete.gfs.log.gz $(BUILD)/fr079.png $(BUILD)/fr079.map.gz
 
-# Parse speed, the -O2 reference, the mapping table, then the mapping-session
-# table (GPU rows when a GPU is usable).
+# Parse speed, the -O2 reference, the mapping table, the large site, cpu_threads
+# from one core to all, the mapping-session table (GPU rows when a GPU is
+# usable), then the batch rates.
 bench: all
 	cmake --build $(BUILD) -j $(JOBS) --target benchmarks
 	$(BUILD)/bin/parse_bench

@@ -1,11 +1,12 @@
 // bench_support.h — what the benchmark programs share: the logs and
-// parameter sets they measure, and a median. (VASCO_SOURCE_DIR is defined
-// by bench/CMakeLists.txt.)
+// parameter sets they measure, a median and the format of a time. (VASCO_SOURCE_DIR
+// is defined by bench/CMakeLists.txt.)
 #ifndef VASCO_BENCH_SUPPORT_H
 #define VASCO_BENCH_SUPPORT_H
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,17 @@ inline double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Seconds as milliseconds for a table: two decimals below 10 ms, one below
+// a second, none above; "-" for a time not measured (0 or less).
+inline std::string ms(double s) {
+  char b[32];
+  if (s <= 0) return "-";
+  if (s < 0.01) std::snprintf(b, sizeof b, "%.2f", s * 1e3);
+  else if (s < 1) std::snprintf(b, sizeof b, "%.1f", s * 1e3);
+  else std::snprintf(b, sizeof b, "%.0f", s * 1e3);
+  return b;
 }
 
 struct Dataset {

@@ -74,6 +74,7 @@ using bench::bench_datasets;
 using bench::bench_param_sets;
 using bench::Dataset;
 using bench::median;
+using bench::ms;
 using bench::now_s;
 using bench::ParamSet;
 
@@ -166,15 +167,6 @@ void run_session_once(const BackendSpec &spec, int threads, const vasco::ScanBat
 }
 
 void print_rule(int width) { std::printf("%s\n", std::string(width, '-').c_str()); }
-
-std::string ms(double s) {
-  char b[32];
-  if (s <= 0) return "-";
-  if (s < 0.01) std::snprintf(b, sizeof b, "%.2f", s * 1e3);
-  else if (s < 1) std::snprintf(b, sizeof b, "%.1f", s * 1e3);
-  else std::snprintf(b, sizeof b, "%.0f", s * 1e3);
-  return b;
-}
 
 // Wall time of a whole log2map process (start to file written), median of runs.
 double log2map_wall(const std::string &bin, const std::string &log, const std::string &backend,

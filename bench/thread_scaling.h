@@ -78,12 +78,6 @@ inline double scaling_map_s(const std::string &backend, int threads, const vasco
   return median(t);
 }
 
-inline std::string scaling_ms(double s) {
-  char b[32];
-  std::snprintf(b, sizeof b, s < 1 ? "%.1f" : "%.0f", s * 1e3);
-  return b;
-}
-
 inline std::string scaling_ratio(double a, double b, const char *format = "%.2f") {
   char buf[32];
   std::snprintf(buf, sizeof buf, format, a / b);
@@ -102,7 +96,7 @@ inline void scaling_rows(const Dataset &ds, const ParamSet &ps, const std::vecto
   const double fast = scaling_map_s("cpu_float", 1, batch, ps.params, geo, runs);
   auto line = [&](const std::string &backend, int threads, double s, const std::string &x1, const std::string &eff) {
     std::printf("| %s | %s | %s | %d%s | %s | %s | %s | %s |\n", ds.name.c_str(), ps.name.c_str(), backend.c_str(),
-                threads, threads > cores ? " (past the cores)" : "", scaling_ms(s).c_str(),
+                threads, threads > cores ? " (past the cores)" : "", ms(s).c_str(),
                 scaling_ratio(one_core, s).c_str(), x1.c_str(), eff.c_str());
   };
   line("cpu_double", 1, one_core, "-", "-");

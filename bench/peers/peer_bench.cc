@@ -48,6 +48,7 @@ using bench::bench_datasets;
 using bench::bench_param_sets;
 using bench::Dataset;
 using bench::median;
+using bench::ms;
 using bench::now_s;
 using bench::ParamSet;
 
@@ -432,12 +433,6 @@ bool parse_options(int argc, char **argv, Options *o) {
     return false;
   }
   return true;
-}
-
-std::string ms(double s) {
-  char b[32];
-  std::snprintf(b, sizeof b, s < 1 ? "%.1f" : "%.0f", s * 1e3);
-  return b;
 }
 
 std::string ratio(double base, double t) {

@@ -309,9 +309,10 @@ void add_tabled_run(const WalkFrame &f, int64_t k_end, const float *column, int 
   uint64_t frac = c->frac;
   Sum *cell = c->cell;
   const float *inc = column + fixed_at(f, c->k).m * row + c->k;
-  // Unrolled by four (GCC keeps the remainder loop): the loop's own count and
-  // branch are a quarter of an update's instructions. fr079 paper 190 -> 186
-  // ms, fr101 defaults 356 -> 335 (min of 15 renders; by two: no faster).
+  // This loop and add_near_run's are unrolled by four (GCC keeps the
+  // remainder loop): a loop's own count and branch are a quarter of an
+  // update's instructions. fr079 paper 190 -> 186 ms, fr101 defaults 356 ->
+  // 335 (min of 15 renders; by two or eight: no faster).
 #pragma GCC unroll 4
   for (int64_t n = k_end - c->k; n > 0; --n) {
     *cell += *inc;
