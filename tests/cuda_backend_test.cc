@@ -99,7 +99,7 @@ TEST_P(CudaGolden, ExactModeIsBitIdenticalToTheOracle) {
 //   intel: class agreement 99.9820 %, known/unknown differs in 1 cell of 5.3 M,
 //          |dp| > 0.1 in 9 of 951593 (9.5e-6)
 // max |dp| itself is not bounded: it reaches 1.0 on fr079 where the oracle
-// pinned a cell at exactly 0 or 1 (saturation, see cuda/float_kernels.cu) and
+// pinned a cell at exactly 0 or 1 (saturation, see vasco_gpu/src/cuda/float_kernels.cu) and
 // the log-odds sum did not. The bounds leave about a factor 3 for other GPUs'
 // rounding; a lost update or a misplaced beam breaks them by far.
 TEST_P(CudaGolden, FloatModeAgreesWithTheOracle) {

@@ -112,16 +112,30 @@ void write_png_file(OutputTransaction &tx, const std::string &path, const MapToW
 
 const std::vector<MapFormatEntry> &map_formats() {
   static const std::vector<MapFormatEntry> formats = {
-      {MapFormat::CarmenMap, ".map", "CARMEN map", read_carmen, write_carmen},
-      {MapFormat::CarmenMapGz, ".map.gz", "CARMEN map, gzipped", read_carmen, write_carmen},
-      {MapFormat::PgmYaml, ".pgm", "ROS map_server / nav2 PGM image with a .yaml beside it", read_pgm, write_pgm},
-      {MapFormat::PngYaml, ".png+yaml", "ROS map_server / nav2 pair NAME.png + NAME.yaml", read_png_pair,
+      {MapFormat::CarmenMap, ".map", "CARMEN map", MapFormatKind::Carmen, read_carmen, write_carmen},
+      {MapFormat::CarmenMapGz, ".map.gz", "CARMEN map, gzipped", MapFormatKind::Carmen, read_carmen, write_carmen},
+      {MapFormat::PgmYaml, ".pgm", "ROS map_server / nav2 PGM image with a .yaml beside it",
+       MapFormatKind::MapServer, read_pgm, write_pgm},
+      {MapFormat::PngYaml, ".png+yaml", "ROS map_server / nav2 pair NAME.png + NAME.yaml",
+       MapFormatKind::MapServer, read_png_pair,
        write_png_pair},
       {MapFormat::Yaml, ".yaml", "ROS map_server YAML (read: the image it names; written: with NAME.pgm)",
-       read_yaml, write_yaml},
-      {MapFormat::Png, ".png", "picture for people (RGB)", read_png_file, write_png_file},
+       MapFormatKind::MapServer, read_yaml, write_yaml},
+      {MapFormat::Png, ".png", "picture for people (RGB)", MapFormatKind::Picture, read_png_file, write_png_file},
   };
   return formats;
+}
+
+std::vector<std::string> map_format_names() {
+  std::vector<std::string> names;
+  for (const MapFormatEntry &f : map_formats()) names.push_back(f.extension + 1);
+  return names;
+}
+
+const MapFormatEntry *find_map_format_by_name(const std::string &name) {
+  for (const MapFormatEntry &f : map_formats())
+    if (name == f.extension + 1) return &f;
+  return nullptr;
 }
 
 std::string known_map_extensions() {

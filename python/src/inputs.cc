@@ -1,6 +1,6 @@
 // Where a Log's scans and poses come from, besides one CARMEN log: pose files
 // of SLAM back ends, several sessions into one grid, scans read elsewhere (a
-// ROS bag, by vasco_gpu._bag), and the log -> map command line run on them
+// ROS bag, by vasco_gpu.bags), and the log -> map command line run on them
 // (bag2map). The keywords are log2map's options, spelt as Python names.
 #include "inputs.h"
 

@@ -69,9 +69,11 @@ constexpr const char *kLogDoc =
     "(keywords > ini > the log's PARAM lines > defaults), the PROTOCOL frame and\n"
     "what the reader counted.";
 
-constexpr const char *kLoadLogDoc =
+// The docs name the scan messages from the engine's list (scan_batch.h).
+const char *load_log_doc() {
+  static const std::string doc =
     "Reads a CARMEN log (.log, .clf, gzipped if the name ends in .gz) as log2map does.\n\n"
-    "Every FLASER and ROBOTLASER1 line is a scan; ``param_file`` is a carmen.ini (``robot`` its\n"
+    "Every " + vasco::scan_message_names(" and ") + " line is a scan; ``param_file`` is a carmen.ini (``robot`` its\n"
     "section), ``overrides`` keys as in Params (they win over the ini, which wins over the log's\n"
     "PARAM lines). Strict by default: a bad line raises FileError with ``.file`` and ``.line``;\n"
     "``lenient=True`` skips bad lines and counts them in ``Log.stats['bad_lines']``. The GIL is\n"
@@ -82,6 +84,14 @@ constexpr const char *kLoadLogDoc =
     "``skip_unposed`` leave out scans without a pose; ``pose_frame`` 'laser' | 'robot'; ``laser_mount``\n"
     "(x, y, theta) of the laser on the robot. Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared\n"
     "frame, ``add`` further logs, each a path or (path, (x, y, theta)).";
+  return doc.c_str();
+}
+
+const char *scans_doc() {
+  static const std::string doc =
+      "The selected scans (" + vasco::scan_message_names(" and ") + " lines, in log order); its arrays are views.";
+  return doc.c_str();
+}
 
 }  // namespace
 
@@ -89,7 +99,7 @@ void bind_log(nb::module_ &m) {
   nb::class_<LogInput>(m, "Log", kLogDoc)
       .def_prop_ro(
           "scans", [](LogInput &in) -> vasco::ScanBatch & { return in.batch; }, nb::rv_policy::reference_internal,
-          "The selected scans (FLASER and ROBOTLASER1 lines, in log order); its arrays are views.")
+          scans_doc())
       .def_prop_ro(
           "params", [](const LogInput &in) { return in.params; }, "The effective parameters (a copy).")
       .def_prop_ro(
@@ -126,7 +136,7 @@ void bind_log(nb::module_ &m) {
                 "laser_mount: tuple[float, float, float] | None = None, "
                 "transform: tuple[float, float, float] | None = None, "
                 "add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float]]] | None = None) -> Log"),
-        kLoadLogDoc);
+        load_log_doc());
 }
 
 }  // namespace vasco_py

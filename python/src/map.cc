@@ -5,6 +5,7 @@
 #include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/tuple.h>
+#include <nanobind/stl/vector.h>
 
 #include <climits>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "arrays.h"
 #include "bindings.h"
 #include "carmen_compat/error.h"
+#include "carmen_compat/atomic_file.h"
 #include "map_files.h"
 #include "carmen_compat/map_digest.h"
 
@@ -157,6 +159,18 @@ void bind_map_files(nb::module_ &m) {
       "path"_a, "map"_a, "mode"_a = "trinary", "description"_a = "",
       nb::sig("def write_map(path: str | os.PathLike, map: Map, mode: str = 'trinary', description: str = '') -> None"),
       kWriteMapDoc);
+  m.def(
+      "_write_maps",
+      [](const std::vector<std::string> &paths, const Map &mp, const std::string &mode, const std::string &description) {
+        nb::gil_scoped_release release;
+        write_maps(paths, mp, mode, description);
+      },
+      "paths"_a, "map"_a, "mode"_a = "trinary", "description"_a = "",
+      "write_map to every one of ``paths`` as one transaction: all are written to temporaries, then\n"
+      "renamed; a failure touches no output and leaves no temporary.");
+  m.def("_fail_rename_for_testing", &carmen::OutputTransaction::fail_rename_for_testing, "n"_a, "err"_a,
+        "Tests only: the n-th rename (1-based) of the next transaction's commit in this process fails\n"
+        "with errno ``err``; 0 disarms.");
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_format.h"
 #include "vasco_gpu/map_output.h"
+#include "vasco_gpu/pipeline/outputs.h"
 #include "vasco_gpu/version.h"
 
 namespace vasco_py {
@@ -77,10 +78,17 @@ carmen::MapToWrite to_write(const Map &m, const std::string &pgm_mode, const std
 }  // namespace
 
 void write_map(const std::string &path, const Map &m, const std::string &pgm_mode, const std::string &description) {
-  const carmen::MapFormatEntry &format = carmen::map_format_of(path);
-  if (format.format != carmen::MapFormat::Png) check_resolution(path, m.grid.resolution);
-  check_cells(m, path);
-  carmen::write_map(path, to_write(m, pgm_mode, description));
+  write_maps({path}, m, pgm_mode, description);
+}
+
+void write_maps(const std::vector<std::string> &paths, const Map &m, const std::string &pgm_mode,
+                const std::string &description) {
+  for (const std::string &path : paths) {
+    const carmen::MapFormatEntry &format = carmen::map_format_of(path);
+    if (format.kind != carmen::MapFormatKind::Picture) check_resolution(path, m.grid.resolution);
+    check_cells(m, path);
+  }
+  vasco::pipeline::write_map_outputs(paths, to_write(m, pgm_mode, description));
 }
 
 }  // namespace vasco_py

@@ -6,6 +6,7 @@
 #define VASCO_PY_MAP_FILES_H
 
 #include <string>
+#include <vector>
 
 #include "carmen_compat/map_file.h"
 #include "vasco_gpu/grid.h"
@@ -31,6 +32,10 @@ Map read_map(const std::string &path);
 // that is not a CARMEN cell value (NaN among them), or, for the formats that
 // carry one, a resolution that is not a positive finite float.
 void write_map(const std::string &path, const Map &m, const std::string &pgm_mode, const std::string &description);
+// The same to every one of `paths` as one transaction (the pipeline's
+// write_map_outputs): all written, or none touched.
+void write_maps(const std::vector<std::string> &paths, const Map &m, const std::string &pgm_mode,
+                const std::string &description);
 
 // Error(BadInput) naming `what` when a cell of `m` is not a CARMEN cell value.
 void check_cells(const Map &m, const std::string &what);

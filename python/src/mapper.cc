@@ -29,6 +29,7 @@
 #include "map_files.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/mapper.hpp"
+#include "vasco_gpu/pipeline/mapped.h"
 
 namespace vasco_py {
 
@@ -276,6 +277,15 @@ void bind_mapper_state(nb::class_<Session> &cls) {
                    "Counts and phase times of the last insert or render.")
       .def_prop_ro("renders", [](Session &s) { return s.state().renders; },
                    "Full renders since construction (each render(), each growth, the first insert).")
+      .def(
+          "_check_mapped",
+          [](Session &s, const Map &m, const std::string &input) {
+            nb::gil_scoped_release release;
+            s.locked([&](vasco::Mapper &mp) { vasco::pipeline::check_mapped(m.grid.cells, mp.scans(), input); });
+          },
+          "map"_a, "input"_a,
+          "FileError naming ``input`` when ``map`` (this session's finished map) has no known cell, saying\n"
+          "why (the pipeline's rule: such a map is not written).")
       .def("__repr__", [](Session &s) {
         return nb::str("Mapper(backend='{}', {} scans)").format(s.backend, s.state().num_scans);
       });

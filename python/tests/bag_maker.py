@@ -1,4 +1,4 @@
-"""Writes small synthetic ROS bags for the tests of vasco_gpu._bag, with rosbags' own writers.
+"""Writes small synthetic ROS bags for the tests of vasco_gpu.bags, with rosbags' own writers.
 
 Three formats: "rosbag1" (a ROS 1 ``.bag`` file), "sqlite3" and "mcap" (ROS 2 bag directories
 with that storage plug-in). The messages are built from rosbags' typestores (ROS 1 Noetic for

@@ -97,7 +97,7 @@ def run_script(name, *args):
     exe = Path(sys.executable).parent / name
     entry = {"bag2map": "bag2map_main", "bag2carmen": "bag2carmen_main"}[name]
     cmd = [str(exe)] if exe.exists() else [sys.executable, "-c",
-                                            f"import sys; from vasco_gpu._bags import {entry}; sys.exit({entry}())"]
+                                            f"import sys; from vasco_gpu.bags.cli import {entry}; sys.exit({entry}())"]
     return subprocess.run(cmd + [str(a) for a in args], capture_output=True, text=True, timeout=300)
 
 

@@ -70,17 +70,20 @@ bool gpu_usable(int device, std::string *why) {
 }
 
 const std::vector<BackendInfo> &backend_registry() {
+  // {name, aliases, exactness, grid on the device, compiled in, summary,
+  //  uses GPUs, uses threads, chooses, factory}
   static const std::vector<BackendInfo> rows = {
       {"cpu_double", {}, Exactness::Exact, false, true,
-       "CARMEN's arithmetic to the letter, one core: bit-identical to CARMEN", cpu_double},
+       "CARMEN's arithmetic to the letter, one core: bit-identical to CARMEN", false, false, false, cpu_double},
       {"cpu_threads", {}, Exactness::Exact, false, true,
-       "cpu_double's bytes on all cores (--threads)", cpu_threads},
+       "cpu_double's bytes on all cores (--threads)", false, true, false, cpu_threads},
       {"cpu_float", {}, Exactness::Float, false, true,
-       "single precision on one core, fast; measured against CARMEN's maps", cpu_float},
+       "single precision on one core, fast; measured against CARMEN's maps", false, false, false, cpu_float},
       {"cuda", {{"cuda_float", CudaMode::Float}, {"cuda_exact", CudaMode::Exact}}, Exactness::ByCudaMode, true,
-       kCudaCompiled, "the GPU: float mode (fastest) or exact mode (bit-identical to cpu_double)", cuda},
+       kCudaCompiled, "the GPU: float mode (fastest) or exact mode (bit-identical to cpu_double)", true, false, false,
+       cuda},
       {"auto", {}, Exactness::ByCudaMode, false, true,
-       "cuda when a GPU is usable, else cpu_threads", automatic},
+       "cuda when a GPU is usable, else cpu_threads", true, true, true, automatic},
   };
   return rows;
 }

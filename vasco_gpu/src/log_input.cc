@@ -87,7 +87,7 @@ void check_downsample(const LogInput &in, const carmen::ParamFile &params, const
 // The steps after reading, the same for logs and bags: poses from a file,
 // the effective parameters, the selected run, the grid.
 LogInput finish_input(StampedScans scans, carmen::ParamFile &params, const LogInputOptions &options,
-                      LogInput in, const char *scan_kind) {
+                      LogInput in, const std::string &scan_kind) {
   apply_pose_file(scans, options.poses, options.log, &in);
   in.params = MapperParams::from_params(params, &in.warnings);
   const long laser_messages = in.load.laser_messages;
@@ -181,9 +181,7 @@ StampedScans read_stamped_scans(const std::string &path, const LogInputOptions &
   reader.strict = !options.lenient;
   reader.memory_budget = options.memory_budget;
   reader.budget_option = options.budget_option;
-  reader.budget_types = carmen::message_type_bit(carmen::MessageType::FLASER) |  // what load_scans keeps
-                        carmen::message_type_bit(carmen::MessageType::ROBOTLASER1) |
-                        carmen::message_type_bit(carmen::MessageType::PARAM);
+  reader.budget_types = scan_message_bits() | carmen::message_type_bit(carmen::MessageType::PARAM);  // what load_scans keeps
   StampedScans out;
   out.batch = load_scans(path, all, reader, stats, options.progress);
   out.stamps = stats->stamps;
@@ -220,7 +218,7 @@ LogInput load_log_input(const LogInputOptions &options) {
     add_counts(in.load, load);
     scans.append(std::move(next), more.transform);
   }
-  return finish_input(std::move(scans), params, options, std::move(in), "FLASER or ROBOTLASER1 scans");
+  return finish_input(std::move(scans), params, options, std::move(in), scan_message_names() + " scans");
 }
 
 LogInput log_input_from_scans(StampedScans scans, const LogInputOptions &options) {

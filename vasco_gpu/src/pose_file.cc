@@ -18,6 +18,7 @@
 #include "carmen_compat/error.h"
 #include "carmen_compat/file_names.h"
 #include "carmen_compat/log_reader.h"
+#include "vasco_gpu/scan_batch.h"
 
 namespace vasco {
 
@@ -262,14 +263,14 @@ std::vector<StampedPose> read_carmen(const std::string &path) {
   carmen::LogMessage msg;
   std::vector<StampedPose> poses;
   while (reader.next(msg)) {
-    if (msg.type != carmen::MessageType::FLASER && msg.type != carmen::MessageType::ROBOTLASER1) continue;
+    if (!is_scan_message(msg.type)) continue;
     StampedPose p;
     p.stamp = msg.laser.timestamp;
     p.line = msg.line;
     p.pose = {msg.laser.laser_pose.x, msg.laser.laser_pose.y, msg.laser.laser_pose.theta};
     poses.push_back(p);
   }
-  if (poses.empty()) throw FileError(path, "no poses: no FLASER or ROBOTLASER1 lines");
+  if (poses.empty()) throw FileError(path, "no poses: no " + scan_message_names() + " lines");
   return poses;
 }
 

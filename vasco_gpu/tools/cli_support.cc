@@ -82,30 +82,6 @@ int exit_status(const std::exception &e, int usage, int other) {
   return other;
 }
 
-namespace {
-
-void check_not_an_input(const std::string &out, const std::vector<std::string> &inputs) {
-  for (const std::string &in : inputs) {
-    if (!in.empty() && carmen::same_target(out, in))
-      throw carmen::Error(carmen::ErrorCode::Usage,
-                          out + ": is the input " + in + ": an output must not overwrite what is read");
-  }
-}
-
-}  // namespace
-
-void check_outputs(const std::vector<std::string> &inputs, const std::vector<std::string> &outputs) {
-  for (size_t i = 0; i < outputs.size(); ++i) {
-    check_not_an_input(outputs[i], inputs);
-    for (size_t j = 0; j < i; ++j) {
-      if (carmen::same_target(outputs[j], outputs[i]))
-        throw carmen::Error(carmen::ErrorCode::Usage, outputs[i] + ": the same file as the output " + outputs[j] +
-                                                          ": give each output once");
-    }
-  }
-  for (const std::string &out : outputs) carmen::check_replaceable(out);
-}
-
 uint64_t parse_mebibytes(const std::string &text, const std::string &option) {
   uint64_t mib = 0;
   const char *end = text.data() + text.size();

@@ -23,12 +23,6 @@ std::string json_string(const std::string &text);
 // carmen::Error of code Usage, `other` for any other failure.
 int exit_status(const std::exception &e, int usage = 2, int other = 1);
 
-// Refuses, before any work, outputs that cannot or must not be written:
-// each must pass carmen::check_replaceable (carmen::FileError, code I/O), none
-// may be one of `inputs` (by device and inode: a log, an ini, a map read) and
-// none may be named twice (carmen::Error, code Usage). `outputs` lists every
-// file a run creates (a .pgm's .yaml included).
-void check_outputs(const std::vector<std::string> &inputs, const std::vector<std::string> &outputs);
 
 // A whole number of MiB, as bytes. Throws carmen::Error(Usage) naming
 // `option` for anything but digits, or a value whose bytes overflow 64 bits.

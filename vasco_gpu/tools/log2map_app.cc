@@ -25,6 +25,7 @@
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_format.h"
 #include "cli_support.h"
+#include "vasco_gpu/pipeline/outputs.h"
 #include "log2map_app.h"
 #include "backend_choice.h"
 #include "log2map_batch.h"
@@ -56,7 +57,8 @@ using cli::seconds_since;
 std::future<bool> start_cuda(const Options &opt, const vasco::BackendOptions &bopt) {
   std::future<bool> ready;
 #if defined(VASCO_HAVE_CUDA)
-  if (opt.backend == "cuda") {
+  const vasco::BackendInfo *b = vasco::find_backend(opt.backend);
+  if (b != nullptr && b->uses_gpus && !b->chooses) {
     ready = std::async(std::launch::async, [dev = bopt.cuda_device] {
       std::string why;
       return vasco::cuda_usable(dev, &why);
@@ -185,7 +187,7 @@ void print_json_error(const std::exception &e) {
 void check_before_work(const Options &opt) {
   std::vector<std::string> inputs = {opt.log, opt.param_file, opt.poses.file, opt.poses.id_map_file};
   for (const vasco::SessionInput &more : opt.more) inputs.push_back(more.path);
-  cli::check_outputs(inputs, files_written(opt.outputs));
+  vasco::pipeline::check_outputs(inputs, files_written(opt.outputs));
   if (opt.json) cli::check_stdout_writable("--json");
   for (const std::string &out : opt.outputs)
     if (out == cli::kStdio) cli::check_stdout_writable("the output '-'");
@@ -194,7 +196,8 @@ void check_before_work(const Options &opt) {
 // --backend auto for one input: the backend expected to finish first, and
 // a note saying which and why.
 std::string chosen_backend(const Options &opt, const vasco::BackendOptions &bopt, const vasco::LogInput &in) {
-  if (opt.backend != "auto") return opt.backend;
+  const vasco::BackendInfo *b = vasco::find_backend(opt.backend);
+  if (b == nullptr || !b->chooses) return opt.backend;
   const int cores = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const BackendChoice c = choose_backend(estimated_cell_updates(in.batch, in.params), cores);
   std::string backend = "cpu_threads", why = c.why;
@@ -246,7 +249,7 @@ int run(const Options &opt, const ToolSpec &spec) {
     if (gpu_ready.valid()) gpu_ready.wait();
   }
   {
-    PhaseTicker ticker("map (" + (opt.backend == "auto" ? std::string("auto") : opt.backend) + ")",
+    PhaseTicker ticker("map (" + opt.backend + ")",
                        progress_wanted(opt));
     make_map(opt, bopt, r);
   }

@@ -21,25 +21,9 @@
 #include "log2map_steps.h"
 #include "task_pool.h"
 #include "vasco_gpu/mapper.hpp"
+#include "vasco_gpu/pipeline/outputs.h"
 
 namespace log2map {
-
-std::string batch_stem(const std::string &input) {
-  std::string name = input;
-  while (name.size() > 1 && name.back() == '/') name.pop_back();  // a ROS 2 bag's directory
-  name = basename_of(name);
-  if (name.size() > 3 && name.compare(name.size() - 3, 3, ".gz") == 0) name.resize(name.size() - 3);
-  const size_t dot = name.rfind('.');
-  if (dot != std::string::npos && dot > 0) name.resize(dot);
-  return name;
-}
-
-std::vector<std::string> batch_outputs(const Options &opt, const std::string &input) {
-  std::vector<std::string> outputs;
-  const std::string dir = opt.out_dir.back() == '/' ? opt.out_dir : opt.out_dir + "/";
-  for (const std::string &f : opt.formats) outputs.push_back(dir + batch_stem(input) + "." + f);
-  return outputs;
-}
 
 namespace {
 
@@ -57,18 +41,19 @@ void make_out_dir(const std::string &dir) {
     throw carmen::FileError(dir, std::string("--out-dir: cannot make the directory: ") + std::strerror(errno), ErrorCode::Io);
 }
 
-// Each input's entry; two inputs writing the same outputs are refused.
+// DIR/STEM.FORMAT for each of opt.formats.
+std::vector<std::string> outputs_of(const Options &opt, const std::string &input) {
+  return vasco::pipeline::plan_outputs({input}, opt.out_dir, opt.formats)[0].outputs;
+}
+
+// Each input's entry (the pipeline's plan: two inputs writing the same
+// outputs are refused).
 std::vector<BatchEntry> plan_entries(const Options &opt) {
   std::vector<BatchEntry> entries;
-  std::map<std::string, std::string> by_stem;
-  for (const std::string &input : opt.inputs) {
-    const auto [at, fresh] = by_stem.emplace(batch_stem(input), input);
-    if (!fresh)
-      throw Error(ErrorCode::Usage, at->second + " and " + input + " would both write " + opt.out_dir + "/" + at->first +
-                                        ".*: give inputs of different names (or map them in two runs)");
+  for (vasco::pipeline::PlannedInput &p : vasco::pipeline::plan_outputs(opt.inputs, opt.out_dir, opt.formats)) {
     BatchEntry e;
-    e.input = input;
-    e.outputs = batch_outputs(opt, input);
+    e.input = std::move(p.input);
+    e.outputs = std::move(p.outputs);
     entries.push_back(std::move(e));
   }
   return entries;
@@ -187,7 +172,7 @@ class BatchRun {
         [this, i, mapped] {
           try {
             const auto t = cli::Clock::now();
-            write_outputs(opt_, opt_.inputs[i], batch_outputs(opt_, opt_.inputs[i]), *mapped);
+            write_outputs(opt_, opt_.inputs[i], outputs_of(opt_, opt_.inputs[i]), *mapped);
             report_.written(i, cli::seconds_since(t));
           } catch (...) {
             fail(i, std::current_exception());
@@ -216,12 +201,13 @@ class BatchRun {
 
 int all_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
 
-// The GPUs a batch maps on: --device's alone when given; else, for cuda and
-// auto, every visible GPU that is usable (none: the one backend as before,
+// The GPUs a batch maps on: --device's alone when given; else, for a backend
+// that uses GPUs (cuda, auto), every visible GPU that is usable (none: the one backend as before,
 // auto then on the CPU).
 std::vector<int> batch_devices(const Options &opt) {
   if (!opt.devices.empty()) return opt.devices;
-  if (opt.device_given || (opt.backend != "cuda" && opt.backend != "auto")) return {opt.device};
+  const vasco::BackendInfo *b = vasco::find_backend(opt.backend);
+  if (opt.device_given || b == nullptr || !b->uses_gpus) return {opt.device};
   std::vector<int> usable;
   for (int d = 0; d < vasco::cuda_device_count(); ++d)
     if (vasco::gpu_usable(d)) usable.push_back(d);
@@ -265,7 +251,7 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     for (const std::string &f : files_written(e.outputs)) files.push_back(f);
   if (opt.json) cli::check_stdout_writable("--json");
   make_out_dir(opt.out_dir);
-  cli::check_outputs(inputs, files);
+  vasco::pipeline::check_outputs(inputs, files);
 
   BatchReport report(opt, std::move(entries));
   {
@@ -279,7 +265,8 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     first.cuda_device = devices.front();
     vasco::Mapper mapper(vasco::MapperParams{}, opt.backend, first);
     report.set_backend(mapper.backend_name());
-    if (opt.backend == "auto" && !mapper.backend_traits().grid_on_device && !opt.quiet)
+    const vasco::BackendInfo *chosen = vasco::find_backend(opt.backend);
+    if (chosen != nullptr && chosen->chooses && !mapper.backend_traits().grid_on_device && !opt.quiet)
       std::fprintf(stderr, "%s: --backend auto: no usable GPU: using %s\n", opt.tool.c_str(), mapper.backend_name().c_str());
     if (devices.size() > 1 && mapper.backend_traits().grid_on_device) {
       std::string list;

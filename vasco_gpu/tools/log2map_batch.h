@@ -15,13 +15,6 @@
 
 namespace log2map {
 
-// The name of an input's outputs: its file (or directory) name less ".gz"
-// and one extension ("fr079.gfs.log.gz" -> "fr079.gfs", "run.mcap" -> "run").
-std::string batch_stem(const std::string &input);
-
-// DIR/STEM.FORMAT for each of opt.formats.
-std::vector<std::string> batch_outputs(const Options &opt, const std::string &input);
-
 // Maps every one of opt.inputs; returns the exit status: 0 when every
 // input was mapped and written, 1 when any failed (each named on stderr).
 // Throws for what stops the whole run (a usage error, an output directory

@@ -12,11 +12,19 @@
 #include "cli_support.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/pipeline/outputs.h"
 #include "vasco_gpu/version.h"
 
 namespace log2map {
 
 namespace {
+
+// "map, map.gz, pgm, png+yaml, yaml, png": the formats --formats takes.
+std::string batch_format_list() {
+  std::string list;
+  for (const std::string &n : carmen::map_format_names()) list += (list.empty() ? "" : ", ") + n;
+  return list;
+}
 
 using carmen::Error;
 using carmen::ErrorCode;
@@ -50,7 +58,7 @@ void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchT
   app.add_option("--out-dir", opt.out_dir,
                  "batch mode: map every " + spec.input_name + " given, in one process, to DIR/NAME.FORMAT")
       ->type_name("DIR");
-  app.add_option("--formats", raw.formats, "batch mode: the outputs of each input, of map, map.gz, pgm, png (default map.gz)")
+  app.add_option("--formats", raw.formats, "batch mode: the outputs of each input, of " + batch_format_list() + " (default map.gz)")
       ->type_name("LIST");
   app.add_flag("--fail-fast", opt.fail_fast, "batch mode: stop at the first input that fails (default: report it, go on)");
   app.add_option("--jobs", opt.jobs, "batch mode: threads reading inputs and writing maps (default: all cores)")
@@ -116,15 +124,22 @@ void finish_map_server_options(const CLI::App &app, const MapServerText &raw, Op
   const bool given = app.count("--mode") || app.count("--free-thresh") || app.count("--occupied-thresh") ||
                      app.count("--negate");
   if (!given) return;
-  bool pair = std::find(opt.formats.begin(), opt.formats.end(), "pgm") != opt.formats.end();
+  bool pair = false;
+  for (const std::string &f : opt.formats) {
+    const carmen::MapFormatEntry *e = carmen::find_map_format_by_name(f);
+    pair = pair || (e != nullptr && e->kind == carmen::MapFormatKind::MapServer);
+  }
   for (const std::string &out : opt.outputs) {
     const carmen::MapFormatEntry *f = out == cli::kStdio ? nullptr : carmen::find_map_format(out);
-    pair = pair || (f != nullptr && (f->format == carmen::MapFormat::PgmYaml ||
-                                     f->format == carmen::MapFormat::PngYaml || f->format == carmen::MapFormat::Yaml));
+    pair = pair || (f != nullptr && f->kind == carmen::MapFormatKind::MapServer);
   }
   if (pair) return;
-  const std::string w = "--mode, --free-thresh, --occupied-thresh and --negate do nothing without a .pgm, .png+yaml "
-                        "or .yaml output";
+  std::string pairs;  // ".pgm, .png+yaml or .yaml"
+  for (const carmen::MapFormatEntry &e : carmen::map_formats())
+    if (e.kind == carmen::MapFormatKind::MapServer) pairs += (pairs.empty() ? "" : ", ") + std::string(e.extension);
+  const size_t last = pairs.rfind(", ");
+  if (last != std::string::npos) pairs.replace(last, 2, " or ");
+  const std::string w = "--mode, --free-thresh, --occupied-thresh and --negate do nothing without a " + pairs + " output";
   opt.warnings.push_back(w);
   std::fprintf(stderr, "%s: warning: %s\n", opt.tool.c_str(), w.c_str());
 }
@@ -190,21 +205,16 @@ void add_param_options(CLI::App &app, std::map<std::string, std::string> &raw) {
   }
 }
 
-// "map.gz,png" as the extensions of batch outputs; each known, none twice.
+// "map.gz,png" as the formats of batch outputs (the pipeline's rules).
 std::vector<std::string> parse_formats(const std::string &text) {
   std::vector<std::string> formats;
   size_t start = 0;
   while (start <= text.size()) {
     const size_t comma = std::min(text.find(',', start), text.size());
-    const std::string f = text.substr(start, comma - start);
-    if (f != "map" && f != "map.gz" && f != "pgm" && f != "png")
-      throw Error(ErrorCode::Usage, "--formats '" + text + "': '" + f + "' is none of map, map.gz, pgm, png");
-    if (std::find(formats.begin(), formats.end(), f) != formats.end())
-      throw Error(ErrorCode::Usage, "--formats '" + text + "': " + f + " is named twice");
-    formats.push_back(f);
+    formats.push_back(text.substr(start, comma - start));
     start = comma + 1;
   }
-  return formats;
+  return vasco::pipeline::check_map_formats(formats, "--formats '" + carmen::printable(text) + "'");
 }
 
 // Batch mode: every positional is an input; the one-input options refused.
@@ -274,17 +284,17 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
 // Options that change nothing for the chosen backend: a warning each (the
 // run goes on), printed at once and carried by --json.
 void warn_about_idle_options(const CLI::App &app, Options &opt) {
-  const bool cpu = opt.backend.rfind("cpu_", 0) == 0;
-  if (app.count("--cuda-mode") && cpu)
+  const vasco::BackendInfo *b = vasco::find_backend(opt.backend);  // --backend takes the registry's names only
+  const bool gpus = b == nullptr || b->uses_gpus, threads = b == nullptr || b->uses_threads;
+  std::string users;  // "cpu_threads and auto": the backends --threads serves
+  for (const vasco::BackendInfo &r : vasco::backend_registry())
+    if (r.uses_threads) users += (users.empty() ? "" : " and ") + std::string(r.name);
+  if (app.count("--cuda-mode") && !gpus)
     opt.warnings.push_back("--cuda-mode does nothing with --backend " + opt.backend + " (only cuda has modes)");
-  if (app.count("--device") && cpu)
-    opt.warnings.push_back("--device does nothing with --backend " + opt.backend);
-  if (app.count("--devices") && cpu)
-    opt.warnings.push_back("--devices does nothing with --backend " + opt.backend);
-  if (app.count("--split-devices") && cpu)
-    opt.warnings.push_back("--split-devices does nothing with --backend " + opt.backend);
-  if (app.count("--threads") && (opt.backend == "cpu_double" || opt.backend == "cpu_float" || opt.backend == "cuda"))
-    opt.warnings.push_back("--threads does nothing with --backend " + opt.backend + " (only cpu_threads and auto use it)");
+  for (const char *option : {"--device", "--devices", "--split-devices"})
+    if (app.count(option) && !gpus) opt.warnings.push_back(std::string(option) + " does nothing with --backend " + opt.backend);
+  if (app.count("--threads") && !threads)
+    opt.warnings.push_back("--threads does nothing with --backend " + opt.backend + " (only " + users + " use it)");
   if (app.count("--robot") && opt.param_file.empty())
     opt.warnings.push_back("--robot does nothing without --param-file (it picks a robot section of the ini)");
   for (const std::string &w : opt.warnings) std::fprintf(stderr, "%s: warning: %s\n", opt.tool.c_str(), w.c_str());

@@ -13,6 +13,7 @@
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
 #include "cli_support.h"
+#include "vasco_gpu/pipeline/mapped.h"
 #include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/map_output.h"
 #include "vasco_gpu/version.h"
@@ -153,21 +154,6 @@ vasco::LogInput read_input_once(const Options &opt, const std::string &log, cons
 
 // Why a log's scans updated no cell, for the error that says so (there is
 // no map to write: finish crops to the known cells).
-std::string why_nothing_was_mapped(const vasco::ScanBatch &b) {
-  uint64_t used = 0;
-  for (float r : b.range) used += vasco::egrid::is_beam_used(r);
-  std::ostringstream m;
-  m << "no beam updated any cell: ";
-  if (used == 0) {
-    m << "every one of the " << b.num_beams() << " ranges of the " << b.num_scans() << " scans mapped is "
-      << vasco::egrid::kLaserRangeLimit << " m or more, NaN or +inf (CARMEN uses a beam only below "
-      << vasco::egrid::kLaserRangeLimit << " m)";
-  } else {
-    m << used << " beams were used, but none reached a cell of the grid";
-  }
-  return m.str();
-}
-
 }  // namespace
 
 void map_input(vasco::Mapper &mapper, const std::string &log, RunResult &r) {
@@ -195,9 +181,8 @@ void map_input(vasco::Mapper &mapper, const std::string &log, RunResult &r) {
   t = Clock::now();
   r.map = mapper.finish();
   r.finish_s = cli::seconds_since(t);
-  r.known = 0;
-  for (float v : r.map.cells) r.known += v != -1.0f;
-  if (r.known == 0) throw carmen::FileError(log, why_nothing_was_mapped(mapper.scans()));
+  r.known = vasco::pipeline::known_cells(r.map.cells);
+  vasco::pipeline::check_mapped(r.map.cells, mapper.scans(), log);
   r.origin = vasco::world_origin(r.map, r.input.geo);
 }
 

@@ -23,6 +23,7 @@
 #include "carmen_compat/map_file.h"
 #include "carmen_compat/map_format.h"
 #include "cli_support.h"
+#include "vasco_gpu/pipeline/outputs.h"
 #include "vasco_gpu/version.h"
 
 namespace {
@@ -73,13 +74,10 @@ enum class OutKind { None, Map, MapServer, Grid };
 OutKind kind_of(const std::string &path) {
   const carmen::MapFormatEntry *f = carmen::find_map_format(path);
   if (f == nullptr) return OutKind::None;
-  switch (f->format) {
-    case carmen::MapFormat::CarmenMap:
-    case carmen::MapFormat::CarmenMapGz: return OutKind::Map;
-    case carmen::MapFormat::PgmYaml:
-    case carmen::MapFormat::PngYaml:
-    case carmen::MapFormat::Yaml: return OutKind::MapServer;
-    case carmen::MapFormat::Png: return OutKind::Grid;
+  switch (f->kind) {
+    case carmen::MapFormatKind::Carmen: return OutKind::Map;
+    case carmen::MapFormatKind::MapServer: return OutKind::MapServer;
+    case carmen::MapFormatKind::Picture: return OutKind::Grid;
   }
   return OutKind::None;
 }
@@ -350,7 +348,7 @@ int main(int argc, char **argv) {
     if (!a.info && a.files[1] != cli::kStdio) {
       const std::vector<std::string> inputs =
           a.files[0] == cli::kStdio ? std::vector<std::string>{a.files[0]} : carmen::map_input_files(a.files[0]);
-      cli::check_outputs(inputs, carmen::map_output_files(a.files[1]));
+      vasco::pipeline::check_outputs(inputs, carmen::map_output_files(a.files[1]));
     }
     if (!a.info && a.files[1] == cli::kStdio) cli::check_stdout_writable("the output '-'");
     if (!carmen_input(a.files[0])) {

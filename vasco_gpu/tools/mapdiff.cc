@@ -24,6 +24,7 @@
 #include "carmen_compat/image_io.h"
 #include "carmen_compat/map_file.h"
 #include "cli_support.h"
+#include "vasco_gpu/pipeline/outputs.h"
 #include "picture_legend.h"
 #include "carmen_compat/map_compare.h"
 #include "carmen_compat/map_digest.h"
@@ -427,7 +428,7 @@ int parse(int argc, char **argv, Options &o) {
 int run(const Options &o) {
   // The picture's file is checked, and both maps read, before anything is
   // written: a bad input or target leaves no picture.
-  if (o.png_given) cli::check_outputs({o.a, o.b}, {o.png});
+  if (o.png_given) vasco::pipeline::check_outputs({o.a, o.b}, {o.png});
   if (o.a == cli::kStdio && o.b == cli::kStdio)
     throw carmen::Error(carmen::ErrorCode::Usage, "A and B are both '-': standard input holds one map");
   const Input a = load(cli::input_path(o.a));

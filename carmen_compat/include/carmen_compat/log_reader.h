@@ -56,6 +56,15 @@ bool is_laser_message(MessageType type);
 // The bit of `type` in LogReaderOptions::budget_types.
 constexpr uint32_t message_type_bit(MessageType type) { return uint32_t(1) << static_cast<int>(type); }
 
+// Every laser type and PARAM, each named (not a range of the enum, so that
+// the budget's default does not move when a type is added or reordered).
+constexpr uint32_t kLaserAndParamBits =
+    message_type_bit(MessageType::FLASER) | message_type_bit(MessageType::RLASER) |
+    message_type_bit(MessageType::ROBOTLASER1) | message_type_bit(MessageType::ROBOTLASER2) |
+    message_type_bit(MessageType::RAWLASER1) | message_type_bit(MessageType::RAWLASER2) |
+    message_type_bit(MessageType::RAWLASER3) | message_type_bit(MessageType::RAWLASER4) |
+    message_type_bit(MessageType::PARAM);
+
 struct Point { double x = 0, y = 0, theta = 0; };
 
 struct LaserConfig {
@@ -154,8 +163,7 @@ struct LogReaderOptions {
   uint64_t memory_budget = 0;
   // The types the caller keeps (message_type_bit of each); every laser type
   // and PARAM by default.
-  uint32_t budget_types = ((message_type_bit(MessageType::RAWLASER4) << 1) - 1) |  // FLASER..RAWLASER4
-                          message_type_bit(MessageType::PARAM);
+  uint32_t budget_types = kLaserAndParamBits;
   // How the user raises the budget, as the error names it ("--max-memory").
   std::string budget_option = "LogReaderOptions::memory_budget";
   // A FIFO, pipe or device named by its path is opened without waiting for a

@@ -58,10 +58,19 @@ struct MapRead {
   std::optional<GlobalOffset> origin;  // as above; none for a PNG or a .map without OFFSET
 };
 
+// What a format holds, for the tools that treat kinds alike (mapconvert copies
+// a CARMEN map whole; the map_server options apply to MapServer outputs).
+enum class MapFormatKind {
+  Carmen,     // a CARMEN map file: chunks, comments, the grid and its offset
+  MapServer,  // a map_server / nav2 image + YAML pair: grid, resolution, origin, thresholds
+  Picture,    // an image for people: the grid only
+};
+
 struct MapFormatEntry {
   MapFormat format;
   const char *extension;  // lower case, with the dot: ".map.gz"
   const char *what;       // for help texts
+  MapFormatKind kind;
   MapRead (*read)(const std::string &path);
   void (*write)(OutputTransaction &tx, const std::string &path, const MapToWrite &map);
 };
@@ -70,6 +79,11 @@ struct MapFormatEntry {
 const std::vector<MapFormatEntry> &map_formats();
 // ".map, .map.gz, .pgm, .png+yaml, .yaml, .png": for messages.
 std::string known_map_extensions();
+// The extensions without their dot ("map", "map.gz", ...): the format names a
+// batch's --formats and Python's map_logs take (a batch writes STEM.NAME).
+std::vector<std::string> map_format_names();
+// The format named so (map_format_names()); nullptr when none is.
+const MapFormatEntry *find_map_format_by_name(const std::string &name);
 
 // The format of `path` by the rule above; nullptr when none matches.
 const MapFormatEntry *find_map_format(const std::string &path);

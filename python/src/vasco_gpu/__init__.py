@@ -62,15 +62,19 @@ from ._core import (
     Mapper,
     Params,
     Scans,
+    backend_names,
+    backend_registry,
     backends,
     compare,
     has_cuda,
     load_log,
+    map_formats,
+    output_stem,
     write_map,
 )
 from . import _core
 from ._cuda import CudaStatus, cuda_available
-from ._bags import load_bag
+from .bags.load import load_bag
 from ._batch import BatchError, LogResult, map_logs
 
 __version__: str = _core.__version__
@@ -97,6 +101,8 @@ __all__ = [
     "TooLargeError",
     "UsageError",
     "__version__",
+    "backend_names",
+    "backend_registry",
     "backends",
     "compare",
     "cuda_available",
@@ -104,7 +110,9 @@ __all__ = [
     "has_cuda",
     "load_bag",
     "load_log",
+    "map_formats",
     "map_logs",
+    "output_stem",
     "read_map",
     "write_map",
 ]

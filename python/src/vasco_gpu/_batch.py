@@ -17,9 +17,7 @@ import dataclasses
 import operator
 import os
 import pickle
-import shutil
 import socket
-import tempfile
 import threading
 import time
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
@@ -28,14 +26,6 @@ from . import _core
 from ._errors import FileError
 
 PathLike = Union[str, "os.PathLike[str]"]
-
-#: The output formats, as log2map's ``--formats`` names them.
-FORMATS = ("map", "map.gz", "pgm", "png")
-
-# The names Mapper(backend=...) accepts; whether one can run is the worker's business (the
-# process calling map_logs may have no GPU while its workers do).
-_BACKEND_NAMES = ("auto", "cpu_double", "cpu_threads", "cpu_float", "cuda", "cuda_exact", "cuda_float")
-
 
 @dataclasses.dataclass
 class LogResult:
@@ -86,22 +76,6 @@ class BatchError(RuntimeError):
 
     def __reduce__(self):
         return (type(self), (self.result, self.results))
-
-
-def output_stem(path: PathLike) -> str:
-    """The name of a log's outputs, as log2map's batch mode makes it: the file name less a
-    trailing ``.gz`` and then less one extension (``fr079-complete.gfs.log.gz`` ->
-    ``fr079-complete.gfs``)."""
-    name = os.fspath(path)
-    while len(name) > 1 and name.endswith("/"):  # a directory (a ROS 2 bag's)
-        name = name[:-1]
-    name = name[name.rfind("/") + 1:]
-    if len(name) > 3 and name.endswith(".gz"):
-        name = name[:-3]
-    dot = name.rfind(".")
-    if dot > 0:
-        name = name[:dot]
-    return name
 
 
 # ---------------------------------------------------------------------------------------------
@@ -170,64 +144,6 @@ def _travels(e: BaseException) -> Optional[BaseException]:
     return e
 
 
-def _commit(outputs: Sequence[str], write) -> None:
-    """Writes ``outputs`` as one transaction: ``write(path)`` writes one of them (with what
-    belongs to it, a .pgm's .yaml) under its own name in a hidden staging directory beside
-    it; once every one is written the files are renamed into place, an existing file kept
-    until all renames are done and put back should one fail. The staging directory goes,
-    whatever happens."""
-    staging: Dict[str, str] = {}
-    try:
-        for out in outputs:
-            folder = os.path.dirname(os.path.abspath(out))
-            if folder not in staging:
-                staging[folder] = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.", suffix=".tmp", dir=folder)
-            try:
-                write(os.path.join(staging[folder], os.path.basename(out)))
-            except Exception as e:  # named as the output, not as its temporary
-                text = str(e).replace(staging[folder] + os.sep, folder + os.sep)
-                raise FileError(text, file=out, message=text, code=getattr(e, "code", "I/O")) from e
-        moves = []
-        for folder, stage in staging.items():
-            kept = os.path.join(stage, ".old")
-            os.mkdir(kept)
-            moves += [(os.path.join(stage, n), os.path.join(folder, n), os.path.join(kept, n))
-                      for n in sorted(os.listdir(stage)) if n != ".old"]
-        for _, final, _ in moves:  # every target checked before the first rename
-            if os.path.lexists(final) and not os.path.isfile(final):
-                why = "cannot be replaced: it is not a regular file"
-                raise FileError(f"{final}: {why}", file=final, message=why, code="I/O")
-        done: List[Tuple[str, Optional[str]]] = []
-        try:
-            for staged, final, old in moves:
-                if os.path.lexists(final):
-                    try:
-                        os.link(final, old)
-                    except OSError:
-                        shutil.copy2(final, old)
-                else:
-                    old = None
-                try:
-                    os.replace(staged, final)
-                except OSError as e:
-                    why = f"cannot be replaced: {e.strerror or e}"
-                    raise FileError(f"{final}: {why}", file=final, message=why, code="I/O") from e
-                done.append((final, old))
-        except BaseException:
-            for final, old in reversed(done):
-                try:
-                    if old is None:
-                        os.unlink(final)
-                    else:
-                        os.replace(old, final)
-                except OSError:
-                    pass
-            raise
-    finally:
-        for stage in staging.values():
-            shutil.rmtree(stage, ignore_errors=True)
-
-
 def _map_one(path: PathLike, outputs: Sequence[str], backend: str = "auto", cuda_mode: Optional[str] = None,
              threads: int = 0, cuda_device: int = 0, max_memory_bytes: Optional[int] = None,
              load_options: Optional[Dict[str, Any]] = None) -> LogResult:
@@ -260,19 +176,16 @@ def _map_one(path: PathLike, outputs: Sequence[str], backend: str = "auto", cuda
                 mapper.insert(log.scans)
                 del log
                 m = mapper.finish()
+                mapper._check_mapped(m, path)  # as log2map: a map without a known cell is not written
             finally:
                 try:
                     mapper.start_over(_core.Params())  # the scans' memory goes now, not at the next log
                 except Exception:
                     pass
-        if m.size_x == 0 or not (m.cells != -1).any():
-            # As log2map: a map without a known cell is not written (finish crops to them).
-            raise FileError(f"{path}: no beam updated any cell", file=path,
-                            message="no beam updated any cell")
         now = time.perf_counter()
         result.seconds["map"], t, phase = now - t, now, "write"
         description = f"vasco_gpu {_core.__version__} {result.backend}"
-        _commit(result.outputs, lambda out: _core.write_map(out, m, description=description))
+        _core._write_maps(result.outputs, m, description=description)
         result.seconds["write"] = time.perf_counter() - t
         result.ok = True
     except Exception as e:
@@ -287,22 +200,13 @@ def _map_one(path: PathLike, outputs: Sequence[str], backend: str = "auto", cuda
 
 
 def _check_formats(formats: Union[str, Sequence[str]]) -> List[str]:
-    if isinstance(formats, str):
-        formats = [formats]
-    formats = list(formats)
-    if not formats:
-        raise ValueError("map_logs: formats: at least one of map, map.gz, pgm, png")
-    for f in formats:
-        if f not in FORMATS:
-            raise ValueError(f"map_logs: format {f!r} is none of map, map.gz, pgm, png")
-        if formats.count(f) > 1:
-            raise ValueError(f"map_logs: format {f!r} is named twice")
-    return formats
+    return _core._check_map_formats([formats] if isinstance(formats, str) else list(formats), "map_logs: formats")
 
 
 def _check_options(backend: str, cuda_mode: Optional[str], threads: int, load_options: Dict[str, Any]) -> None:
-    if backend not in _BACKEND_NAMES:
-        raise ValueError(f"map_logs: backend {backend!r}: expected one of {', '.join(_BACKEND_NAMES)}")
+    names = _core.backend_names()  # compiled here or not: the workers may have what this process lacks
+    if backend not in names:
+        raise ValueError(f"map_logs: backend {backend!r}: expected one of {', '.join(names)}")
     if cuda_mode not in (None, "float", "exact"):
         raise ValueError(f"map_logs: cuda_mode {cuda_mode!r}: expected 'float' or 'exact'")
     try:
@@ -326,20 +230,7 @@ def _check_options(backend: str, cuda_mode: Optional[str], threads: int, load_op
 def _plan(paths: Sequence[PathLike], out_dir: PathLike, formats: List[str]) -> List[Tuple[str, List[str]]]:
     if isinstance(paths, (str, bytes, os.PathLike)):
         raise TypeError("map_logs: paths: expected a list of logs, not one path")
-    out = os.fspath(out_dir)
-    seen: Dict[str, str] = {}
-    plan = []
-    for p in paths:
-        p = os.fspath(p)
-        stem = output_stem(p)
-        if not stem:
-            raise ValueError(f"map_logs: {p!r}: no file name to name its outputs after")
-        if stem in seen:
-            raise ValueError(f"map_logs: {seen[stem]} and {p} would both write {os.path.join(out, stem)}.*: "
-                             "give logs of different names (or map them in two calls)")
-        seen[stem] = p
-        plan.append((p, [os.path.join(out, f"{stem}.{f}") for f in formats]))
-    return plan
+    return _core._plan_outputs([os.fspath(p) for p in paths], os.fspath(out_dir), formats, "map_logs: ")
 
 
 def _not_run(path: str, outputs: List[str], backend: str) -> LogResult:
@@ -366,7 +257,7 @@ def map_logs(paths: Sequence[PathLike], out_dir: PathLike, formats: Union[str, S
     Each log ``DIR/NAME.EXT[.gz]`` is read with ``load_log(path, **load_options)`` (its PARAM
     lines, ``param_file``, ``overrides``, ``lenient``, ``poses``, ... as load_log takes them),
     mapped with its parameters and written to ``out_dir/NAME.FORMAT`` for each of ``formats``
-    (``map``, ``map.gz``, ``pgm`` with its ``.yaml``, ``png``): the bytes log2map writes for the
+    (a name of :func:`map_formats`: ``map``, ``map.gz``, ``pgm`` with its ``.yaml``, ...): the bytes log2map writes for the
     log with the same backend (the GRIDMAP; the header's time differs). ``out_dir`` is made when
     missing. A log's outputs are one transaction: all are written under temporary names beside
     them and renamed at the end, so a failed log leaves no file behind and an existing output
@@ -399,8 +290,8 @@ def map_logs(paths: Sequence[PathLike], out_dir: PathLike, formats: Union[str, S
     (Dask's) reports them as not mapped, though a task that was past its start still writes
     its outputs, whole.
 
-    Raises before any work: ValueError for a format that is none of map, map.gz, pgm, png (or
-    one named twice), two logs of the same output name (``a/x.log`` and ``b/x.log.gz``), an
+    Raises before any work: ValueError for a format that is not a name of
+    :func:`map_formats` (or one named twice, or two that write one file), two logs of the same output name (``a/x.log`` and ``b/x.log.gz``), an
     unknown backend or cuda_mode, threads outside 0..1024; TypeError for a keyword load_log
     does not take; load_log's errors for its options (a missing ``param_file``, a bad override).
     """
@@ -409,6 +300,9 @@ def map_logs(paths: Sequence[PathLike], out_dir: PathLike, formats: Union[str, S
     _check_options(backend, cuda_mode, threads, load_options)
     threads = operator.index(threads)
     os.makedirs(os.fspath(out_dir), exist_ok=True)
+    # As log2map: no output may be a log, the param_file or another output.
+    inputs = [p for p, _ in plan] + ([os.fspath(load_options["param_file"])] if load_options.get("param_file") else [])
+    _core._check_outputs(inputs, [o for _, outputs in plan for o in outputs], replaceable=False)
     args = (backend, cuda_mode, threads, cuda_device, max_memory_bytes, load_options)
 
     if executor is None:

@@ -3,7 +3,7 @@ vasco_gpu's C++ engine (see the package vasco_gpu for the documentation).
 """
 
 import os
-from typing import Annotated
+from typing import Annotated, Any
 
 import numpy
 import numpy.typing
@@ -26,6 +26,34 @@ def backends() -> list[str]:
       cpu_threads: cpu_double's bytes on all cores (--threads)
       cpu_float: single precision on one core, fast; measured against CARMEN's maps
       auto: cuda when a GPU is usable, else cpu_threads
+    """
+
+def backend_registry() -> list[dict[str, Any]]:
+    """
+    Every backend of the engine's registry, compiled into this build or not, in the order the
+    help lists them: a dict each with 'name', 'aliases' (a list of (alias, cuda mode)), 'exactness'
+    ('exact', 'float' or 'by_cuda_mode'), 'grid_on_device', 'compiled', 'summary', and what the
+    options mean for it: 'uses_gpus', 'uses_threads', 'chooses' (auto: picks another per input).
+    """
+
+def backend_names() -> list[str]:
+    """
+    Every name and alias Mapper(backend=...) takes, compiled into this build or not.
+    """
+
+def map_formats() -> list[dict[str, str]]:
+    """
+    Every map format of the engine's table, in the order the help lists them: a dict each with
+    'name' (what map_logs' formats and log2map --formats take: 'map.gz'), 'extension' ('.map.gz'),
+    'what' and 'kind' ('carmen', 'map_server' or 'picture'). A path's extension (any case) picks
+    its format in read_map and write_map.
+    """
+
+def output_stem(path: str | os.PathLike) -> str:
+    """
+    The name of an input's outputs, as log2map's batch mode makes it: the file name less a
+    trailing ``.gz`` and then less one extension (``fr079-complete.gfs.log.gz`` ->
+    ``fr079-complete.gfs``; a ROS 2 bag's directory ``run/`` -> ``run``).
     """
 
 class Params:

@@ -82,6 +82,11 @@ struct BackendInfo {
   bool grid_on_device;
   bool compiled;        // false: named but not in this build (cuda without nvcc)
   const char *summary;  // one line, for --backend's help and the docs
+  // What a front end's options mean for it, so that none decides by name
+  // (log2map warns of an option that does nothing, hands GPUs to a batch):
+  bool uses_gpus;     // a CUDA device and mode matter (--device, --devices, --split-devices, --cuda-mode)
+  bool uses_threads;  // BackendOptions::threads matters (--threads)
+  bool chooses;       // picks another backend for each input (auto); the tools say which
   // Creates the renderer; throws Error(NoGpu) when the backend cannot run here.
   std::unique_ptr<Renderer> (*make)(const BackendOptions &options);
 };

@@ -80,6 +80,18 @@ struct LogLoadStats {
   std::vector<uint8_t> robot_pose_known;
 };
 
+// Which log messages are the scans a map is made of (DESIGN §3 step 1): the
+// front laser's lines with a laser pose, FLASER and ROBOTLASER1 (RLASER and
+// ROBOTLASER2 are the rear laser's; RAWLASERn carry no pose). Written once
+// here: load_scans, the log input's memory budget, the pose files' CARMEN
+// logs and the Python bindings read it.
+bool is_scan_message(carmen::MessageType type);
+// message_type_bit of each scan message type.
+uint32_t scan_message_bits();
+// Their names for messages and help texts: "FLASER or ROBOTLASER1" (`joiner`
+// " or ") or "FLASER and ROBOTLASER1".
+std::string scan_message_names(const char *joiner = " or ");
+
 // Reads the laser scans of a log by DESIGN §3 step 1: every FLASER and
 // ROBOTLASER1 line in file order (laser pose; FLASER's configuration guessed
 // from its beam count), then the contiguous subset [first_scan, first_scan +

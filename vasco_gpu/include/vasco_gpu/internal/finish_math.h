@@ -1,6 +1,6 @@
 // finish_math.h — CARMEN 0.7.4's finish of an evidence grid (DESIGN §2 step
 // 7), written once and compiled into the CPU finish (grid.cc) and the GPU's
-// (cuda/finish_kernels.cu): the mean of each ds x ds block's known cells,
+// (src/cuda/finish_kernels.cu): the mean of each ds x ds block's known cells,
 // summed in double in CARMEN's order; the bounding box of the known blocks,
 // from CARMEN's start values; the crop to that box plus the border, clamped
 // to the block grid; the new size max - min (no +1) at resolution * ds.

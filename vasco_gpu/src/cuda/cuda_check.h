@@ -1,6 +1,6 @@
 // cuda_check.h — one error-check macro for every CUDA call, RAII owners for
 // device memory, pinned host memory, streams and events. Used by the kernels
-// (cuda/) and the host side of the CUDA backend (vasco_gpu/src/cuda/).
+// and the host side of the CUDA backend, both in vasco_gpu/src/cuda/.
 #ifndef VASCO_CUDA_CHECK_H
 #define VASCO_CUDA_CHECK_H
 

@@ -1,0 +1,125 @@
+// registries.cc — the engine's lists as Python reads them: the backends
+// (backend.h), the map formats (map_format.h) and the pipeline's rules for
+// outputs (vasco_gpu/pipeline/outputs.h), so that no Python file lists a
+// backend, a format or an output rule of its own.
+#include <nanobind/nanobind.h>
+#include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/pair.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bindings.h"
+#include "carmen_compat/map_format.h"
+#include "vasco_gpu/backend.h"
+#include "vasco_gpu/pipeline/outputs.h"
+
+namespace vasco_py {
+
+namespace {
+
+using namespace nb::literals;
+
+const char *exactness_name(vasco::Exactness e) {
+  switch (e) {
+    case vasco::Exactness::Exact: return "exact";
+    case vasco::Exactness::Float: return "float";
+    case vasco::Exactness::ByCudaMode: return "by_cuda_mode";
+  }
+  return "?";
+}
+
+const char *kind_name(carmen::MapFormatKind k) {
+  switch (k) {
+    case carmen::MapFormatKind::Carmen: return "carmen";
+    case carmen::MapFormatKind::MapServer: return "map_server";
+    case carmen::MapFormatKind::Picture: return "picture";
+  }
+  return "?";
+}
+
+nb::list backend_rows() {
+  nb::list rows;
+  for (const vasco::BackendInfo &b : vasco::backend_registry()) {
+    nb::list aliases;
+    for (const vasco::BackendAlias &a : b.aliases)
+      aliases.append(nb::make_tuple(a.name, a.cuda_mode == vasco::CudaMode::Exact ? "exact" : "float"));
+    nb::dict row;
+    row["name"] = b.name;
+    row["aliases"] = aliases;
+    row["exactness"] = exactness_name(b.exactness);
+    row["grid_on_device"] = b.grid_on_device;
+    row["compiled"] = b.compiled;
+    row["summary"] = b.summary;
+    row["uses_gpus"] = b.uses_gpus;
+    row["uses_threads"] = b.uses_threads;
+    row["chooses"] = b.chooses;
+    rows.append(row);
+  }
+  return rows;
+}
+
+nb::list format_rows() {
+  nb::list rows;
+  for (const carmen::MapFormatEntry &f : carmen::map_formats()) {
+    nb::dict row;
+    row["name"] = f.extension + 1;
+    row["extension"] = f.extension;
+    row["what"] = f.what;
+    row["kind"] = kind_name(f.kind);
+    rows.append(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+void bind_registries(nb::module_ &m) {
+  m.def("backend_registry", &backend_rows,
+        nb::sig("def backend_registry() -> list[dict[str, typing.Any]]"),
+        "Every backend of the engine's registry, compiled into this build or not, in the order the\n"
+        "help lists them: a dict each with 'name', 'aliases' (a list of (alias, cuda mode)), 'exactness'\n"
+        "('exact', 'float' or 'by_cuda_mode'), 'grid_on_device', 'compiled', 'summary', and what the\n"
+        "options mean for it: 'uses_gpus', 'uses_threads', 'chooses' (auto: picks another per input).");
+  m.def("backend_names", &vasco::backend_names,
+        "Every name and alias Mapper(backend=...) takes, compiled into this build or not.");
+  m.def("map_formats", &format_rows, nb::sig("def map_formats() -> list[dict[str, str]]"),
+        "Every map format of the engine's table, in the order the help lists them: a dict each with\n"
+        "'name' (what map_logs' formats and log2map --formats take: 'map.gz'), 'extension' ('.map.gz'),\n"
+        "'what' and 'kind' ('carmen', 'map_server' or 'picture'). A path's extension (any case) picks\n"
+        "its format in read_map and write_map.");
+  m.def(
+      "output_stem", [](const std::filesystem::path &path) { return vasco::pipeline::output_stem(path.string()); },
+      "path"_a, nb::sig("def output_stem(path: str | os.PathLike) -> str"),
+        "The name of an input's outputs, as log2map's batch mode makes it: the file name less a\n"
+        "trailing ``.gz`` and then less one extension (``fr079-complete.gfs.log.gz`` ->\n"
+        "``fr079-complete.gfs``; a ROS 2 bag's directory ``run/`` -> ``run``).");
+  m.def("_check_map_formats", &vasco::pipeline::check_map_formats, "names"_a, "what"_a,
+        "The formats of a batch checked (UsageError beginning with ``what``).");
+  m.def(
+      "_plan_outputs",
+      [](const std::vector<std::string> &inputs, const std::string &out_dir, const std::vector<std::string> &formats,
+         const std::string &who) {
+        std::vector<std::pair<std::string, std::vector<std::string>>> plan;
+        for (vasco::pipeline::PlannedInput &p : vasco::pipeline::plan_outputs(inputs, out_dir, formats, who))
+          plan.emplace_back(std::move(p.input), std::move(p.outputs));
+        return plan;
+      },
+      "inputs"_a, "out_dir"_a, "formats"_a, "who"_a = "",
+      "[(input, [outputs])] of a batch: DIR/STEM.FORMAT; two inputs of one stem refused (UsageError).");
+  m.def(
+      "_check_outputs",
+      [](const std::vector<std::string> &inputs, const std::vector<std::string> &outputs, bool replaceable) {
+        nb::gil_scoped_release release;
+        vasco::pipeline::check_outputs(inputs, vasco::pipeline::output_files(outputs), replaceable);
+      },
+      "inputs"_a, "outputs"_a, "replaceable"_a = true,
+      "Refuses an output (or a file it writes, a .pgm's .yaml) that is an input or another output\n"
+      "(UsageError), or, with ``replaceable``, that a rename could not replace (FileError).");
+}
+
+}  // namespace vasco_py

@@ -1,0 +1,164 @@
+"""The console scripts bag2map (log2map's command line on bags) and bag2carmen (a bag as a
+CARMEN log).
+
+bag2map runs log2map's own command line, in C++ (``vasco_gpu._core._run_tool``, DESIGN §1),
+with the bag options of BAG_OPTIONS added to it and :func:`_tool_reader` in place of the log
+reader; the command line hands the reader the bag options given, and some of log2map's own
+(HANDED_ON), as text by name. bag2carmen parses its command line with argparse, its bag
+options from the same table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+from dataclasses import dataclass
+from typing import Callable
+
+from .. import _core
+from .carmen_writer import write_carmen_log
+from .errors import BagError
+from .load import reader_module, read_for_engine
+
+
+@dataclass(frozen=True)
+class BagOption:
+    """An option of both tools: --flag METAVAR, which sets read_for_engine's keyword."""
+
+    flag: str
+    keyword: str
+    help: str
+    metavar: str
+    default: str | None = None  # bag2carmen's value when the option is not given, or empty
+
+    def value(self, parsed: argparse.Namespace) -> str | None:
+        """The option's value in bag2carmen's parsed command line."""
+        given = getattr(parsed, self.keyword)
+        return given if self.default is None else (given or self.default)
+
+
+# bag2map's options beyond log2map's, and bag2carmen's bag options.
+BAG_OPTIONS = (
+    BagOption("scan-topic", "scan_topic", "the sensor_msgs/LaserScan topic (default: the only one)", "TOPIC"),
+    BagOption("fixed-frame", "fixed_frame", "the frame the map is in: the root of the tf chain to each scan "
+              "(default: map), or the frame of --pose-topic's poses", "FRAME"),
+    BagOption("base-frame", "base_frame", "the robot's frame for --pose-topic (default: the odometry's child "
+              "frame, else base_link)", "FRAME"),
+    BagOption("pose-topic", "pose_topic", "the robot's poses from a nav_msgs/Odometry, geometry_msgs/PoseStamped "
+              "or PoseWithCovarianceStamped topic instead of /tf (the laser mount from /tf_static or "
+              "--laser-mount)", "TOPIC"),
+    BagOption("no-return", "no_return", "what a +inf range (REP 117: no return) does: skip (default; CARMEN's "
+              "max-range readings) or free (clears up to vasco_range_max, as ROS mappers do)", "skip|free",
+              default="skip"),
+)
+
+
+def _mount_of(text: str | None):
+    """X,Y,THETA text as a tuple of floats, None for none; ValueError for a bad number."""
+    if not text:
+        return None
+    parts = text.split(",")
+    return tuple(float(p) for p in parts)
+
+
+# log2map's own options that its command line hands to bag2map's reader too, with the bag
+# options (vasco_gpu/tools/log2map_steps.cc): (flag, read_for_engine's keyword, its value from
+# the option's text). --laser-mount's text is one log2map has already checked as X,Y,THETA.
+HANDED_ON = (
+    ("poses", "need_poses", lambda text: False),  # a pose file gives the poses: the bag need not
+    ("laser-mount", "laser_mount", _mount_of),
+    ("skip-unposed", "skip_unposed", lambda text: True),
+)
+
+
+def _tool_reader(path: str, values: dict, progress) -> dict:
+    """bag2map's reader of one input: `values` holds the options given, as text by flag."""
+    keywords = {o.keyword: values[o.flag] for o in BAG_OPTIONS if o.flag in values}
+    keywords.update({keyword: value(values[flag]) for flag, keyword, value in HANDED_ON if flag in values})
+    return read_for_engine(path, progress=progress, **keywords)
+
+
+BAG2MAP_SUMMARY = (
+    "bag2map: builds a CARMEN evidence-grid map (vasco/egrid.c) from a ROS bag's laser scans.\n"
+    "Inputs: ROS 1 .bag, ROS 2 bag directories (sqlite3, MCAP) and .mcap files. Outputs by extension:\n"
+    ".map, .map.gz (CARMEN), .pgm (+ .yaml, ROS map_server), .png. Every other option is log2map's.")
+
+
+def bag2map_main(argv: list[str] | None = None) -> int:
+    """The console script bag2map: log2map's command line with ROS bags as inputs."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    return _core._run_tool(["bag2map", *args], "bag2map", BAG2MAP_SUMMARY, "BAG",
+                           "ROS 1 .bag, ROS 2 bag directory (sqlite3 or MCAP) or .mcap file",
+                           [(o.flag, o.help, o.metavar) for o in BAG_OPTIONS], _tool_reader)
+
+
+def _bag2carmen_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="bag2carmen", description=(
+        "Writes a ROS bag's laser scans and poses as a CARMEN log (ROBOTLASER1 lines), for CARMEN's own "
+        "tools and log2map. The output is written whole or not at all."))
+    p.add_argument("bag", metavar="BAG", help="ROS 1 .bag, ROS 2 bag directory (sqlite3 or MCAP) or .mcap file")
+    p.add_argument("out", metavar="OUT", help="the CARMEN log to write (.log, .clf; gzipped if .gz)")
+    for o in BAG_OPTIONS:
+        p.add_argument("--" + o.flag, dest=o.keyword, help=o.help, metavar=o.metavar)
+    p.add_argument("--laser-mount", metavar="X,Y,THETA", help="the laser in the robot's frame (for --pose-topic)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress")
+    return p
+
+
+def _write_whole(out: str, write: Callable[[str], None]) -> None:
+    """Writes to a temporary beside `out`, renamed over it only when complete."""
+    directory = os.path.dirname(os.path.abspath(out))
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(out) + ".", suffix=".tmp", dir=directory)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, out)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def bag2carmen_main(argv: list[str] | None = None) -> int:
+    """The console script bag2carmen. Exit 0 done, 1 bad input, 2 usage error."""
+    parser = _bag2carmen_parser()
+    try:
+        a = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    except SystemExit as e:
+        return 0 if e.code == 0 else 2
+    try:
+        mount = _mount_of(a.laser_mount)
+    except ValueError:
+        print(f"bag2carmen: --laser-mount '{a.laser_mount}': expected X,Y,THETA", file=sys.stderr)
+        return 2
+    if os.path.exists(a.out) and os.path.exists(a.bag) and os.path.samefile(a.out, a.bag):
+        print(f"bag2carmen: {a.out}: the output is the input", file=sys.stderr)
+        return 2
+    reader_module()  # without rosbags: the ImportError that says to install it
+    try:
+        d = read_for_engine(a.bag, laser_mount=mount, **{o.keyword: o.value(a) for o in BAG_OPTIONS})
+        ext = a.out.lower()
+        if not (ext.endswith(".log") or ext.endswith(".clf") or ext.endswith(".log.gz") or ext.endswith(".clf.gz")):
+            print(f"bag2carmen: {a.out}: expected a .log or .clf name (gzipped if .gz)", file=sys.stderr)
+            return 2
+        gz = ext.endswith(".gz")
+
+        def write(tmp):
+            if gz:
+                import gzip
+                with gzip.open(tmp, "wt", compresslevel=6, encoding="ascii", newline="\n") as f:
+                    write_carmen_log(d["bag"], f)
+            else:
+                with open(tmp, "w", encoding="ascii", newline="\n") as f:
+                    write_carmen_log(d["bag"], f)
+
+        _write_whole(a.out, write)
+    except (BagError, ValueError, OSError) as e:
+        print(f"bag2carmen: {e}", file=sys.stderr)
+        return 1
+    if not a.quiet:
+        b = d["bag"]
+        print(f"bag2carmen: {a.bag}: {len(b.stamps)} scans of {b.topic} -> {a.out}", file=sys.stderr)
+    return 0

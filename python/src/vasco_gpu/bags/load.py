@@ -1,0 +1,115 @@
+""":func:`load_bag`: a ROS bag into a :class:`vasco_gpu.Log`, as load_log gives one; and
+:func:`read_for_engine`, the bag's scans in the form the engine takes them (load_bag and
+bag2map).
+
+The bag is read by :func:`vasco_gpu.bags.reader.read_bag` (through ``rosbags``: ROS 1 ``.bag``,
+ROS 2 sqlite3 and MCAP, no ROS install); what comes after it (Mapper, finish, write_map,
+compare, the command line's outputs, transaction and exit statuses) is the CARMEN path's own.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Callable
+
+import numpy as np
+
+from .. import _core
+from .errors import BagError
+
+
+def reader_module():
+    try:
+        from . import reader
+    except ImportError as e:  # rosbags missing: say what to install
+        raise ImportError(f"reading ROS bags needs the 'rosbags' package (pip install rosbags): {e}") from e
+    return reader
+
+
+def read_for_engine(path, *, scan_topic=None, fixed_frame=None, base_frame=None, pose_topic=None, laser_mount=None,
+                    no_return="skip", need_poses=True, skip_unposed=False, progress=None):
+    """The bag's scans as the engine takes them: {'scans', 'stamps', 'mounts', 'unposed'}; with
+    skip_unposed the scans outside the poses' time span are left out and counted."""
+    reader = reader_module()
+    b = reader.read_bag(os.fspath(path), scan_topic=scan_topic,
+                        fixed_frame=fixed_frame if fixed_frame is not None else ("map" if pose_topic is None else None),
+                        base_frame=base_frame, pose_topic=pose_topic, laser_mount=laser_mount,
+                        pose_source="auto" if need_poses else "none", no_return=no_return, progress=progress,
+                        outside_span="skip" if skip_unposed and need_poses else "error")
+    keep = np.isfinite(b.poses).all(axis=1) if need_poses else np.ones(len(b.stamps), dtype=bool)
+    if need_poses and not keep.any():
+        raise BagError(os.fspath(path), f"none of the {len(keep)} scans of {b.topic} lies within the time "
+                                        "span of the poses", topic=b.topic)
+    counts = b.beam_counts[keep]
+    ranges = b.ranges[np.repeat(keep, b.beam_counts)]
+    scans = _core.Scans(b.poses[keep], ranges, counts.astype(np.float64), b.first_angle[keep], b.angle_step[keep])
+    scans.lines[:] = 0  # a bag has no lines: errors name the scan by its index
+    mounts = None if b.mounts is None else b.mounts[keep]
+    return {"scans": scans, "stamps": b.stamps[keep], "mounts": mounts, "unposed": int((~keep).sum()), "bag": b}
+
+
+def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame: str | None = None,
+             base_frame: str | None = None, pose_topic: str | None = None,
+             laser_mount: tuple[float, float, float] | None = None, no_return: str = "skip",
+             param_file: str | os.PathLike | None = None, robot: str = "",
+             overrides: dict[str, float | int] | None = None,
+             progress: Callable[[int, int], Any] | None = None, **pose_keywords) -> _core.Log:
+    """Reads a ROS 1 ``.bag``, a ROS 2 bag (sqlite3 or MCAP) or an ``.mcap`` into a :class:`Log`.
+
+    Scans are the ``sensor_msgs/LaserScan`` messages of ``scan_topic`` (default: the only such
+    topic), ranges mapped to CARMEN's semantics by REP 117 (see the README's table;
+    ``no_return='free'`` makes +inf clear free space). The laser pose at each scan's stamp comes
+    from ``/tf`` + ``/tf_static`` (the chain from ``fixed_frame``, default ``map``, to the scan's
+    frame, interpolated in time), or from ``pose_topic`` (Odometry, PoseStamped,
+    PoseWithCovarianceStamped) and the mount (``/tf_static`` or ``laser_mount``), or from a pose
+    file: ``poses=FILE`` and the other pose keywords of :func:`load_log`, matched by stamp.
+    ``skip_unposed=True`` without a pose file leaves out (and counts, ``Log.unposed_skipped``)
+    the scans outside the poses' time span, which are otherwise an error. ``add=[bag, (bag,
+    (x, y, theta))]`` and ``transform=`` put several sessions into one grid, as in load_log.
+    The parameters come from ``param_file`` and ``overrides`` (a bag has no PARAM lines). Errors
+    name the bag, and the topic and stamp where one is at fault (:class:`FileError`).
+    """
+    from .._errors import FileError
+
+    reader_module()
+    more = pose_keywords.pop("add", None) or []
+    transform = pose_keywords.pop("transform", None)
+    sessions = [(path, transform)] + [m if isinstance(m, tuple) else (m, None) for m in more]
+    need_poses = pose_keywords.get("poses") is None
+    options = dict(scan_topic=scan_topic, fixed_frame=fixed_frame, base_frame=base_frame, pose_topic=pose_topic,
+                   laser_mount=laser_mount, no_return=no_return, need_poses=need_poses,
+                   skip_unposed=bool(pose_keywords.pop("skip_unposed", False)) if need_poses else False,
+                   progress=progress)
+    if len(sessions) > 1 and pose_keywords.get("poses") is not None:
+        raise _core_usage_error("poses= applies to one input: write each session's poses into it first")
+    d = None
+    for p, t in sessions:
+        try:
+            one = read_for_engine(p, **options)
+        except BagError as e:
+            raise FileError(str(e), file=os.fspath(p), line=None, message=str(e)) from e
+        d = _append_session(d, one, t)
+    return _core._log_from_scans(d, os.fspath(path), param_file, robot, overrides, **pose_keywords)
+
+
+def _core_usage_error(message: str):
+    from .._errors import UsageError
+    return UsageError(message)
+
+
+def _append_session(d: dict | None, more: dict, transform) -> dict:
+    """Scans of one more session, taken into the shared frame by `transform`, after d's."""
+    if transform is not None:
+        x, y, theta = (float(v) for v in transform)
+        more["scans"].transform(x, y, theta)
+    if d is None:
+        return more
+    n0, n1 = len(d["scans"]), len(more["scans"])
+    d["scans"].extend(more["scans"])
+    d["unposed"] += more["unposed"]
+    d["stamps"] = np.concatenate([d["stamps"], more["stamps"]])
+    if d["mounts"] is not None or more["mounts"] is not None:
+        unknown = lambda n: np.full((n, 3), np.nan)
+        d["mounts"] = np.concatenate([d["mounts"] if d["mounts"] is not None else unknown(n0),
+                                      more["mounts"] if more["mounts"] is not None else unknown(n1)])
+    return d

@@ -1,0 +1,148 @@
+"""The laser pose at each scan's stamp: from tf (the chain fixed frame -> scan frame), or from a
+pose topic's base poses (PoseSeries) and the laser mount, or none (a pose file follows)."""
+
+from __future__ import annotations
+
+from array import array
+
+import numpy as np
+
+from .errors import BagError
+from .geometry import planar, planar_compose, unit_quaternion, wrap_angle, yaw
+from .header import frame_name, stamp_ns, stamp_seconds, stamp_text
+from .series import bracket, first_outside, sorted_samples
+from .tf import TfBuffer
+
+
+class PoseSeries:
+    """Base poses from a pose topic: stamps, (x, y, yaw), the frame and the base frame."""
+
+    def __init__(self, path, topic: str, msgtype: str, fixed_frame: str | None, base_frame: str | None):
+        self.path, self.topic, self.msgtype = path, topic, msgtype
+        self.fixed_frame = fixed_frame
+        self.base_frame = base_frame
+        self.ns = array("q")
+        self.values = array("d")
+
+    def add(self, msg) -> None:
+        ns = stamp_ns(msg.header.stamp)
+        frame = frame_name(msg.header.frame_id)
+        if self.fixed_frame is None:
+            self.fixed_frame = frame
+        elif frame != self.fixed_frame:
+            raise BagError(self.path, f"pose on {self.topic!r} at stamp {stamp_text(ns)} is in frame "
+                                      f"{frame!r}, not the fixed frame {self.fixed_frame!r} (pass "
+                                      f"fixed_frame={frame!r}, or None to accept the topic's frame)",
+                           topic=self.topic, stamp=stamp_seconds(ns))
+        if self.msgtype == "nav_msgs/msg/Odometry":
+            self._check_child(frame_name(msg.child_frame_id), ns)
+        pose = msg.pose if self.msgtype == "geometry_msgs/msg/PoseStamped" else msg.pose.pose
+        o = pose.orientation
+        what = f"pose on {self.topic!r} at stamp {stamp_text(ns)}"
+        q = unit_quaternion((o.x, o.y, o.z, o.w), what, self.path)
+        self.ns.append(ns)
+        self.values.extend((float(pose.position.x), float(pose.position.y), float(yaw(q))))
+
+    def _check_child(self, child: str, ns: int) -> None:
+        """Odometry's child_frame_id is the base frame; it must agree with base_frame if given."""
+        if not child:
+            return
+        if self.base_frame is None:
+            self.base_frame = child
+        elif child != self.base_frame:
+            raise BagError(self.path, f"odometry on {self.topic!r} at stamp {stamp_text(ns)} has "
+                                      f"child_frame_id {child!r}, not the base frame {self.base_frame!r}",
+                           topic=self.topic, stamp=stamp_seconds(ns))
+
+    def inside_span(self, ns: np.ndarray) -> np.ndarray:
+        """Which stamps ns lie within the topic's time span."""
+        if not self.ns:
+            return np.zeros(len(ns), dtype=bool)
+        times, _ = sorted_samples(self.ns, self.values, 3)
+        return (ns >= times[0]) & (ns <= times[-1])
+
+    def at(self, ns: np.ndarray) -> np.ndarray:
+        """(n, 3) base poses at stamps ns: samples on exact hits, else linear x, y and shortest-arc
+        yaw between the bracketing samples; a stamp outside the topic's span is a BagError."""
+        if not self.ns:
+            raise BagError(self.path, f"pose topic {self.topic!r} has no messages", topic=self.topic)
+        times, vals = sorted_samples(self.ns, self.values, 3)
+        bad = first_outside(times, ns)
+        if bad is not None:
+            raise BagError(self.path, f"scan stamp {stamp_text(bad)} is outside the time span "
+                                      f"[{stamp_text(times[0])}, {stamp_text(times[-1])}] of pose topic "
+                                      f"{self.topic!r} (skip_unposed / --skip-unposed leaves such scans out)",
+                           topic=self.topic, stamp=stamp_seconds(bad))
+        hit, i, lo, hi, f = bracket(times, ns)
+        a, b = vals[lo], vals[hi]
+        out = np.empty((len(ns), 3))
+        out[:, :2] = a[:, :2] + (b[:, :2] - a[:, :2]) * f[:, None]
+        out[:, 2] = a[:, 2] + wrap_angle(b[:, 2] - a[:, 2]) * f
+        out[hit] = vals[i[hit]]  # exact hits: the sample unchanged
+        return out
+
+
+def static_mount(path, tf: TfBuffer | None, base: str, frame: str) -> np.ndarray | None:
+    """The laser pose (x, y, yaw) in base from static tf links only; (0, 0, 0) when the frames
+    are equal; None when there is no static chain."""
+    if base == frame:
+        return np.zeros(3)
+    if tf is None or base not in tf.frames() or frame not in tf.frames():
+        return None
+    try:
+        t, q = tf.lookup(base, frame, np.zeros(1, dtype=np.int64), static_only=True)
+    except BagError:  # no chain, or a /tf link on it (TfError)
+        return None
+    return planar(path, t, q, f"the laser frame {frame!r} in {base!r}")[0]
+
+
+def _inside(ns: np.ndarray, inside: np.ndarray | None, pose_at) -> np.ndarray:
+    """pose_at(ns) where inside (all when None), NaN rows elsewhere."""
+    if inside is None:
+        return pose_at(ns)
+    poses = np.full((len(ns), 3), np.nan)
+    if inside.any():
+        poses[inside] = pose_at(ns[inside])
+    return poses
+
+
+def poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mount_arg, outside_span="error"):
+    """(poses (n, 3), mounts (n, 3) or None, pose_source label) for the scans' stamps; with
+    outside_span "skip", NaN rows for the scans outside the poses' time span."""
+    n, frame = len(ns), scans.frame_id
+    skip = outside_span == "skip"
+    if source == "tf":
+        if skip and len(tf):
+            root = fixed_frame if fixed_frame is not None else tf.root(frame)
+            inside = tf.covers(root, frame, ns)
+        else:
+            inside = None
+        poses = _inside(ns, inside, lambda t: _tf_poses(path, tf, fixed_frame, frame, t))
+        mount = mount_arg if mount_arg is not None else static_mount(path, tf, base_frame or "base_link", frame)
+        label = "tf"
+    elif source == "topic":
+        base = series.base_frame or "base_link"
+        mount = mount_arg if mount_arg is not None else static_mount(path, tf, base, frame)
+        if mount is None:
+            raise BagError(path, f"no static tf chain (/tf_static) from the base frame {base!r} to the "
+                                 f"scans' frame {frame!r}; pass laser_mount (--laser-mount x,y,yaw)",
+                           topic=series.topic)
+        poses = _inside(ns, series.inside_span(ns) if skip else None,
+                        lambda t: planar_compose(series.at(t), mount))
+        label = f"topic:{series.topic}"
+    else:
+        poses = np.full((n, 3), np.nan)
+        mount = mount_arg if mount_arg is not None else static_mount(path, tf, base_frame or "base_link", frame)
+        label = "none"
+    mounts = None if mount is None else np.tile(np.asarray(mount, dtype=np.float64), (n, 1))
+    return poses, mounts, label
+
+
+def _tf_poses(path, tf: TfBuffer, fixed_frame: str | None, frame: str, ns: np.ndarray) -> np.ndarray:
+    """(n, 3) laser poses in fixed_frame from tf (None: the root of the laser frame's tree)."""
+    if not len(tf):
+        raise BagError(path, "/tf and /tf_static hold no transforms")
+    if fixed_frame is None:
+        fixed_frame = tf.root(frame)
+    t, q = tf.lookup(fixed_frame, frame, ns)
+    return planar(path, t, q, f"the laser frame {frame!r} in {fixed_frame!r}")

@@ -1,0 +1,142 @@
+"""Opening a bag with rosbags: what the file is (sniffed from its first bytes), the path rosbags
+needs, the ROS 2 Humble definitions of types a bag does not define, why an open failed (and
+the repair tool a cut-short recording wants), and one pass over the messages of some topics.
+
+Importing this module raises ImportError when rosbags is not installed.
+"""
+
+from __future__ import annotations
+
+from contextlib import contextmanager, suppress
+from pathlib import Path
+
+from rosbags.highlevel import AnyReader  # an ImportError here: rosbags is not installed
+from rosbags.typesys import Stores, get_typestore
+
+from .errors import BagError
+from .header import stamp_text
+from .topics import short_type
+
+_MAGICS = (  # (first bytes, what it is, the suffix rosbags needs for it)
+    (b"#ROSBAG V", "a ROS 1 bag", ".bag"),
+    (b"\x89MCAP", "an MCAP file", ".mcap"),
+    (b"SQLite format 3\x00", "an SQLite3 file", ".db3"),
+)
+
+
+def _sniff(path: Path) -> tuple[str, str] | None:
+    """(what, expected suffix) from a file's first bytes, or None if it is none of the three."""
+    with suppress(OSError), path.open("rb") as f:
+        head = f.read(16)
+        for magic, what, suffix in _MAGICS:
+            if head.startswith(magic):
+                return what, suffix
+    return None
+
+
+def _storage_target(path) -> Path:
+    """The path to hand to rosbags, after the checks whose errors rosbags words poorly.
+
+    rosbags picks the format from the name: a directory is a ROS 2 bag (needs metadata.yaml),
+    ``.bag`` ROS 1, ``.mcap`` / ``.db3`` a bare ROS 2 storage file. A directory without
+    metadata.yaml but with exactly one storage file is read through that file.
+    """
+    p = Path(path)
+    if not p.exists():
+        raise BagError(path, "no such file or directory")
+    if p.is_dir():
+        if (p / "metadata.yaml").exists():
+            return p
+        inner = sorted(x for x in p.iterdir() if x.suffix in (".mcap", ".db3") and x.is_file())
+        if len(inner) == 1:
+            return inner[0]
+        if not inner:
+            raise BagError(path, "is a directory without metadata.yaml and without a .db3 or .mcap file: "
+                                 "not a ROS 2 bag")
+        names = ", ".join(x.name for x in inner)
+        raise BagError(path, f"is a directory without metadata.yaml holding several storage files ({names}); "
+                             "a split bag needs its metadata.yaml")
+    if p.stat().st_size == 0:
+        raise BagError(path, "is empty (0 bytes): not a ROS bag")
+    sniffed = _sniff(p)
+    if sniffed is None:
+        raise BagError(path, "is not a ROS bag: it starts like none of a ROS 1 bag, an MCAP file or an "
+                             "SQLite3 database")
+    what, suffix = sniffed
+    if p.suffix != suffix:
+        raise BagError(path, f"is {what} but its name does not end in {suffix}; rosbags chooses the format "
+                             f"by the name, so rename it (or link it) to end in {suffix}")
+    return p
+
+
+def _repair_hint(target: Path, err: BaseException) -> str:
+    """A hint for the usual damage: a recording cut short loses what is written at the end."""
+    text = str(err).lower()
+    if target.suffix == ".bag" and ("index" in text or "header" in text):
+        return " (a ROS 1 bag cut short loses its index; 'rosbag reindex' may restore it)"
+    if target.suffix == ".mcap" and ("end magic" in text or "footer" in text or "summary" in text):
+        return " (an MCAP file cut short has no footer; 'mcap recover' may repair it)"
+    return ""
+
+
+def reason(err: BaseException) -> str:
+    """One line saying what an exception from rosbags says."""
+    text = str(err).strip() or type(err).__name__
+    return text.splitlines()[0]
+
+
+@contextmanager
+def open_bag(path):
+    """An open rosbags AnyReader on path; any failure to open is a BagError chained to the cause."""
+    target = _storage_target(path)
+    default = get_typestore(Stores.ROS2_HUMBLE)
+    try:
+        reader = AnyReader([target], default_typestore=default)
+        reader.open()
+    except Exception as err:  # rosbags raises many kinds (ReaderError, KeyError, sqlite3, zstd, ...)
+        why = f"{reason(err)}{_repair_hint(target, err)}"
+        raise BagError(path, f"cannot be read as a ROS bag: {why}") from err
+    try:
+        _ensure_types(reader, default)
+        yield reader
+    finally:
+        with suppress(Exception):
+            reader.close()
+
+
+def _ensure_types(reader, default) -> None:
+    """Registers the default (ROS 2 Humble) definitions of types the bag uses but does not define.
+
+    AnyReader falls back to the default store only when no connection has a definition; a bag
+    that defines some types and not others would otherwise fail on the undefined ones.
+    """
+    missing = {c.msgtype for c in reader.connections} - set(reader.typestore.fielddefs)
+    if missing and reader.is2:
+        extra = {k: v for k, v in default.fielddefs.items() if k not in reader.typestore.fielddefs}
+        with suppress(Exception):
+            reader.typestore.register(extra)
+
+
+def read_messages(reader, path, handlers: dict, progress) -> None:
+    """One pass over the connections of the topics in handlers, in bag order, each message
+    deserialized with the bag's definitions and passed to its topic's handler; progress (a
+    reader.Progress) ticks once a message."""
+    topics = reader.topics
+    connections = [c for name in handlers for c in topics[name].connections]
+    stream = reader.messages(connections=connections)
+    while True:
+        try:
+            item = next(stream, None)
+        except Exception as err:
+            raise BagError(path, f"reading failed after {progress.done} messages: {reason(err)}") from err
+        if item is None:
+            break
+        connection, t_ns, raw = item
+        try:
+            msg = reader.deserialize(raw, connection.msgtype)
+        except Exception as err:
+            raise BagError(path, f"cannot deserialize a {short_type(connection.msgtype)} message on "
+                                 f"{connection.topic!r} received at {stamp_text(t_ns)}: {reason(err)}",
+                           topic=connection.topic) from err
+        handlers[connection.topic](msg)
+        progress.tick()

@@ -1,0 +1,214 @@
+"""tf's frame tree: TfBuffer takes TFMessages (from a bag's /tf and /tf_static, or live from a
+ROS 2 node's subscriptions) and looks up the transform between two frames at given stamps."""
+
+from __future__ import annotations
+
+from array import array
+
+import numpy as np
+
+from .errors import TfError
+from .geometry import compose, inverse, is_identity, slerp, unit_quaternion
+from .header import frame_name, stamp_ns, stamp_seconds, stamp_text
+from .series import bracket, first_outside, sorted_samples
+
+__all__ = ["TfBuffer"]
+
+
+class _Edge:
+    """One parent -> child link of tf: a static transform, or a time series of samples."""
+
+    def __init__(self, parent: str, child: str, static: bool):
+        self.parent, self.child, self.static = parent, child, static
+        self.ns = array("q")
+        self.values = array("d")  # tx ty tz qx qy qz qw per sample
+        self._arrays = None
+
+    def add(self, ns: int, t, q) -> None:
+        if self.static:  # the latest static transform wins, as in tf2
+            del self.ns[:], self.values[:]
+        self.ns.append(ns)
+        self.values.extend((*t, *q))
+        self._arrays = None
+
+    def arrays(self):
+        """(stamps (k,), translations (k, 3), quaternions (k, 4)) sorted by stamp."""
+        if self._arrays is None:
+            times, vals = sorted_samples(self.ns, self.values, 7)
+            self._arrays = (times, vals[:, :3].copy(), vals[:, 3:].copy())
+        return self._arrays
+
+    def span_text(self) -> str:
+        ns = self.arrays()[0]
+        return f"[{stamp_text(ns[0])}, {stamp_text(ns[-1])}]"
+
+
+class TfBuffer:
+    """tf's frame tree from TFMessages, with lookups at stamps in whole nanoseconds.
+
+    Feed it with :meth:`add_message` (a ``tf2_msgs/TFMessage`` or anything shaped like one:
+    ``.transforms``, each with ``.header.frame_id``, ``.header.stamp.sec`` / ``.nanosec``,
+    ``.child_frame_id``, ``.transform.translation`` and ``.transform.rotation``), in any order
+    and at any time; then :meth:`lookup` gives ``T_target_source`` at stamps. As in tf2, each
+    frame has one parent; a static link (``/tf_static``) holds its latest transform at every
+    stamp, a dynamic one (``/tf``) is interpolated between its samples (linear translation,
+    slerp) and never extrapolated. Every sample is kept (a bag's whole history).
+
+    ``file``, ``stamp_name`` and ``outside_hint`` shape the error messages only: the bag the
+    transforms come from (None when fed live), what the looked-up stamps are, and a hint added
+    to the error for a stamp outside a link's samples. Errors are :class:`TfError`.
+    """
+
+    def __init__(self, file=None, *, stamp_name: str = "stamp", outside_hint: str = ""):
+        self.file = file
+        self.stamp_name = stamp_name
+        self.outside_hint = outside_hint
+        self._edges: dict[str, _Edge] = {}  # by child: each child has one parent
+
+    def __len__(self) -> int:
+        """The number of parent -> child links."""
+        return len(self._edges)
+
+    def add_message(self, msg, static: bool = False, topic: str | None = None) -> None:
+        """Adds the transforms of one TFMessage; static: it came on /tf_static. topic (default
+        /tf or /tf_static) is named by the errors."""
+        for ts in msg.transforms:
+            self.add_transform(ts, static, topic)
+
+    def add_transform(self, ts, static: bool = False, topic: str | None = None) -> None:
+        """Adds one TransformStamped (or anything shaped like one)."""
+        if topic is None:
+            topic = "/tf_static" if static else "/tf"
+        parent, child = frame_name(ts.header.frame_id), frame_name(ts.child_frame_id)
+        ns = stamp_ns(ts.header.stamp)
+        edge = self._edges.get(child)
+        if edge is None:
+            edge = self._edges[child] = _Edge(parent, child, static)
+        elif edge.parent != parent:
+            was = f"{edge.parent!r} on {'/tf_static' if edge.static else '/tf'}"
+            raise TfError(self.file, f"frame {child!r} has two parents in tf: {was} and {parent!r} on "
+                                     f"{topic} (stamp {stamp_text(ns)}); tf must be a tree",
+                          topic=topic, stamp=stamp_seconds(ns))
+        elif edge.static != static:
+            raise TfError(self.file, f"tf {parent} -> {child} is on both /tf and /tf_static (stamp "
+                                     f"{stamp_text(ns)} on {topic}); a link is either static or not",
+                          topic=topic, stamp=stamp_seconds(ns))
+        tr, rot = ts.transform.translation, ts.transform.rotation
+        what = f"tf {parent} -> {child} at stamp {stamp_text(ns)}"
+        q = unit_quaternion((rot.x, rot.y, rot.z, rot.w), what, self.file, TfError)
+        edge.add(ns, (float(tr.x), float(tr.y), float(tr.z)), q)
+
+    def frames(self) -> list[str]:
+        """Every frame named by a link, sorted."""
+        return sorted({e.child for e in self._edges.values()} | {e.parent for e in self._edges.values()})
+
+    def up(self, frame: str) -> list[str]:
+        """frame, its parent, grandparent, ... up to its root."""
+        chain = [frame]
+        while chain[-1] in self._edges:
+            chain.append(self._edges[chain[-1]].parent)
+            if len(chain) > len(self._edges) + 1:
+                raise TfError(self.file, f"tf has a cycle through {frame!r}")
+        return chain
+
+    def root(self, frame: str) -> str:
+        """The root of frame's tree (frame itself when it has no parent)."""
+        return self.up(frame)[-1]
+
+    def _reach_text(self, frame: str) -> str:
+        """'laser' reaches 'odom' via base_link / 'map' is the root of its tree."""
+        chain = self.up(frame)
+        if len(chain) == 1:
+            return f"{frame!r} is the root of another tree"
+        via = f" via {', '.join(chain[1:-1])}" if len(chain) > 2 else ""
+        return f"{frame!r} reaches {chain[-1]!r}{via}"
+
+    def _no_chain_text(self, target: str, source: str) -> str:
+        """Why target and source are not connected, naming the missing link."""
+        known = set(self.frames())
+        if source not in known and target not in known:
+            why = f"neither {source!r} nor {target!r} is in tf"
+        elif source not in known:
+            why = f"{source!r} is not in tf"
+        elif target not in known:
+            why = f"{self._reach_text(source)}, {target!r} has no connection to it"
+        else:
+            why = f"{self._reach_text(source)}, {self._reach_text(target)}"
+        frames = ", ".join(sorted(known))
+        return f"no transform chain from {target!r} to {source!r}: {why} (frames in /tf: {frames})"
+
+    def _path_between(self, target: str, source: str) -> tuple[list[str], list[str]]:
+        """(frames from source up to the common ancestor, frames from target up to it); a
+        TfError naming the missing link when the two are not in one tree."""
+        up_s, up_t = self.up(source), self.up(target)
+        common = next((f for f in up_s if f in set(up_t)), None)
+        if common is None:
+            raise TfError(self.file, self._no_chain_text(target, source))
+        return up_s[: up_s.index(common) + 1], up_t[: up_t.index(common) + 1]
+
+    def _edge_at(self, edge: _Edge, ns: np.ndarray):
+        """The edge's transform at stamps ns: None for an identity static link (to be skipped),
+        the sample itself on an exact stamp hit, interpolated between the bracketing samples."""
+        times, tr, qs = edge.arrays()
+        if edge.static:
+            if is_identity(tr[0], qs[0]):
+                return None
+            n = len(ns)
+            return np.broadcast_to(tr[0], (n, 3)), np.broadcast_to(qs[0], (n, 4))
+        bad = first_outside(times, ns)
+        if bad is not None:
+            hint = f" ({self.outside_hint})" if self.outside_hint else ""
+            raise TfError(self.file, f"{self.stamp_name} {stamp_text(bad)} is outside the time span "
+                                     f"{edge.span_text()} of tf {edge.parent} -> {edge.child} "
+                                     f"({len(times)} samples); tf is not extrapolated{hint}",
+                          topic="/tf", stamp=stamp_seconds(bad))
+        hit, i, lo, hi, f = bracket(times, ns)
+        t = tr[lo] + (tr[hi] - tr[lo]) * f[:, None]
+        q = slerp(qs[lo], qs[hi], f)
+        t[hit], q[hit] = tr[i[hit]], qs[i[hit]]  # exact hits: the sample unchanged
+        return t, q
+
+    def _down(self, chain: list[str], ns: np.ndarray, static_only: bool):
+        """T_ancestor_frame for chain = [frame, ..., ancestor], composed from the ancestor down;
+        None when every link is an identity static transform. Identity static links are skipped,
+        not multiplied, so an identity mount leaves the pose's bits unchanged. With static_only,
+        a dynamic link is a TfError."""
+        total = None
+        for child in reversed(chain[:-1]):
+            edge = self._edges[child]
+            if static_only and not edge.static:
+                raise TfError(self.file, f"tf {edge.parent} -> {edge.child} is on /tf: not a static chain")
+            link = self._edge_at(edge, ns)
+            if link is not None:
+                total = link if total is None else compose(total, link)
+        return total
+
+    def covers(self, target: str, source: str, stamps) -> np.ndarray:
+        """Which stamps lie within the time span of every /tf link between the two frames
+        (static links have none): the stamps lookup can answer without extrapolating."""
+        ns = np.atleast_1d(np.asarray(stamps, dtype=np.int64))
+        up_s, up_t = self._path_between(target, source)
+        inside = np.ones(len(ns), dtype=bool)
+        for chain in (up_s, up_t):
+            for child in chain[:-1]:
+                edge = self._edges[child]
+                if not edge.static:
+                    times = edge.arrays()[0]
+                    inside &= (ns >= times[0]) & (ns <= times[-1])
+        return inside
+
+    def lookup(self, target: str, source: str, stamps, static_only: bool = False):
+        """T_target_source at stamps (whole nanoseconds, a number or an array of n): translations
+        (n, 3) and quaternions (n, 4, x y z w), float64; a point p in source is t + q p q* in
+        target. Computed as inv(T_common_target) * T_common_source through the two frames'
+        common ancestor. static_only: a chain with a /tf link is a TfError."""
+        ns = np.atleast_1d(np.asarray(stamps, dtype=np.int64))
+        up_s, up_t = self._path_between(target, source)
+        a = self._down(up_s, ns, static_only)
+        b = self._down(up_t, ns, static_only)
+        if a is None:
+            n = len(ns)
+            a = (np.zeros((n, 3)), np.tile([0.0, 0.0, 0.0, 1.0], (n, 1)))
+        if b is None:
+            return np.array(a[0], dtype=np.float64), np.array(a[1], dtype=np.float64)
+        return compose(inverse(b), a)

@@ -1,0 +1,141 @@
+"""Tests of vasco_gpu.bags.TfBuffer, tf's frame tree fed message by message as a ROS node would
+(no bag, no rosbags): a static link below a dynamic one, lookups at a sample's stamp and
+between two, in both directions, and the errors for what tf cannot answer. The expected
+transforms are worked out by hand in the comments.
+
+The subpackage is loaded by file path, without vasco_gpu's compiled extension.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import sys
+from pathlib import Path
+from types import SimpleNamespace as NS
+
+import numpy as np
+import pytest
+
+BAGS = Path(__file__).resolve().parent.parent / "src" / "vasco_gpu" / "bags"
+
+
+def _load_package(name: str, directory: Path):
+    spec = importlib.util.spec_from_file_location(name, directory / "__init__.py",
+                                                  submodule_search_locations=[str(directory)])
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+bags = _load_package("vasco_gpu_bags_tf_under_test", BAGS)
+
+SEC0 = 1_700_000_000  # the stamps: SEC0 + 1 s, + 2 s, + 3 s
+R = math.sqrt(0.5)  # sin 45 deg = cos 45 deg
+YAW_90 = (0.0, 0.0, R, R)  # (x, y, z, w) of a turn by 90 deg about z
+IDENTITY = (0.0, 0.0, 0.0, 1.0)
+
+
+def ns(seconds_after: float) -> int:
+    return (SEC0 + int(seconds_after)) * 1_000_000_000
+
+
+def tf_message(*links):
+    """A TFMessage-like message of (parent, child, whole seconds after SEC0, (x, y, z), (qx, qy, qz, qw))."""
+    return NS(transforms=[
+        NS(header=NS(frame_id=parent, stamp=NS(sec=SEC0 + after, nanosec=0)), child_frame_id=child,
+           transform=NS(translation=NS(x=t[0], y=t[1], z=t[2]), rotation=NS(x=q[0], y=q[1], z=q[2], w=q[3])))
+        for parent, child, after, t, q in links])
+
+
+def make_buffer():
+    """map -> base_link on /tf: at 1 s (1, 2, 0) heading 0, at 3 s (3, 2, 0) heading 90 deg (the
+    later sample given first); base_link -> laser on /tf_static: (0.5, 0, 0.2) turned by 90 deg,
+    given with a leading '/' as ROS 1 writes frames."""
+    tf = bags.TfBuffer()
+    tf.add_message(tf_message(("map", "base_link", 3, (3.0, 2.0, 0.0), YAW_90)))
+    tf.add_message(tf_message(("/base_link", "/laser", 0, (0.5, 0.0, 0.2), YAW_90)), static=True)
+    tf.add_message(tf_message(("map", "base_link", 1, (1.0, 2.0, 0.0), IDENTITY)))
+    return tf
+
+
+def assert_transform(got, want_t, want_q):
+    t, q = got
+    assert t.shape == (1, 3) and q.shape == (1, 4)
+    np.testing.assert_allclose(t[0], want_t, rtol=0, atol=1e-12)
+    sign = 1.0 if np.dot(q[0], want_q) >= 0 else -1.0  # q and -q are one rotation
+    np.testing.assert_allclose(sign * q[0], want_q, rtol=0, atol=1e-12)
+
+
+def test_the_tree():
+    tf = make_buffer()
+    assert len(tf) == 2
+    assert tf.frames() == ["base_link", "laser", "map"]
+    assert tf.up("laser") == ["laser", "base_link", "map"] and tf.root("laser") == "map"
+
+
+def test_lookup_at_a_sample():
+    # At 1 s the base is at (1, 2, 0) heading 0: the laser at (1, 2, 0) + (0.5, 0, 0.2), heading 90 deg.
+    assert_transform(make_buffer().lookup("map", "laser", ns(1)), (1.5, 2.0, 0.2), YAW_90)
+    # At 3 s the base is at (3, 2, 0) heading 90 deg: (0.5, 0, 0.2) turned by 90 deg is (0, 0.5, 0.2);
+    # the laser heads 180 deg: (0, 0, sin 90 deg, cos 90 deg).
+    assert_transform(make_buffer().lookup("map", "laser", ns(3)), (3.0, 2.5, 0.2), (0.0, 0.0, 1.0, 0.0))
+
+
+def test_lookup_between_two_samples():
+    # At 2 s, half way: the base at (2, 2, 0) heading 45 deg (slerp half way between 0 and 90 deg);
+    # (0.5, 0, 0.2) turned by 45 deg is (0.5 cos 45, 0.5 sin 45, 0.2); the laser heads 135 deg.
+    half = 0.5 * R
+    want_q = (0.0, 0.0, math.sin(math.radians(67.5)), math.cos(math.radians(67.5)))
+    assert_transform(make_buffer().lookup("map", "laser", ns(2)), (2.0 + half, 2.0 + half, 0.2), want_q)
+    # Several stamps at once, in any order.
+    t, q = make_buffer().lookup("map", "laser", np.array([ns(3), ns(2), ns(1)]))
+    np.testing.assert_allclose(t, [(3.0, 2.5, 0.2), (2.0 + half, 2.0 + half, 0.2), (1.5, 2.0, 0.2)], atol=1e-12)
+
+
+def test_lookup_the_other_way():
+    # map in the laser frame at 1 s: the inverse of (1.5, 2, 0.2) heading 90 deg. Turning
+    # (1.5, 2, 0.2) back by 90 deg gives (2, -1.5, 0.2); negated: (-2, 1.5, -0.2), heading -90 deg.
+    assert_transform(make_buffer().lookup("laser", "map", ns(1)), (-2.0, 1.5, -0.2), (0.0, 0.0, -R, R))
+
+
+def test_static_chain():
+    tf = make_buffer()
+    # A static link holds at every stamp, also with static_only.
+    assert_transform(tf.lookup("base_link", "laser", 0, static_only=True), (0.5, 0.0, 0.2), YAW_90)
+    with pytest.raises(bags.TfError, match="map -> base_link is on /tf"):
+        tf.lookup("map", "laser", ns(1), static_only=True)
+
+
+def test_incremental_samples_extend_the_span():
+    tf = make_buffer()
+    with pytest.raises(bags.TfError, match="outside the time span"):
+        tf.lookup("map", "laser", ns(4))
+    assert tf.covers("map", "laser", [ns(1), ns(4)]).tolist() == [True, False]
+    # At 5 s the base is at (5, 2, 0) heading 90 deg: at 4 s, half way from 3 s, (4, 2, 0) heading 90 deg.
+    tf.add_message(tf_message(("map", "base_link", 5, (5.0, 2.0, 0.0), YAW_90)))
+    assert_transform(tf.lookup("map", "laser", ns(4)), (4.0, 2.5, 0.2), (0.0, 0.0, 1.0, 0.0))
+
+
+def test_missing_chain():
+    tf = make_buffer()
+    with pytest.raises(bags.TfError) as e:
+        tf.lookup("map", "camera", ns(1))
+    assert str(e.value) == ("no transform chain from 'map' to 'camera': 'camera' is not in tf "
+                            "(frames in /tf: base_link, laser, map)")
+    assert isinstance(e.value, bags.BagError) and e.value.file is None
+    tf.add_message(tf_message(("odom", "wheel", 1, (0.0, 0.0, 0.0), IDENTITY)))
+    with pytest.raises(bags.TfError, match="'wheel' reaches 'odom', 'laser' reaches 'map' via base_link"):
+        tf.lookup("laser", "wheel", ns(1))
+
+
+def test_refused_transforms():
+    tf = make_buffer()
+    with pytest.raises(bags.TfError, match="frame 'laser' has two parents in tf: 'base_link' on /tf_static and "
+                                           "'odom' on /tf_static"):
+        tf.add_message(tf_message(("odom", "laser", 1, (0.0, 0.0, 0.0), IDENTITY)), static=True)
+    with pytest.raises(bags.TfError, match="is on both /tf and /tf_static"):
+        tf.add_message(tf_message(("map", "base_link", 2, (0.0, 0.0, 0.0), IDENTITY)), static=True)
+    with pytest.raises(bags.TfError, match="invalid rotation quaternion"):
+        tf.add_message(tf_message(("map", "base_link", 2, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0))))
