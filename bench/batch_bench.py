@@ -4,7 +4,7 @@ process per log, on this host, for every backend that runs here, in one run;
 then one-log runs of each bundled log with --backend auto against
 cpu_threads and cuda (auto should never be more than 10 % slower than the
 faster of the two); last, the constants of auto's cost model
-(vasco_gpu/tools/backend_choice.cc) as measured on this host.
+(vasco_gpu/app/backend_choice.cc) as measured on this host.
 
     python3 bench/batch_bench.py [--bin build/bin] [--copies 200] [--per-process 20]
 
@@ -177,7 +177,7 @@ def main() -> int:
         for devices, rate in scaling:
             print(f"{devices:22} {devices.count(',') + 1:8d} {rate:8.1f} {rate / scaling[0][1]:12.2f}x")
     print()
-    print("auto's cost model measured here (compare vasco_gpu/tools/backend_choice.cc):")
+    print("auto's cost model measured here (compare vasco_gpu/app/backend_choice.cc):")
     for line in model:
         print("  " + line)
     return 0

@@ -24,7 +24,7 @@
 #include <thread>
 #include <vector>
 
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/internal/parallel.h"
 #if defined(VASCO_HAVE_CUDA)

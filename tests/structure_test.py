@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The tree's structure, checked: (1) no include runs upward — each source may include
 headers of its own layer or a lower one (carmen_compat < the engine, kernels included <
-pipeline < tools < Python bindings); (2) no Python file of the package lists backend names
+pipeline < the command line library < the tools' mains and the Python bindings); (2) no Python file of the package lists backend names
 or map formats (they come from the C++ registries through _core); (3) no file of the Python
 package is over 600 lines. Prints each violation with its file and line; exits 1 if any."""
 import pathlib
@@ -14,9 +14,10 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 LAYERS = [
     ("carmen_compat/", 0, "carmen_compat"),
     ("vasco_gpu/pipeline/", 2, "pipeline"),
-    ("vasco_gpu/tools/", 3, "tools"),
+    ("vasco_gpu/app/", 3, "command line library"),
+    ("vasco_gpu/tools/", 4, "tools"),
     ("vasco_gpu/", 1, "engine"),
-    ("python/src/", 4, "Python bindings"),
+    ("python/src/", 5, "Python bindings"),
 ]
 # How an include names a header of a layer (the include roots of each).
 INCLUDE_ROOTS = [

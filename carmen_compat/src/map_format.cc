@@ -138,6 +138,13 @@ const MapFormatEntry *find_map_format_by_name(const std::string &name) {
   return nullptr;
 }
 
+std::string known_map_extensions(MapFormatKind kind) {
+  std::string s;
+  for (const MapFormatEntry &f : map_formats())
+    if (f.kind == kind) s += (s.empty() ? "" : ", ") + std::string(f.extension);
+  return s;
+}
+
 std::string known_map_extensions() {
   std::string s;
   for (const MapFormatEntry &f : map_formats()) s += (s.empty() ? "" : ", ") + std::string(f.extension);

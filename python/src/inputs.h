@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 
 namespace vasco_py {
 

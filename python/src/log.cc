@@ -15,7 +15,7 @@
 #include "bindings.h"
 #include "inputs.h"
 #include "param_keys.h"
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 
 namespace vasco_py {
 

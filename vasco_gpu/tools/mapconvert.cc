@@ -7,6 +7,7 @@
 //
 // Exit status: 0 ok, 1 a file could not be read or written (the message
 // names it), 2 usage error.
+#include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include <exception>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "carmen_compat/error.h"
@@ -158,27 +160,6 @@ struct Args {
   std::vector<std::string> files;
 };
 
-// "--name VALUE" or "--name=VALUE" at args[*i]: *value (moving *i past
-// it) and true, or false when args[*i] is not this option. Sets *missing when the
-// value is not there.
-bool option_value(const std::vector<std::string> &args, size_t *i, const std::string &name, std::string *value,
-                  bool *missing) {
-  const std::string &s = args[*i];
-  if (s == name) {
-    if (*i + 1 >= args.size()) {
-      *missing = true;
-      return true;
-    }
-    *value = args[++*i];
-    return true;
-  }
-  if (s.rfind(name + "=", 0) == 0) {
-    *value = s.substr(name.size() + 1);
-    return true;
-  }
-  return false;
-}
-
 // A threshold: one finite number, the whole text.
 bool parse_threshold(const std::string &text, double *out) {
   char *end = nullptr;
@@ -189,48 +170,43 @@ bool parse_threshold(const std::string &text, double *out) {
   return true;
 }
 
-// Parses argv into *a; returns 0, or usage_error's code.
-int parse_args(const std::vector<std::string> &args, Args *a) {
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string &s = args[i];
-    std::string value;
-    bool missing = false;
-    if (s == "--help" || s == "-h") {
-      a->help = true;
-      return 0;
-    } else if (s == "--version") {
-      a->version = true;
-      return 0;
-    } else if (s == "-q" || s == "--quiet") {
-      a->quiet = true;
-    } else if (s == "--info") {
-      a->info = true;
-    } else if (option_value(args, &i, "--mode", &value, &missing)) {
-      if (missing) return usage_error("--mode needs a value");
-      if (!carmen::parse_pgm_mode(value, &a->map_server.mode)) {
-        return usage_error("unknown --mode '" + value + "' (trinary, scale or raw)");
-      }
-      a->mode_given = true;
-    } else if (option_value(args, &i, "--free-thresh", &value, &missing) ||
-               option_value(args, &i, "--occupied-thresh", &value, &missing)) {
-      const bool is_free = s.rfind("--free-thresh", 0) == 0;
-      const char *name = is_free ? "--free-thresh" : "--occupied-thresh";
-      if (missing) return usage_error(std::string(name) + " needs a value");
-      if (!parse_threshold(value, is_free ? &a->map_server.free_thresh : &a->map_server.occupied_thresh))
-        return usage_error(std::string(name) + " '" + value + "': expected a number from 0 to 1");
-      a->thresholds_given = true;
-    } else if (s == "--negate") {
-      a->map_server.negate = true;
-      a->thresholds_given = true;
-    } else if (s == "--") {
-      a->files.insert(a->files.end(), args.begin() + static_cast<long>(i) + 1, args.end());
-      break;
-    } else if (s.size() > 1 && s[0] == '-') {  // "-" alone is standard input or output
-      return usage_error("unknown option '" + s + "'");
-    } else {
-      a->files.push_back(s);
-    }
+// Parses argv into *a with CLI11 (the tools' one way to read a command line);
+// returns 0, or usage_error's code. The options' values are checked here, in
+// mapconvert's words; --help prints kUsage.
+int parse_args(int argc, char **argv, Args *a) {
+  CLI::App app{"mapconvert", "mapconvert"};
+  app.set_help_flag();  // kUsage is the help
+  app.allow_extras(false);
+  std::string mode, free_thresh, occupied_thresh;
+  app.add_flag("--help,-h", a->help);
+  app.add_flag("--version", a->version);
+  app.add_flag("--quiet,-q", a->quiet);
+  app.add_flag("--info", a->info);
+  app.add_flag("--negate", a->map_server.negate);
+  app.add_option("--mode", mode);
+  app.add_option("--free-thresh", free_thresh);
+  app.add_option("--occupied-thresh", occupied_thresh);
+  app.add_option("files", a->files);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError &e) {
+    return usage_error(e.what());
   }
+  if (a->help || a->version) return 0;
+  if (app.count("--mode")) {
+    if (!carmen::parse_pgm_mode(mode, &a->map_server.mode))
+      return usage_error("unknown --mode '" + mode + "' (trinary, scale or raw)");
+    a->mode_given = true;
+  }
+  for (const auto &[name, text, value] : {std::make_tuple("--free-thresh", &free_thresh, &a->map_server.free_thresh),
+                                          std::make_tuple("--occupied-thresh", &occupied_thresh,
+                                                          &a->map_server.occupied_thresh)}) {
+    if (!app.count(name)) continue;
+    if (!parse_threshold(*text, value))
+      return usage_error(std::string(name) + " '" + *text + "': expected a number from 0 to 1");
+    a->thresholds_given = true;
+  }
+  a->thresholds_given = a->thresholds_given || a->map_server.negate;
   return 0;
 }
 
@@ -331,7 +307,7 @@ void convert_grid(const std::string &in, const std::string &out, const carmen::M
 
 int main(int argc, char **argv) {
   Args a;
-  if (const int rc = parse_args(std::vector<std::string>(argv + 1, argv + argc), &a)) return rc;
+  if (const int rc = parse_args(argc, argv, &a)) return rc;
   if (a.help) {
     std::fputs(kUsage, stdout);
     return 0;

@@ -79,6 +79,8 @@ struct MapFormatEntry {
 const std::vector<MapFormatEntry> &map_formats();
 // ".map, .map.gz, .pgm, .png+yaml, .yaml, .png": for messages.
 std::string known_map_extensions();
+// Those of one kind: ".pgm, .png+yaml, .yaml" for MapServer.
+std::string known_map_extensions(MapFormatKind kind);
 // The extensions without their dot ("map", "map.gz", ...): the format names a
 // batch's --formats and Python's map_logs take (a batch writes STEM.NAME).
 std::vector<std::string> map_format_names();

@@ -64,7 +64,7 @@ def _mount_of(text: str | None):
 
 
 # log2map's own options that its command line hands to bag2map's reader too, with the bag
-# options (vasco_gpu/tools/log2map_steps.cc): (flag, read_for_engine's keyword, its value from
+# options (vasco_gpu/app/log2map_steps.cc): (flag, read_for_engine's keyword, its value from
 # the option's text). --laser-mount's text is one log2map has already checked as X,Y,THETA.
 HANDED_ON = (
     ("poses", "need_poses", lambda text: False),  # a pose file gives the poses: the bag need not
@@ -80,16 +80,17 @@ def _tool_reader(path: str, values: dict, progress) -> dict:
     return read_for_engine(path, progress=progress, **keywords)
 
 
-BAG2MAP_SUMMARY = (
-    "bag2map: builds a CARMEN evidence-grid map (vasco/egrid.c) from a ROS bag's laser scans.\n"
-    "Inputs: ROS 1 .bag, ROS 2 bag directories (sqlite3, MCAP) and .mcap files. Outputs by extension:\n"
-    ".map, .map.gz (CARMEN), .pgm (+ .yaml, ROS map_server), .png. Every other option is log2map's.")
+def _bag2map_summary() -> str:
+    extensions = ", ".join(f["extension"] for f in _core.map_formats())  # the engine's format table
+    return ("bag2map: builds a CARMEN evidence-grid map (vasco/egrid.c) from a ROS bag's laser scans.\n"
+            "Inputs: ROS 1 .bag, ROS 2 bag directories (sqlite3, MCAP) and .mcap files. Outputs by extension:\n"
+            f"{extensions}. Every other option is log2map's.")
 
 
 def bag2map_main(argv: list[str] | None = None) -> int:
     """The console script bag2map: log2map's command line with ROS bags as inputs."""
     args = list(sys.argv[1:] if argv is None else argv)
-    return _core._run_tool(["bag2map", *args], "bag2map", BAG2MAP_SUMMARY, "BAG",
+    return _core._run_tool(["bag2map", *args], "bag2map", _bag2map_summary(), "BAG",
                            "ROS 1 .bag, ROS 2 bag directory (sqlite3 or MCAP) or .mcap file",
                            [(o.flag, o.help, o.metavar) for o in BAG_OPTIONS], _tool_reader)
 

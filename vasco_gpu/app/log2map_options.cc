@@ -40,7 +40,7 @@ bool parse_double(const std::string &text, double *out) {
 void add_input_options(CLI::App &app, const ToolSpec &spec, Options &opt) {
   app.add_option(spec.input_name, opt.log, spec.input_help + "; - for standard input")->required();
   app.add_option("OUT", opt.outputs,
-                 "output files: .map, .map.gz, .pgm, .png+yaml, .yaml, .png; - for a CARMEN map on standard output "
+                 "output files: " + carmen::known_map_extensions() + "; - for a CARMEN map on standard output "
                  "(with --out-dir: "
                  "further " + spec.input_name + "s)");
   app.add_option("--param-file", opt.param_file, "carmen.ini with vasco_* keys (default: vasco's defaults)");
@@ -100,7 +100,8 @@ struct MapServerText {
 void add_map_server_options(CLI::App &app, Options &opt, MapServerText &raw) {
   carmen::MapServerOptions &o = opt.map_server;
   app.add_option("--mode", raw.mode,
-                 "grey levels of .pgm, .png+yaml and .yaml outputs: trinary (default), scale (unknown transparent "
+                 "grey levels of " + carmen::known_map_extensions(carmen::MapFormatKind::MapServer) +
+                     " outputs: trinary (default), scale (unknown transparent "
                  "in a PNG; a PGM cannot say unknown in scale mode) or raw")
       ->check(CLI::IsMember({"trinary", "scale", "raw"}));
   // 0.196 is what ROS 1's map_saver writes; nav2's map_saver writes 0.25.
@@ -134,9 +135,7 @@ void finish_map_server_options(const CLI::App &app, const MapServerText &raw, Op
     pair = pair || (f != nullptr && f->kind == carmen::MapFormatKind::MapServer);
   }
   if (pair) return;
-  std::string pairs;  // ".pgm, .png+yaml or .yaml"
-  for (const carmen::MapFormatEntry &e : carmen::map_formats())
-    if (e.kind == carmen::MapFormatKind::MapServer) pairs += (pairs.empty() ? "" : ", ") + std::string(e.extension);
+  std::string pairs = carmen::known_map_extensions(carmen::MapFormatKind::MapServer);  // ".pgm, .png+yaml or .yaml"
   const size_t last = pairs.rfind(", ");
   if (last != std::string::npos) pairs.replace(last, 2, " or ");
   const std::string w = "--mode, --free-thresh, --occupied-thresh and --negate do nothing without a " + pairs + " output";

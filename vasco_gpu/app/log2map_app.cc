@@ -34,7 +34,7 @@
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/internal/egrid_math.h"
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 #include "vasco_gpu/map_output.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/params.h"
@@ -289,7 +289,7 @@ ToolSpec log2map_spec() {
   spec.name = "log2map";
   spec.summary =
       "log2map: builds a CARMEN evidence-grid map (vasco/egrid.c) from a laser log.\n"
-      "Outputs by extension: .map, .map.gz (CARMEN), .pgm (+ .yaml, ROS map_server), .png.";
+      "Outputs by extension: " + carmen::known_map_extensions() + ".";
   spec.input_name = "LOG";
   spec.input_help = "CARMEN log (.log, .clf, or gzipped .gz)";
   return spec;

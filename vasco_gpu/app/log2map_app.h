@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 
 namespace log2map {
 

@@ -1,4 +1,4 @@
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 
 #include <cmath>
 #include <limits>

@@ -17,7 +17,7 @@
 #include "log2map_options.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 #include "vasco_gpu/mapper.hpp"
 
 namespace log2map {

@@ -6,8 +6,8 @@
 // the log's own PARAM lines > vasco's defaults. vasco_first_scan and
 // vasco_num_scans follow it too: every laser message is read first and the
 // run is selected once the log's PARAM lines are known.
-#ifndef VASCO_GPU_LOG_INPUT_H
-#define VASCO_GPU_LOG_INPUT_H
+#ifndef VASCO_GPU_PIPELINE_LOG_INPUT_H
+#define VASCO_GPU_PIPELINE_LOG_INPUT_H
 
 #include <cstdint>
 #include <functional>
@@ -114,4 +114,4 @@ StampedScans read_stamped_scans(const std::string &path, const LogInputOptions &
 
 }  // namespace vasco
 
-#endif  // VASCO_GPU_LOG_INPUT_H
+#endif  // VASCO_GPU_PIPELINE_LOG_INPUT_H

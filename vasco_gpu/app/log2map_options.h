@@ -10,7 +10,7 @@
 
 #include "carmen_compat/image_io.h"
 #include "log2map_app.h"
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 #include "vasco_gpu/pose_file.h"
 
 namespace log2map {
