@@ -25,7 +25,7 @@
 #include "vasco_gpu/backend.h"
 #include "carmen_compat/map_compare.h"
 #include "vasco_gpu/grid.h"
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 #include "carmen_compat/map_digest.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/renderer.h"

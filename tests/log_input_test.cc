@@ -1,7 +1,7 @@
 // log_input: parameters from the command line, the ini and the log's own
 // PARAM lines, with one precedence for every key (command line > ini > log >
 // defaults), the scans they select, and errors that name the log.
-#include "vasco_gpu/internal/log_input.h"
+#include "vasco_gpu/pipeline/log_input.h"
 
 #include <gtest/gtest.h>
 
