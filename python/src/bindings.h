@@ -15,6 +15,7 @@ namespace nb = nanobind;
 void bind_errors(nb::module_ &m);   // C++ error codes -> vasco_gpu._errors classes
 void bind_module(nb::module_ &m);   // version, backends, _cuda_available
 void bind_registries(nb::module_ &m);  // backend_registry, map_formats, output rules
+void bind_output_file(nb::module_ &m);  // _OutputFile (atomic_file.h)
 void bind_params(nb::module_ &m);   // Params
 void bind_frame(nb::module_ &m);    // Frame
 void bind_scans(nb::module_ &m);    // Scans

@@ -99,6 +99,7 @@ NB_MODULE(_core, m) {
   vasco_py::bind_errors(m);
   vasco_py::bind_module(m);
   vasco_py::bind_registries(m);
+  vasco_py::bind_output_file(m);
   vasco_py::bind_params(m);
   vasco_py::bind_frame(m);
   vasco_py::bind_scans(m);

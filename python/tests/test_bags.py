@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import os
 import shutil
+import stat
 import subprocess
 import sys
 from pathlib import Path
@@ -207,6 +208,25 @@ def test_bag2map_errors_name_the_bag(tmp_path, intel):
     assert not (tmp_path / "x.map").exists()
     r = run_script("bag2carmen", path, tmp_path / "x.txt")
     assert r.returncode == 2
+
+
+def test_bag2carmen_writes_through_the_engines_output_file(tmp_path, intel):
+    # The log is written as every map is (atomic_file.h): a FIFO target is refused and left as it
+    # is, and a new file gets 0666 less the umask (not a private temporary's 0600).
+    path = tf_bag(tmp_path, "mcap", intel, count=50)
+    fifo = tmp_path / "pipe.log"
+    os.mkfifo(fifo)
+    r = run_script("bag2carmen", path, fifo)
+    assert r.returncode == 1 and "pipe.log" in r.stderr, r.stderr
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)
+    umask = os.umask(0o022)
+    try:
+        r = run_script("bag2carmen", path, tmp_path / "plain.log")
+    finally:
+        os.umask(umask)
+    assert r.returncode == 0, r.stderr
+    assert stat.S_IMODE(os.stat(tmp_path / "plain.log").st_mode) == 0o644
+    assert sorted(os.listdir(tmp_path)) == sorted(["pipe.log", "plain.log", Path(path).name])  # no temporary
 
 
 def test_bag2map_batch_mode_gives_each_bags_map(tmp_path, intel):

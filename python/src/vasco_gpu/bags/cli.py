@@ -11,11 +11,10 @@ options from the same table.
 from __future__ import annotations
 
 import argparse
+import io
 import os
 import sys
-import tempfile
 from dataclasses import dataclass
-from typing import Callable
 
 from .. import _core
 from .carmen_writer import write_carmen_log
@@ -108,20 +107,6 @@ def _bag2carmen_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _write_whole(out: str, write: Callable[[str], None]) -> None:
-    """Writes to a temporary beside `out`, renamed over it only when complete."""
-    directory = os.path.dirname(os.path.abspath(out))
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(out) + ".", suffix=".tmp", dir=directory)
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, out)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def bag2carmen_main(argv: list[str] | None = None) -> int:
     """The console script bag2carmen. Exit 0 done, 1 bad input, 2 usage error."""
     parser = _bag2carmen_parser()
@@ -146,16 +131,22 @@ def bag2carmen_main(argv: list[str] | None = None) -> int:
             return 2
         gz = ext.endswith(".gz")
 
-        def write(tmp):
-            if gz:
+        # The engine's output file (atomic_file.h): a hidden temporary beside the target, renamed
+        # over it only when complete; a FIFO or directory target refused; gone on a failure.
+        out = _core._OutputFile(a.out)
+        try:
+            with os.fdopen(out.take_fd(), "wb") as raw:
                 import gzip
-                with gzip.open(tmp, "wt", compresslevel=6, encoding="ascii", newline="\n") as f:
-                    write_carmen_log(d["bag"], f)
-            else:
-                with open(tmp, "w", encoding="ascii", newline="\n") as f:
-                    write_carmen_log(d["bag"], f)
-
-        _write_whole(a.out, write)
+                sink = gzip.GzipFile(filename="", mode="wb", compresslevel=6, fileobj=raw, mtime=0) if gz else raw
+                text = io.TextIOWrapper(sink, encoding="ascii", newline="\n")
+                write_carmen_log(d["bag"], text)
+                text.flush()
+                text.detach()
+                if gz:
+                    sink.close()  # the gzip trailer; raw stays open for the with
+            out.commit()
+        finally:
+            out.abandon()  # nothing once committed
     except (BagError, ValueError, OSError) as e:
         print(f"bag2carmen: {e}", file=sys.stderr)
         return 1
