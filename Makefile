@@ -86,16 +86,13 @@ demo: configure
 
 # Parse speed, the -O2 reference, the mapping table, the large site, cpu_threads
 # from one core to all, the mapping-session table (GPU rows when a GPU is
-# usable), then the batch rates.
+# usable), then the batch rates: bench/run_all.sh runs them in that order and
+# writes the whole output, under a header (date, machine, commit), to
+# bench/results/bench-DATE.txt (BENCH_OUT=FILE for another), the file the
+# docs' performance tables are quoted from.
 bench: all
 	cmake --build $(BUILD) -j $(JOBS) --target benchmarks
-	$(BUILD)/bin/parse_bench
-	$(BUILD)/bin/oracle_o2_bench
-	$(BUILD)/bin/mapping_bench
-	$(BUILD)/bin/mapping_bench --large
-	$(BUILD)/bin/mapping_bench --thread-scaling
-	$(BUILD)/bin/session_bench
-	python3 bench/batch_bench.py --bin $(BUILD)/bin
+	bash bench/run_all.sh $(BUILD)
 
 # Our CPU backends beside MRPT's COccupancyGridMap2D and OctoMap's OcTree on the same logs and poses.
 # Needs the optional packages libmrpt-maps-dev and liboctomap-dev (neither `make deps` nor CI installs

@@ -66,7 +66,7 @@ def run_json(log2map: str, backend: str, log: str, out: str) -> dict:
     return json.loads(p.stdout)
 
 
-def cost_model(log2map: str, backends: list[str], tmp: str, repeat: int) -> list[str]:
+def cost_model(log2map: str, backends: list[str], tmp: str, repeat: int) -> tuple[list[str], dict[str, float]]:
     """auto's constants measured here: cpu_threads' cells per core-second and the GPU's cells
     per second (cell_updates over seconds.map_total, the best of `repeat`, on the bundled
     log with the most cells), and the GPU's start-up as one process pays it (the wall-clock
@@ -75,23 +75,47 @@ def cost_model(log2map: str, backends: list[str], tmp: str, repeat: int) -> list
     out = os.path.join(tmp, "model.map")
     biggest = max((os.path.join(LOGS, n) for n in os.listdir(LOGS)),
                   key=lambda p: run_json(log2map, "cpu_threads", p, out)["cell_updates"])
-    lines = []
+    lines, values = [], {}
     for b in backends:
         runs = [run_json(log2map, b, biggest, out) for _ in range(repeat)]
         cells = runs[0]["cell_updates"]
         s = min(r["seconds"]["map_total"] for r in runs)
         if b == "cpu_threads":
+            values["cpu_cells_per_core_second"] = cells / s / cores
             lines.append(f"kCpuCellsPerCoreSecond  {cells / s / cores:10.3g}   ({cells} cells of {os.path.basename(biggest)} "
                          f"in {s:.4f} s on {cores} cores)")
         else:
+            values["gpu_cells_per_second"] = cells / s
             lines.append(f"kGpuCellsPerSecond      {cells / s:10.3g}   ({cells} cells in {s:.4f} s)")
     if "cuda" in backends:
         tiny = os.path.join(tmp, "tiny.log")
         tiny_log(tiny)
         start = best([log2map, "--backend", "cuda", "--quiet", tiny, out], repeat) - \
             best([log2map, "--backend", "cpu_threads", "--quiet", tiny, out], repeat)
+        values["gpu_start_seconds"] = start
         lines.append(f"kGpuStartSeconds        {start:10.3f}   (a 20-scan log: cuda less cpu_threads, wall-clock)")
-    return lines
+    return lines, values
+
+
+def write_cost_model(path: str, values: dict[str, float], command: str) -> None:
+    """The measured table backend_choice.cc is built from (vasco_gpu/app/CMakeLists.txt reads
+    it): a header saying which run made it, then one "name value" line per constant."""
+    if set(values) != {"cpu_cells_per_core_second", "gpu_cells_per_second", "gpu_start_seconds"}:
+        sys.exit(f"batch_bench: --cost-model-out needs a usable GPU (measured only {sorted(values)})")
+    try:
+        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                                text=True).stdout.strip() or "unknown"
+    except OSError:
+        commit = "unknown"
+    gpu = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"], capture_output=True,
+                         text=True).stdout.strip().splitlines()
+    with open(path, "w") as f:
+        f.write("# auto's cost model (vasco_gpu/app/backend_choice.cc), as measured by one run of\n")
+        f.write(f"#   {command}\n")
+        f.write(f"# date: {time.strftime('%Y-%m-%d', time.gmtime())}, commit: {commit}, "
+                f"cores: {os.cpu_count()}, GPU: {gpu[0] if gpu else 'none'}\n")
+        for name in sorted(values):
+            f.write(f"{name} {values[name]:.3g}\n")
 
 
 def gpu_count() -> int:
@@ -119,6 +143,9 @@ def main() -> int:
     ap.add_argument("--per-process", type=int, default=20, help="logs run one process each (the rate's sample)")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--formats", default="map.gz")
+    ap.add_argument("--cost-model-out", metavar="FILE",
+                    help="write auto's measured constants as the table backend_choice.cc is built from "
+                         "(vasco_gpu/app/backend_cost_model.txt)")
     a = ap.parse_args()
     log2map = os.path.join(a.bin, "log2map")
     with tempfile.TemporaryDirectory(prefix="batch_bench_") as tmp:
@@ -151,7 +178,7 @@ def main() -> int:
             t = {b: best([log2map, "--backend", b, "--quiet", path, os.path.join(tmp, "one.map.gz")], a.repeat)
                  for b in ["auto"] + backends}
             one.append((log, t))
-        model = cost_model(log2map, backends, tmp, a.repeat)
+        model, model_values = cost_model(log2map, backends, tmp, a.repeat)
         scaling = []
         if "cuda" in backends:
             for devices in device_sets(gpu_count()):
@@ -180,6 +207,9 @@ def main() -> int:
     print("auto's cost model measured here (compare vasco_gpu/app/backend_choice.cc):")
     for line in model:
         print("  " + line)
+    if a.cost_model_out:
+        write_cost_model(a.cost_model_out, model_values, "python3 bench/batch_bench.py " + " ".join(sys.argv[1:]))
+        print(f"batch_bench: wrote {a.cost_model_out}")
     return 0
 
 

@@ -10,19 +10,21 @@ namespace log2map {
 
 namespace {
 
-// Measured on an H200 host (16 cores, CUDA 13) by `python3 bench/batch_bench.py`
-// (its last table; README "Choosing a backend"): one core of cpu_threads
-// updates about 7.0e7 cells a second on fr101 (3.0e8 cells in 0.27 s on 16
-// cores; the threads scale close to linearly: the grid is split into
-// stripes with no shared cell), the GPU 2.3e10 once running (float mode;
-// exact mode is within 2x), and its start-up in one process (context and
-// module) costs 0.29 s of wall-clock time. Another host's cores may be
-// faster or slower (a 2-core development machine measured 9e7): batch_bench
-// prints its values; a wrong rate moves the choice only for logs on which
-// both backends take about as long.
-constexpr double kCpuCellsPerCoreSecond = 7.0e7;
-constexpr double kGpuStartSeconds = 0.29;
-constexpr double kGpuCellsPerSecond = 2.3e10;
+// Read from the measured table backend_cost_model.txt (its header names the
+// run; vasco_gpu/app/CMakeLists.txt passes each line here): one core of
+// cpu_threads' cell updates a second (the threads scale close to linearly:
+// the grid is split into stripes with no shared cell), the GPU's once
+// running (float mode; exact mode is within 2x), and its start-up in one
+// process (context and module) in wall-clock seconds. Another host's cores
+// may be faster or slower: batch_bench prints its values; a wrong rate moves
+// the choice only for logs on which both backends take about as long.
+#if !defined(VASCO_COST_CPU_CELLS_PER_CORE_SECOND) || !defined(VASCO_COST_GPU_CELLS_PER_SECOND) || \
+    !defined(VASCO_COST_GPU_START_SECONDS)
+#error "backend_cost_model.txt lacks a constant of auto's cost model"
+#endif
+constexpr double kCpuCellsPerCoreSecond = VASCO_COST_CPU_CELLS_PER_CORE_SECOND;
+constexpr double kGpuStartSeconds = VASCO_COST_GPU_START_SECONDS;
+constexpr double kGpuCellsPerSecond = VASCO_COST_GPU_CELLS_PER_SECOND;
 
 }  // namespace
 

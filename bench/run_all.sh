@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Every benchmark of `make bench`, in one run on one machine, its whole output
+# written to one file (bench/results/bench-DATE.txt unless BENCH_OUT names
+# another) under a header: date, machine, GPU, commit. The docs' performance
+# tables are quoted from such a file (docs/performance.md names it), never
+# copied by hand.
+#   bench/run_all.sh BUILD_DIR [STEP...]   (steps: parse oracle mapping large scaling session batch)
+set -euo pipefail
+build=${1:?usage: bench/run_all.sh BUILD_DIR [STEP...]}
+shift
+steps=${*:-parse oracle mapping large scaling session batch}
+root=$(cd "$(dirname "$0")/.." && pwd)
+out=${BENCH_OUT:-$root/bench/results/bench-$(date -u +%Y-%m-%d).txt}
+mkdir -p "$(dirname "$out")"
+tmp=$(mktemp "$out.XXXXXX")
+trap 'rm -f "$tmp"' EXIT
+{
+  echo "# vasco_gpu benchmarks: bench/run_all.sh $build $steps"
+  echo "# date: $(date -u '+%Y-%m-%d %H:%M UTC')"
+  echo "# commit: $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)$(git -C "$root" diff --quiet HEAD 2>/dev/null || echo ' (with uncommitted changes)')"
+  echo "# machine: $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
+  echo "# GPU: $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -1 || true)"
+} > "$tmp"
+run() {
+  echo >> "$tmp"
+  echo "## $*" >> "$tmp"
+  "$@" 2>&1 | tee -a "$tmp"
+}
+for step in $steps; do
+  case $step in
+    parse) run "$build/bin/parse_bench" ;;
+    oracle) run "$build/bin/oracle_o2_bench" ;;
+    mapping) run "$build/bin/mapping_bench" ;;
+    large) run "$build/bin/mapping_bench" --large ;;
+    scaling) run "$build/bin/mapping_bench" --thread-scaling ;;
+    session) run "$build/bin/session_bench" ;;
+    batch) run python3 "$root/bench/batch_bench.py" --bin "$build/bin" ;;
+    *) echo "bench/run_all.sh: unknown step '$step'" >&2; exit 2 ;;
+  esac
+done
+mv "$tmp" "$out"
+trap - EXIT
+echo "bench/run_all.sh: wrote $out"
