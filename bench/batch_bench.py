@@ -102,9 +102,10 @@ def write_cost_model(path: str, values: dict[str, float], command: str) -> None:
     it): a header saying which run made it, then one "name value" line per constant."""
     if set(values) != {"cpu_cells_per_core_second", "gpu_cells_per_second", "gpu_start_seconds"}:
         sys.exit(f"batch_bench: --cost-model-out needs a usable GPU (measured only {sorted(values)})")
+    commit = os.environ.get("BENCH_COMMIT", "")
     try:
-        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                                text=True).stdout.strip() or "unknown"
+        commit = commit or subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                                          text=True).stdout.strip() or "unknown"
     except OSError:
         commit = "unknown"
     gpu = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"], capture_output=True,

@@ -5,6 +5,10 @@
 # tables are quoted from such a file (docs/performance.md names it), never
 # copied by hand.
 #   bench/run_all.sh BUILD_DIR [STEP...]   (steps: parse oracle mapping large scaling session batch)
+# COST_MODEL_OUT=FILE: batch_bench also writes auto's measured constants there
+# (vasco_gpu/app/backend_cost_model.txt is such a file); BATCH_ARGS: more of
+# batch_bench's options; BENCH_COMMIT: the commit to name where the tree is
+# a copy without its git history.
 set -euo pipefail
 build=${1:?usage: bench/run_all.sh BUILD_DIR [STEP...]}
 shift
@@ -17,7 +21,7 @@ trap 'rm -f "$tmp"' EXIT
 {
   echo "# vasco_gpu benchmarks: bench/run_all.sh $build $steps"
   echo "# date: $(date -u '+%Y-%m-%d %H:%M UTC')"
-  echo "# commit: $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)$(git -C "$root" diff --quiet HEAD 2>/dev/null || echo ' (with uncommitted changes)')"
+  echo "# commit: ${BENCH_COMMIT:-$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)}"
   echo "# machine: $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
   echo "# GPU: $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -1 || true)"
 } > "$tmp"
@@ -34,7 +38,8 @@ for step in $steps; do
     large) run "$build/bin/mapping_bench" --large ;;
     scaling) run "$build/bin/mapping_bench" --thread-scaling ;;
     session) run "$build/bin/session_bench" ;;
-    batch) run python3 "$root/bench/batch_bench.py" --bin "$build/bin" ;;
+    batch) run python3 "$root/bench/batch_bench.py" --bin "$build/bin" ${BATCH_ARGS:-} \
+             ${COST_MODEL_OUT:+--cost-model-out "$COST_MODEL_OUT"} ;;
     *) echo "bench/run_all.sh: unknown step '$step'" >&2; exit 2 ;;
   esac
 done
