@@ -1,8 +1,9 @@
-"""The README's Python blocks and the shell blocks that need the package's console scripts
-(bag2map, bag2carmen, python -c), run here with the installed package; the rest of the
-README is tests/docs/readme_test.py's (ctest ReadmeCommandsWork). Both read the README
-through tests/docs/readme_blocks.py and take each block's check from
-tests/docs/readme_checks.py, where the fixtures and the substitutions used here are stated.
+"""The Python blocks of README.md and of docs/*.md, and the shell blocks that need the
+package's console scripts (bag2map, bag2carmen, python -c), run here with the installed
+package; the rest of the documents is tests/docs/readme_test.py's (ctest
+ReadmeCommandsWork). Both read the documents through tests/docs/readme_blocks.py and take
+each block's check from tests/docs/readme_checks.py, where the fixtures and the
+substitutions used here are stated.
 
 Substitutions and fixtures: bags made here from intel (bag_maker.py) where a block names
 run.mcap, run.bag, run/ and pose files; backend="cuda" becomes cpu_threads without a usable
@@ -24,7 +25,6 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "tests" / "docs"
-README = ROOT / "README.md"
 LOGS = ROOT / "logs"
 GOLDEN_FR079 = ROOT / "tests" / "data" / "golden" / "maps" / "fr079-complete.gfs__vasco_default_ds4.map.gz"
 
@@ -45,21 +45,38 @@ vg = pytest.importorskip("vasco_gpu")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
+DOCS = readme_blocks.doc_files(ROOT)
+
+
 def python_blocks():
-    """(block, check) of every README block this file runs."""
+    """(document, block, check) of every block of the documents that this file runs."""
     out = []
-    for b in readme_blocks.read_blocks(README):
-        c = readme_checks.check_for(b.key)
-        if c is not None and (c.kind == "python" or (c.kind == "run" and c.python)):
-            out.append(pytest.param(b, c, id=f"README.md:{b.line}"))
+    for path in DOCS:
+        doc = readme_blocks.doc_name(path, ROOT)
+        for b in readme_blocks.read_blocks(path):
+            c = readme_checks.check_for(doc, b.key)
+            if c is not None and (c.kind == "python" or (c.kind == "run" and c.python)):
+                out.append(pytest.param(doc, b, c, id=f"{doc}:{b.line}"))
     return out
+
+
+def test_python_blocks_are_found():
+    # A table or a parser that finds no Python block would make every test below vanish.
+    kinds = {(p.values[0], p.values[2].kind) for p in python_blocks()}
+    assert ("README.md", "python") in kinds and ("docs/python.md", "run") in kinds, kinds
 
 
 def test_the_table_knows_every_block():
     # readme_test.py fails on these too; here so that a Python-only run sees them.
-    keys = [b.key for b in readme_blocks.read_blocks(README)]
-    unknown = [k for k in keys if readme_checks.check_for(k) is None]
-    stale = [k for k in readme_checks.CHECKS if k not in keys]
+    unknown, stale = [], []
+    names = set()
+    for path in DOCS:
+        doc = readme_blocks.doc_name(path, ROOT)
+        names.add(doc)
+        keys = [b.key for b in readme_blocks.read_blocks(path)]
+        unknown += [(doc, k) for k in keys if readme_checks.check_for(doc, k) is None]
+        stale += [(doc, k) for k in readme_checks.CHECKS.get(doc, {}) if k not in keys]
+    stale += [(doc, "*") for doc in readme_checks.CHECKS if doc not in names]
     assert not unknown and not stale, (unknown, stale)
 
 
@@ -151,7 +168,13 @@ def fixture_dask_logs(d, intel):
     return {"logs": [str(d / "a.log.gz"), str(d / "b.log.gz")]}
 
 
-FIXTURES = {"bags": fixture_bags, "loop_closure": fixture_loop_closure, "dask_logs": fixture_dask_logs}
+def fixture_logs(d, intel):
+    """logs/: the bundled logs, as the repository root has them."""
+    (d / "logs").symlink_to(LOGS, target_is_directory=True)
+
+
+FIXTURES = {"bags": fixture_bags, "loop_closure": fixture_loop_closure, "dask_logs": fixture_dask_logs,
+            "logs": fixture_logs}
 
 
 # --- tools on PATH --------------------------------------------------------------------------
@@ -184,7 +207,9 @@ def tool_dir(d: Path) -> Path:
     tools = d / ".tools"
     tools.mkdir()
     for name in ("python", "python3"):
-        (tools / name).symlink_to(sys.executable)
+        # A script, not a link: a link to a virtual environment's python starts outside it.
+        (tools / name).write_text(f"#!/bin/sh\nexec '{sys.executable}' \"$@\"\n")
+        (tools / name).chmod(0o755)
     for name, entry in (("bag2map", "bag2map_main"), ("bag2carmen", "bag2carmen_main")):
         exe = Path(sys.executable).parent / name
         script = tools / name
@@ -211,8 +236,8 @@ def substituted(text, subs):
     return text
 
 
-@pytest.mark.parametrize("block,check", python_blocks())
-def test_readme_block(block, check, tmp_path, monkeypatch, intel):
+@pytest.mark.parametrize("doc,block,check", python_blocks())
+def test_readme_block(doc, block, check, tmp_path, monkeypatch, intel):
     for module in check.needs:
         pytest.importorskip(module)
     made = FIXTURES[check.fixture](tmp_path, intel) if check.fixture else None
@@ -231,15 +256,15 @@ def test_readme_block(block, check, tmp_path, monkeypatch, intel):
             want = next((s for p, s in check.status.items() if cmd.startswith(p)), 0)
             r = subprocess.run(["bash", "-c", substituted(cmd, check.subs)], cwd=tmp_path, env=env,
                                capture_output=True, text=True, timeout=300)
-            assert r.returncode == want, (f"README.md:{block.content_line(offset)}: `{cmd}` exits "
+            assert r.returncode == want, (f"{doc}:{block.content_line(offset)}: `{cmd}` exits "
                                           f"{r.returncode}, not {want}:\n{r.stderr}{r.stdout}")
     else:
         code = substituted(block.text, check.subs)
         namespace = {"__name__": "__readme__", "BACKEND": "cuda" if vg.cuda_available() else "cpu_threads"}
         namespace.update(made or {})
-        exec(compile(code, f"README.md:{block.line + 1}", "exec"), namespace)
+        exec(compile(code, f"{doc}:{block.line + 1}", "exec"), namespace)
         results = namespace.get("results")
         if results is not None:
             assert all(r.ok for r in results), [r.error for r in results if not r.ok]
     missing = [o for o in check.outputs if not (tmp_path / o).exists()]
-    assert not missing, f"after README.md:{block.line}, missing: {missing}"
+    assert not missing, f"after {doc}:{block.line}, missing: {missing}"

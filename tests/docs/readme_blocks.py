@@ -1,7 +1,8 @@
-"""The fenced code blocks of a Markdown file, and the command lines of a shell block.
+"""The fenced code blocks of a Markdown file, the command lines of a shell block, and the
+headings, anchors and links of a Markdown file.
 
 Standard library only (Python 3.9+): the docs test (readme_test.py) and the Python tests
-(python/tests/test_readme.py) both read README.md through this module.
+(python/tests/test_readme.py) both read README.md and docs/*.md through this module.
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import List, Tuple
+from typing import Dict, List, Optional, Tuple
 
 _OPEN = re.compile(r"^( {0,3})(`{3,}|~{3,})[ \t]*([^`\s]*)[^`]*$")
 SHELL_LANGS = ("sh", "bash", "shell", "console")
@@ -124,3 +125,99 @@ def shell_commands(text: str) -> List[Tuple[int, str]]:
     if pending.strip():
         out.append((pending_at, pending.strip()))
     return out
+
+
+# --- the documents -------------------------------------------------------------------------
+
+
+def doc_files(source, readme=None) -> List[Path]:
+    """The Markdown files the docs test walks: the README (README.md of the source tree
+    unless given), then every .md file under the source tree's docs/, sorted."""
+    source = Path(source)
+    readme = Path(readme) if readme else source / "README.md"
+    docs = sorted(p for p in (source / "docs").rglob("*.md") if p.is_file())
+    return [readme] + [p for p in docs if p.resolve() != readme.resolve()]
+
+
+def doc_name(path, source) -> str:
+    """A document's name in the check table: its path relative to the source tree, with '/'
+    (README.md, docs/cli.md); a file outside the tree keeps its own name."""
+    path, source = Path(path).resolve(), Path(source).resolve()
+    try:
+        return path.relative_to(source).as_posix()
+    except ValueError:
+        return path.name
+
+
+def outside_fences(text: str) -> List[Tuple[int, str]]:
+    """(line number, line) of every line outside fenced blocks (fences themselves left out)."""
+    out = []
+    fence = None
+    for n, ln in enumerate(text.splitlines(), 1):
+        m = re.match(r"^ {0,3}(`{3,}|~{3,})", ln)
+        if m:
+            if fence is None:
+                fence = m.group(1)
+            elif m.group(1)[0] == fence[0] and len(m.group(1)) >= len(fence) and not ln.strip()[len(m.group(1)):].strip():
+                fence = None
+            continue
+        if fence is None:
+            out.append((n, ln))
+    return out
+
+
+_HEADING = re.compile(r"^ {0,3}(#{1,6})\s+(.*?)(?:\s+#+)?\s*$")
+
+
+def headings(text: str) -> List[Tuple[int, int, str]]:
+    """(line, level, text) of every ATX heading outside fenced blocks."""
+    out = []
+    for n, ln in outside_fences(text):
+        m = _HEADING.match(ln)
+        if m:
+            out.append((n, len(m.group(1)), m.group(2)))
+    return out
+
+
+def slug(heading: str) -> str:
+    """The anchor GitHub gives a heading: links reduced to their text, lower case, every
+    character but letters, digits, '_', '-' and blanks dropped, blanks made '-'."""
+    s = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", heading.strip()).lower()
+    s = re.sub(r"[^\w\- ]", "", s)
+    return s.replace(" ", "-")
+
+
+def anchors(text: str) -> Dict[str, int]:
+    """Every heading's anchor -> its line; a repeated anchor gets -1, -2, ... as on GitHub."""
+    out: Dict[str, int] = {}
+    seen: Dict[str, int] = {}
+    for n, _, h in headings(text):
+        base = slug(h)
+        a = base
+        if base in seen:
+            seen[base] += 1
+            a = f"{base}-{seen[base]}"
+        else:
+            seen[base] = 0
+        out[a] = n
+    return out
+
+
+_LINK = re.compile(r"(?<!!)\[((?:[^\[\]]|\[[^\]]*\])*)\]\(\s*<?([^)\s>]*)>?(?:\s+\"[^\"]*\")?\s*\)")
+
+
+def links(text: str) -> List[Tuple[int, str, str]]:
+    """(line, link text, target) of every inline link outside fenced blocks and code spans."""
+    out = []
+    for n, ln in outside_fences(text):
+        plain = re.sub(r"(`+)(.+?)\1", lambda m: " " * len(m.group(0)), ln)
+        for m in _LINK.finditer(plain):
+            out.append((n, m.group(1), m.group(2)))
+    return out
+
+
+def split_target(target: str) -> Tuple[str, Optional[str]]:
+    """A link target as (path, anchor): ("docs/cli.md", "log2map"), ("", "top"), or
+    (path, None) without an anchor."""
+    path, sep, anchor = target.partition("#")
+    return path, (anchor if sep else None)

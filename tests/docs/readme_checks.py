@@ -1,9 +1,11 @@
-"""What checks each fenced block of README.md, keyed by readme_blocks.Block.key, and the
-fixtures that make the files the blocks' commands name (standard library only).
+"""What checks each fenced block of README.md and of every Markdown file under docs/, keyed
+by the document (its path in the source tree: "README.md", "docs/cli.md") and then by
+readme_blocks.Block.key, and the fixtures that make the files the blocks' commands name
+(standard library only).
 
-Every block of the README must have an entry here, and every entry a block: a new or
-changed block fails the docs test until this table says how it is checked, and an entry
-whose block is gone fails as stale.
+Every block of every document must have an entry here, and every entry a block: a new or
+changed block (or a new document with blocks) fails the docs test until this table says
+how it is checked, and an entry whose block or document is gone fails as stale.
 
 Kinds of check:
   run          each command of a shell block runs with bash in a scratch directory that the
@@ -12,15 +14,17 @@ Kinds of check:
                Commands starting with a prefix in `skip` are not run (the reason says why);
                `python=True`: the block needs the Python package's console scripts, so
                python/tests/test_readme.py runs it and the docs test skips it.
-  make-target  each `make X` line: `make -n -C SOURCE X` (a dry run) must succeed, its
-               output naming `mentions[X]`; the targets themselves are never run here.
+  make-target  each `make [VAR=VALUE...] X` line: `make -n -C SOURCE [VAR=VALUE...] X` (a dry
+               run) must succeed, its output naming `mentions[X]`; the targets themselves are
+               never run here.
   compile      a C or C++ fragment, put into `harness` (its #include lines first), must
                compile against the source tree's headers (syntax only).
   covered-by   another test checks what the block says: each (file, strings) of `files`
                must exist and contain every string.
   synopsis     a usage block of `tool`: every option in it must be in `tool --help`; the
                `examples` commands (the synopsis filled in) run as in `run`.
-  output       a sample of a tool's output: `command` runs (fixture first); with
+  output       a sample of a tool's output: `command` runs (fixture first; $VASCO_SOURCE and
+               $VASCO_BUILD name the source tree and the build directory); with
                `output_file` that file must equal the block, else one line of the
                command's stderr must match the block's line with numbers and the
                alternatives of `alternatives` generalised.
@@ -202,6 +206,11 @@ def fixture_freiburg(scratch: Path, source: Path, bin_dir: Path) -> None:
     shutil.copy(source / "tests" / "data" / "maps" / "freiburg.map", scratch / "freiburg.map")
 
 
+def fixture_logs(scratch: Path, source: Path, bin_dir: Path) -> None:
+    """logs/: the bundled logs, as the repository root has them."""
+    (scratch / "logs").symlink_to(source / "logs", target_is_directory=True)
+
+
 FIXTURES: Dict[str, Callable[[Path, Path, Path], None]] = {
     "intel": fixture_intel,
     "poses": fixture_poses,
@@ -209,94 +218,130 @@ FIXTURES: Dict[str, Callable[[Path, Path, Path], None]] = {
     "runs": fixture_runs,
     "fr079_maps": fixture_fr079_maps,
     "freiburg": fixture_freiburg,
+    "logs": fixture_logs,
 }
 
 # ---------------------------------------------------------------------------------------
-# The table: README block key -> check.
+# The table: document -> block key -> check.
 
-CHECKS: Dict[str, Check] = {
-    # Quick start.
-    "sh: make demo": Check(
-        "make-target",
-        mentions={"demo": ["build/bin/log2map", "build/fr079.png", "build/fr079.map.gz"],
-                  "test": ["ctest"]}),
-    # log2map.
-    "text: log2map [options] LOG OUT [OUT...]": Check(
-        "synopsis", tool="log2map", fixture="intel",
-        examples=["log2map -q --backend cpu_threads intel.log.gz a.map a.map.gz a.pgm a.png",
-                  "log2map -q --backend cpu_threads --out-dir d --formats map.gz,png intel.log.gz",
-                  "test -f a.yaml && test -f d/intel.map.gz && test -f d/intel.png"]),
-    "sh: log2map --poses optimized.g2o intel.log.gz after.map.gz": Check(
-        "run", fixture="poses", outputs=["after.map.gz"]),
-    "sh: log2map monday.log.gz --add tuesday.log.gz@12.5,-3.0,1.5708": Check(
-        "run", fixture="sessions", outputs=["both.map.gz"]),
-    "text: log2map: --backend auto: 3.4e+08 cell updates: about 0.302 s": Check(
-        "output", fixture="intel", command="log2map --backend auto intel.log.gz auto.map.gz",
-        alternatives=[("start-up): using cpu_threads",
-                       r"start-up\)(; no usable GPU \(.*\))?: using (cpu_threads|cuda)")]),
-    "sh: log2map --out-dir maps --formats map.gz,png runs/*.log.gz": Check(
-        "run", fixture="runs",
-        outputs=["maps/run1.map.gz", "maps/run1.png", "maps/run2.map.gz", "maps/run2.png"]),
-    "text: summary: 27 cases": Check(
-        "covered-by",
-        files=[("tests/golden_check.cc", ["summary: %d cases", "identical to CARMEN"]),
-               ("Makefile", ["golden_check --golden $(GOLDEN_DIR)"])]),
-    # mapdiff.
-    "sh: mapdiff carmen/fr079.map.gz today/fr079.map.gz": Check(
-        "run", fixture="fr079_maps", status={"mapdiff": 0}, outputs=["diff.png"]),
-    # From a ROS bag.
-    "sh: bag2map run.mcap map.pgm map.map.gz": Check(
-        "run", python=True, fixture="bags",
-        outputs=["map.pgm", "map.yaml", "map.map.gz", "map.png", "run.log.gz"]),
-    'python: log = vg.load_bag("run.mcap")': Check(
-        "python", fixture="bags", outputs=["map.pgm", "map.yaml"], needs=["rosbags"]),
-    "yaml: image: map.pgm": Check(
-        "output", fixture="intel", command="log2map -q --backend cpu_threads intel.log.gz map.pgm",
-        output_file="map.yaml"),
-    "sh: ros2 run nav2_map_server map_server --ros-args -p yaml_filen": Check(
-        "skip", reason="needs ROS 2 (nav2_map_server)"),
-    # Mapping sessions.
-    "cpp: vasco::MapperParams params;": Check("compile", harness=CXX_HARNESS),
-    "c: vasco_mapper_params p;": Check("compile", harness=C_HARNESS),
-    # mapconvert.
-    "text: mapconvert [-q] [--mode trinary|scale|raw] IN OUT": Check(
-        "synopsis", tool="mapconvert", fixture="freiburg",
-        examples=["mapconvert -q --mode scale freiburg.map out.pgm", "test -f out.yaml",
-                  "mapconvert freiburg.map out.map.gz", "mapconvert freiburg.map out.png",
-                  "mapconvert --info freiburg.map", "mapconvert --version"]),
-    # C API: installing in place of CARMEN's libraries.
-    "make: VASCO = /opt/vasco_gpu": Check(
-        "covered-by",
-        files=[("tests/install/install_test.sh", ["-legrid", "-lmap_io", "-lreadlog", "-Wl,-rpath,"]),
-               ("tests/CMakeLists.txt", ["InstalledTreeServesCarmenClients"])]),
-    "make: CFLAGS += $(shell pkg-config --cflags vasco_gpu)": Check(
-        "covered-by",
-        files=[("tests/install/install_test.sh", ["pkg-config --cflags --libs vasco_gpu)",
-                                                  "pkg-config --libs vasco_gpu-static"])]),
-    "cmake: find_package(vasco_gpu REQUIRED)": Check(
-        "covered-by",
-        files=[("tests/install/CMakeLists.txt", ["find_package(vasco_gpu REQUIRED)", "vasco_gpu::vasco_gpu ",
-                                                 "vasco_gpu::vasco_gpu_shared"]),
-               ("tests/install/c_project/CMakeLists.txt", ["find_package(vasco_gpu REQUIRED)"])]),
-    # Python.
-    "sh: pip install .": Check(
-        "run", python=True, reason="python -c needs the package: python/tests/test_readme.py runs it",
-        skip={"pip install": "pip install: CI's pip step (.ci/run) runs it"}),
-    "sh: cmake -S . -B build-py -DVASCO_GPU_BUILD_PYTHON=ON -DPython_": Check(
-        "covered-by",
-        files=[("CMakeLists.txt", ["option(VASCO_GPU_BUILD_PYTHON"]),
-               ("python/CMakeLists.txt", ["add_custom_target(vasco_gpu_python"]),
-               ("python/tests/conftest.py", ["ROOT"])]),
-    'python: log = vg.load_log("logs/fr079-complete.gfs.log.gz")': Check(
-        "python", fixture="loop_closure", outputs=["after.png"],
-        subs=[('backend="cuda"', 'backend=BACKEND'), ("optimizer.poses()", "mapper.poses")]),
-    "python: with LocalCluster(n_workers=4, threads_per_worker=1) as clus": Check(
-        "python", fixture="dask_logs", outputs=["maps/a.map.gz", "maps/a.png", "maps/b.map.gz"],
-        subs=[("n_workers=4", "n_workers=2")], needs=["dask.distributed"]),
-    # Layout.
-    "text: carmen_compat/ CARMEN's formats and C libraries; no mapping": Check("layout"),
+CHECKS: Dict[str, Dict[str, Check]] = {
+    "README.md": {
+        # Quick start.
+        "sh: make demo": Check(
+            "make-target",
+            mentions={"demo": ["build/bin/log2map", "build/fr079.png", "build/fr079.map.gz"],
+                      "test": ["ctest"]}),
+        # Without CUDA.
+        "sh: make CMAKE_FLAGS=-DVASCO_GPU_CUDA=OFF test": Check(
+            "make-target", mentions={"test": ["-DVASCO_GPU_CUDA=OFF", "ctest"]}),
+        # The tour.
+        "sh: log2map logs/intel.gfs.log.gz intel.map.gz intel.pgm intel.p": Check(
+            "run", fixture="logs", outputs=["intel.map.gz", "intel.pgm", "intel.yaml", "intel.png", "coarse.map.gz"]),
+        'python: log = vg.load_log("logs/intel.gfs.log.gz")': Check(
+            "python", fixture="logs", outputs=["intel.png"]),
+    },
+    "docs/DESIGN.md": {
+        "text: python/ (vasco_gpu, nanobind) log2map mapdiff mapconvert": Check(
+            "skip", reason="a diagram of the libraries (DESIGN §1), not a command"),
+    },
+    "docs/backends-and-accuracy.md": {
+        "text: golden_check: no golden maps at ../shared/golden (SHA256SUMS": Check(
+            "output",
+            command='make -s -C "$VASCO_SOURCE" -o all golden BUILD="$VASCO_BUILD" '
+                    'GOLDEN_DIR="$PWD/no-golden" GOLDEN_DATA="$PWD/no-data"',
+            alternatives=[("../shared/golden", r"\S+")]),
+        "text: summary: 27 cases": Check(
+            "covered-by",
+            files=[("tests/golden_check.cc", ["summary: %d cases", "identical to CARMEN"]),
+                   ("Makefile", ["golden_check --golden $(GOLDEN_DIR)"])]),
+    },
+    "docs/bags-and-poses.md": {
+        "sh: log2map --poses optimized.g2o intel.log.gz after.map.gz": Check(
+            "run", fixture="poses", outputs=["after.map.gz"]),
+        "sh: bag2map run.mcap map.pgm map.map.gz": Check(
+            "run", python=True, fixture="bags",
+            outputs=["map.pgm", "map.yaml", "map.map.gz", "map.png", "run.log.gz"]),
+        'python: log = vg.load_bag("run.mcap")': Check(
+            "python", fixture="bags", outputs=["map.pgm", "map.yaml"], needs=["rosbags"]),
+        "yaml: image: map.pgm": Check(
+            "output", fixture="intel", command="log2map -q --backend cpu_threads intel.log.gz map.pgm",
+            output_file="map.yaml"),
+        "sh: ros2 run nav2_map_server map_server --ros-args -p yaml_filen": Check(
+            "skip", reason="needs ROS 2 (nav2_map_server)"),
+    },
+    "docs/building.md": {
+        "sh: make CMAKE_FLAGS=-DVASCO_GPU_CUDA=OFF test": Check(
+            "make-target", mentions={"test": ["-DVASCO_GPU_CUDA=OFF", "ctest"]}),
+    },
+    "docs/c-api-and-carmen.md": {
+        "make: VASCO = /opt/vasco_gpu": Check(
+            "covered-by",
+            files=[("tests/install/install_test.sh", ["-legrid", "-lmap_io", "-lreadlog", "-Wl,-rpath,"]),
+                   ("tests/CMakeLists.txt", ["InstalledTreeServesCarmenClients"])]),
+        "make: CFLAGS += $(shell pkg-config --cflags vasco_gpu)": Check(
+            "covered-by",
+            files=[("tests/install/install_test.sh", ["pkg-config --cflags --libs vasco_gpu)",
+                                                      "pkg-config --libs vasco_gpu-static"])]),
+        "cmake: find_package(vasco_gpu REQUIRED)": Check(
+            "covered-by",
+            files=[("tests/install/CMakeLists.txt", ["find_package(vasco_gpu REQUIRED)", "vasco_gpu::vasco_gpu ",
+                                                     "vasco_gpu::vasco_gpu_shared"]),
+                   ("tests/install/c_project/CMakeLists.txt", ["find_package(vasco_gpu REQUIRED)"])]),
+    },
+    "docs/cli.md": {
+        "text: log2map [options] LOG OUT [OUT...]": Check(
+            "synopsis", tool="log2map", fixture="intel",
+            examples=["log2map -q --backend cpu_threads intel.log.gz a.map a.map.gz a.pgm a.png",
+                      "log2map -q --backend cpu_threads --out-dir d --formats map.gz,png intel.log.gz",
+                      "test -f a.yaml && test -f d/intel.map.gz && test -f d/intel.png"]),
+        "sh: log2map monday.log.gz --add tuesday.log.gz@12.5,-3.0,1.5708": Check(
+            "run", fixture="sessions", outputs=["both.map.gz"]),
+        "text: log2map: --backend auto: 3.4e+08 cell updates: about 0.302 s": Check(
+            "output", fixture="intel", command="log2map --backend auto intel.log.gz auto.map.gz",
+            alternatives=[("start-up): using cpu_threads",
+                           r"start-up\)(; no usable GPU \(.*\))?: using (cpu_threads|cuda)")]),
+        "sh: log2map --out-dir maps --formats map.gz,png runs/*.log.gz": Check(
+            "run", fixture="runs",
+            outputs=["maps/run1.map.gz", "maps/run1.png", "maps/run2.map.gz", "maps/run2.png"]),
+        "sh: mapdiff carmen/fr079.map.gz today/fr079.map.gz": Check(
+            "run", fixture="fr079_maps", status={"mapdiff": 0}, outputs=["diff.png"]),
+        "text: mapconvert [-q] [--mode trinary|scale|raw] IN OUT": Check(
+            "synopsis", tool="mapconvert", fixture="freiburg",
+            examples=["mapconvert -q --mode scale freiburg.map out.pgm", "test -f out.yaml",
+                      "mapconvert freiburg.map out.map.gz", "mapconvert freiburg.map out.png",
+                      "mapconvert --info freiburg.map", "mapconvert --version"]),
+    },
+    "docs/contributing.md": {
+        "text: carmen_compat/ CARMEN's formats and C libraries; no mapping": Check("layout"),
+        "sh: python3 tests/docs/readme_test.py --readme README.md --sourc": Check(
+            "covered-by",
+            files=[("tests/CMakeLists.txt", ["docs/readme_test.py", "--readme ${VASCO_SOURCE_DIR}/README.md",
+                                             "--source ${VASCO_SOURCE_DIR}", "--bin ${CMAKE_BINARY_DIR}/bin"])]),
+    },
+    "docs/python.md": {
+        "sh: pip install .": Check(
+            "run", python=True, reason="python -c needs the package: python/tests/test_readme.py runs it",
+            skip={"pip install": "pip install: CI's pip step (.ci/run) runs it"}),
+        "sh: cmake -S . -B build-py -DVASCO_GPU_BUILD_PYTHON=ON -DPython_": Check(
+            "covered-by",
+            files=[("CMakeLists.txt", ["option(VASCO_GPU_BUILD_PYTHON"]),
+                   ("python/CMakeLists.txt", ["add_custom_target(vasco_gpu_python"]),
+                   ("python/tests/conftest.py", ["ROOT"])]),
+        'python: log = vg.load_log("logs/fr079-complete.gfs.log.gz")': Check(
+            "python", fixture="loop_closure", outputs=["after.png"],
+            subs=[('backend="cuda"', 'backend=BACKEND'), ("optimizer.poses()", "mapper.poses")]),
+        "python: with LocalCluster(n_workers=4, threads_per_worker=1) as clus": Check(
+            "python", fixture="dask_logs", outputs=["maps/a.map.gz", "maps/a.png", "maps/b.map.gz"],
+            subs=[("n_workers=4", "n_workers=2")], needs=["dask.distributed"]),
+    },
+    "docs/sessions.md": {
+        "cpp: vasco::MapperParams params;": Check("compile", harness=CXX_HARNESS),
+        "c: vasco_mapper_params p;": Check("compile", harness=C_HARNESS),
+    },
 }
 
 
-def check_for(key: str) -> Optional[Check]:
-    return CHECKS.get(key)
+def check_for(doc: str, key: str) -> Optional[Check]:
+    """The check of the block with this key in this document (a name as
+    readme_blocks.doc_name gives it), or None."""
+    return CHECKS.get(doc, {}).get(key)

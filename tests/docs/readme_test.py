@@ -1,14 +1,20 @@
 #!/usr/bin/env python3
-"""The README's commands and snippets, run or checked (ctest ReadmeCommandsWork).
+"""The documentation's commands and snippets, run or checked (ctest ReadmeCommandsWork).
 
-Every fenced block of README.md must have an entry in readme_checks.CHECKS, which says how
-it is checked (see that module); a block without one fails, and so does an entry without a
-block. Besides the blocks, the `make TARGET` spans of the prose must name targets of the
-Makefile, and the options that inline code spans give log2map, mapconvert and mapdiff
-must be in the tool's --help.
+The documents are README.md and every Markdown file under the source tree's docs/. Every
+fenced block of each must have an entry in readme_checks.CHECKS under that document, which
+says how it is checked (see that module); a block without one fails, and so does an entry
+without a block. Besides the blocks, in each document: the `make TARGET` spans of the prose
+must name targets of the Makefile; the options that inline code spans give log2map,
+mapconvert and mapdiff must be in the tool's --help; the CMake variables that
+`-DVASCO_...` and `cmake.define.VASCO_...` name must be the project's options; the source paths that inline code names must exist; every
+relative link must lead to a file that exists, and its #anchor to a heading of it; and the
+contents list at the top of each document (before its first `##` heading) must link every
+`##` heading.
 
-Prints one line per block (README line, check, ok / skipped / FAILED and why) and a
-summary; exits 0 only when no check failed. Standard library only (Python 3.9+).
+Prints one line per block (document:line, check, ok / skipped / FAILED and why), one per
+document's prose and links, and a summary; exits 0 only when no check failed. Standard
+library only (Python 3.9+).
 
   python3 tests/docs/readme_test.py --readme README.md --source . --bin build/bin
 """
@@ -23,7 +29,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -44,6 +50,7 @@ class Context:
     def __init__(self, args):
         self.readme = Path(args.readme).resolve()
         self.source = Path(args.source).resolve()
+        self.doc = self.readme.name  # the document being checked (readme_blocks.doc_name)
         self.bin = Path(args.bin).resolve()
         self.cc = args.cc
         self.cxx = args.cxx
@@ -57,10 +64,13 @@ class Context:
         for k in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL"):  # ctest under make: no jobserver here
             env.pop(k, None)
         env["LC_ALL"] = "C"
+        env["VASCO_SOURCE"] = str(self.source)
+        env["VASCO_BUILD"] = str(self.bin.parent)
         return env
 
     def scratch(self, name: str) -> Path:
-        d = self.scratch_root / name
+        """A new scratch directory for a block of the current document."""
+        d = self.scratch_root / (re.sub(r"[^\w.-]", "_", self.doc) + "." + name)
         d.mkdir(parents=True)
         return d
 
@@ -119,12 +129,12 @@ def run_commands(ctx: Context, check: Check, commands: List[Tuple[int, str]], bl
     for offset, cmd in commands:
         reason = skip_reason(check, cmd)
         if reason is not None:
-            skipped.append(f"{ctx.readme.name}:{block.content_line(offset)} ({reason})")
+            skipped.append(f"{ctx.doc}:{block.content_line(offset)} ({reason})")
             continue
         want = expected_status(check, cmd)
         r = bash(ctx, cmd, d)
         if r.returncode != want:
-            raise Failed(f"README.md:{block.content_line(offset)}: `{cmd}` exits {r.returncode}, "
+            raise Failed(f"{ctx.doc}:{block.content_line(offset)}: `{cmd}` exits {r.returncode}, "
                          f"not {want}: {short(r.stderr or r.stdout)}")
         ran += 1
     missing = [o for o in check.outputs if not (d / o).exists()]
@@ -151,11 +161,11 @@ def do_run(ctx: Context, check: Check, block: Block) -> str:
     return run_commands(ctx, check, commands, block, d)
 
 
-def make_dry_run(ctx: Context, target: str) -> str:
-    r = subprocess.run(["make", "-n", "-C", str(ctx.source), target], capture_output=True, text=True,
+def make_dry_run(ctx: Context, target: str, variables: Sequence[str] = ()) -> str:
+    r = subprocess.run(["make", "-n", "-C", str(ctx.source), *variables, target], capture_output=True, text=True,
                        env=ctx.env(), timeout=60)
     if r.returncode != 0:
-        raise Failed(f"`make -n {target}` exits {r.returncode}: {short(r.stderr)}")
+        raise Failed(f"`make -n {' '.join([*variables, target])}` exits {r.returncode}: {short(r.stderr)}")
     return r.stdout
 
 
@@ -163,13 +173,15 @@ def do_make_target(ctx: Context, check: Check, block: Block) -> str:
     targets = []
     for offset, cmd in readme_blocks.shell_commands(block.text):
         words = cmd.split()
-        if words[0] != "make" or len(words) != 2:
-            raise Failed(f"README.md:{block.content_line(offset)}: `{cmd}` is not one `make TARGET`")
-        out = make_dry_run(ctx, words[1])
-        for m in check.mentions.get(words[1], ()):
+        variables = words[1:-1]
+        if words[0] != "make" or len(words) < 2 or not all(re.fullmatch(r"[A-Z_]+=\S*", v) for v in variables):
+            raise Failed(f"{ctx.doc}:{block.content_line(offset)}: `{cmd}` is not one `make [VAR=VALUE...] TARGET`")
+        target = words[-1]
+        out = make_dry_run(ctx, target, variables)
+        for m in check.mentions.get(target, ()):
             if m not in out:
-                raise Failed(f"`make -n {words[1]}` does not mention {m!r}")
-        targets.append(words[1])
+                raise Failed(f"`make -n {' '.join(words[1:])}` does not mention {m!r}")
+        targets.append(" ".join(words[1:]))
     return "targets " + ", ".join(targets) + " exist (make -n)"
 
 
@@ -423,85 +435,234 @@ def prose_checks(ctx: Context, text: str, counts: Dict[str, int]) -> List[str]:
                 continue
             counts["options"] += 1
             if not option_in_help(ctx, tool, opt):
-                problems.append(f"README.md:{n}: `{span}`: {opt} is not in `{tool} --help`")
+                problems.append(f"{ctx.doc}:{n}: `{span}`: {opt} is not in `{tool} --help`")
     counts["targets"] = len(targets)
     for target, n in sorted(targets.items(), key=lambda kv: kv[1]):
         try:
             make_dry_run(ctx, target)
         except Failed as e:
-            problems.append(f"README.md:{n}: `make {target}`: {e}")
+            problems.append(f"{ctx.doc}:{n}: `make {target}`: {e}")
     return problems
+
+
+# --- CMake options, links and contents -----------------------------------------------------
+
+CMAKE_VAR = re.compile(r"(?:-D|cmake\.define\.)(VASCO_[A-Z0-9_]+)")
+
+
+def cmake_text(ctx: Context) -> str:
+    if not hasattr(ctx, "_cmake_text"):
+        files = [p for p in ctx.source.rglob("CMakeLists.txt")] + list(ctx.source.rglob("*.cmake"))
+        files = [p for p in files if not any(part.startswith("build") or part == ".git"
+                                             for part in p.relative_to(ctx.source).parts)]
+        ctx._cmake_text = "\n".join(p.read_text(errors="replace") for p in files)
+    return ctx._cmake_text
+
+
+def cmake_option_checks(ctx: Context, text: str, counts: Dict[str, int]) -> List[str]:
+    """Problems with the CMake variables the document sets (-DVASCO_X, cmake.define.VASCO_X,
+    in prose or blocks): each must be an option() or a cache variable of the project."""
+    problems = []
+    names: Dict[str, int] = {}
+    for n, ln in enumerate(text.splitlines(), 1):
+        for m in CMAKE_VAR.finditer(ln):
+            names.setdefault(m.group(1), n)
+    defined = cmake_text(ctx)
+    for name, n in names.items():
+        if not re.search(r"\b(option|set)\(\s*" + re.escape(name) + r"\b[^)]*(CACHE|\"|OFF|ON)", defined):
+            problems.append(f"{ctx.doc}:{n}: {name} is not an option or cache variable of the CMake project")
+    counts["cmake"] = len(names)
+    return problems
+
+
+def link_checks(ctx: Context, path: Path, text: str, counts: Dict[str, int]) -> List[str]:
+    """Problems with the document's relative links: the file must exist (inside the source
+    tree), and an #anchor must be a heading of that file (a Markdown file) or of this one."""
+    problems = []
+    n_links = 0
+    for n, label, target in readme_blocks.links(text):
+        if re.match(r"[a-z][a-z0-9+.-]*:", target, re.I):  # https:, mailto:, ...
+            continue
+        n_links += 1
+        rel, anchor = readme_blocks.split_target(target)
+        dest = (path.parent / rel).resolve() if rel else path
+        if rel and not dest.exists():
+            problems.append(f"{ctx.doc}:{n}: [{label}]({target}): {rel} does not exist")
+            continue
+        try:
+            dest.relative_to(ctx.source)
+        except ValueError:
+            problems.append(f"{ctx.doc}:{n}: [{label}]({target}) leads out of the source tree")
+            continue
+        if anchor is not None and dest.suffix == ".md":
+            if anchor not in readme_blocks.anchors(dest.read_text(encoding="utf-8")):
+                problems.append(f"{ctx.doc}:{n}: [{label}]({target}): no heading of "
+                                f"{readme_blocks.doc_name(dest, ctx.source)} has the anchor #{anchor}")
+    counts["links"] = n_links
+    return problems
+
+
+def tree_files(ctx: Context) -> List[str]:
+    """Every file and directory of the source tree (posix paths; build directories, .git and
+    caches left out)."""
+    if not hasattr(ctx, "_tree"):
+        out = []
+        for dirpath, dirnames, filenames in os.walk(ctx.source):
+            rel = Path(dirpath).relative_to(ctx.source)
+            dirnames[:] = [d for d in dirnames if not (d.startswith("build") or d.startswith(".") or d == "__pycache__")
+                           or rel.parts == () and d == ".ci"]
+            out += [(rel / n).as_posix() for n in dirnames + filenames]
+        ctx._tree = out
+    return ctx._tree
+
+
+def path_checks(ctx: Context, text: str, counts: Dict[str, int]) -> List[str]:
+    """Problems with the source paths the prose names in inline code: a span that is a path
+    (`a/b`, `a/b.h`, `a/`) starting at a top-level entry of the source tree must name a file
+    or directory there, or the end of one (`vasco_gpu/mapper.hpp` as an #include names it).
+    Placeholders (a part in capitals, as `src/NAME_backend.cc`) are left alone."""
+    problems = []
+    tops = {p.name for p in ctx.source.iterdir() if not p.name.startswith("build")}  # outputs
+    tree = None
+    n_paths = 0
+    for n, ln in readme_blocks.outside_fences(text):
+        for m in re.finditer(r"(`+)(.+?)\1", ln):
+            span = m.group(2).strip()
+            if not re.fullmatch(r"[\w.-]+(/[\w.-]+)+/?", span) or span.split("/")[0] not in tops:
+                continue
+            if re.search(r"(^|/|_)[A-Z]{3,}(_|\.|/|$)", span):
+                continue
+            n_paths += 1
+            if (ctx.source / span).exists():
+                continue
+            tree = tree or tree_files(ctx)
+            tail = "/" + span.rstrip("/")
+            if not any(f.endswith(tail) for f in tree):
+                problems.append(f"{ctx.doc}:{n}: `{span}` is not in the source tree")
+    counts["paths"] = n_paths
+    return problems
+
+
+def contents_checks(ctx: Context, text: str) -> List[str]:
+    """Problems with the document's contents list: the links to its own anchors between the
+    first heading and the first `##` heading must name every `##` heading."""
+    hs = readme_blocks.headings(text)
+    sections = [(n, h) for n, level, h in hs if level == 2]
+    if not sections:
+        return []
+    first_section = sections[0][0]
+    listed = {readme_blocks.split_target(t)[1] for n, _, t in readme_blocks.links(text)
+              if n < first_section and t.startswith("#")}
+    if not listed:
+        return [f"{ctx.doc}: no contents list (links to its `##` sections) before line {first_section}"]
+    anchors = readme_blocks.anchors(text)
+    by_line = {line: a for a, line in anchors.items()}
+    return [f"{ctx.doc}:{n}: the contents list does not link `## {h}` (#{by_line[n]})"
+            for n, h in sections if by_line[n] not in listed]
 
 
 # --- main ---------------------------------------------------------------------------------
 
 
+def check_document(ctx: Context, path: Path, report) -> int:
+    """Checks one document; returns its number of blocks."""
+    ctx.doc = readme_blocks.doc_name(path, ctx.source)
+    name = ctx.doc
+    text = path.read_text(encoding="utf-8")
+    blocks = readme_blocks.parse_blocks(text)
+    seen: Dict[str, int] = {}
+    for b in blocks:
+        key = b.key
+        if key in seen:
+            report(f"{name}:{b.line}", b.describe(), "FAILED",
+                   f"its key {key!r} is also the key of the block at line {seen[key]}: "
+                   "make the blocks' first lines differ")
+            continue
+        seen[key] = b.line
+        check = readme_checks.check_for(name, key)
+        if check is None:
+            report(f"{name}:{b.line}", "unknown block", "FAILED",
+                   f"{b.describe()} the docs test does not know: add a check for {key!r} "
+                   f"under {name!r} to tests/docs/readme_checks.py")
+            continue
+        problems = table_problems(check)
+        if problems:
+            report(f"{name}:{b.line}", check.kind, "FAILED", "; ".join(problems))
+            continue
+        try:
+            note = KINDS[check.kind](ctx, check, b)
+            report(f"{name}:{b.line}", check.kind, "skipped" if note.startswith("skipped: ") else "ok",
+                   note[len("skipped: "):] if note.startswith("skipped: ") else note)
+        except Failed as e:
+            report(f"{name}:{b.line}", check.kind, "FAILED", str(e))
+        except (OSError, subprocess.SubprocessError) as e:
+            report(f"{name}:{b.line}", check.kind, "FAILED", f"{type(e).__name__}: {e}")
+    for key in readme_checks.CHECKS.get(name, {}):
+        if key not in seen:
+            report(f"{name}:-", "stale entry", "FAILED",
+                   f"readme_checks.CHECKS[{name!r}] has {key!r}, which no block of {name} has any more: "
+                   "remove or update it")
+    counts: Dict[str, int] = {}
+    try:
+        problems = prose_checks(ctx, text, counts)
+    except Failed as e:
+        problems = [str(e)]
+    problems += cmake_option_checks(ctx, text, counts)
+    problems += path_checks(ctx, text, counts)
+    report(f"{name}:-", "prose (make targets, tool options, CMake options, source paths in inline code)",
+           "FAILED" if problems else "ok",
+           "\n  " + "\n  ".join(problems) if problems else
+           f"{counts.get('targets', 0)} make targets exist, {counts.get('options', 0)} options in the tools' "
+           f"--help, {counts.get('cmake', 0)} CMake options defined, {counts.get('paths', 0)} source paths there")
+    problems = link_checks(ctx, path, text, counts) + contents_checks(ctx, text)
+    report(f"{name}:-", "links and contents", "FAILED" if problems else "ok",
+           "\n  " + "\n  ".join(problems) if problems else
+           f"{counts.get('links', 0)} relative links lead somewhere; the contents list names every section")
+    return len(blocks)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--readme", required=True, help="README.md to check")
-    ap.add_argument("--source", required=True, help="the source tree (Makefile, logs/, tests/data)")
+    ap.add_argument("--readme", required=True, help="README.md to check (the docs/ of --source too)")
+    ap.add_argument("--source", required=True, help="the source tree (Makefile, logs/, tests/data, docs/)")
     ap.add_argument("--bin", required=True, help="the build's bin directory (log2map, mapconvert, mapdiff)")
     ap.add_argument("--cc", default=os.environ.get("CC", "cc"), help="C compiler of the compile checks")
     ap.add_argument("--cxx", default=os.environ.get("CXX", "c++"), help="C++ compiler of the compile checks")
+    ap.add_argument("--only", action="append", default=[],
+                    help="check only this document (a path; may be repeated); stale documents are not reported")
     ap.add_argument("--keep", action="store_true", help="keep the scratch directories")
     args = ap.parse_args(argv)
     ctx = Context(args)
-    name = ctx.readme.name
-    text = ctx.readme.read_text(encoding="utf-8")
-    blocks = readme_blocks.parse_blocks(text)
+    docs = readme_blocks.doc_files(ctx.source, ctx.readme)
+    if args.only:
+        only = {Path(o).resolve() for o in args.only}
+        docs = [d for d in docs if d.resolve() in only]
+        if len(docs) != len(only):
+            print(f"--only: not a document of the docs test: {sorted(str(o) for o in only - {d.resolve() for d in docs})}")
+            return 1
     results = {"ok": 0, "skipped": 0, "FAILED": 0}
 
-    def report(line, what, status, why):
+    def report(where, what, status, why):
         results[status] += 1
-        print(f"{name}:{line}: {what}: {status}" + (f": {why}" if why else ""), flush=True)
+        print(f"{where}: {what}: {status}" + (f": {why}" if why else ""), flush=True)
 
-    seen: Dict[str, int] = {}
+    n_blocks = 0
     try:
-        for b in blocks:
-            key = b.key
-            if key in seen:
-                report(b.line, b.describe(), "FAILED",
-                       f"its key {key!r} is also the key of the block at line {seen[key]}: "
-                       "make the blocks' first lines differ")
-                continue
-            seen[key] = b.line
-            check = readme_checks.check_for(key)
-            if check is None:
-                report(b.line, "unknown block", "FAILED",
-                       f"{b.describe()} the docs test does not know: add a check for {key!r} "
-                       "to tests/docs/readme_checks.py")
-                continue
-            problems = table_problems(check)
-            if problems:
-                report(b.line, check.kind, "FAILED", "; ".join(problems))
-                continue
-            try:
-                note = KINDS[check.kind](ctx, check, b)
-                report(b.line, check.kind, "skipped" if note.startswith("skipped: ") else "ok",
-                       note[len("skipped: "):] if note.startswith("skipped: ") else note)
-            except Failed as e:
-                report(b.line, check.kind, "FAILED", str(e))
-            except (OSError, subprocess.SubprocessError) as e:
-                report(b.line, check.kind, "FAILED", f"{type(e).__name__}: {e}")
-        for key in readme_checks.CHECKS:
-            if key not in seen:
-                report("-", "stale entry", "FAILED",
-                       f"readme_checks.CHECKS has {key!r}, which no block of {name} has any more: "
-                       "remove or update it")
-        counts: Dict[str, int] = {}
-        try:
-            problems = prose_checks(ctx, text, counts)
-        except Failed as e:
-            problems = [str(e)]
-        report("-", "prose (make targets, tool options in inline code)", "FAILED" if problems else "ok",
-               "\n  " + "\n  ".join(problems) if problems else
-               f"{counts.get('targets', 0)} make targets exist, {counts.get('options', 0)} options in the tools' --help")
+        for path in docs:
+            n_blocks += check_document(ctx, path, report)
+        if not args.only:
+            names = {readme_blocks.doc_name(d, ctx.source) for d in docs}
+            for doc in readme_checks.CHECKS:
+                if doc not in names:
+                    report(f"{doc}:-", "stale document", "FAILED",
+                           f"readme_checks.CHECKS has entries for {doc}, which the docs test does not walk "
+                           "(gone, or not under docs/): remove or move them")
     finally:
         if ctx.keep:
             print(f"scratch kept in {ctx.scratch_root}")
         else:
             shutil.rmtree(ctx.scratch_root, ignore_errors=True)
-    print(f"{name}: {len(blocks)} blocks: {results['ok']} ok, {results['skipped']} skipped, "
+    print(f"{len(docs)} documents, {n_blocks} blocks: {results['ok']} ok, {results['skipped']} skipped, "
           f"{results['FAILED']} failed")
     return 1 if results["FAILED"] else 0
 
