@@ -1,5 +1,5 @@
 // mapping_bench — the benchmark harness behind `make bench` (speed claims
-// are made only through it; see README "Performance").
+// are made only through it; see docs/performance.md).
 //
 // For each dataset (fr079-complete.gfs: 4791 x 360; fr101.carmen full rate:
 // 4758 x 360) and parameter set (paper: range_max 6.4 m at 2.5 cm, as in the
@@ -492,7 +492,7 @@ void print_table(const std::vector<Row> &rows) {
 }
 
 // The performance targets on fr079 (map phase), each met or missed by how much, and why a miss is what
-// it is (measured with Nsight Compute on an H200; see README "Performance").
+// it is (measured with Nsight Compute on an H200; see docs/performance.md, "History").
 struct Target {
   const char *params, *backend;
   double limit_ms;

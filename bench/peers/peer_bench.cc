@@ -493,7 +493,7 @@ void print_table(const std::vector<Row> &rows) {
 // as MRPT (one core) on every log and parameter set measured; a miss says by how much.
 constexpr double kTargetOverMrpt = 1.25;
 
-// Why a miss, as measured (README "Peers"): on fr079 / paper on the development machine cpu_float's render
+// Why a miss, as measured (docs/performance.md, "Peers"): on fr079 / paper on the development machine cpu_float's render
 // took ~182 ms, of it ~117 in the walk loops (0.72 ns an update: 6 to 8 instructions and the loops' exits), ~39
 // in the beams' set-up (23 ns a beam: the fixed-point frame's two 64-bit divisions and square root, the
 // searches for the run ends) and ~26 in the rest (placement, the reach box, the merge). MRPT does less work:
@@ -501,7 +501,7 @@ constexpr double kTargetOverMrpt = 1.25;
 constexpr const char *kWhyMissed =
     "  why: cpu_float makes ~8% more updates than MRPT (CARMEN's 0.2 m wall behind every hit) at ~0.7 ns an "
     "update (6 to 8 instructions), plus ~23 ns a beam of set-up (the walk's frame, two 64-bit divisions, and the "
-    "searches for where its free, range_sure and stop runs end); README \"Peers\" lists what was tried\n";
+    "searches for where its free, range_sure and stop runs end); docs/performance.md \"History\" lists what was tried\n";
 
 void print_target(const std::vector<Row> &rows) {
   bool header = false, missed = false;

@@ -71,7 +71,7 @@ int64_t grown_size(int need, int current) {
 }
 
 // What the session keeps in host memory at most, estimated before it is
-// allocated (DESIGN §8, the README's table of bytes a cell):
+// allocated (DESIGN §8, docs/performance.md, "Large sites: past 2^30 cells"):
 //  - per cell of the renderer's grid, what the renderer says it keeps in host
 //    memory (RendererTraits::host_bytes_per_cell: a host grid's 4-byte
 //    floats, cpu_float's 8-byte sums over the cells a call reaches; 0 for a

@@ -86,7 +86,7 @@ class CudaRenderer : public Renderer {
   // The grid as finish and read see it.
   virtual cuda::GridCells cells() const = 0;
   // Device memory the mode keeps per cell of its grid at most (the grid and
-  // its per-cell scratch; the README's table of bytes a cell).
+  // its per-cell scratch; docs/performance.md, "Large sites: past 2^30 cells").
   virtual double device_bytes_per_cell() const = 0;
 
   // Grows the grid to `cells` (dropping its contents), refused first by

@@ -57,7 +57,7 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     """Reads a ROS 1 ``.bag``, a ROS 2 bag (sqlite3 or MCAP) or an ``.mcap`` into a :class:`Log`.
 
     Scans are the ``sensor_msgs/LaserScan`` messages of ``scan_topic`` (default: the only such
-    topic), ranges mapped to CARMEN's semantics by REP 117 (see the README's table;
+    topic), ranges mapped to CARMEN's semantics by REP 117 (see docs/bags-and-poses.md, "REP 117 ranges, in CARMEN's terms";
     ``no_return='free'`` makes +inf clear free space). The laser pose at each scan's stamp comes
     from ``/tf`` + ``/tf_static`` (the chain from ``fixed_frame``, default ``map``, to the scan's
     frame, interpolated in time), or from ``pose_topic`` (Odometry, PoseStamped,
