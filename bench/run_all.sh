@@ -4,7 +4,8 @@
 # another) under a header: date, machine, GPU, commit. The docs' performance
 # tables are quoted from such a file (docs/performance.md names it), never
 # copied by hand.
-#   bench/run_all.sh BUILD_DIR [STEP...]   (steps: parse oracle mapping large scaling session batch)
+#   bench/run_all.sh BUILD_DIR [STEP...]   (BUILD_DIR absolute or from the repository root;
+#                                          steps: parse oracle mapping large scaling session batch)
 # COST_MODEL_OUT=FILE: batch_bench also writes auto's measured constants there
 # (vasco_gpu/app/backend_cost_model.txt is such a file); BATCH_ARGS: more of
 # batch_bench's options; BENCH_COMMIT: the commit to name where the tree is
@@ -14,6 +15,7 @@ build=${1:?usage: bench/run_all.sh BUILD_DIR [STEP...]}
 shift
 steps=${*:-parse oracle mapping large scaling session batch}
 root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"  # the steps' paths are the repository's
 out=${BENCH_OUT:-$root/bench/results/bench-$(date -u +%Y-%m-%d).txt}
 mkdir -p "$(dirname "$out")"
 tmp=$(mktemp "$out.XXXXXX")
@@ -38,7 +40,7 @@ for step in $steps; do
     large) run "$build/bin/mapping_bench" --large ;;
     scaling) run "$build/bin/mapping_bench" --thread-scaling ;;
     session) run "$build/bin/session_bench" ;;
-    batch) run python3 "$root/bench/batch_bench.py" --bin "$build/bin" ${BATCH_ARGS:-} \
+    batch) run python3 bench/batch_bench.py --bin "$build/bin" ${BATCH_ARGS:-} \
              ${COST_MODEL_OUT:+--cost-model-out "$COST_MODEL_OUT"} ;;
     *) echo "bench/run_all.sh: unknown step '$step'" >&2; exit 2 ;;
   esac
