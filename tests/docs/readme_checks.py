@@ -31,6 +31,9 @@ Kinds of check:
   layout       the Layout tree: every directory and file it names must exist.
   python       a Python block: python/tests/test_readme.py runs it (fixture, substitutions
                `subs` stated here, `outputs` must exist afterwards); skipped by the docs test.
+  quoted       a benchmark's output quoted from a results file: the block's lines must be a
+               run of consecutive lines of `quote_of` (a file of bench/results/, made by one
+               bench/run_all.sh run under a header naming its date, machine and commit).
   skip         not checked: `reason` says why.
 """
 
@@ -67,6 +70,7 @@ class Check:
     alternatives: Sequence[Tuple[str, str]] = ()
     subs: Sequence[Tuple[str, str]] = ()
     needs: Sequence[str] = ()  # Python modules a python check needs (skipped without them)
+    quote_of: str = ""  # quoted: the results file the block comes from
 
 
 # ---------------------------------------------------------------------------------------
@@ -224,6 +228,9 @@ FIXTURES: Dict[str, Callable[[Path, Path, Path], None]] = {
 # ---------------------------------------------------------------------------------------
 # The table: document -> block key -> check.
 
+# The bench run docs/performance.md quotes.
+BENCH_RUN = "bench/results/bench-2026-12-04-h200.txt"
+
 CHECKS: Dict[str, Dict[str, Check]] = {
     "README.md": {
         # Quick start.
@@ -317,6 +324,17 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "covered-by",
             files=[("tests/CMakeLists.txt", ["docs/readme_test.py", "--readme ${VASCO_SOURCE_DIR}/README.md",
                                              "--source ${VASCO_SOURCE_DIR}", "--bin ${CMAKE_BINARY_DIR}/bin"])]),
+    },
+    "docs/performance.md": {
+        key: Check("quoted", quote_of=BENCH_RUN) for key in (
+            "text: vasco_gpu mapping_bench: median of 5 runs after a warm-up; t",
+            "text: Ablation of the paper's kernel (float, no lost updates), map",
+            "text: file MB messages median s MB/s",
+            "text: fr079, vasco defaults, median of 5 runs (one core):",
+            "text: log2map end to end (process start to .map.gz written), fr079",
+            "text: Mapping session (vasco defaults; re-render = new poses in ho",
+            "text: batch_bench: 120 copies of fr079-complete.gfs.log.gz, output",
+        )
     },
     "docs/python.md": {
         "sh: pip install .": Check(

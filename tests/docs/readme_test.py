@@ -351,6 +351,34 @@ def do_python(ctx: Context, check: Check, block: Block) -> str:
     return "skipped: " + readme_checks.PY_RUNS_IT
 
 
+def do_quoted(ctx: Context, check: Check, block: Block) -> str:
+    source = ctx.source / check.quote_of
+    if not source.is_file():
+        raise Failed(f"{check.quote_of} is not there")
+    lines = [line.rstrip() for line in source.read_text(errors="replace").splitlines()]
+    want = [line.rstrip() for line in block.text.splitlines()]
+    if not lines[0].startswith("# vasco_gpu benchmarks:") or not any(l.startswith("# commit:") for l in lines[:6]):
+        raise Failed(f"{check.quote_of} lacks bench/run_all.sh's header (date, machine, commit)")
+    if not want or not any(lines[i:i + len(want)] == want for i in range(len(lines) - len(want) + 1)):
+        raise Failed(f"the block is not a run of lines of {check.quote_of}: quote the run, do not edit it")
+    return f"{len(want)} lines quoted from {check.quote_of}"
+
+
+def hand_table_checks(ctx: Context, text: str) -> List[str]:
+    """docs/performance.md: figures of the current run are quoted blocks; a Markdown table is
+    allowed only under its dated sections (Earlier runs, History)."""
+    if ctx.doc != "docs/performance.md":
+        return []
+    problems, dated, fenced = [], False, False
+    for n, line in enumerate(text.splitlines(), 1):
+        fenced = fenced != line.startswith("```")
+        if line.startswith("## "):
+            dated = line[3:].strip() in ("Earlier runs", "History")
+        if line.startswith("|") and not dated and not fenced:
+            problems.append(f"line {n}: a table typed by hand above 'Earlier runs': quote the bench run instead")
+    return problems
+
+
 def do_skip(ctx: Context, check: Check, block: Block) -> str:
     return "skipped: " + check.reason
 
@@ -358,6 +386,7 @@ def do_skip(ctx: Context, check: Check, block: Block) -> str:
 KINDS = {
     "run": do_run, "make-target": do_make_target, "compile": do_compile, "covered-by": do_covered_by,
     "synopsis": do_synopsis, "output": do_output, "layout": do_layout, "python": do_python, "skip": do_skip,
+    "quoted": do_quoted,
 }
 
 
@@ -609,6 +638,7 @@ def check_document(ctx: Context, path: Path, report) -> int:
         problems = [str(e)]
     problems += cmake_option_checks(ctx, text, counts)
     problems += path_checks(ctx, text, counts)
+    problems += hand_table_checks(ctx, text)
     report(f"{name}:-", "prose (make targets, tool options, CMake options, source paths in inline code)",
            "FAILED" if problems else "ok",
            "\n  " + "\n  ".join(problems) if problems else

@@ -1,7 +1,9 @@
 // map_format.h — the map formats, one table: which extension is which
 // format, and how each is read and written (Open3D's t/io extension tables
-// are the model). Adding a format is one row in map_format.cc and its reader
-// and writer.
+// are the model). Adding a format is a MapFormat value here, one row in
+// map_format.cc (and a case in map_output_files for a format of several
+// files) and its reader and writer; every tool, binding and batch reads the
+// table (docs/contributing.md walks it).
 //
 // The rule (file_names.h): the extension decides, compared without regard to
 // ASCII case, so "x.PNG" is a PNG and "x.Map.Gz" a gzipped CARMEN map. Every
