@@ -31,8 +31,10 @@ all: configure
 configure: deps
 	@$(call configure_in,$(BUILD),$(CONFIGURE_ARGS))
 
+# After the suite, each test that skipped and the reason it gave (tests/skipped_report.py).
 test: all
-	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow; rc=$$?; \
+	  python3 $(CURDIR)/tests/skipped_report.py $(abspath $(BUILD)) || true; exit $$rc
 
 # Installs headers, static and shared libraries (also under CARMEN's names libegrid,
 # libmap_io, libreadlog), tools, the CMake package, vasco_gpu.pc (shared) and
