@@ -8,6 +8,7 @@
 // Exit status: 0 ok, 1 a file could not be read or written (the message
 // names it), 2 usage error.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -30,26 +31,23 @@
 
 namespace {
 
-const char kUsage[] =
+const char kUsageHead[] =
     "Usage: mapconvert [-q] [--mode trinary|scale|raw] [--free-thresh F] [--occupied-thresh O]\n"
     "                  [--negate] IN OUT\n"
     "   or: mapconvert --info IN\n"
     "   or: mapconvert --version\n"
     "\n"
-    "Converts the map IN to OUT, each in the format its extension says:\n"
-    "  .map       CARMEN map (from a CARMEN map: every chunk it reads; HMAP, unknown\n"
-    "             and repeated chunks are dropped, with a note)\n"
-    "  .map.gz    CARMEN map, gzip-compressed\n"
-    "  .pgm       ROS map_server / nav2 PGM image, with a .yaml beside it (origin from\n"
-    "             the map's OFFSET chunk, else 0 0 0)\n"
-    "  .png+yaml  the same pair with a PNG: OUT x.png+yaml writes x.png and x.yaml\n"
-    "             (in scale mode unknown cells are transparent; a PGM cannot say\n"
-    "             unknown in scale mode: it gets grey 205, which map_server reads\n"
-    "             as occupancy 0.196)\n"
-    "  .yaml      map_server YAML: as IN, the map it describes (its image, PGM or\n"
-    "             PNG, read the way map_server reads it); as OUT, x.yaml and x.pgm\n"
-    "  .png       picture for people (black occupied, white free, grey in between,\n"
-    "             unknown grey-green #708986); not an input (no resolution or origin)\n"
+    "Converts the map IN to OUT, each in the format its extension says (any case):\n";
+
+const char kUsageTail[] =
+    "A CARMEN map is copied whole (every chunk it reads; HMAP, unknown and repeated\n"
+    "chunks are dropped, with a note); a map_server pair gets the map's OFFSET\n"
+    "chunk as its origin (else 0 0 0); in scale mode a .png+yaml's unknown cells are\n"
+    "transparent, while a PGM cannot say unknown in scale mode: it gets grey 205,\n"
+    "which map_server reads as occupancy 0.196. A .yaml IN is the map it describes\n"
+    "(its image, PGM or PNG, read the way map_server reads it); a .png is a picture\n"
+    "(black occupied, white free, grey in between, unknown grey-green #708986), not\n"
+    "an input: it holds no resolution or origin.\n"
     "Options of the map_server outputs (.pgm, .png+yaml, .yaml), written to the YAML:\n"
     "  --mode M             trinary (default), scale or raw grey levels\n"
     "  --free-thresh F      p below F is free (default 0.196, what ROS 1's map_saver\n"
@@ -63,8 +61,22 @@ const char kUsage[] =
     "\n"
     "Exit status: 0 ok, 1 a file could not be read or written, 2 usage error.\n";
 
+// The usage text: its list of formats is the map-format table's.
+const std::string &usage() {
+  static const std::string text = [] {
+    std::string t = kUsageHead;
+    for (const carmen::MapFormatEntry &f : carmen::map_formats()) {
+      std::string ext = f.extension;
+      ext.resize(std::max<size_t>(ext.size(), 11), ' ');
+      t += "  " + ext + f.what + "\n";
+    }
+    return t + kUsageTail;
+  }();
+  return text;
+}
+
 int usage_error(const std::string &msg) {
-  std::fprintf(stderr, "mapconvert: %s\n%s", msg.c_str(), kUsage);
+  std::fprintf(stderr, "mapconvert: %s\n%s", msg.c_str(), usage().c_str());
   return 2;
 }
 
@@ -172,10 +184,10 @@ bool parse_threshold(const std::string &text, double *out) {
 
 // Parses argv into *a with CLI11 (the tools' one way to read a command line);
 // returns 0, or usage_error's code. The options' values are checked here, in
-// mapconvert's words; --help prints kUsage.
+// mapconvert's words; --help prints usage().
 int parse_args(int argc, char **argv, Args *a) {
   CLI::App app{"mapconvert", "mapconvert"};
-  app.set_help_flag();  // kUsage is the help
+  app.set_help_flag();  // usage() is the help
   app.allow_extras(false);
   std::string mode, free_thresh, occupied_thresh;
   app.add_flag("--help,-h", a->help);
@@ -309,7 +321,7 @@ int main(int argc, char **argv) {
   Args a;
   if (const int rc = parse_args(argc, argv, &a)) return rc;
   if (a.help) {
-    std::fputs(kUsage, stdout);
+    std::fputs(usage().c_str(), stdout);
     return 0;
   }
   if (a.version) {
