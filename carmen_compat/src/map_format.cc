@@ -108,20 +108,38 @@ void write_png_file(OutputTransaction &tx, const std::string &path, const MapToW
   write_png(tx.add(path), m.grid);
 }
 
+
+// The files of the map_server pairs, besides the path itself.
+std::vector<std::string> pgm_files(const std::string &path) { return {path, yaml_path_for(path)}; }
+std::vector<std::string> png_pair_files(const std::string &path) {
+  return {png_of_pair(path), yaml_path_for(png_of_pair(path))};
+}
+std::vector<std::string> yaml_files_written(const std::string &path) { return {path, pgm_of_yaml(path)}; }
+std::vector<std::string> yaml_files_read(const std::string &path) {
+  try {
+    return {path, map_server_image_of(path)};
+  } catch (const FileError &) {
+    return {path};  // reading it will say what is wrong
+  }
+}
+
 }  // namespace
 
+// {extension, what, kind, read, write, files written, files read, the name
+// other code tells it apart by}
 const std::vector<MapFormatEntry> &map_formats() {
   static const std::vector<MapFormatEntry> formats = {
-      {MapFormat::CarmenMap, ".map", "CARMEN map", MapFormatKind::Carmen, read_carmen, write_carmen},
-      {MapFormat::CarmenMapGz, ".map.gz", "CARMEN map, gzipped", MapFormatKind::Carmen, read_carmen, write_carmen},
-      {MapFormat::PgmYaml, ".pgm", "ROS map_server / nav2 PGM image with a .yaml beside it",
-       MapFormatKind::MapServer, read_pgm, write_pgm},
-      {MapFormat::PngYaml, ".png+yaml", "ROS map_server / nav2 pair NAME.png + NAME.yaml",
-       MapFormatKind::MapServer, read_png_pair,
-       write_png_pair},
-      {MapFormat::Yaml, ".yaml", "ROS map_server YAML (read: the image it names; written: with NAME.pgm)",
-       MapFormatKind::MapServer, read_yaml, write_yaml},
-      {MapFormat::Png, ".png", "picture for people (RGB)", MapFormatKind::Picture, read_png_file, write_png_file},
+      {".map", "CARMEN map", MapFormatKind::Carmen, read_carmen, write_carmen, nullptr, nullptr, MapFormat::CarmenMap},
+      {".map.gz", "CARMEN map, gzipped", MapFormatKind::Carmen, read_carmen, write_carmen, nullptr, nullptr,
+       MapFormat::CarmenMapGz},
+      {".pgm", "ROS map_server / nav2 PGM image with a .yaml beside it", MapFormatKind::MapServer, read_pgm,
+       write_pgm, pgm_files, pgm_files, MapFormat::PgmYaml},
+      {".png+yaml", "ROS map_server / nav2 pair NAME.png + NAME.yaml", MapFormatKind::MapServer, read_png_pair,
+       write_png_pair, png_pair_files, png_pair_files, MapFormat::PngYaml},
+      {".yaml", "ROS map_server YAML (read: the image it names; written: with NAME.pgm)", MapFormatKind::MapServer,
+       read_yaml, write_yaml, yaml_files_written, yaml_files_read, MapFormat::Yaml},
+      {".png", "picture for people (RGB)", MapFormatKind::Picture, read_png_file, write_png_file, nullptr, nullptr,
+       MapFormat::Png},
   };
   return formats;
 }
@@ -164,21 +182,13 @@ const MapFormatEntry &map_format_of(const std::string &path) {
 }
 
 std::vector<std::string> map_output_files(const std::string &path) {
-  switch (map_format_of(path).format) {
-    case MapFormat::PgmYaml: return {path, yaml_path_for(path)};
-    case MapFormat::PngYaml: return {png_of_pair(path), yaml_path_for(png_of_pair(path))};
-    case MapFormat::Yaml: return {path, pgm_of_yaml(path)};
-    default: return {path};
-  }
+  const MapFormatEntry &f = map_format_of(path);
+  return f.files_written != nullptr ? f.files_written(path) : std::vector<std::string>{path};
 }
 
 std::vector<std::string> map_input_files(const std::string &path) {
-  if (map_format_of(path).format != MapFormat::Yaml) return map_output_files(path);
-  try {
-    return {path, map_server_image_of(path)};
-  } catch (const FileError &) {
-    return {path};  // reading it will say what is wrong
-  }
+  const MapFormatEntry &f = map_format_of(path);
+  return f.files_read != nullptr ? f.files_read(path) : std::vector<std::string>{path};
 }
 
 MapServerOptions map_server_options_of(const MapToWrite &m) {

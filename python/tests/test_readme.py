@@ -217,7 +217,7 @@ def tool_dir(d: Path) -> Path:
             script.symlink_to(exe)
         else:
             script.write_text(f"#!/bin/sh\nexec '{sys.executable}' -c "
-                              f"'import sys; from vasco_gpu._bags import {entry}; sys.exit({entry}())' \"$@\"\n")
+                              f"'import sys; from vasco_gpu.bags.cli import {entry}; sys.exit({entry}())' \"$@\"\n")
             script.chmod(0o755)
     log2map = find_log2map()
     if log2map is not None:

@@ -1,9 +1,9 @@
 // map_format.h — the map formats, one table: which extension is which
 // format, and how each is read and written (Open3D's t/io extension tables
-// are the model). Adding a format is a MapFormat value here, one row in
-// map_format.cc (and a case in map_output_files for a format of several
-// files) and its reader and writer; every tool, binding and batch reads the
-// table (docs/contributing.md walks it).
+// are the model). Adding a format is one row in map_format.cc and its reader
+// and writer (in a file of their own, declared in map_format.cc beside the
+// row); every tool, binding and batch reads the table (docs/contributing.md
+// walks it).
 //
 // The rule (file_names.h): the extension decides, compared without regard to
 // ASCII case, so "x.PNG" is a PNG and "x.Map.Gz" a gzipped CARMEN map. Every
@@ -33,7 +33,10 @@
 
 namespace carmen {
 
-enum class MapFormat { CarmenMap, CarmenMapGz, PgmYaml, PngYaml, Yaml, Png };
+// The formats other code tells apart by name. A format added later needs no
+// value here: its row says MapFormat::Other (the default) and is known by
+// its extension.
+enum class MapFormat { CarmenMap, CarmenMapGz, PgmYaml, PngYaml, Yaml, Png, Other };
 
 // Everything a writer needs, for every format.
 struct MapToWrite {
@@ -69,12 +72,16 @@ enum class MapFormatKind {
 };
 
 struct MapFormatEntry {
-  MapFormat format;
   const char *extension;  // lower case, with the dot: ".map.gz"
   const char *what;       // for help texts
   MapFormatKind kind;
   MapRead (*read)(const std::string &path);
   void (*write)(OutputTransaction &tx, const std::string &path, const MapToWrite &map);
+  // Every file writing `path` creates, and every file reading it reads, for a
+  // format of several files (a map_server pair); nullptr: the path alone.
+  std::vector<std::string> (*files_written)(const std::string &path) = nullptr;
+  std::vector<std::string> (*files_read)(const std::string &path) = nullptr;
+  MapFormat format = MapFormat::Other;
 };
 
 // Every format, in the order help texts list them.
