@@ -168,6 +168,12 @@ static void errors(const vasco_mapper_params *p) {
   double bad_pose[3] = {0, NAN, 0};
   CHECK(vasco_mapper_insert(m, 1, bad_pose, counts, ranges, firsts, steps) == VASCO_ERR_INVALID_ARGUMENT, "NaN pose");
   CHECK(strstr(vasco_last_error(m), "scan 0") != NULL, "message: %s", vasco_last_error(m));
+  double nan_first[1] = {NAN}, inf_step[1] = {INFINITY}, pose0[3] = {0, 0, 0};
+  CHECK(vasco_mapper_insert(m, 1, pose0, counts, ranges, nan_first, steps) == VASCO_ERR_INVALID_ARGUMENT,
+        "NaN first angle");
+  CHECK(strstr(vasco_last_error(m), "angle") != NULL, "message: %s", vasco_last_error(m));
+  CHECK(vasco_mapper_insert(m, 1, pose0, counts, ranges, firsts, inf_step) == VASCO_ERR_INVALID_ARGUMENT,
+        "inf angle step");
   double moved[NUM_SCANS * 3];
   memcpy(moved, poses, sizeof moved);
   moved[3 * 7 + 2] = INFINITY;

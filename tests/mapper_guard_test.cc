@@ -284,6 +284,10 @@ TEST(MapperGuard, BatchesWhoseArraysDisagreeAreRefusedNamingTheScan) {
   expect_refused([](ScanBatch &b) { b.x[1] = std::nan(""); }, "scan 1", false);
   expect_refused([](ScanBatch &b) { b.theta[2] = INFINITY; }, "scan 2", false);
   expect_refused([](ScanBatch &b) { b.y[0] = -INFINITY; }, "scan 0", false);
+  // A non-finite beam angle was mapped (the map doubled in width): refused like a pose.
+  expect_refused([](ScanBatch &b) { b.first_angle[1] = std::nan(""); }, "scan 1: the first beam's angle", false);
+  expect_refused([](ScanBatch &b) { b.angle_step[2] = INFINITY; }, "scan 2: the angle step", false);
+  expect_refused([](ScanBatch &b) { b.first_angle[0] = -INFINITY; }, "scan 0", false);
   EXPECT_EQ(code_of([] { drive(2, 0.1).checked_ranges_of(2); }), ErrorCode::Usage);
 }
 

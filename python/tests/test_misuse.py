@@ -84,6 +84,18 @@ def test_whole_beam_counts_of_any_dtype_are_accepted():
         np.testing.assert_array_equal(s.beam_counts, [181, 181])
 
 
+@pytest.mark.parametrize("first, step", [(float("nan"), np.pi / 180), (-np.pi / 2, float("inf")),
+                                          (float("-inf"), np.pi / 180)])
+def test_non_finite_beam_angles_are_refused_by_insert(first, step):
+    # A NaN or infinite angle was mapped (399-568 cells changed, the map twice as wide): refused,
+    # naming the scan, and the session keeps nothing of the call.
+    s = vg.Scans(np.zeros((2, 3)), np.full(362, 2.0, np.float32), [181, 181], first, step)
+    m = vg.Mapper()
+    with pytest.raises(vg.BadInputError, match="scan 0: the (first beam's angle|angle step) is not finite"):
+        m.insert(s)
+    assert len(m) == 0
+
+
 # ---- Mapper: threads, the GIL and Ctrl-C ----
 
 @pytest.mark.parametrize("threads", [1025, 3000, 2**31 - 1, -1])

@@ -72,9 +72,14 @@ void ScanBatch::validate() const {
 
 void ScanBatch::validate_for_mapping() const {
   validate();
-  for (size_t s = 0; s < num_scans(); ++s)
+  for (size_t s = 0; s < num_scans(); ++s) {
     if (!std::isfinite(x[s]) || !std::isfinite(y[s]) || !std::isfinite(theta[s]))
       bad_scan(s, "the pose is not finite");
+    // A NaN or infinite beam angle places every beam of the scan nowhere (or
+    // at a wrapped angle): refused where it enters, as a pose is.
+    if (!std::isfinite(first_angle[s])) bad_scan(s, "the first beam's angle is not finite");
+    if (!std::isfinite(angle_step[s])) bad_scan(s, "the angle step is not finite");
+  }
 }
 
 const float *ScanBatch::checked_ranges_of(size_t s) const {

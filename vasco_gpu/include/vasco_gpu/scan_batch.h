@@ -37,8 +37,9 @@ struct ScanBatch {
   // long, starting at 0, never decreasing, ending at num_beams(), and every
   // scan's beam count an int.
   void validate() const;
-  // validate(), then every pose (x, y, theta) finite: Error(BadInput) naming
-  // the first bad pose. What a mapping session accepts.
+  // validate(), then every pose (x, y, theta), first angle and angle step
+  // finite: Error(BadInput) naming the first bad scan. What a mapping session
+  // accepts.
   void validate_for_mapping() const;
   // Scan s's ranges after checking s and its offsets (for bindings that hand
   // out one scan): Error(Usage) for s out of range, else as validate().
