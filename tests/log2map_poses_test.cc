@@ -4,6 +4,7 @@
 // route a user without these options would take.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -153,19 +154,22 @@ TEST_F(Log2MapPoses, TumPosesByTimestampAgreeUpToTheQuaternionsRounding) {
 
 TEST_F(Log2MapPoses, AScanWithoutAPoseIsNamedOrSkippedWhenAsked) {
   // Poses for every other scan only, by timestamp: scan 1 falls between two
-  // poses 2 scans apart (intel's scans are ~0.2 s apart: beyond 0.1 s).
+  // poses 2 scans apart, more than 0.01 s; with no tolerance, no odd scan
+  // takes a neighbour's pose (two are within 0.01 s of one).
   std::string tum;
   for (size_t i = 0; i < moved_.size(); i += 2)
     tum += g17(moved_[i].stamp()) + " " + g17(moved_[i].get(0)) + " " + g17(moved_[i].get(1)) + " 0 0 0 0 1\n";
   maptest::write_bytes(dir_.file("sparse.txt"), tum);
-  const ToolRun bad = log2map({"--poses", dir_.file("sparse.txt"), "--pose-tolerance", "0.01", kIntel, dir_.file("x.map")});
+  const ToolRun bad = log2map({"--poses", dir_.file("sparse.txt"), "--pose-max-gap", "0.01", "--pose-tolerance", "0",
+                               kIntel, dir_.file("x.map")});
   EXPECT_EQ(bad.status, 1) << bad.output;
   EXPECT_TRUE(contains(bad.output, "sparse.txt")) << bad.output;
   EXPECT_TRUE(contains(bad.output, "scan 1")) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "more than --pose-max-gap 0.01")) << bad.output;
   EXPECT_FALSE(maptest::file_exists(dir_.file("x.map")));
 
-  const ToolRun skip = log2map({"--json", "--poses", dir_.file("sparse.txt"), "--pose-tolerance", "0.01",
-                                "--skip-unposed", kIntel, dir_.file("x.map")});
+  const ToolRun skip = log2map({"--json", "--poses", dir_.file("sparse.txt"), "--pose-max-gap", "0.01",
+                                "--pose-tolerance", "0", "--skip-unposed", kIntel, dir_.file("x.map")});
   ASSERT_EQ(skip.status, 0) << skip.output;
   EXPECT_TRUE(contains(skip.output, "\"posed_from_file\":455")) << skip.output;
   EXPECT_TRUE(contains(skip.output, "\"unposed_skipped\":455")) << skip.output;
@@ -173,6 +177,8 @@ TEST_F(Log2MapPoses, AScanWithoutAPoseIsNamedOrSkippedWhenAsked) {
 
 TEST_F(Log2MapPoses, BadPoseOptionsAreUsageErrors) {
   EXPECT_EQ(log2map({"--pose-tolerance", "0.5", kIntel, dir_.file("x.map")}).status, 2);
+  EXPECT_EQ(log2map({"--pose-max-gap", "2", kIntel, dir_.file("x.map")}).status, 2);  // without --poses
+  EXPECT_EQ(log2map({"--poses", "p.txt", "--pose-max-gap", "-1", kIntel, dir_.file("x.map")}).status, 2);
   EXPECT_EQ(log2map({"--poses", "p.txt", "--pose-match", "sideways", kIntel, dir_.file("x.map")}).status, 2);
   EXPECT_EQ(log2map({"--transform", "1,2", kIntel, dir_.file("x.map")}).status, 2);
   EXPECT_EQ(log2map({"--add", kIntel + "@1,2,nan", kIntel, dir_.file("x.map")}).status, 2);
@@ -296,6 +302,182 @@ TEST_F(Log2MapPoses, ASessionsTransformTakesItIntoTheSharedFrame) {
   r = log2map({"--backend", "cpu_double", dir_.file("shared.log"), dir_.file("shared.map")});
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(differing(gridmap_of(dir_.file("ab.map")), gridmap_of(dir_.file("shared.map"))), 0u);
+}
+
+// ---------------------------------------------------------------------------
+// Keyframes of a SLAM back end: a pose every 5th scan of fr101 (its scans are
+// 0.2 to 0.85 s apart, so the keyframes about a second), in a TUM file.
+
+const std::string kFr101 = std::string(VASCO_LOGS_DIR) + "/fr101.carmen.log.gz";
+constexpr size_t kKeyframeScans = 400;  // the first 400 scans: enough, and quick
+constexpr double kTwoPi = 6.283185307179586;
+
+// A log's lines up to its n-th FLASER line; FLASER lines split, the others
+// (PARAM, ODOM, RLASER, comments) kept as they are.
+struct LogLines {
+  std::vector<std::string> other;  // other[i]: the lines before scans[i] (and after the last, at the end)
+  std::vector<Flaser> scans;
+  std::string text() const {
+    std::string s;
+    for (size_t i = 0; i < scans.size(); ++i) s += other[i] + scans[i].text();
+    return s + other.back();
+  }
+};
+
+LogLines first_scans(const std::string &path, size_t n) {
+  std::istringstream in(maptest::gunzip_file(path));
+  LogLines log;
+  log.other.emplace_back();
+  for (std::string line; std::getline(in, line) && log.scans.size() < n;) {
+    if (line.rfind("FLASER ", 0) != 0) {
+      log.other.back() += line + "\n";
+      continue;
+    }
+    Flaser f;
+    std::istringstream ls(line);
+    for (std::string t; ls >> t;) f.tok.push_back(t);
+    log.scans.push_back(f);
+    log.other.emplace_back();
+  }
+  return log;
+}
+
+// The keyframes: every 5th scan and the last, their poses moved as an
+// optimizer might (headings wrapped into [-pi, pi], as a TUM yaw reads back).
+struct Keyframe {
+  size_t scan;
+  double stamp, x, y, theta;
+};
+
+std::vector<Keyframe> keyframes_of(const std::vector<Flaser> &scans) {
+  std::vector<Keyframe> k;
+  for (size_t i = 0; i < scans.size(); ++i) {
+    if (i % 5 != 0 && i + 1 != scans.size()) continue;
+    const double a = double(i);
+    k.push_back({i, scans[i].stamp(), scans[i].get(0) + 0.05 * std::sin(a), scans[i].get(1) - 0.03 * std::cos(a),
+                 std::remainder(scans[i].get(2) + 0.01 * std::sin(0.5 * a), kTwoPi)});
+  }
+  return k;
+}
+
+std::string tum_of(const std::vector<Keyframe> &keys) {
+  std::string tum = "# t x y z qx qy qz qw\n";
+  for (const Keyframe &k : keys)
+    tum += g17(k.stamp) + " " + g17(k.x) + " " + g17(k.y) + " 0 0 0 " + g17(std::sin(k.theta / 2)) + " " +
+           g17(std::cos(k.theta / 2)) + "\n";
+  return tum;
+}
+
+// What a scan between keyframes a and b should get, written out here:
+// u = (t - ta) / (tb - ta); x, y linear; theta by the shorter arc.
+void set_between(Flaser &f, const Keyframe &a, const Keyframe &b) {
+  const double u = (f.stamp() - a.stamp) / (b.stamp - a.stamp);
+  double d = std::remainder(b.theta - a.theta, kTwoPi);
+  if (d >= kTwoPi / 2) d -= kTwoPi;
+  f.set(0, a.x + u * (b.x - a.x));
+  f.set(1, a.y + u * (b.y - a.y));
+  f.set(2, a.theta + u * d);
+}
+
+class Log2MapKeyframes : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    log_ = first_scans(kFr101, kKeyframeScans);
+    ASSERT_EQ(log_.scans.size(), kKeyframeScans);
+    keys_ = keyframes_of(log_.scans);
+    maptest::write_bytes(dir_.file("fr101.log"), log_.text());
+    maptest::write_bytes(dir_.file("keyframes.txt"), tum_of(keys_));
+  }
+  TempDir dir_;
+  LogLines log_;
+  std::vector<Keyframe> keys_;
+};
+
+TEST_F(Log2MapKeyframes, AKeyframeASecondMapsWithTheDefaults) {
+  // The map of a log carrying the poses interpolated here.
+  LogLines want = log_;
+  size_t k = 0;
+  for (size_t i = 0; i < want.scans.size(); ++i) {
+    while (keys_[k + 1].scan < i) ++k;
+    if (keys_[k].scan == i || keys_[k + 1].scan == i) {
+      const Keyframe &key = keys_[k].scan == i ? keys_[k] : keys_[k + 1];
+      want.scans[i].set(0, key.x);
+      want.scans[i].set(1, key.y);
+      want.scans[i].set(2, key.theta);
+    } else {
+      set_between(want.scans[i], keys_[k], keys_[k + 1]);
+    }
+  }
+  maptest::write_bytes(dir_.file("want.log"), want.text());
+  ToolRun r = log2map({"--backend", "cpu_threads", "--quiet", dir_.file("want.log"), dir_.file("want.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = log2map({"--backend", "cpu_threads", "--json", "--poses", dir_.file("keyframes.txt"), dir_.file("fr101.log"),
+               dir_.file("got.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"posed_from_file\":" + std::to_string(kKeyframeScans))) << r.output;
+  // The keyframes' headings come back from the quaternions within a few
+  // ulps, and so do the interpolated ones: as with intel's TUM file above,
+  // at most 0.01% of the cells may differ.
+  const std::vector<float> want_map = gridmap_of(dir_.file("want.map"));
+  const std::vector<float> got = gridmap_of(dir_.file("got.map"));
+  ASSERT_EQ(got.size(), want_map.size());
+  EXPECT_LE(differing(got, want_map), want_map.size() / 10000);
+  // Not the map of the log's own poses: the file's were used.
+  r = log2map({"--backend", "cpu_threads", "--quiet", dir_.file("fr101.log"), dir_.file("own.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_GT(differing(gridmap_of(dir_.file("own.map")), want_map), want_map.size() / 10000);
+}
+
+// "%.6g": how the messages write a distance that is not close to its limit.
+std::string g6(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+TEST_F(Log2MapKeyframes, AGapOverTheLimitNamesTheDistances) {
+  const ToolRun r = log2map({"--poses", dir_.file("keyframes.txt"), "--pose-max-gap", "0.5", dir_.file("fr101.log"),
+                             dir_.file("x.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  // Scan 1 lies between the keyframes of scans 0 and 5, about a second apart.
+  const double t = log_.scans[1].stamp(), gap = keys_[1].stamp - keys_[0].stamp;
+  const double nearer = std::min(t - keys_[0].stamp, keys_[1].stamp - t);
+  ASSERT_GT(gap, 0.5);
+  ASSERT_GT(nearer, 0.1);
+  EXPECT_TRUE(contains(r.output, "keyframes.txt: no pose for")) << r.output;
+  EXPECT_TRUE(contains(r.output, "(scan 1, stamp ")) << r.output;
+  EXPECT_TRUE(contains(r.output, "are " + g6(gap) + " s apart, more than --pose-max-gap 0.5, and the nearer is " +
+                                     g6(nearer) + " s away, more than --pose-tolerance 0.1"))
+      << r.output;
+  EXPECT_FALSE(maptest::file_exists(dir_.file("x.map")));
+  const ToolRun any = log2map({"--backend", "cpu_threads", "--quiet", "--poses", dir_.file("keyframes.txt"),
+                               "--pose-max-gap", "inf", dir_.file("fr101.log"), dir_.file("x.map")});
+  EXPECT_EQ(any.status, 0) << any.output;
+}
+
+TEST_F(Log2MapKeyframes, ScansAfterTheLastPoseTakeItWithinTheTolerance) {
+  // The trajectory ends at scan 300's keyframe; scans 301 to 399 come after.
+  std::vector<Keyframe> cut(keys_.begin(), keys_.begin() + 61);
+  ASSERT_EQ(cut.back().scan, 300u);
+  maptest::write_bytes(dir_.file("cut.txt"), tum_of(cut));
+  const double after = log_.scans[301].stamp() - cut.back().stamp;  // 0.2 s or so: more than 0.1
+  ToolRun r = log2map({"--poses", dir_.file("cut.txt"), dir_.file("fr101.log"), dir_.file("x.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "(scan 301, stamp ")) << r.output;
+  ASSERT_GT(after, 0.1);
+  EXPECT_TRUE(contains(r.output, g6(after) + " s after the last pose (")) << r.output;
+  EXPECT_TRUE(contains(r.output, "), more than --pose-tolerance 0.1")) << r.output;
+  // Within the tolerance: every later scan takes the last pose, unchanged.
+  const double span = log_.scans.back().stamp() - cut.back().stamp;
+  r = log2map({"--backend", "cpu_threads", "--json", "--poses", dir_.file("cut.txt"), "--pose-tolerance",
+               g17(span), dir_.file("fr101.log"), dir_.file("within.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"posed_from_file\":" + std::to_string(kKeyframeScans))) << r.output;
+  // Just short of it, the last scan has none.
+  r = log2map({"--json", "--poses", dir_.file("cut.txt"), "--pose-tolerance", g17(span * (1 - 1e-9)),
+               "--skip-unposed", dir_.file("fr101.log"), dir_.file("short.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"unposed_skipped\":1")) << r.output;
 }
 
 }  // namespace

@@ -639,43 +639,129 @@ TEST(PoseMatch, TimestampShortestArcAcrossPi) {
   EXPECT_EQ(m.pose[3].theta, 1.0);
 }
 
-TEST(PoseMatch, TimestampToleranceIsInclusive) {
-  const PoseFile f = stamped_file({{10, {0, 0, 0}}, {10.5, {1, 0, 0}}});
+// Keyframes of a SLAM back end, one a second: every scan between two of
+// them is interpolated with the defaults, however far it is from both (the
+// old rule wanted both within --pose-tolerance, 0.1 s: none of these).
+TEST(PoseMatch, TimestampKeyframesASecondApartInterpolateWithTheDefaults) {
+  const PoseFile f = stamped_file({{100, {0, 0, 0.5}}, {101, {1, -2, 1.5}}, {102.5, {4, 1, -3}}});
+  const std::vector<double> stamps = {100.25, 100.5, 100.75, 101.5, 102.2};
+  const PoseMatch m = vasco::match_poses(f, stamps.size(), stamps, "intel.log", {}, PoseMatchOptions{});
+  EXPECT_EQ(m.matched, std::vector<uint8_t>(stamps.size(), 1));
+  EXPECT_EQ(m.interpolated, stamps.size());
+  EXPECT_EQ(m.nearest, 0u);
+  // Written out: u = (t - t0) / (t1 - t0); x = x0 + u (x1 - x0), theta by the shorter arc.
+  EXPECT_EQ(m.pose[0].x, 0.25);
+  EXPECT_EQ(m.pose[0].y, -0.5);
+  EXPECT_EQ(m.pose[0].theta, 0.75);
+  EXPECT_EQ(m.pose[1].x, 0.5);
+  EXPECT_EQ(m.pose[2].y, -1.5);
+  // 101.5: u = 1/3 between (1, -2, 1.5) and (4, 1, -3); -3 - 1.5 = -4.5 is
+  // 2 pi - 4.5 = 1.783 the short way.
+  EXPECT_NEAR(m.pose[3].x, 2, 1e-15);
+  EXPECT_NEAR(m.pose[3].y, -1, 1e-15);
+  EXPECT_NEAR(m.pose[3].theta, 1.5 + (2 * kPi - 4.5) / 3, 1e-15);
+  // 102.2: u = 0.8.
+  EXPECT_NEAR(m.pose[4].x, 1 + 0.8 * 3, 1e-14);
+  EXPECT_NEAR(m.pose[4].theta, 1.5 + 0.8 * (2 * kPi - 4.5), 1e-14);
+}
+
+TEST(PoseMatch, TimestampMaxGapIsInclusive) {
+  const PoseFile f = stamped_file({{10, {0, 0, 0}}, {12, {1, 0, 0}}});
   PoseMatchOptions o;
-  o.tolerance = 0.25;  // 10.25 is 0.25 from both, exactly
-  PoseMatch m = vasco::match_poses(f, 1, {10.25}, "", {}, o);
-  EXPECT_EQ(m.pose[0].x, 0.5);
-  o.tolerance = 0.125;
+  o.max_gap = 2;  // 10 .. 12 is 2 s, exactly
+  PoseMatch m = vasco::match_poses(f, 1, {11.5}, "", {}, o);
+  EXPECT_EQ(m.pose[0].x, 0.75);
+  EXPECT_EQ(m.interpolated, 1u);
+  o.max_gap = 1.5;
   o.skip_unmatched = true;
-  m = vasco::match_poses(f, 1, {10.25}, "", {}, o);
+  m = vasco::match_poses(f, 1, {11.5}, "", {}, o);
   EXPECT_EQ(m.matched[0], 0);
   EXPECT_EQ(m.unmatched, 1u);
-  o.tolerance = 0;  // exact stamps only
-  m = vasco::match_poses(f, 2, {10.5, 10.25}, "", {}, o);
+  o.max_gap = 0;  // no interpolation: exact stamps (and ends within the tolerance) only
+  m = vasco::match_poses(f, 3, {12, 11, 10.0625}, "", {}, o);
+  EXPECT_EQ(m.matched, std::vector<uint8_t>({1, 0, 1}));
+  EXPECT_EQ(m.nearest, 1u);
+  EXPECT_EQ(m.pose[2].x, 0);
+  o.max_gap = std::numeric_limits<double>::infinity();  // any gap
+  m = vasco::match_poses(f, 1, {11}, "", {}, o);
+  EXPECT_EQ(m.pose[0].x, 0.5);
+}
+
+// Before the first pose and after the last, a scan takes the end pose,
+// unchanged, when it is within the tolerance (inclusive); never extrapolated.
+TEST(PoseMatch, TimestampOutsideTheTrajectoryTakesTheEndPoseWithinTheTolerance) {
+  const PoseFile f = stamped_file({{10, {0.1, 1.0 / 3, -2.0 / 3}}, {11, {3, 20, 1}}});
+  PoseMatchOptions o;
+  o.tolerance = 0.25;
+  PoseMatch m = vasco::match_poses(f, 4, {9.75, 9.875, 11.125, 11.25}, "", {}, o);
+  EXPECT_EQ(m.matched, std::vector<uint8_t>({1, 1, 1, 1}));
+  EXPECT_EQ(m.nearest, 4u);
+  EXPECT_EQ(m.interpolated, 0u);
+  EXPECT_TRUE(same_bits(m.pose[0].x, 0.1));
+  EXPECT_TRUE(same_bits(m.pose[0].y, 1.0 / 3));
+  EXPECT_TRUE(same_bits(m.pose[1].theta, -2.0 / 3));
+  EXPECT_EQ(m.pose[2].y, 20);
+  EXPECT_EQ(m.pose[3].theta, 1);
+  o.tolerance = 0.125;
+  o.skip_unmatched = true;
+  m = vasco::match_poses(f, 4, {9.75, 9.875, 11.125, 11.25}, "", {}, o);
+  EXPECT_EQ(m.matched, std::vector<uint8_t>({0, 1, 1, 0}));
+  EXPECT_EQ(m.unmatched, 2u);
+  o.tolerance = 0;  // exact stamps only at the ends
+  m = vasco::match_poses(f, 2, {10, 9.999}, "", {}, o);
   EXPECT_EQ(m.matched, std::vector<uint8_t>({1, 0}));
 }
 
-TEST(PoseMatch, TimestampNoPoseErrors) {
+// A gap wider than max_gap is a hole in the trajectory: its sides are ends.
+TEST(PoseMatch, TimestampInAWideGapTakesTheNearerSideWithinTheTolerance) {
+  const PoseFile f = stamped_file({{10, {1, 0, 0}}, {20, {2, 0, 0}}});
+  PoseMatchOptions o;
+  o.skip_unmatched = true;
+  const PoseMatch m = vasco::match_poses(f, 4, {10.0625, 19.9375, 15, 10.25}, "", {}, o);
+  EXPECT_EQ(m.matched, std::vector<uint8_t>({1, 1, 0, 0}));
+  EXPECT_EQ(m.pose[0].x, 1);
+  EXPECT_EQ(m.pose[1].x, 2);
+  EXPECT_EQ(m.nearest, 2u);
+  EXPECT_EQ(m.interpolated, 0u);
+}
+
+TEST(PoseMatch, TimestampNoPoseErrorsStateTheDistances) {
   const PoseFile f = stamped_file({{1083.0, {}}, {1083.9, {}}, {1090.5, {}}});
   const std::vector<long> lines = {810, 811, 812, 813};
-  const auto no_pose = [&](double stamp, size_t scan) {
+  const auto no_pose = [&](double stamp, size_t scan, PoseMatchOptions o = PoseMatchOptions{}) {
     std::vector<double> stamps = {1083.0, 1083.0, 1083.0, 1083.0};
     stamps[scan] = stamp;
-    return error_of([&] { vasco::match_poses(f, 4, stamps, "intel.log", lines, PoseMatchOptions{}); },
-                    ErrorCode::BadInput);
+    return error_of([&] { vasco::match_poses(f, 4, stamps, "intel.log", lines, o); }, ErrorCode::BadInput);
   };
-  std::string what = no_pose(1083.25, 2);
-  EXPECT_CONTAINS(what, "traj.txt: no pose for intel.log line 812 (scan 2, stamp 1083.25): the nearest poses are at "
-                        "1083 and 1083.9, more than the tolerance 0.1 s away (--pose-tolerance)");
+  std::string what = no_pose(1087, 2);
+  EXPECT_CONTAINS(what, "traj.txt: no pose for intel.log line 812 (scan 2, stamp 1087): the poses around it (1083.9 "
+                        "and 1090.5) are 6.6 s apart, more than --pose-max-gap 5, and the nearer is 3.1 s away, more "
+                        "than --pose-tolerance 0.1");
   what = no_pose(1082.5, 1);
-  EXPECT_CONTAINS(what, "traj.txt: no pose for intel.log line 811 (scan 1, stamp 1082.5): before the first pose (1083)");
+  EXPECT_CONTAINS(what, "traj.txt: no pose for intel.log line 811 (scan 1, stamp 1082.5): 0.5 s before the first pose "
+                        "(1083), more than --pose-tolerance 0.1");
   what = no_pose(1090.75, 3);
-  EXPECT_CONTAINS(what, "traj.txt: no pose for intel.log line 813 (scan 3, stamp 1090.75): after the last pose (1090.5)");
+  EXPECT_CONTAINS(what, "traj.txt: no pose for intel.log line 813 (scan 3, stamp 1090.75): 0.25 s after the last pose "
+                        "(1090.5), more than --pose-tolerance 0.1");
+  PoseMatchOptions narrow;
+  narrow.max_gap = 0.5;
+  narrow.tolerance = 0.125;
+  what = no_pose(1083.25, 2, narrow);
+  EXPECT_CONTAINS(what, "(scan 2, stamp 1083.25): the poses around it (1083 and 1083.9) are 0.9 s apart, more than "
+                        "--pose-max-gap 0.5, and the nearer is 0.25 s away, more than --pose-tolerance 0.125");
   what = no_pose(std::numeric_limits<double>::quiet_NaN(), 0);  // a bag message without a stamp
   EXPECT_CONTAINS(what, "traj.txt: no pose for intel.log line 810 (scan 0, stamp nan): the scan has no timestamp");
   // Without a source or lines the scan is named by its index.
   what = error_of([&] { vasco::match_poses(f, 1, {2000}, "", {}, PoseMatchOptions{}); }, ErrorCode::BadInput);
-  EXPECT_CONTAINS(what, "traj.txt: no pose for scan 0, stamp 2000: after the last pose");
+  EXPECT_CONTAINS(what, "traj.txt: no pose for scan 0, stamp 2000: 909.5 s after the last pose");
+}
+
+// A distance just over its limit is never printed as the limit.
+TEST(PoseMatch, TimestampDistancesJustOverTheLimitShowTheirDigits) {
+  const PoseFile f = stamped_file({{10, {}}, {15.0000001, {}}});
+  const std::string what = error_of([&] { vasco::match_poses(f, 1, {12}, "", {}, PoseMatchOptions{}); },
+                                    ErrorCode::BadInput);
+  EXPECT_CONTAINS(what, "are 5.0000001 s apart, more than --pose-max-gap 5,");
 }
 
 TEST(PoseMatch, TimestampSkipUnmatchedCounts) {
@@ -683,7 +769,7 @@ TEST(PoseMatch, TimestampSkipUnmatchedCounts) {
   PoseMatchOptions o;
   o.skip_unmatched = true;
   o.tolerance = 0.5;
-  // before, exact, interpolated, in the 11..20 gap, exact, after.
+  // before, exact, interpolated, in the 11..20 gap (wider than 5 s), exact, after.
   const PoseMatch m = vasco::match_poses(f, 6, {9, 10, 10.5, 15, 20, 21}, "intel.log", {}, o);
   EXPECT_EQ(m.matched, std::vector<uint8_t>({0, 1, 1, 0, 1, 0}));
   EXPECT_EQ(m.unmatched, 3u);
@@ -705,6 +791,12 @@ TEST(PoseMatch, UsageErrors) {
     o.tolerance = bad;
     what = error_of([&] { vasco::match_poses(t, 1, {10}, "intel.log", {}, o); }, ErrorCode::Usage);
     EXPECT_CONTAINS(what, "tolerance");
+  }
+  for (double bad : {-0.5, std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::infinity()}) {
+    PoseMatchOptions o;
+    o.max_gap = bad;
+    what = error_of([&] { vasco::match_poses(t, 1, {10}, "intel.log", {}, o); }, ErrorCode::Usage);
+    EXPECT_CONTAINS(what, "--pose-max-gap");
   }
   PoseMatchOptions o = matching(PoseMatching::Id);
   o.id_map = {{0, 0}, {0, 1}};

@@ -51,8 +51,9 @@ vasco::Pose2 pose_triple(nb::handle h, const char *what) {
 }
 
 const std::set<std::string> &input_keywords() {
-  static const std::set<std::string> k = {"poses",     "pose_format", "pose_match",  "pose_tolerance", "pose_ids",
-                                          "skip_unposed", "pose_frame", "laser_mount", "transform",      "add"};
+  static const std::set<std::string> k = {"poses",        "pose_format", "pose_match",  "pose_tolerance",
+                                          "pose_max_gap", "pose_ids",    "skip_unposed", "pose_frame",
+                                          "laser_mount",  "transform",   "add"};
   return k;
 }
 
@@ -61,6 +62,7 @@ void set_pose_options(vasco::PoseSource &p, const std::string &key, nb::handle v
   else if (key == "pose_format") p.format = vasco::pose_file_format_from_name(nb::cast<std::string>(v));
   else if (key == "pose_match") p.match.matching = vasco::pose_matching_from_name(nb::cast<std::string>(v));
   else if (key == "pose_tolerance") p.match.tolerance = nb::cast<double>(v);
+  else if (key == "pose_max_gap") p.match.max_gap = nb::cast<double>(v);
   else if (key == "pose_ids") p.id_map_file = as_path(v);
   else if (key == "skip_unposed") p.match.skip_unmatched = nb::cast<bool>(v);
   else if (key == "laser_mount") {
@@ -192,10 +194,12 @@ void fill_input_options(vasco::LogInputOptions &o, const std::string &path, std:
     }
   }
   if (pose_options && o.poses.file.empty())
-    throw Error(ErrorCode::Usage, "pose_format, pose_match, pose_tolerance, pose_ids, skip_unposed, pose_frame and "
-                                  "laser_mount go with poses=FILE");
+    throw Error(ErrorCode::Usage, "pose_format, pose_match, pose_tolerance, pose_max_gap, pose_ids, skip_unposed, "
+                                  "pose_frame and laser_mount go with poses=FILE");
   if (!(o.poses.match.tolerance >= 0) || !std::isfinite(o.poses.match.tolerance))
     throw Error(ErrorCode::Usage, "pose_tolerance must be a finite number of seconds >= 0");
+  if (!(o.poses.match.max_gap >= 0))
+    throw Error(ErrorCode::Usage, "pose_max_gap must be a number of seconds >= 0 (math.inf: any gap)");
 }
 
 void bind_inputs(nb::module_ &m) {

@@ -16,8 +16,9 @@ namespace vasco_py {
 namespace nb = nanobind;
 
 // Fills `o` from load_log's arguments: the source, the ini and overrides,
-// and the keywords poses, pose_format, pose_match, pose_tolerance, pose_ids,
-// skip_unposed, pose_frame, laser_mount, transform, add (TypeError for any
+// and the keywords poses, pose_format, pose_match, pose_tolerance,
+// pose_max_gap, pose_ids, skip_unposed, pose_frame, laser_mount, transform,
+// add (TypeError for any
 // other; None means not given).
 void fill_input_options(vasco::LogInputOptions &o, const std::string &path,
                         std::optional<std::filesystem::path> param_file, const std::string &robot,

@@ -46,8 +46,11 @@ nb::list backend_rows() {
   nb::list rows;
   for (const vasco::BackendInfo &b : vasco::backend_registry()) {
     nb::list aliases;
-    for (const vasco::BackendAlias &a : b.aliases)
-      aliases.append(nb::make_tuple(a.name, a.cuda_mode == vasco::CudaMode::Exact ? "exact" : "float"));
+    for (const vasco::BackendAlias &a : b.aliases) {
+      nb::object mode = nb::none();  // an alias that keeps the mode (gpu)
+      if (a.sets_cuda_mode) mode = nb::str(a.cuda_mode == vasco::CudaMode::Exact ? "exact" : "float");
+      aliases.append(nb::make_tuple(a.name, mode));
+    }
     nb::dict row;
     row["name"] = b.name;
     row["aliases"] = aliases;
@@ -82,9 +85,10 @@ void bind_registries(nb::module_ &m) {
   m.def("backend_registry", &backend_rows,
         nb::sig("def backend_registry() -> list[dict[str, typing.Any]]"),
         "Every backend of the engine's registry, compiled into this build or not, in the order the\n"
-        "help lists them: a dict each with 'name', 'aliases' (a list of (alias, cuda mode)), 'exactness'\n"
-        "('exact', 'float' or 'by_cuda_mode'), 'grid_on_device', 'compiled', 'summary', and what the\n"
-        "options mean for it: 'uses_gpus', 'uses_threads', 'chooses' (auto: picks another per input).");
+        "help lists them: a dict each with 'name', 'aliases' (a list of (alias, cuda mode), the mode\n"
+        "None for an alias that keeps it), 'exactness' ('exact', 'float' or 'by_cuda_mode'),\n"
+        "'grid_on_device', 'compiled', 'summary', and what the options mean for it: 'uses_gpus',\n"
+        "'uses_threads', 'chooses' (auto: picks another per input).");
   m.def("backend_names", &vasco::backend_names,
         "Every name and alias Mapper(backend=...) takes, compiled into this build or not.");
   m.def("map_formats", &format_rows, nb::sig("def map_formats() -> list[dict[str, str]]"),

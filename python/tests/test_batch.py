@@ -324,7 +324,7 @@ def test_argument_errors(tmp_path):
         (ValueError, "'jpg' is none of", dict(formats=("map.gz", "jpg"))),
         (ValueError, "named twice", dict(formats=("png", "png"))),
         (ValueError, "at least one", dict(formats=())),
-        (ValueError, "backend 'gpu'", dict(backend="gpu")),
+        (ValueError, "backend 'gpu9000'", dict(backend="gpu9000")),
         (ValueError, "cuda_mode", dict(cuda_mode="fast")),
         (ValueError, "threads", dict(threads=-1)),
         (TypeError, "bogus", dict(bogus=1)),

@@ -143,11 +143,40 @@ void finish_map_server_options(const CLI::App &app, const MapServerText &raw, Op
   std::fprintf(stderr, "%s: warning: %s\n", opt.tool.c_str(), w.c_str());
 }
 
+// "cuda_float, cuda_exact (the mode too), gpu (cuda)": the registry's aliases
+// of compiled backends, for --backend's help.
+std::string backend_aliases_help() {
+  std::string text;
+  for (const vasco::BackendInfo &b : vasco::backend_registry()) {
+    if (!b.compiled) continue;
+    for (const vasco::BackendAlias &a : b.aliases) {
+      text += (text.empty() ? "" : ", ") + std::string(a.name) + " (" + b.name;
+      if (a.sets_cuda_mode) text += a.cuda_mode == vasco::CudaMode::Exact ? " --cuda-mode exact" : " --cuda-mode float";
+      text += ")";
+    }
+  }
+  return text.empty() ? text : "also: " + text + "\n";
+}
+
 void add_backend_options(CLI::App &app, Options &opt) {
-  std::vector<std::string> backends;  // the registry's names; one not compiled in says why when run
-  for (const vasco::BackendInfo &b : vasco::backend_registry()) backends.push_back(b.name);
-  app.add_option("--backend", opt.backend, "the backend (default: auto; for one LOG, auto takes the one a cost model expects to finish first), one of:\n" + vasco::backend_help())
-      ->check(CLI::IsMember(backends));
+  // The registry's names and aliases (one not compiled in says why when
+  // run); an unknown one is refused naming the nearest.
+  const CLI::Validator known_backend(
+      [](std::string &name) -> std::string {
+        try {
+          vasco::resolve_backend_name(name, nullptr);
+          return std::string();
+        } catch (const carmen::Error &e) {
+          return e.what();
+        }
+      },
+      "");
+  app.add_option("--backend", opt.backend,
+                 "the backend (default: auto; for one LOG, auto takes the one a cost model expects to finish "
+                 "first), one of:\n" +
+                     vasco::backend_help() + backend_aliases_help())
+      ->type_name("NAME")
+      ->check(known_backend);
   app.add_option("--threads", opt.threads,
                  "threads of cpu_threads, 1 to " + std::to_string(vasco::kMaxThreads) + " (default: all cores)")
       ->check(CLI::Range(0, vasco::kMaxThreads));
@@ -177,8 +206,20 @@ void add_pose_options(CLI::App &app, Options &opt, PoseText &raw) {
       ->check(CLI::IsMember({"auto", "order", "id", "time"}));
   app.add_option("--pose-ids", opt.poses.id_map_file, "g2o vertex id -> scan index pairs ('id scan' lines) for --pose-match id")
       ->type_name("FILE");
+  app.add_option("--pose-max-gap", opt.poses.match.max_gap,
+                 "time matching: a scan between two poses at most this far apart, in s, takes their interpolation "
+                 "(default 5; inf: any gap)")
+      ->type_name("SECONDS")
+      ->check(CLI::Validator(
+          [](std::string &v) -> std::string {
+            double d = 0;
+            return parse_double(v, &d) && d >= 0 ? std::string() : "expected seconds >= 0 (inf: any gap), not " + v;
+          },
+          ""));
   app.add_option("--pose-tolerance", opt.poses.match.tolerance,
-                 "time matching: the poses around a scan's stamp may be this far from it, in s (default 0.1)")
+                 "time matching: a scan before the first pose, after the last or in a wider gap takes the nearest "
+                 "pose if at most this far, in s (default 0.1)")
+      ->type_name("SECONDS")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--skip-unposed", opt.poses.match.skip_unmatched, "leave out (and count) scans without a pose instead of stopping");
   app.add_option("--pose-frame", raw.frame, "the poses are of the laser (default) or of the robot")
@@ -246,6 +287,21 @@ void finish_batch_options(const CLI::App &app, const BatchText &raw, Options &op
 
 void warn_about_idle_options(const CLI::App &app, Options &opt);
 
+// --backend cuda_exact, cuda_float, gpu: the registry's name, and the mode
+// an alias sets (a --cuda-mode that says otherwise is a usage error).
+void resolve_backend_alias(const CLI::App &app, Options &opt) {
+  vasco::BackendOptions o;
+  o.cuda_mode = opt.cuda_mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
+  const vasco::CudaMode asked = o.cuda_mode;
+  const std::string name = vasco::resolve_backend_name(opt.backend, &o);
+  const std::string mode = o.cuda_mode == vasco::CudaMode::Exact ? "exact" : "float";
+  if (app.count("--cuda-mode") && o.cuda_mode != asked)
+    throw Error(ErrorCode::Usage, "--backend " + opt.backend + " is --cuda-mode " + mode + ": not with --cuda-mode " +
+                                      opt.cuda_mode);
+  opt.backend = name;
+  opt.cuda_mode = mode;
+}
+
 // Everything checked after parsing that CLI11 cannot: a usage error.
 void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &raw, const std::string &max_memory,
                     Options &opt) {
@@ -259,6 +315,7 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
       throw Error(ErrorCode::Usage, "--json and the output '-' both want standard output: write the map to a file");
     opt.log = cli::input_path(opt.log);
   }
+  resolve_backend_alias(app, opt);
   opt.poses.format = vasco::pose_file_format_from_name(raw.format);
   opt.poses.match.matching = vasco::pose_matching_from_name(raw.match);
   opt.poses.robot_frame = raw.frame == "robot";
@@ -273,7 +330,7 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
   // A bag reader takes --laser-mount (a pose topic's mount) and --skip-unposed
   // (scans outside the poses' time span) without --poses too.
   const bool pose_options = app.count("--pose-format") || app.count("--pose-match") || app.count("--pose-ids") ||
-                            app.count("--pose-tolerance") || app.count("--pose-frame") ||
+                            app.count("--pose-tolerance") || app.count("--pose-max-gap") || app.count("--pose-frame") ||
                             ((app.count("--laser-mount") || app.count("--skip-unposed")) && !spec.read);
   if (pose_options && opt.poses.file.empty())
     throw Error(ErrorCode::Usage, "the --pose-* options, --skip-unposed and --laser-mount go with --poses FILE");
@@ -283,7 +340,7 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
 // Options that change nothing for the chosen backend: a warning each (the
 // run goes on), printed at once and carried by --json.
 void warn_about_idle_options(const CLI::App &app, Options &opt) {
-  const vasco::BackendInfo *b = vasco::find_backend(opt.backend);  // --backend takes the registry's names only
+  const vasco::BackendInfo *b = vasco::find_backend(opt.backend);  // the registry's name (resolve_backend_alias)
   const bool gpus = b == nullptr || b->uses_gpus, threads = b == nullptr || b->uses_threads;
   std::string users;  // "cpu_threads and auto": the backends --threads serves
   for (const vasco::BackendInfo &r : vasco::backend_registry())
@@ -297,6 +354,22 @@ void warn_about_idle_options(const CLI::App &app, Options &opt) {
   if (app.count("--robot") && opt.param_file.empty())
     opt.warnings.push_back("--robot does nothing without --param-file (it picks a robot section of the ini)");
   for (const std::string &w : opt.warnings) std::fprintf(stderr, "%s: warning: %s\n", opt.tool.c_str(), w.c_str());
+}
+
+// "Did you mean --pose-tolerance?" for each unexpected argument that is a
+// near miss of an option's name (CLI11 does not suggest); empty otherwise.
+std::string option_suggestions(const CLI::App &app, const CLI::Error &e) {
+  if (dynamic_cast<const CLI::ExtrasError *>(&e) == nullptr) return std::string();
+  std::vector<std::string> names;
+  for (const CLI::Option *o : app.get_options())
+    for (const std::string &n : o->get_lnames()) names.push_back("--" + n);
+  std::string text;
+  for (const std::string &arg : app.remaining()) {
+    if (arg.size() < 3 || arg.compare(0, 2, "--") != 0) continue;
+    const std::string near = vasco::closest_name(arg.substr(0, arg.find('=')), names);
+    if (!near.empty()) text += "Did you mean " + near + " (not " + arg.substr(0, arg.find('=')) + ")?\n";
+  }
+  return text;
 }
 
 }  // namespace
@@ -333,8 +406,8 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
   CLI::App app{spec.summary, spec.name};  // named: usage lines say "log2map", not argv[0]
   // Errors name the program, as every message of the tools does.
   const std::string tool = spec.name;
-  app.failure_message([tool](const CLI::App *, const CLI::Error &e) {
-    return tool + ": " + e.what() + "\nRun '" + tool + " --help' for usage.\n";
+  app.failure_message([tool](const CLI::App *a, const CLI::Error &e) {
+    return tool + ": " + e.what() + "\n" + option_suggestions(*a, e) + "Run '" + tool + " --help' for usage.\n";
   });
   app.set_version_flag("--version", [&spec] {
     std::string s = spec.name + " (vasco_gpu) " + vasco::version() + "\nbackends compiled in:";

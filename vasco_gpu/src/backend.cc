@@ -2,6 +2,9 @@
 // session APIs' name resolution, egrid.h and the tools' --backend help.
 #include "vasco_gpu/backend.h"
 
+#include <algorithm>
+#include <cctype>
+#include <limits>
 #include <sstream>
 
 #include "host_renderer.h"
@@ -79,7 +82,8 @@ const std::vector<BackendInfo> &backend_registry() {
        "cpu_double's bytes on all cores (--threads)", false, true, false, cpu_threads},
       {"cpu_float", {}, Exactness::Float, false, true,
        "single precision on one core, fast; measured against CARMEN's maps", false, false, false, cpu_float},
-      {"cuda", {{"cuda_float", CudaMode::Float}, {"cuda_exact", CudaMode::Exact}}, Exactness::ByCudaMode, true,
+      {"cuda", {{"cuda_float", CudaMode::Float}, {"cuda_exact", CudaMode::Exact}, {"gpu", CudaMode::Float, false}},
+       Exactness::ByCudaMode, true,
        kCudaCompiled, "the GPU: float mode (fastest) or exact mode (bit-identical to cpu_double)", true, false, false,
        cuda},
       {"auto", {}, Exactness::ByCudaMode, false, true,
@@ -107,12 +111,15 @@ std::vector<std::string> compiled_backends() {
 std::string resolve_backend_name(const std::string &name, BackendOptions *options) {
   const BackendInfo *b = find_backend(name);
   if (b == nullptr) {
+    const std::vector<std::string> names = backend_names();
     std::string known;
-    for (const std::string &n : backend_names()) known += " " + n;
-    throw Error(ErrorCode::Usage, "unknown backend '" + carmen::printable(name) + "' (known:" + known + ")");
+    for (const std::string &n : names) known += " " + n;
+    const std::string near = closest_name(name, names);
+    const std::string hint = near.empty() ? "" : ": did you mean '" + near + "'?";
+    throw Error(ErrorCode::Usage, "unknown backend '" + carmen::printable(name) + "'" + hint + " (known:" + known + ")");
   }
   for (const BackendAlias &a : b->aliases)
-    if (name == a.name && options != nullptr) options->cuda_mode = a.cuda_mode;
+    if (name == a.name && a.sets_cuda_mode && options != nullptr) options->cuda_mode = a.cuda_mode;
   return b->name;
 }
 
@@ -123,6 +130,38 @@ std::vector<std::string> backend_names() {
     for (const BackendAlias &a : b.aliases) names.push_back(a.name);
   }
   return names;
+}
+
+std::string closest_name(const std::string &name, const std::vector<std::string> &known) {
+  const auto lower = [](std::string s) {
+    for (char &c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  };
+  const std::string a = lower(name);
+  std::string best;
+  size_t best_distance = std::numeric_limits<size_t>::max();
+  for (const std::string &candidate : known) {
+    const std::string b = lower(candidate);
+    // Optimal string alignment distance, row by row (rows i-2, i-1, i).
+    std::vector<size_t> two(b.size() + 1), one(b.size() + 1), row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) one[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+      row[0] = i;
+      for (size_t j = 1; j <= b.size(); ++j) {
+        row[j] = std::min({one[j] + 1, row[j - 1] + 1, one[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) row[j] = std::min(row[j], two[j - 2] + 1);
+      }
+      std::swap(two, one);
+      std::swap(one, row);
+    }
+    const size_t d = one[b.size()];
+    const size_t limit = b.size() <= 7 ? 1 : b.size() <= 11 ? 2 : 3;
+    if (d <= limit && d < best_distance) {
+      best = candidate;
+      best_distance = d;
+    }
+  }
+  return best;
 }
 
 std::string backend_help() {

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -395,32 +396,66 @@ Pose2 interpolate(const StampedPose &p0, const StampedPose &p1, double t) {
   return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * angle_difference(a.theta, b.theta)};
 }
 
-// The pose at stamp t, or false with why there is none.
-bool pose_at(const std::vector<StampedPose> &poses, double t, double tolerance, Pose2 &pose, bool &interpolated,
-             std::string &why) {
+// A distance in seconds for messages: few digits, but enough that it
+// never reads as the limit it exceeds (5.0000001 is not "5").
+std::string seconds_text(double d, double limit) {
+  for (int digits = 6; digits < 17; ++digits) {
+    char a[40], b[40];
+    std::snprintf(a, sizeof a, "%.*g", digits, d);
+    std::snprintf(b, sizeof b, "%.*g", digits, limit);
+    if (std::strcmp(a, b) != 0) return a;
+  }
+  return number_text(d);
+}
+
+// How a scan's stamp was matched.
+enum class StampMatch { None, Exact, Interpolated, Nearest };
+
+// The pose at stamp t (PoseMatchOptions: exact, interpolated within a gap
+// of at most max_gap, else the nearest pose within tolerance), or None with
+// why there is none: how far the stamp is from the poses, against which
+// limit.
+StampMatch pose_at(const std::vector<StampedPose> &poses, double t, const PoseMatchOptions &o, Pose2 &pose,
+                   std::string &why) {
   if (!std::isfinite(t)) {
     why = "the scan has no timestamp";
-    return false;
+    return StampMatch::None;
   }
   const auto it = std::lower_bound(poses.begin(), poses.end(), t,
                                    [](const StampedPose &p, double stamp) { return p.stamp < stamp; });
-  interpolated = false;
   if (it != poses.end() && it->stamp == t) {
     pose = it->pose;  // exactly as in the file, no arithmetic
-    return true;
+    return StampMatch::Exact;
   }
-  if (it == poses.begin()) why = "before the first pose (" + number_text(it->stamp) + ")";
-  if (it == poses.end()) why = "after the last pose (" + number_text(poses.back().stamp) + ")";
-  if (!why.empty()) return false;
+  const std::string tolerance = "--pose-tolerance " + number_text(o.tolerance);
+  if (it == poses.begin() || it == poses.end()) {
+    const bool before = it == poses.begin();
+    const StampedPose &end = before ? poses.front() : poses.back();
+    const double d = before ? end.stamp - t : t - end.stamp;
+    if (d <= o.tolerance) {
+      pose = end.pose;
+      return StampMatch::Nearest;
+    }
+    why = seconds_text(d, o.tolerance) + " s " + (before ? "before the first" : "after the last") + " pose (" +
+          number_text(end.stamp) + "), more than " + tolerance;
+    return StampMatch::None;
+  }
   const StampedPose &p0 = *(it - 1), &p1 = *it;
-  if (t - p0.stamp <= tolerance && p1.stamp - t <= tolerance) {
+  const double gap = p1.stamp - p0.stamp;
+  if (gap <= o.max_gap) {
     pose = interpolate(p0, p1, t);
-    interpolated = true;
-    return true;
+    return StampMatch::Interpolated;
   }
-  why = "the nearest poses are at " + number_text(p0.stamp) + " and " + number_text(p1.stamp) +
-        ", more than the tolerance " + number_text(tolerance) + " s away (--pose-tolerance)";
-  return false;
+  // A hole in the trajectory: its sides are ends, as the trajectory's are.
+  const double d0 = t - p0.stamp, d1 = p1.stamp - t;
+  if (std::min(d0, d1) <= o.tolerance) {
+    pose = d0 <= d1 ? p0.pose : p1.pose;
+    return StampMatch::Nearest;
+  }
+  why = "the poses around it (" + number_text(p0.stamp) + " and " + number_text(p1.stamp) + ") are " +
+        seconds_text(gap, o.max_gap) + " s apart, more than --pose-max-gap " + number_text(o.max_gap) +
+        ", and the nearer is " + seconds_text(std::min(d0, d1), o.tolerance) + " s away, more than " + tolerance;
+  return StampMatch::None;
 }
 
 void check_stamped(const PoseFile &file, const Scans &scans) {
@@ -436,14 +471,14 @@ void match_by_time(const PoseFile &file, const Scans &scans, const PoseMatchOpti
   check_stamped(file, scans);
   const std::vector<StampedPose> poses = by_stamp(file.path, file.poses);
   for (size_t s = 0; s < scans.count; ++s) {
-    bool interpolated = false;
-    std::string why;
-    if (!poses.empty() && pose_at(poses, scans.stamps[s], options.tolerance, m.pose[s], interpolated, why)) {
+    std::string why = "the file has no poses";
+    const StampMatch how = poses.empty() ? StampMatch::None : pose_at(poses, scans.stamps[s], options, m.pose[s], why);
+    if (how != StampMatch::None) {
       m.matched[s] = 1;
-      m.interpolated += interpolated;
+      m.interpolated += how == StampMatch::Interpolated;
+      m.nearest += how == StampMatch::Nearest;
       continue;
     }
-    if (file.poses.empty()) why = "the file has no poses";
     if (!options.skip_unmatched) throw FileError(file.path, "no pose for " + scan_name(scans, s) + ": " + why);
     ++m.unmatched;
   }
@@ -495,6 +530,9 @@ PoseMatch match_poses(const PoseFile &file, size_t num_scans, const std::vector<
   if (!std::isfinite(options.tolerance) || options.tolerance < 0)
     throw carmen::Error(ErrorCode::Usage, "the pose tolerance " + number_text(options.tolerance) +
                                               " s is not a finite number >= 0 (--pose-tolerance)");
+  if (std::isnan(options.max_gap) || options.max_gap < 0)
+    throw carmen::Error(ErrorCode::Usage, "the largest gap between poses " + number_text(options.max_gap) +
+                                              " s is not a number >= 0 (--pose-max-gap; inf: any gap)");
   PoseMatch m;
   m.used = options.matching;
   if (m.used == PoseMatching::Auto) m.used = file.has_stamps() ? PoseMatching::Timestamp : PoseMatching::Order;

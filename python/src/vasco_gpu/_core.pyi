@@ -31,9 +31,10 @@ def backends() -> list[str]:
 def backend_registry() -> list[dict[str, Any]]:
     """
     Every backend of the engine's registry, compiled into this build or not, in the order the
-    help lists them: a dict each with 'name', 'aliases' (a list of (alias, cuda mode)), 'exactness'
-    ('exact', 'float' or 'by_cuda_mode'), 'grid_on_device', 'compiled', 'summary', and what the
-    options mean for it: 'uses_gpus', 'uses_threads', 'chooses' (auto: picks another per input).
+    help lists them: a dict each with 'name', 'aliases' (a list of (alias, cuda mode), the mode
+    None for an alias that keeps it), 'exactness' ('exact', 'float' or 'by_cuda_mode'),
+    'grid_on_device', 'compiled', 'summary', and what the options mean for it: 'uses_gpus',
+    'uses_threads', 'chooses' (auto: picks another per input).
     """
 
 def backend_names() -> list[str]:
@@ -394,7 +395,7 @@ class Log:
 
     def __repr__(self) -> str: ...
 
-def load_log(path: str | os.PathLike, param_file: str | os.PathLike | None = None, robot: str = '', overrides: dict[str, float | int] | None = None, lenient: bool = False, *, poses: str | os.PathLike | None = None, pose_format: str | None = None, pose_match: str | None = None, pose_tolerance: float | None = None, pose_ids: str | os.PathLike | None = None, skip_unposed: bool | None = None, pose_frame: str | None = None, laser_mount: tuple[float, float, float] | None = None, transform: tuple[float, float, float] | None = None, add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float]]] | None = None) -> Log:
+def load_log(path: str | os.PathLike, param_file: str | os.PathLike | None = None, robot: str = '', overrides: dict[str, float | int] | None = None, lenient: bool = False, *, poses: str | os.PathLike | None = None, pose_format: str | None = None, pose_match: str | None = None, pose_tolerance: float | None = None, pose_max_gap: float | None = None, pose_ids: str | os.PathLike | None = None, skip_unposed: bool | None = None, pose_frame: str | None = None, laser_mount: tuple[float, float, float] | None = None, transform: tuple[float, float, float] | None = None, add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float]]] | None = None) -> Log:
     """
     Reads a CARMEN log (.log, .clf, gzipped if the name ends in .gz) as log2map does.
 
@@ -406,7 +407,9 @@ def load_log(path: str | os.PathLike, param_file: str | os.PathLike | None = Non
 
     Poses from a SLAM back end (log2map --poses): ``poses`` a TUM trajectory, g2o file or CARMEN log;
     with it (None: the default) ``pose_format`` 'auto' | 'tum' | 'g2o' | 'carmen'; ``pose_match`` 'auto' |
-    'order' | 'id' | 'time'; ``pose_tolerance`` seconds (0.1); ``pose_ids`` a file of 'id scan' pairs;
+    'order' | 'id' | 'time'; by time, a scan between two poses at most ``pose_max_gap`` seconds apart (5;
+    math.inf: any) takes their interpolation, one before the first, after the last or in a wider gap the
+    nearest pose if at most ``pose_tolerance`` seconds (0.1) away; ``pose_ids`` a file of 'id scan' pairs;
     ``skip_unposed`` leave out scans without a pose; ``pose_frame`` 'laser' | 'robot'; ``laser_mount``
     (x, y, theta) of the laser on the robot. Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared
     frame, ``add`` further logs, each a path or (path, (x, y, theta)).

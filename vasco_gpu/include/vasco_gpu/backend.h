@@ -65,10 +65,13 @@ struct BackendOptions {
 
 class Renderer;
 
-// Another name of a backend that also chooses its CUDA mode (cuda_exact, cuda_float).
+// Another name of a backend: one that also chooses its CUDA mode
+// (cuda_exact, cuda_float), or one that leaves the mode as it is (gpu:
+// sets_cuda_mode false, cuda_mode then unused).
 struct BackendAlias {
   const char *name;
   CudaMode cuda_mode;
+  bool sets_cuda_mode = true;
 };
 
 // Whether a backend's grid is CARMEN's bytes.
@@ -77,7 +80,7 @@ enum class Exactness { Exact, Float, ByCudaMode };
 // One row of the registry: everything the APIs and the tools say about a backend.
 struct BackendInfo {
   const char *name;                   // what make_renderer takes: cpu_double, ..., auto
-  std::vector<BackendAlias> aliases;  // names that also set BackendOptions::cuda_mode
+  std::vector<BackendAlias> aliases;  // other names, some of which also set BackendOptions::cuda_mode
   Exactness exactness;
   bool grid_on_device;
   bool compiled;        // false: named but not in this build (cuda without nvcc)
@@ -101,10 +104,19 @@ const BackendInfo *find_backend(const std::string &name_or_alias);
 // runs: cuda when a GPU is usable, else cpu_threads).
 std::vector<std::string> compiled_backends();
 
-// The session APIs' names (C API, egrid.h, Python): a name or an alias.
-// Returns the registry's name; an alias sets options->cuda_mode. Throws
-// Error(Usage) for a name that is neither.
+// The session APIs' names (C API, egrid.h, Python, log2map's --backend): a
+// name or an alias. Returns the registry's name; an alias that sets a mode
+// sets options->cuda_mode. Throws Error(Usage) for a name that is neither,
+// listing the known names and, for a near miss, "did you mean 'cpu_double'?".
 std::string resolve_backend_name(const std::string &name, BackendOptions *options);
+
+// The name of `known` closest to `name` by edit distance (letters inserted,
+// deleted, replaced or two neighbours swapped; case ignored) when it is
+// close enough to be a typo of it: at most one edit for names of up to 7
+// letters, two up to 11, three beyond. Empty when none is; the first of
+// equally close ones. For "did you mean" in messages: the backend names
+// here, log2map's option names.
+std::string closest_name(const std::string &name, const std::vector<std::string> &known);
 
 // Every name and alias resolve_backend_name accepts, compiled in or not. A
 // session reports its backend (Renderer::name()) as one of them: a CPU name,
