@@ -244,3 +244,61 @@ def write_bag(
 def bag_path(tmp_path, fmt, name="test"):
     """Where write_bag should put a bag of this format: a .bag file or a directory."""
     return Path(tmp_path) / (f"{name}.bag" if fmt == "rosbag1" else name)
+
+
+MULTI_ECHO = "sensor_msgs/msg/MultiEchoLaserScan"
+
+
+class Recording:
+    """A bag shaped like a real recording, message by message: scans on several topics (LaserScan
+    or MultiEchoLaserScan), tf links on /tf and /tf_static, each with its header stamp and the
+    time the bag received it (by default the stamp: a late or early receive time is how a
+    recorder sees a laser driver whose clock is wrong, or a message that arrives late).
+
+    ``write(path)`` writes them in receive order with the format's writer.
+    """
+
+    def __init__(self, fmt: str):
+        self.fmt = fmt
+        self.messages = _Messages(ros1=fmt == "rosbag1")
+        self.events = []  # (receive ns, order, topic, type, message)
+        self.topics = {}  # topic -> type, in first-use order (connections are written for all)
+
+    def add(self, receive: float, topic: str, msgtype: str, msg) -> None:
+        """Any message, received at `receive` (float seconds)."""
+        self.topics.setdefault(topic, msgtype)
+        self.events.append((stamp_ns(receive), len(self.events), topic, msgtype, msg))
+
+    def scan(self, topic, t, frame, ranges, angle_min, angle_increment, range_min, range_max, receive=None):
+        msg = self.messages.laser_scan(t, frame, ranges, angle_min, angle_increment, range_min, range_max)
+        self.add(t if receive is None else receive, topic, LASER_SCAN, msg)
+
+    def multi_echo(self, topic, t, frame, echoes, intensities, angle_min, angle_increment, range_min, range_max,
+                   receive=None):
+        """echoes, intensities: one float sequence a beam (intensities may be [] for none)."""
+        T = self.messages.T
+        echo = lambda values: T["sensor_msgs/msg/LaserEcho"](echoes=np.asarray(values, dtype=np.float32))
+        n = len(echoes)
+        msg = T[MULTI_ECHO](
+            header=self.messages.header(t, frame),
+            angle_min=float(angle_min),
+            angle_max=float(np.float32(angle_min) + np.float32(angle_increment) * np.float32(max(n - 1, 0))),
+            angle_increment=float(angle_increment), time_increment=0.0, scan_time=0.0,
+            range_min=float(range_min), range_max=float(range_max),
+            ranges=[echo(e) for e in echoes], intensities=[echo(i) for i in intensities],
+        )
+        self.add(t if receive is None else receive, topic, MULTI_ECHO, msg)
+
+    def tf(self, t, parent, child, x, y, yaw, static=False, receive=None):
+        link = self.messages.transform(float(t), parent, child, x, y, yaw)
+        topic = "/tf_static" if static else "/tf"
+        self.add(t if receive is None else receive, topic, TF_MESSAGE, self.messages.tf_message([link]))
+
+    def write(self, path):
+        self.events.sort(key=lambda e: (e[0], e[1]))
+        with _Writer(Path(path), self.fmt, self.messages) as w:
+            for topic, msgtype in self.topics.items():
+                w.connection(topic, msgtype)
+            for t_ns, _, topic, msgtype, msg in self.events:
+                w.write(topic, msgtype, t_ns, msg)
+        return Path(path)

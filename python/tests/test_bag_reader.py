@@ -27,7 +27,7 @@ pytest.importorskip("rosbags")
 HERE = Path(__file__).resolve().parent
 BAGS = HERE.parent / "src" / "vasco_gpu" / "bags"
 # The modules that import the compiled extension (through the parent package): not loaded here.
-ENGINE_MODULES = ("load.py", "cli.py")
+ENGINE_MODULES = ("load.py", "cli.py", "carmen2bag.py")
 
 
 def _load(name: str, path: Path, package: bool = False):
@@ -490,11 +490,11 @@ def test_no_scan_topic_and_empty_bag(tmp_path, fmt):
     p = make(tmp_path, fmt, "tfonly", scan_topic=None, tf_poses=base_poses(5))
     with pytest.raises(vb.BagError) as e:
         vb.read_bag(p)
-    assert "no sensor_msgs/LaserScan topic (topics: '/tf' (tf2_msgs/TFMessage))" in str(e.value)
+    assert "no sensor_msgs/LaserScan or MultiEchoLaserScan topic (topics: '/tf' (tf2_msgs/TFMessage))" in str(e.value)
     q = make(tmp_path, fmt, "empty", stamps=[], ranges=[], scan_topic=None)
     with pytest.raises(vb.BagError) as e:
         vb.read_bag(q)
-    assert q.name in str(e.value) and "no sensor_msgs/LaserScan topic" in str(e.value)
+    assert q.name in str(e.value) and "no sensor_msgs/LaserScan or MultiEchoLaserScan topic" in str(e.value)
 
 
 def test_not_a_bag(tmp_path):
@@ -660,3 +660,162 @@ def test_range_texts_round_trip_through_double():
     assert same.all()
     assert "nan" in texts and "inf" in texts and "-inf" in texts
     assert writer.range_texts(np.array([2.35, 0.1], dtype=np.float32)) == ["2.35", "0.1"]
+
+
+# ----------------------------------------------------------------------------------------------
+# Bags as recorded: edges of the poses' span, gaps, receive stamps; several lasers; multi-echo
+
+
+def chain_recording(fmt, scan_stamps, odom_stamps, map_stamps, frame="laser", mount=(0.0, 0.0, 0.0)):
+    """A localisation stack's tf: map -> odom (identity, at map_stamps), odom -> base_link (the
+    base poses, at odom_stamps), base_link -> frame on /tf_static; one LaserScan a scan stamp."""
+    rec = bm.Recording(fmt)
+    rec.tf(scan_stamps[0], "base_link", frame, *mount, static=True)
+    for t in map_stamps:
+        rec.tf(t, "map", "odom", 0.0, 0.0, 0.0)
+    for t, p in zip(odom_stamps, base_poses(len(odom_stamps))):
+        rec.tf(t, "odom", "base_link", *p)
+    for t, r in zip(scan_stamps, plain_ranges(len(scan_stamps))):
+        rec.scan("/scan", t, frame, r, ANGLE_MIN, ANGLE_STEP, RMIN, RMAX)
+    return rec
+
+
+def stamp_of(t: float) -> str:
+    sec, ns = bm.split_stamp(t)
+    return f"{sec}.{ns:09d}"
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_scans_beyond_the_chain_are_edges(tmp_path, fmt):
+    # map -> odom post-dated (from the 3rd scan + 0.05 s on), odometry ending at the 8th of 10.
+    scans = stamps_of(10)
+    rec = chain_recording(fmt, scans, scans[:8], [t + 0.05 for t in scans[2:]])
+    p = rec.write(bm.bag_path(tmp_path, fmt))
+    b = vb.read_bag(p, outside_span="edges")
+    posed = np.isfinite(b.poses).all(axis=1)
+    assert posed.tolist() == [False] * 3 + [True] * 5 + [False] * 2
+    assert b.edges["before"] == 3 and b.edges["after"] == 2
+    assert b.edges["first"] == pytest.approx(scans[2] + 0.05) and b.edges["last"] == pytest.approx(scans[7])
+    with pytest.raises(vb.BagError, match="map -> odom"):
+        vb.read_bag(p)  # outside_span="error": read_bag's default
+
+
+@pytest.mark.parametrize("fmt", ["rosbag1", "mcap"])
+def test_a_gap_inside_the_span_names_the_stamp(tmp_path, fmt):
+    # odometry silent for 20 s, longer than tf2 keeps history: the scans in the gap have no pose.
+    scans = stamps_of(4) + [T0 + 12.0] + [T0 + 25.0 + 0.1 * k for k in range(4)]
+    odom = stamps_of(4) + [T0 + 25.0 + 0.1 * k for k in range(4)]
+    p = chain_recording(fmt, scans, odom, scans).write(bm.bag_path(tmp_path, fmt))
+    with pytest.raises(vb.BagError) as e:
+        vb.read_bag(p, outside_span="edges")
+    text = str(e.value)
+    assert p.name in text and stamp_of(T0 + 12.0) in text and "gap" in text and "odom -> base_link" in text
+    assert e.value.stamp == pytest.approx(T0 + 12.0, abs=1e-6)
+    b = vb.read_bag(p, outside_span="skip")
+    assert np.isnan(b.poses[4]).all() and np.isfinite(np.delete(b.poses, 4, axis=0)).all()
+
+
+def test_receive_stamps_for_a_driver_with_a_bad_clock(tmp_path):
+    # The laser's clock is off by 1000 s; the bag received each scan at the true time.
+    scans = stamps_of(5)
+    rec = bm.Recording("mcap")
+    rec.tf(scans[0], "base_link", "laser", 0.0, 0.0, 0.0, static=True)
+    for t, p in zip(scans, base_poses(5)):
+        rec.tf(t, "map", "base_link", *p)
+    for t, r in zip(scans, plain_ranges(5)):
+        rec.scan("/scan", t - 1000.0, "laser", r, ANGLE_MIN, ANGLE_STEP, RMIN, RMAX, receive=t)
+    p = rec.write(bm.bag_path(tmp_path, "mcap"))
+    b = vb.read_bag(p, outside_span="edges")
+    assert np.isnan(b.poses).all() and b.edges["before"] == 5
+    r = vb.read_bag(p, stamp="receive")
+    np.testing.assert_array_equal(r.stamps, expected_stamps(scans))
+    good = vb.read_bag(make(tmp_path, "mcap", "good", tf_poses=base_poses(5), static_mount=(0, 0, 0)))
+    assert np.array_equal(bits(r.poses), bits(good.poses))
+    with pytest.raises(ValueError, match="stamp"):
+        vb.read_bag(p, stamp="bag")
+
+
+def two_lasers(fmt, n=9):
+    """/front every scan stamp at (0.2, 0, 0), /rear every third at (-0.3, 0.1, pi); the rear's
+    messages received 0.15 s late (after the next front scan)."""
+    scans = stamps_of(n)
+    rec = bm.Recording(fmt)
+    rec.tf(scans[0], "base_link", "front", 0.2, 0.0, 0.0, static=True)
+    rec.tf(scans[0], "base_link", "rear", -0.3, 0.1, math.pi, static=True)
+    for t, p in zip(scans, base_poses(n)):
+        rec.tf(t, "map", "base_link", *p)
+    ranges = plain_ranges(n)
+    for k, t in enumerate(scans):
+        rec.scan("/front", t, "front", ranges[k], ANGLE_MIN, ANGLE_STEP, RMIN, RMAX)
+        if k % 3 == 1:
+            rec.scan("/rear", t + 0.01, "rear", ranges[k][:20], ANGLE_MIN, ANGLE_STEP, RMIN, RMAX, receive=t + 0.15)
+    return rec
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_two_lasers_each_at_its_mount_in_stamp_order(tmp_path, fmt):
+    p = two_lasers(fmt).write(bm.bag_path(tmp_path, fmt))
+    with pytest.raises(vb.BagError, match="several laser scan topics"):
+        vb.read_bag(p)
+    b = vb.read_bag(p, scan_topic=["/front", "rear"])
+    assert b.topics == ("/front", "/rear") and b.frame_ids == ("front", "rear")
+    assert len(b.stamps) == 12 and (np.diff(b.stamps) > 0).all()
+    assert b.topic_index.tolist() == [0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0]
+    assert b.beam_counts.tolist() == [20 if k == 1 else 37 for k in b.topic_index]
+    assert b.mounts[b.topic_index == 0].tolist() == [[0.2, 0.0, 0.0]] * 9
+    assert b.mounts[b.topic_index == 1][:, :2].tolist() == [[-0.3, 0.1]] * 3
+    front = vb.read_bag(p, scan_topic="/front")
+    assert np.array_equal(bits(b.poses[b.topic_index == 0]), bits(front.poses))
+    rear = vb.read_bag(p, scan_topic="/rear")
+    assert np.array_equal(bits(b.poses[b.topic_index == 1]), bits(rear.poses))
+    assert np.array_equal(bits(b.ranges[:37]), bits(front.ranges[:37]))
+    assert vb.read_bag(p, scan_topic="/front,/rear").topic_index.tolist() == b.topic_index.tolist()
+    with pytest.raises(ValueError, match="several scan topics"):
+        vb.read_bag(p, scan_topic=["/front", "/rear"], laser_mount=(0, 0, 0))
+
+
+ECHOES = [[1.0, 2.0, 3.0], [], [4.5], [2.5, 7.25, 9.0]]
+POWER = [[10.0, 90.0, 50.0], [], [3.0], [70.0, 70.0, 20.0]]
+
+
+def echo_bag(tmp_path, fmt, power=POWER, name="echo"):
+    rec = bm.Recording(fmt)
+    rec.tf(T0, "map", "laser", 0.0, 0.0, 0.0, static=True)
+    rec.multi_echo("/echoes", T0, "laser", ECHOES, power, ANGLE_MIN, ANGLE_STEP, RMIN, RMAX)
+    return rec.write(bm.bag_path(tmp_path, fmt, name))
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_multi_echo_scans(tmp_path, fmt):
+    p = echo_bag(tmp_path, fmt)
+    last = vb.read_bag(p)
+    assert last.topic == "/echoes" and last.beam_counts.tolist() == [4]
+    assert last.ranges.tolist() == [3.0, np.inf, 4.5, 9.0] and last.counts["pos_inf"] == 1
+    assert vb.read_bag(p, echo="first").ranges.tolist() == [1.0, np.inf, 4.5, 2.5]
+    assert vb.read_bag(p, echo="strongest").ranges.tolist() == [2.0, np.inf, 4.5, 2.5]  # a tie: the first
+    assert vb.read_bag(p, no_return="free").ranges[1] == vb.NO_RETURN_FREE  # no echo: no return
+    bare = echo_bag(tmp_path, fmt, power=[], name="bare")
+    with pytest.raises(vb.BagError) as e:
+        vb.read_bag(bare, echo="strongest")
+    text = str(e.value)
+    assert bare.name in text and "'/echoes'" in text and stamp_of(T0) in text and "no intensities" in text
+    assert vb.read_bag(bare).ranges.tolist() == [3.0, np.inf, 4.5, 9.0]
+    with pytest.raises(ValueError, match="echo"):
+        vb.read_bag(p, echo="second")
+
+
+def test_a_bag_whose_only_sensor_is_not_a_laser(tmp_path):
+    rec = bm.Recording("mcap")
+    T = rec.messages.T
+    cloud = T["sensor_msgs/msg/PointCloud2"](
+        header=rec.messages.header(T0, "velodyne"), height=1, width=0, fields=[], is_bigendian=False,
+        point_step=16, row_step=0, data=np.zeros(0, dtype=np.uint8), is_dense=True)
+    rec.add(T0, "/points", "sensor_msgs/msg/PointCloud2", cloud)
+    rec.tf(T0, "map", "velodyne", 0.0, 0.0, 0.0, static=True)
+    p = rec.write(bm.bag_path(tmp_path, "mcap"))
+    with pytest.raises(vb.BagError) as e:
+        vb.read_bag(p)
+    text = str(e.value)
+    assert p.name in text and "'/points' (sensor_msgs/PointCloud2)" in text and "pointcloud_to_laserscan" in text
+    with pytest.raises(vb.BagError, match="pointcloud_to_laserscan"):
+        vb.read_bag(p, scan_topic="/points")

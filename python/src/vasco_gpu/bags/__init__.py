@@ -2,8 +2,8 @@
 directories (sqlite3 or MCAP storage, with ``metadata.yaml``) and bare ``.db3`` / ``.mcap``
 files, as plain NumPy arrays; and tf's frame tree for live use (TfBuffer).
 
-:func:`read_bag` reads the ``sensor_msgs/LaserScan`` messages of one topic and the pose of the
-laser at each scan's ``header.stamp``, taken either from tf (``/tf``, ``/tf_static``) or from a
+:func:`read_bag` reads the ``sensor_msgs/LaserScan`` (or ``MultiEchoLaserScan``) messages of one
+or more topics and the pose of each laser at each scan's stamp, taken either from tf (``/tf``, ``/tf_static``) or from a
 pose topic (``nav_msgs/Odometry``, ``geometry_msgs/PoseStamped``,
 ``geometry_msgs/PoseWithCovarianceStamped``). :func:`write_carmen_log` writes the result as a
 CARMEN log of ``ROBOTLASER1`` lines. :class:`TfBuffer` is the tf tree read_bag builds, which a
@@ -27,11 +27,11 @@ poses), :mod:`.tf` (TfBuffer), :mod:`.topics` (which topics to read), :mod:`.sto
 from __future__ import annotations
 
 from .carmen_writer import write_carmen_log
-from .errors import BagError, TfError
+from .errors import BagError, BagWarning, TfError
 from .scans import NO_RETURN_FREE, BagScans
 from .tf import TfBuffer
 
-__all__ = ["BagError", "BagScans", "NO_RETURN_FREE", "TfBuffer", "TfError", "read_bag", "write_carmen_log"]
+__all__ = ["BagError", "BagScans", "BagWarning", "NO_RETURN_FREE", "TfBuffer", "TfError", "read_bag", "write_carmen_log"]
 
 
 def __getattr__(name: str):

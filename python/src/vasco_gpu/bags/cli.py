@@ -40,7 +40,9 @@ class BagOption:
 
 # bag2map's options beyond log2map's, and bag2carmen's bag options.
 BAG_OPTIONS = (
-    BagOption("scan-topic", "scan_topic", "the sensor_msgs/LaserScan topic (default: the only one)", "TOPIC"),
+    BagOption("scan-topic", "scan_topic", "a sensor_msgs/LaserScan or MultiEchoLaserScan topic (default: the "
+              "only one); repeat it (or separate names by commas) to map several lasers together, each "
+              "at its own mount, their scans in stamp order", "TOPIC"),
     BagOption("fixed-frame", "fixed_frame", "the frame the map is in: the root of the tf chain to each scan "
               "(default: map), or the frame of --pose-topic's poses", "FRAME"),
     BagOption("base-frame", "base_frame", "the robot's frame for --pose-topic (default: the odometry's child "
@@ -51,6 +53,10 @@ BAG_OPTIONS = (
     BagOption("no-return", "no_return", "what a +inf range (REP 117: no return) does: skip (default; CARMEN's "
               "max-range readings) or free (clears up to vasco_range_max, as ROS mappers do)", "skip|free",
               default="skip"),
+    BagOption("echo", "echo", "the echo a MultiEchoLaserScan beam gives: first, last (default) or strongest "
+              "(the largest intensity)", "first|last|strongest", default="last"),
+    BagOption("stamp", "stamp", "a scan's time: its header stamp (default) or the time the bag received it "
+              "(receive: for a laser driver whose clock is wrong)", "header|receive", default="header"),
 )
 
 
@@ -76,7 +82,43 @@ def _tool_reader(path: str, values: dict, progress) -> dict:
     """bag2map's reader of one input: `values` holds the options given, as text by flag."""
     keywords = {o.keyword: values[o.flag] for o in BAG_OPTIONS if o.flag in values}
     keywords.update({keyword: value(values[flag]) for flag, keyword, value in HANDED_ON if flag in values})
-    return read_for_engine(path, progress=progress, **keywords)
+    d = read_for_engine(path, progress=progress, **keywords)
+    _warn(d.pop("warnings", []))
+    return d
+
+
+def _warn(texts, tool: str = "bag2map") -> None:
+    """tool: warning: TEXT on stderr (a line of its own, after a progress bar's)."""
+    for text in texts:
+        lead = "\n" if sys.stderr.isatty() else ""
+        print(f"{lead}{tool}: warning: {text}", file=sys.stderr, flush=True)
+
+
+def _join_repeated(args: list[str], flag: str) -> list[str]:
+    """--FLAG given more than once (the command line takes each option once) as one --FLAG with
+    the values joined by commas, where the first was; arguments after '--' are left alone."""
+    option, values, out, first, k = "--" + flag, [], [], None, 0
+    while k < len(args):
+        a = args[k]
+        if a == "--":
+            out.extend(args[k:])
+            break
+        if a == option and k + 1 < len(args):
+            values.append(args[k + 1])
+            k += 2
+        elif a.startswith(option + "="):
+            values.append(a[len(option) + 1:])
+            k += 1
+        else:
+            out.append(a)
+            k += 1
+            continue
+        if first is None:
+            first = len(out)
+    if len(values) > 1:
+        out[first:first] = [option, ",".join(values)]
+        return out
+    return args
 
 
 def _bag2map_summary() -> str:
@@ -88,7 +130,7 @@ def _bag2map_summary() -> str:
 
 def bag2map_main(argv: list[str] | None = None) -> int:
     """The console script bag2map: log2map's command line with ROS bags as inputs."""
-    args = list(sys.argv[1:] if argv is None else argv)
+    args = _join_repeated(list(sys.argv[1:] if argv is None else argv), "scan-topic")
     return _core._run_tool(["bag2map", *args], "bag2map", _bag2map_summary(), "BAG",
                            "ROS 1 .bag, ROS 2 bag directory (sqlite3 or MCAP) or .mcap file",
                            [(o.flag, o.help, o.metavar) for o in BAG_OPTIONS], _tool_reader)
@@ -101,7 +143,8 @@ def _bag2carmen_parser() -> argparse.ArgumentParser:
     p.add_argument("bag", metavar="BAG", help="ROS 1 .bag, ROS 2 bag directory (sqlite3 or MCAP) or .mcap file")
     p.add_argument("out", metavar="OUT", help="the CARMEN log to write (.log, .clf; gzipped if .gz)")
     for o in BAG_OPTIONS:
-        p.add_argument("--" + o.flag, dest=o.keyword, help=o.help, metavar=o.metavar)
+        repeated = {"action": "append"} if o.flag == "scan-topic" else {}
+        p.add_argument("--" + o.flag, dest=o.keyword, help=o.help, metavar=o.metavar, **repeated)
     p.add_argument("--laser-mount", metavar="X,Y,THETA", help="the laser in the robot's frame (for --pose-topic)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress")
     return p
@@ -125,6 +168,7 @@ def bag2carmen_main(argv: list[str] | None = None) -> int:
     reader_module()  # without rosbags: the ImportError that says to install it
     try:
         d = read_for_engine(a.bag, laser_mount=mount, **{o.keyword: o.value(a) for o in BAG_OPTIONS})
+        _warn(d.pop("warnings", []), "bag2carmen")
         ext = a.out.lower()
         if not (ext.endswith(".log") or ext.endswith(".clf") or ext.endswith(".log.gz") or ext.endswith(".clf.gz")):
             print(f"bag2carmen: {a.out}: expected a .log or .clf name (gzipped if .gz)", file=sys.stderr)
@@ -152,5 +196,6 @@ def bag2carmen_main(argv: list[str] | None = None) -> int:
         return 1
     if not a.quiet:
         b = d["bag"]
-        print(f"bag2carmen: {a.bag}: {len(b.stamps)} scans of {b.topic} -> {a.out}", file=sys.stderr)
+        print(f"bag2carmen: {a.bag}: {len(b.stamps)} scans of {', '.join(b.topics or (b.topic,))} -> {a.out}",
+              file=sys.stderr)
     return 0

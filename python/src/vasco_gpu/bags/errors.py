@@ -1,11 +1,12 @@
 """The errors of the bag reader: BagError (a bag that cannot be read as asked) and TfError (a
-tf lookup that cannot be answered, from a bag or from a live TfBuffer)."""
+tf lookup that cannot be answered, from a bag or from a live TfBuffer); BagWarning (scans left
+out at the ends of the poses' time span)."""
 
 from __future__ import annotations
 
 import os
 
-__all__ = ["BagError", "TfError"]
+__all__ = ["BagError", "BagWarning", "TfError"]
 
 
 class BagError(Exception):
@@ -33,6 +34,12 @@ class TfError(BagError):
     A BagError too, with the same attributes: ``.file`` is the bag the transforms came from, or
     None for a :class:`TfBuffer` fed live (``str()`` is then the message alone).
     """
+
+
+class BagWarning(UserWarning):
+    """What load_bag warns of and reads on: scans before the first or after the last pose of the
+    chain, left out and counted (a localisation stack's tf starts after the laser and its
+    odometry may end before it)."""
 
 
 def _make_bag_error(file, message, topic, stamp, cls=BagError):

@@ -10,12 +10,13 @@ compare, the command line's outputs, transaction and exit statuses) is the CARME
 from __future__ import annotations
 
 import os
+import warnings
 from typing import Any, Callable
 
 import numpy as np
 
 from .. import _core
-from .errors import BagError
+from .errors import BagError, BagWarning
 
 
 def reader_module():
@@ -26,26 +27,54 @@ def reader_module():
     return reader
 
 
+def edge_warning(b) -> str | None:
+    """The one line about the scans left out before the first and after the last pose, or None."""
+    e = b.edges
+    if not e or not (e["before"] or e["after"]):
+        return None
+    topics = ", ".join(b.topics or (b.topic,))
+    return (f"{b.path}: {e['before']} scans of {topics} before the first pose ({e['first']:.9f}) and "
+            f"{e['after']} after the last ({e['last']:.9f}) have no pose: left out")
+
+
 def read_for_engine(path, *, scan_topic=None, fixed_frame=None, base_frame=None, pose_topic=None, laser_mount=None,
-                    no_return="skip", need_poses=True, skip_unposed=False, progress=None):
-    """The bag's scans as the engine takes them: {'scans', 'stamps', 'mounts', 'unposed'}; with
-    skip_unposed the scans outside the poses' time span are left out and counted."""
+                    no_return="skip", need_poses=True, skip_unposed=False, progress=None, echo="last",
+                    stamp="header"):
+    """The bag's scans as the engine takes them: {'scans', 'stamps', 'mounts', 'unposed', 'edges',
+    'warnings', 'bag'}. The scans before the first and after the last pose of their chain are
+    left out and counted ('unposed', and 'edges': before, after), with one warning; a scan in a
+    gap of the poses is an error, unless skip_unposed leaves out every scan without a pose."""
     reader = reader_module()
+    outside = ("skip" if skip_unposed else "edges") if need_poses else "error"
     b = reader.read_bag(os.fspath(path), scan_topic=scan_topic,
                         fixed_frame=fixed_frame if fixed_frame is not None else ("map" if pose_topic is None else None),
                         base_frame=base_frame, pose_topic=pose_topic, laser_mount=laser_mount,
                         pose_source="auto" if need_poses else "none", no_return=no_return, progress=progress,
-                        outside_span="skip" if skip_unposed and need_poses else "error")
+                        outside_span=outside, echo=echo, stamp=stamp)
     keep = np.isfinite(b.poses).all(axis=1) if need_poses else np.ones(len(b.stamps), dtype=bool)
     if need_poses and not keep.any():
-        raise BagError(os.fspath(path), f"none of the {len(keep)} scans of {b.topic} lies within the time "
-                                        "span of the poses", topic=b.topic)
+        raise BagError(os.fspath(path), _none_posed_text(b, len(keep), stamp), topic=b.topic)
     counts = b.beam_counts[keep]
     ranges = b.ranges[np.repeat(keep, b.beam_counts)]
     scans = _core.Scans(b.poses[keep], ranges, counts.astype(np.float64), b.first_angle[keep], b.angle_step[keep])
     scans.lines[:] = 0  # a bag has no lines: errors name the scan by its index
     mounts = None if b.mounts is None else b.mounts[keep]
-    return {"scans": scans, "stamps": b.stamps[keep], "mounts": mounts, "unposed": int((~keep).sum()), "bag": b}
+    warning = edge_warning(b) if need_poses else None
+    edges = {k: (b.edges or {}).get(k, 0) for k in ("before", "after")}
+    return {"scans": scans, "stamps": b.stamps[keep], "mounts": mounts, "unposed": int((~keep).sum()), "bag": b,
+            "edges": edges, "warnings": [warning] if warning else []}
+
+
+def _none_posed_text(b, n: int, stamp: str) -> str:
+    """Why no scan has a pose: the scans' stamps against the poses' span."""
+    topics = ", ".join(b.topics or (b.topic,))
+    text = f"none of the {n} scans of {topics} lies within the time span of the poses"
+    if b.edges:
+        text += (f": the scans' stamps run from {b.stamps.min():.9f} to {b.stamps.max():.9f}, the poses "
+                 f"from {b.edges['first']:.9f} to {b.edges['last']:.9f}")
+    if stamp == "header":
+        text += " (a laser driver with a wrong clock: --stamp receive takes the time the bag received each scan)"
+    return text
 
 
 def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame: str | None = None,
@@ -53,18 +82,22 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
              laser_mount: tuple[float, float, float] | None = None, no_return: str = "skip",
              param_file: str | os.PathLike | None = None, robot: str = "",
              overrides: dict[str, float | int] | None = None,
-             progress: Callable[[int, int], Any] | None = None, **pose_keywords) -> _core.Log:
+             progress: Callable[[int, int], Any] | None = None, echo: str = "last", stamp: str = "header",
+             **pose_keywords) -> _core.Log:
     """Reads a ROS 1 ``.bag``, a ROS 2 bag (sqlite3 or MCAP) or an ``.mcap`` into a :class:`Log`.
 
-    Scans are the ``sensor_msgs/LaserScan`` messages of ``scan_topic`` (default: the only such
-    topic), ranges mapped to CARMEN's semantics by REP 117 (see docs/bags-and-poses.md, "REP 117 ranges, in CARMEN's terms";
+    Scans are the ``sensor_msgs/LaserScan`` (or ``MultiEchoLaserScan``: ``echo`` ``first``,
+    ``last`` or ``strongest``) messages of ``scan_topic`` (default: the only such topic; a list
+    of topics maps several lasers together, each in its own frame, merged in stamp order),
+    stamped by their header (``stamp='receive'``: by the time the bag received them), ranges mapped to CARMEN's semantics by REP 117 (see docs/bags-and-poses.md, "REP 117 ranges, in CARMEN's terms";
     ``no_return='free'`` makes +inf clear free space). The laser pose at each scan's stamp comes
     from ``/tf`` + ``/tf_static`` (the chain from ``fixed_frame``, default ``map``, to the scan's
     frame, interpolated in time), or from ``pose_topic`` (Odometry, PoseStamped,
     PoseWithCovarianceStamped) and the mount (``/tf_static`` or ``laser_mount``), or from a pose
     file: ``poses=FILE`` and the other pose keywords of :func:`load_log`, matched by stamp.
-    ``skip_unposed=True`` without a pose file leaves out (and counts, ``Log.unposed_skipped``)
-    the scans outside the poses' time span, which are otherwise an error. ``add=[bag, (bag,
+    The scans before the first and after the last pose of the chain are left out and counted
+    (``Log.unposed_skipped``) with one :class:`BagWarning`; a scan in a gap of the poses is an
+    error, unless ``skip_unposed=True`` (without a pose file) leaves out every scan without one. ``add=[bag, (bag,
     (x, y, theta))]`` and ``transform=`` put several sessions into one grid, as in load_log.
     The parameters come from ``param_file`` and ``overrides`` (a bag has no PARAM lines). Errors
     name the bag, and the topic and stamp where one is at fault (:class:`FileError`).
@@ -79,7 +112,7 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     options = dict(scan_topic=scan_topic, fixed_frame=fixed_frame, base_frame=base_frame, pose_topic=pose_topic,
                    laser_mount=laser_mount, no_return=no_return, need_poses=need_poses,
                    skip_unposed=bool(pose_keywords.pop("skip_unposed", False)) if need_poses else False,
-                   progress=progress)
+                   progress=progress, echo=echo, stamp=stamp)
     if len(sessions) > 1 and pose_keywords.get("poses") is not None:
         raise _core_usage_error("poses= applies to one input: write each session's poses into it first")
     d = None
@@ -88,6 +121,8 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
             one = read_for_engine(p, **options)
         except BagError as e:
             raise FileError(str(e), file=os.fspath(p), line=None, message=str(e)) from e
+        for text in one.pop("warnings", []):
+            warnings.warn(BagWarning(text), stacklevel=2)
         d = _append_session(d, one, t)
     return _core._log_from_scans(d, os.fspath(path), param_file, robot, overrides, **pose_keywords)
 
@@ -107,6 +142,7 @@ def _append_session(d: dict | None, more: dict, transform) -> dict:
     n0, n1 = len(d["scans"]), len(more["scans"])
     d["scans"].extend(more["scans"])
     d["unposed"] += more["unposed"]
+    d["edges"] = {k: d["edges"][k] + more["edges"][k] for k in d["edges"]}
     d["stamps"] = np.concatenate([d["stamps"], more["stamps"]])
     if d["mounts"] is not None or more["mounts"] is not None:
         unknown = lambda n: np.full((n, 3), np.nan)

@@ -24,7 +24,7 @@ class PoseSeries:
         self.ns = array("q")
         self.values = array("d")
 
-    def add(self, msg) -> None:
+    def add(self, msg, receive_ns: int | None = None) -> None:
         ns = stamp_ns(msg.header.stamp)
         frame = frame_name(msg.header.frame_id)
         if self.fixed_frame is None:
@@ -54,12 +54,12 @@ class PoseSeries:
                                       f"child_frame_id {child!r}, not the base frame {self.base_frame!r}",
                            topic=self.topic, stamp=stamp_seconds(ns))
 
-    def inside_span(self, ns: np.ndarray) -> np.ndarray:
-        """Which stamps ns lie within the topic's time span."""
+    def span(self):
+        """(first, last) stamp of the topic's poses in whole nanoseconds; None without any."""
         if not self.ns:
-            return np.zeros(len(ns), dtype=bool)
+            return None
         times, _ = sorted_samples(self.ns, self.values, 3)
-        return (ns >= times[0]) & (ns <= times[-1])
+        return int(times[0]), int(times[-1])
 
     def at(self, ns: np.ndarray) -> np.ndarray:
         """(n, 3) base poses at stamps ns: samples on exact hits, else linear x, y and shortest-arc
@@ -106,17 +106,33 @@ def _inside(ns: np.ndarray, inside: np.ndarray | None, pose_at) -> np.ndarray:
     return poses
 
 
+def _edges(ns: np.ndarray, span) -> dict | None:
+    """The scans before the first and after the last pose: counts and the span's ends."""
+    if span is None:
+        return None
+    before = ns < span[0]
+    return {"before": int(before.sum()), "after": int(((ns > span[1]) & ~before).sum()), "first": span[0],
+            "last": span[1]}
+
+
 def poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mount_arg, outside_span="error"):
-    """(poses (n, 3), mounts (n, 3) or None, pose_source label) for the scans' stamps; with
-    outside_span "skip", NaN rows for the scans outside the poses' time span."""
+    """(poses (n, 3), mounts (n, 3) or None, pose_source label, edges) for the scans' stamps.
+
+    outside_span: "error" (a stamp without a pose is a BagError), "edges" (NaN rows for the
+    scans before the first and after the last pose of the chain, counted in edges; a stamp in a
+    gap of the chain stays an error) or "skip" (NaN rows for every scan without a pose)."""
     n, frame = len(ns), scans.frame_id
-    skip = outside_span == "skip"
+    edges = None
     if source == "tf":
-        if skip and len(tf):
+        inside = None
+        if outside_span != "error" and len(tf):
             root = fixed_frame if fixed_frame is not None else tf.root(frame)
-            inside = tf.covers(root, frame, ns)
-        else:
-            inside = None
+            span = tf.span(root, frame)
+            edges = _edges(ns, span)
+            if outside_span == "skip":
+                inside = tf.covers(root, frame, ns)
+            elif span is not None:
+                inside = (ns >= span[0]) & (ns <= span[1])
         poses = _inside(ns, inside, lambda t: _tf_poses(path, tf, fixed_frame, frame, t))
         mount = mount_arg if mount_arg is not None else static_mount(path, tf, base_frame or "base_link", frame)
         label = "tf"
@@ -127,15 +143,19 @@ def poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, moun
             raise BagError(path, f"no static tf chain (/tf_static) from the base frame {base!r} to the "
                                  f"scans' frame {frame!r}; pass laser_mount (--laser-mount x,y,yaw)",
                            topic=series.topic)
-        poses = _inside(ns, series.inside_span(ns) if skip else None,
-                        lambda t: planar_compose(series.at(t), mount))
+        inside = None
+        if outside_span != "error":
+            span = series.span()
+            edges = _edges(ns, span)
+            inside = np.zeros(n, dtype=bool) if span is None else (ns >= span[0]) & (ns <= span[1])
+        poses = _inside(ns, inside, lambda t: planar_compose(series.at(t), mount))
         label = f"topic:{series.topic}"
     else:
         poses = np.full((n, 3), np.nan)
         mount = mount_arg if mount_arg is not None else static_mount(path, tf, base_frame or "base_link", frame)
         label = "none"
     mounts = None if mount is None else np.tile(np.asarray(mount, dtype=np.float64), (n, 1))
-    return poses, mounts, label
+    return poses, mounts, label, edges
 
 
 def _tf_poses(path, tf: TfBuffer, fixed_frame: str | None, frame: str, ns: np.ndarray) -> np.ndarray:

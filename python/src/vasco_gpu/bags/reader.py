@@ -1,8 +1,10 @@
-""":func:`read_bag`: the scans of one LaserScan topic of a bag with the laser pose at each stamp.
+""":func:`read_bag`: the scans of a bag's laser scan topics with the laser pose at each stamp.
 
-Scans are kept in bag order (the order ``rosbags`` yields them: by receive time) and are not
-sorted by header stamp, as log2map keeps a log's order: the map depends on it (the first scan
-sets the grid's frame, and CARMEN's updates round in the order they come).
+The scans of one topic are kept in bag order (the order ``rosbags`` yields them: by receive
+time) and are not sorted by header stamp, as log2map keeps a log's order: the map depends on it
+(the first scan sets the grid's frame, and CARMEN's updates round in the order they come). The
+scans of several topics are merged in stamp order (a stable sort: equal stamps keep the order
+of the topics as given).
 
 Importing this module raises ImportError when rosbags is not installed.
 """
@@ -18,10 +20,10 @@ from .errors import BagError
 from .geometry import check_mount
 from .header import stamp_seconds
 from .poses import PoseSeries, poses_for
-from .scans import NO_RETURN_MODES, BagScans, ScanAccumulator
+from .scans import ECHO_MODES, NO_RETURN_MODES, STAMP_MODES, BagScans, ScanAccumulator
 from .storage import open_bag, read_messages
 from .tf import TfBuffer
-from .topics import check_pose_topic, choose_pose_source, pick_scan_topic, tf_topics
+from .topics import MULTI_ECHO, check_pose_topic, choose_pose_source, norm_type, pick_scan_topics, tf_topics
 
 __all__ = ["read_bag"]
 
@@ -51,7 +53,13 @@ class Progress:
             self._report()
 
 
-def _check_arguments(pose_source, no_return, pose_topic, outside_span="error"):
+#: A /tf link's samples further apart than this leave the stamps between them without a
+#: transform: tf2's buffer keeps 10 s of history (its default cache time).
+TF_MAX_GAP = 10.0
+OUTSIDE_SPAN = ("error", "edges", "skip")
+
+
+def _check_arguments(pose_source, no_return, pose_topic, outside_span="error", echo="last", stamp="header"):
     """ValueError for arguments that no bag could make valid."""
     if no_return not in NO_RETURN_MODES:
         raise ValueError(f"no_return must be one of {NO_RETURN_MODES}, not {no_return!r}")
@@ -59,48 +67,65 @@ def _check_arguments(pose_source, no_return, pose_topic, outside_span="error"):
         raise ValueError(f"pose_source must be one of {POSE_SOURCES}, not {pose_source!r}")
     if pose_source == "topic" and pose_topic is None:
         raise ValueError("pose_source 'topic' needs pose_topic")
-    if outside_span not in ("error", "skip"):
-        raise ValueError(f"outside_span must be 'error' or 'skip', not {outside_span!r}")
+    if outside_span not in OUTSIDE_SPAN:
+        raise ValueError(f"outside_span must be one of {OUTSIDE_SPAN}, not {outside_span!r}")
+    if echo not in ECHO_MODES:
+        raise ValueError(f"echo must be one of {ECHO_MODES}, not {echo!r}")
+    if stamp not in STAMP_MODES:
+        raise ValueError(f"stamp must be one of {STAMP_MODES}, not {stamp!r}")
 
 
 def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_topic=None,
              laser_mount=None, pose_source="auto", no_return="skip", progress=None,
-             outside_span="error") -> BagScans:
-    """The scans of one LaserScan topic of the bag at path, with the laser pose at each stamp.
+             outside_span="error", echo="last", stamp="header") -> BagScans:
+    """The scans of the bag's laser scan topics at path, with the laser pose at each stamp.
 
-    scan_topic: the LaserScan topic; None takes the only one. fixed_frame: the frame of the
-    poses (with tf, None means the root of the scan frame's tree; with a pose topic, None accepts
-    the topic's frame). base_frame: the robot's frame (default Odometry's child_frame_id, else
-    "base_link"). pose_topic: a nav_msgs/Odometry, geometry_msgs/PoseStamped or
-    PoseWithCovarianceStamped topic of base poses. laser_mount: (x, y, yaw) of the laser in the
-    base frame, instead of /tf_static. pose_source: "auto" (pose_topic if given, else tf),
-    "tf", "topic" or "none" (NaN poses; the caller brings them). no_return: "skip" or "free"
-    (see :mod:`vasco_gpu.bags.scans`). progress: progress(done_messages, total_messages).
-    outside_span: a scan stamp outside the time span of the poses (a /tf link on the chain, or
-    the pose topic) is a BagError ("error", the default) or gets a NaN pose ("skip": the caller
-    leaves those scans out; recorders often start the laser before tf).
+    scan_topic: the sensor_msgs/LaserScan or MultiEchoLaserScan topic; None takes the only one;
+    several (a list, or names separated by commas) are read together, each scan posed in its own
+    frame (so each laser with its own mount), and merged in stamp order (one topic keeps bag
+    order). fixed_frame: the frame of the poses (with tf, None means the root of the scan
+    frame's tree; with a pose topic, None accepts the topic's frame). base_frame: the robot's
+    frame (default Odometry's child_frame_id, else "base_link"). pose_topic: a
+    nav_msgs/Odometry, geometry_msgs/PoseStamped or PoseWithCovarianceStamped topic of base
+    poses. laser_mount: (x, y, yaw) of the laser in the base frame, instead of /tf_static (one
+    topic only). pose_source: "auto" (pose_topic if given, else tf), "tf", "topic" or "none"
+    (NaN poses; the caller brings them). no_return: "skip" or "free" (see
+    :mod:`vasco_gpu.bags.scans`). progress: progress(done_messages, total_messages).
+    outside_span: a scan stamp without a pose (outside the time span of the poses: of a /tf link
+    on the chain, or of the pose topic; or in a gap of over TF_MAX_GAP seconds of a /tf link) is
+    a BagError ("error", the default), or gets a NaN pose ("skip": the caller leaves those scans
+    out), or gets a NaN pose when it lies before the first or after the last pose of the chain,
+    counted in ``edges``, while a gap stays a BagError ("edges"). echo: the echo a
+    MultiEchoLaserScan beam gives, "first", "last" (default) or "strongest". stamp: a scan's
+    stamp is its "header" stamp (default) or the time the bag received it ("receive", for a
+    driver whose clock is wrong); the poses are looked up at it.
 
     Raises BagError for anything about the bag, ValueError for arguments that are wrong in
     themselves.
     """
-    _check_arguments(pose_source, no_return, pose_topic, outside_span)
+    _check_arguments(pose_source, no_return, pose_topic, outside_span, echo, stamp)
     mount_arg = check_mount(laser_mount)
     with open_bag(path) as reader:
         topics = reader.topics
-        topic = pick_scan_topic(path, topics, scan_topic)
-        if topics[topic].msgcount == 0:
-            raise BagError(path, f"LaserScan topic {topic!r} has no messages", topic=topic)
+        names = pick_scan_topics(path, topics, scan_topic)
+        if mount_arg is not None and len(names) > 1:
+            raise ValueError("laser_mount (--laser-mount) gives one mount: with several scan topics each "
+                             "laser's mount comes from /tf_static")
+        for name in names:
+            if topics[name].msgcount == 0:
+                raise BagError(path, f"scan topic {name!r} has no messages", topic=name)
         source = choose_pose_source(path, topics, pose_source, pose_topic)
-        scans = ScanAccumulator(path, topic, no_return)
-        handlers = {topic: scans.add}
+        accs = [ScanAccumulator(path, name, no_return, norm_type(topics[name].msgtype) == MULTI_ECHO, echo, stamp)
+                for name in names]
+        handlers = {acc.topic: acc.add for acc in accs}
         tf = None
         if tf_topics(topics):
-            tf = TfBuffer(path, stamp_name="scan stamp",
+            tf = TfBuffer(path, stamp_name="scan stamp", max_gap=TF_MAX_GAP,
                           outside_hint="skip_unposed / --skip-unposed leaves such scans out")
             for name in tf_topics(topics):
                 static = name.rstrip("/").endswith("tf_static")
                 if static or source == "tf":  # /tf only when it gives the poses
-                    handlers[name] = (lambda m, s=static, n=name: tf.add_message(m, s, n))
+                    handlers[name] = (lambda m, t, s=static, n=name: tf.add_message(m, s, n))
         series = None
         if source == "topic":
             name, msgtype = check_pose_topic(path, topics, pose_topic)
@@ -110,16 +135,53 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
         ticker = Progress(progress, total)
         read_messages(reader, path, handlers, ticker)
         ticker.end()
-    if not scans.ns:
-        raise BagError(path, f"LaserScan topic {topic!r} has no messages", topic=topic)
-    ns = np.frombuffer(scans.ns, dtype=np.int64).copy()
-    poses, mounts, label = poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mount_arg,
-                                     outside_span)
+    parts = []
+    for acc in accs:
+        if not acc.ns:
+            raise BagError(path, f"scan topic {acc.topic!r} has no messages", topic=acc.topic)
+        ns = np.frombuffer(acc.ns, dtype=np.int64).copy()
+        try:
+            parts.append((acc, ns) + poses_for(path, source, acc, ns, tf, series, fixed_frame, base_frame,
+                                               mount_arg, outside_span))
+        except BagError as e:
+            if len(accs) > 1 and e.topic != acc.topic:  # say which laser's scans
+                e.message += f" (scans of {acc.topic!r})"
+                e.args = (e.args[0] + f" (scans of {acc.topic!r})",)
+            raise
+    return _merge(path, parts)
+
+
+def _merge(path, parts) -> BagScans:
+    """One BagScans of the topics' scans: in bag order for one topic, else in stamp order."""
+    ns = np.concatenate([p[1] for p in parts])
+    order = np.argsort(ns, kind="stable") if len(parts) > 1 else np.arange(len(ns))
+    index = np.concatenate([np.full(len(p[1]), k, dtype=np.int64) for k, p in enumerate(parts)])[order]
+    counts = np.concatenate([np.frombuffer(p[0].beam_counts, dtype=np.int64) for p in parts])
+    ranges = [r for p in parts for r in p[0].ranges]
+    column = lambda field: np.concatenate([np.frombuffer(getattr(p[0], field), dtype=np.float64)
+                                           for p in parts])[order]
+    if all(p[3] is None for p in parts):
+        mounts = None
+    else:
+        mounts = np.concatenate([p[3] if p[3] is not None else np.full((len(p[1]), 3), np.nan)
+                                 for p in parts])[order]
+    total = {}
+    for p in parts:
+        for key, value in p[0].counts.items():
+            total[key] = total.get(key, 0) + value
+    edges = None
+    known = [p[5] for p in parts if p[5] is not None]
+    if known:
+        edges = {"before": sum(e["before"] for e in known), "after": sum(e["after"] for e in known),
+                 "first": stamp_seconds(min(e["first"] for e in known)),
+                 "last": stamp_seconds(max(e["last"] for e in known))}
+    first = parts[0][0]
     return BagScans(
-        path=os.fspath(path), topic=topic, frame_id=scans.frame_id, stamps=stamp_seconds(ns), poses=poses,
-        mounts=mounts, ranges=np.concatenate(scans.ranges) if scans.ranges else np.zeros(0, np.float32),
-        beam_counts=np.frombuffer(scans.beam_counts, dtype=np.int64).copy(),
-        first_angle=np.frombuffer(scans.first_angle, dtype=np.float64).copy(),
-        angle_step=np.frombuffer(scans.angle_step, dtype=np.float64).copy(), counts=dict(scans.counts),
-        pose_source=label, range_max=np.frombuffer(scans.range_max, dtype=np.float64).copy(),
+        path=os.fspath(path), topic=first.topic, frame_id=first.frame_id, stamps=stamp_seconds(ns[order]),
+        poses=np.concatenate([p[2] for p in parts])[order], mounts=mounts,
+        ranges=np.concatenate([ranges[k] for k in order]) if ranges else np.zeros(0, np.float32),
+        beam_counts=counts[order], first_angle=column("first_angle"), angle_step=column("angle_step"),
+        counts=total, pose_source=parts[0][4], range_max=column("range_max"),
+        topics=tuple(p[0].topic for p in parts), topic_index=index,
+        frame_ids=tuple(p[0].frame_id for p in parts), edges=edges,
     )

@@ -1,5 +1,5 @@
-"""sensor_msgs/LaserScan messages into the mapper's arrays, ranges by REP 117; BagScans, the
-scans of one topic with their poses.
+"""sensor_msgs/LaserScan messages (and MultiEchoLaserScan's, one echo a beam) into the mapper's
+arrays, ranges by REP 117; BagScans, the scans of one or more topics with their poses.
 
 Range policy: REP 117 readings turned into CARMEN's semantics
 ---------------------------------------------------------------
@@ -57,6 +57,12 @@ class BagScans:
     the laser frame. ``poses`` is the laser pose in the fixed frame, ``mounts`` the laser pose
     in the base frame. ``range_max`` (an addition to the interface, per scan ``msg.range_max``)
     is what :func:`write_carmen_log` writes as the device's maximum range.
+
+    Several topics (``topics``, each with its frame in ``frame_ids``) are merged in stamp
+    order; ``topic_index[s]`` is scan s's topic in ``topics``, ``topic`` and ``frame_id`` are
+    the first's. ``edges``: the scans before the first and after the last pose of their topic's
+    chain, left out (``outside_span="edges"``): {"before", "after", "first", "last"} (counts,
+    and the first and last stamp with a pose, in seconds) or None.
     """
 
     path: str
@@ -72,6 +78,10 @@ class BagScans:
     counts: dict
     pose_source: str
     range_max: np.ndarray | None = None
+    topics: tuple = ()
+    topic_index: np.ndarray | None = None
+    frame_ids: tuple = ()
+    edges: dict | None = None
 
 
 def apply_rep117(v: np.ndarray, rmin: float, rmax: float, no_return: str, counts: dict) -> np.ndarray:
@@ -94,11 +104,53 @@ def apply_rep117(v: np.ndarray, rmin: float, rmax: float, no_return: str, counts
     return out
 
 
+ECHO_MODES = ("first", "last", "strongest")
+STAMP_MODES = ("header", "receive")
+
+
+def pick_echoes(msg, echo: str, fail) -> np.ndarray:
+    """One range a beam of a sensor_msgs/MultiEchoLaserScan, as float32: its first or last echo,
+    or the echo of the largest intensity ("strongest"; ties: the first). A beam without an echo
+    is +inf (REP 117: no return). fail(what) gives the BagError to raise."""
+    echoes = [np.asarray(e.echoes, dtype=np.float32).ravel() for e in msg.ranges]
+    n = len(echoes)
+    lens = np.fromiter((len(e) for e in echoes), dtype=np.int64, count=n)
+    out = np.full(n, np.inf, dtype=np.float32)
+    has = lens > 0
+    if not has.any():
+        return out
+    flat = np.concatenate(echoes)
+    starts = np.concatenate([[0], np.cumsum(lens)[:-1]])
+    if echo == "first":
+        out[has] = flat[starts[has]]
+    elif echo == "last":
+        out[has] = flat[starts[has] + lens[has] - 1]
+    else:
+        power = [np.asarray(e.echoes, dtype=np.float64).ravel() for e in msg.intensities]
+        if not power:
+            raise fail("has no intensities: echo 'strongest' (--echo strongest) needs them; take the first "
+                       "or last echo instead")
+        plens = np.fromiter((len(e) for e in power), dtype=np.int64, count=len(power))
+        if len(power) != n or not np.array_equal(plens, lens):
+            raise fail(f"has intensities for {int(plens.sum())} echoes of {len(power)} beams, ranges for "
+                       f"{int(lens.sum())} echoes of {n} beams: echo 'strongest' needs one intensity an echo")
+        p = np.concatenate(power)
+        p = np.where(np.isnan(p), -np.inf, p)
+        seg = starts[has]
+        best = np.maximum.reduceat(p, seg) if len(p) else p
+        index = np.arange(len(p))
+        first_best = np.where(p == np.repeat(best, lens[has]), index, len(p))
+        out[has] = flat[np.minimum.reduceat(first_best, seg)]
+    return out
+
+
 class ScanAccumulator:
     """Collects the scans of the chosen topic in bag order, applying the range policy."""
 
-    def __init__(self, path, topic: str, no_return: str):
+    def __init__(self, path, topic: str, no_return: str, multi_echo: bool = False, echo: str = "last",
+                 stamp: str = "header"):
         self.path, self.topic, self.no_return = path, topic, no_return
+        self.multi_echo, self.echo, self.receive = multi_echo, echo, stamp == "receive"
         self.frame_id: str | None = None
         self.ns = array("q")
         self.first_angle = array("d")
@@ -113,8 +165,9 @@ class ScanAccumulator:
         return BagError(self.path, f"scan at stamp {stamp_text(ns)} on {self.topic!r} {what}",
                         topic=self.topic, stamp=stamp_seconds(ns))
 
-    def add(self, msg) -> None:
-        ns = stamp_ns(msg.header.stamp)
+    def add(self, msg, receive_ns: int | None = None) -> None:
+        """One message; receive_ns: when the bag received it (the scan's stamp with stamp "receive")."""
+        ns = int(receive_ns) if self.receive and receive_ns is not None else stamp_ns(msg.header.stamp)
         frame = frame_name(msg.header.frame_id)
         if self.frame_id is None:
             self.frame_id = frame
@@ -127,7 +180,8 @@ class ScanAccumulator:
         a0, da = float(msg.angle_min), float(msg.angle_increment)
         if not (math.isfinite(a0) and math.isfinite(da)):
             raise self._error(ns, f"has angle_min {a0!r}, angle_increment {da!r}")
-        r = apply_rep117(msg.ranges, rmin, rmax, self.no_return, self.counts)
+        raw = pick_echoes(msg, self.echo, lambda what: self._error(ns, what)) if self.multi_echo else msg.ranges
+        r = apply_rep117(raw, rmin, rmax, self.no_return, self.counts)
         self.ns.append(ns)
         self.first_angle.append(a0)
         self.angle_step.append(da)

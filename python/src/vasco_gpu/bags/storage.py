@@ -119,8 +119,8 @@ def _ensure_types(reader, default) -> None:
 
 def read_messages(reader, path, handlers: dict, progress) -> None:
     """One pass over the connections of the topics in handlers, in bag order, each message
-    deserialized with the bag's definitions and passed to its topic's handler; progress (a
-    reader.Progress) ticks once a message."""
+    deserialized with the bag's definitions and passed to its topic's handler with the time the
+    bag received it (whole nanoseconds); progress (a reader.Progress) ticks once a message."""
     topics = reader.topics
     connections = [c for name in handlers for c in topics[name].connections]
     stream = reader.messages(connections=connections)
@@ -138,5 +138,5 @@ def read_messages(reader, path, handlers: dict, progress) -> None:
             raise BagError(path, f"cannot deserialize a {short_type(connection.msgtype)} message on "
                                  f"{connection.topic!r} received at {stamp_text(t_ns)}: {reason(err)}",
                            topic=connection.topic) from err
-        handlers[connection.topic](msg)
+        handlers[connection.topic](msg, t_ns)
         progress.tick()

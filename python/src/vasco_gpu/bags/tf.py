@@ -54,15 +54,21 @@ class TfBuffer:
     stamp, a dynamic one (``/tf``) is interpolated between its samples (linear translation,
     slerp) and never extrapolated. Every sample is kept (a bag's whole history).
 
+    ``max_gap`` (seconds, default None: no limit) refuses a stamp between two samples of a link
+    further apart than that: tf2's buffer keeps 10 s of history, so a live lookup across a wider
+    gap finds the older sample gone.
+
     ``file``, ``stamp_name`` and ``outside_hint`` shape the error messages only: the bag the
     transforms come from (None when fed live), what the looked-up stamps are, and a hint added
-    to the error for a stamp outside a link's samples. Errors are :class:`TfError`.
+    to the error for a stamp outside a link's samples (or in a gap). Errors are :class:`TfError`.
     """
 
-    def __init__(self, file=None, *, stamp_name: str = "stamp", outside_hint: str = ""):
+    def __init__(self, file=None, *, stamp_name: str = "stamp", outside_hint: str = "",
+                 max_gap: float | None = None):
         self.file = file
         self.stamp_name = stamp_name
         self.outside_hint = outside_hint
+        self.max_gap_ns = None if max_gap is None else int(round(max_gap * 1e9))
         self._edges: dict[str, _Edge] = {}  # by child: each child has one parent
 
     def __len__(self) -> int:
@@ -163,6 +169,16 @@ class TfBuffer:
                                      f"({len(times)} samples); tf is not extrapolated{hint}",
                           topic="/tf", stamp=stamp_seconds(bad))
         hit, i, lo, hi, f = bracket(times, ns)
+        gap = self._in_gap(times, ns, hit, lo, hi)
+        if gap.any():
+            k = int(np.argmax(gap))
+            hint = f" ({self.outside_hint})" if self.outside_hint else ""
+            wide = (times[hi[k]] - times[lo[k]]) * 1e-9
+            raise TfError(self.file, f"{self.stamp_name} {stamp_text(ns[k])} falls in a gap of {wide:.3f} s "
+                                     f"between samples {stamp_text(times[lo[k]])} and {stamp_text(times[hi[k]])} "
+                                     f"of tf {edge.parent} -> {edge.child}, wider than {self.max_gap_ns * 1e-9:g} s "
+                                     f"(tf2 keeps {self.max_gap_ns * 1e-9:g} s of history: it has no transform "
+                                     f"there){hint}", topic="/tf", stamp=stamp_seconds(ns[k]))
         t = tr[lo] + (tr[hi] - tr[lo]) * f[:, None]
         q = slerp(qs[lo], qs[hi], f)
         t[hit], q[hit] = tr[i[hit]], qs[i[hit]]  # exact hits: the sample unchanged
@@ -183,18 +199,38 @@ class TfBuffer:
                 total = link if total is None else compose(total, link)
         return total
 
+    def _in_gap(self, times, ns, hit, lo, hi) -> np.ndarray:
+        """Which stamps (within the span, located by bracket) lie in a gap wider than max_gap."""
+        if self.max_gap_ns is None:
+            return np.zeros(len(ns), dtype=bool)
+        return ~hit & ((times[hi] - times[lo]) > self.max_gap_ns)
+
+    def _moving(self, target: str, source: str) -> list[_Edge]:
+        """The /tf links on the chain between the two frames."""
+        up_s, up_t = self._path_between(target, source)
+        return [self._edges[c] for chain in (up_s, up_t) for c in chain[:-1] if not self._edges[c].static]
+
+    def span(self, target: str, source: str):
+        """(first, last) stamps in whole nanoseconds at which every /tf link between the two
+        frames has samples on both sides, or None when the chain has no /tf link (static: every
+        stamp). first > last when the links' spans do not overlap."""
+        moving = self._moving(target, source)
+        if not moving:
+            return None
+        return (max(int(e.arrays()[0][0]) for e in moving), min(int(e.arrays()[0][-1]) for e in moving))
+
     def covers(self, target: str, source: str, stamps) -> np.ndarray:
         """Which stamps lie within the time span of every /tf link between the two frames
-        (static links have none): the stamps lookup can answer without extrapolating."""
+        (static links have none), and in no gap wider than max_gap: the stamps lookup answers."""
         ns = np.atleast_1d(np.asarray(stamps, dtype=np.int64))
-        up_s, up_t = self._path_between(target, source)
         inside = np.ones(len(ns), dtype=bool)
-        for chain in (up_s, up_t):
-            for child in chain[:-1]:
-                edge = self._edges[child]
-                if not edge.static:
-                    times = edge.arrays()[0]
-                    inside &= (ns >= times[0]) & (ns <= times[-1])
+        for edge in self._moving(target, source):
+            times = edge.arrays()[0]
+            within = (ns >= times[0]) & (ns <= times[-1])
+            if within.any() and self.max_gap_ns is not None:
+                hit, _, lo, hi, _ = bracket(times, ns[within])
+                within[within] = ~self._in_gap(times, ns[within], hit, lo, hi)
+            inside &= within
         return inside
 
     def lookup(self, target: str, source: str, stamps, static_only: bool = False):

@@ -1,11 +1,26 @@
-"""The bag's topics: message type names, the LaserScan topic to read, the tf topics, the pose
-source (tf or a pose topic) and the pose topic's type."""
+"""The bag's topics: message type names, the scan topics to read (LaserScan, MultiEchoLaserScan;
+a clear word on sensors that are neither), the tf topics, the pose source (tf or a pose topic)
+and the pose topic's type."""
 
 from __future__ import annotations
 
 from .errors import BagError
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
+MULTI_ECHO = "sensor_msgs/msg/MultiEchoLaserScan"
+SCAN_TYPES = (LASER_SCAN, MULTI_ECHO)
+# Sensors a bag may hold that are not laser scans: why each is not mapped, and what turns it into
+# a LaserScan.
+_CLOUD = "a 3-D point cloud; pointcloud_to_laserscan turns it into a LaserScan"
+_DEPTH = "an image; depthimage_to_laserscan turns a depth image into a LaserScan"
+UNSUPPORTED_SENSORS = {
+    "sensor_msgs/msg/PointCloud2": _CLOUD,
+    "sensor_msgs/msg/PointCloud": _CLOUD,
+    "sensor_msgs/msg/Image": _DEPTH,
+    "sensor_msgs/msg/CompressedImage": _DEPTH,
+    "sensor_msgs/msg/Range": "one range a message (a sonar or infrared ranger), not a scan",
+    "sensor_msgs/msg/Imu": "an inertial unit: no ranges",
+}
 TF_TYPES = ("tf2_msgs/msg/TFMessage", "tf/msg/tfMessage")  # ROS 2 / ROS 1 tf2, old ROS 1 tf
 TF_TOPICS = ("/tf", "/tf_static")
 POSE_TYPES = (
@@ -48,26 +63,65 @@ def topics_of_type(topics, msgtypes) -> list[str]:
     return sorted(name for name, info in topics.items() if norm_type(info.msgtype) in msgtypes)
 
 
-def pick_scan_topic(path, topics, scan_topic: str | None) -> str:
-    """The LaserScan topic to read: the named one (which must be a LaserScan) or the only one."""
-    scans = topics_of_type(topics, (LASER_SCAN,))
+def scan_topic_names(scan_topic) -> list[str] | None:
+    """The scan topics asked for: None (the only one), a name, names separated by commas (as
+    bag2map's --scan-topic hands them on), or a sequence of names; each once, in order."""
+    if scan_topic is None:
+        return None
+    items = [scan_topic] if isinstance(scan_topic, str) else list(scan_topic)
+    names: list[str] = []
+    for item in items:
+        for name in str(item).split(","):
+            name = name.strip()
+            if name and name not in names:
+                names.append(name)
+    if not names:
+        raise ValueError(f"scan_topic names no topic: {scan_topic!r}")
+    return names
+
+
+def _unsupported_text(name: str, msgtype: str | None) -> str:
+    """'/points' (sensor_msgs/PointCloud2): a 3-D point cloud; ... (what to do)."""
+    why = UNSUPPORTED_SENSORS.get(norm_type(msgtype) or "", "")
+    return f"{name!r} ({short_type(msgtype)}){': ' + why if why else ''}"
+
+
+def _no_scan_text(topics) -> str:
+    """Why a bag has nothing to map: its topics, and its sensors that are not laser scans."""
+    text = f"no sensor_msgs/LaserScan or MultiEchoLaserScan topic (topics: {topic_listing(topics)})"
+    sensors = [name for name, info in sorted(topics.items()) if norm_type(info.msgtype) in UNSUPPORTED_SENSORS]
+    if sensors:
+        listed = "; ".join(_unsupported_text(name, topics[name].msgtype) for name in sensors)
+        text += f"; its sensor topics are not laser scans, which are all that is mapped: {listed}"
+    return text
+
+
+def pick_scan_topics(path, topics, scan_topic) -> list[str]:
+    """The scan topics to read: the named ones (each a LaserScan or MultiEchoLaserScan), or the
+    only one. scan_topic as :func:`scan_topic_names` takes it."""
+    scans = topics_of_type(topics, SCAN_TYPES)
     listing = ", ".join(repr(t) for t in scans) or "none"
-    if scan_topic is not None:
-        name = resolve_topic(scan_topic, topics)
+    names = scan_topic_names(scan_topic)
+    if names is None:
+        if not scans:
+            raise BagError(path, _no_scan_text(topics))
+        if len(scans) > 1:
+            raise BagError(path, f"several laser scan topics ({listing}); pass scan_topic (--scan-topic) to "
+                                 "choose one, or several to map them together")
+        return scans
+    chosen = []
+    for wanted in names:
+        name = resolve_topic(wanted, topics)
         if name is None:
-            raise BagError(path, f"no topic {scan_topic!r} in the bag (LaserScan topics: {listing})",
-                           topic=scan_topic)
+            raise BagError(path, f"no topic {wanted!r} in the bag (LaserScan topics: {listing})", topic=wanted)
         if name not in scans:
             kind = short_type(topics[name].msgtype)
-            raise BagError(path, f"topic {name!r} is {kind}, not sensor_msgs/LaserScan "
-                                 f"(LaserScan topics: {listing})", topic=name)
-        return name
-    if not scans:
-        raise BagError(path, f"no sensor_msgs/LaserScan topic (topics: {topic_listing(topics)})")
-    if len(scans) > 1:
-        raise BagError(path, f"several sensor_msgs/LaserScan topics ({listing}); pass scan_topic "
-                             "(--scan-topic) to choose one")
-    return scans[0]
+            hint = UNSUPPORTED_SENSORS.get(norm_type(topics[name].msgtype) or "")
+            raise BagError(path, f"topic {name!r} is {kind}, not sensor_msgs/LaserScan or MultiEchoLaserScan"
+                                 f"{' (' + hint + ')' if hint else ''} (LaserScan topics: {listing})", topic=name)
+        if name not in chosen:
+            chosen.append(name)
+    return chosen
 
 
 def tf_topics(topics) -> list[str]:
