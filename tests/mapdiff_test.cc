@@ -3,12 +3,14 @@
 #include <png.h>
 #include <sys/stat.h>
 
+#include <cstdio>
 #include <cstring>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "carmen_compat/map_file.h"
+#include "carmen_compat/map_format.h"
 #include "map_test_support.h"
 #include "tool_support.h"
 #include "carmen_compat/map_compare.h"
@@ -506,6 +508,119 @@ TEST(CompareGrids, OffsetShift) {
   EXPECT_TRUE(contains(why, "whole number")) << why;
   EXPECT_FALSE(carmen::offset_shift({0, 0, 0.5}, {0, 0, 0.5}, 0.25, &sx, &sy, &why));
   EXPECT_TRUE(contains(why, "theta")) << why;
+}
+
+// ---------------------------------------------------------------------------
+// Every format of the map table (carmen_compat/map_format.h)
+// ---------------------------------------------------------------------------
+
+// Writes `g` at `path` in the format of its name, through the format table.
+std::string write_any(const std::string &path, const GridMap &g, std::optional<GlobalOffset> origin = std::nullopt) {
+  carmen::MapToWrite m;
+  m.grid = g;
+  m.origin = origin;
+  carmen::write_map(path, m);
+  return path;
+}
+
+const GlobalOffset kOrigin{1.5, -2.25, 0};
+
+TEST_F(MapDiff, TwoPgmMaps) {
+  const std::string a = write_any(dir_.file("a.pgm"), base_grid(), kOrigin);
+  const std::string b = write_any(dir_.file("b.pgm"), base_grid(), kOrigin);
+  ToolRun r = mapdiff({a, b});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "A: " + a + " (ROS map_server / nav2 PGM image with a .yaml beside it; "
+                                          "its origin is the offset)\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "offset x 1.5 y -2.25 theta 0\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "verdict: identical\n")) << r.output;
+
+  // A free cell made occupied: one cell differs, in A's coordinates.
+  GridMap g = base_grid();
+  g.at(4, 1) = 1.0f;
+  write_any(b, g, kOrigin);
+  r = mapdiff({a, b});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "alignment: by OFFSET: B's cell (0, 0) is A's cell (0, 0)")) << r.output;
+  EXPECT_TRUE(contains(r.output, "verdict: different: 1 cell differs")) << r.output;
+  EXPECT_TRUE(contains(r.output, "  (4, 1)  A ")) << r.output;
+
+  // Moved by two cells: aligned by the origins.
+  write_any(b, crop(base_grid(), 2, 0, 4, 4), GlobalOffset{kOrigin.x + 0.2, kOrigin.y, 0});
+  r = mapdiff({"--max-status-differs", "8", a, b});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "alignment: by OFFSET: B's cell (0, 0) is A's cell (2, 0)")) << r.output;
+}
+
+TEST_F(MapDiff, PngYamlPairReadsAsItsPgm) {
+  const std::string a = write_any(dir_.file("a.pgm"), base_grid(), kOrigin);
+  const std::string b = write_any(dir_.file("b.png+yaml"), base_grid(), kOrigin);
+  EXPECT_TRUE(maptest::file_exists(dir_.file("b.png")) && maptest::file_exists(dir_.file("b.yaml")));
+  const ToolRun r = mapdiff({a, b});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "B: " + b + " (ROS map_server / nav2 pair NAME.png + NAME.yaml; ")) << r.output;
+  EXPECT_TRUE(contains(r.output, "verdict: identical\n")) << r.output;
+  // The map_server YAML names the same map.
+  EXPECT_EQ(mapdiff({"-q", dir_.file("b.yaml"), a}).output, "identical\n");
+  const ToolRun j = mapdiff({"--json", a, b});
+  EXPECT_TRUE(contains(j.output, "\"format\":\".pgm\"}")) << j.output;
+  EXPECT_TRUE(contains(j.output, "\"format\":\".png+yaml\"}")) << j.output;
+}
+
+// A CARMEN map and its map_server conversion: the same resolution (a YAML's
+// 0.1 is the GRIDMAP's float32 0.1), the same place, the same classes; the
+// trinary image keeps the classes, not the values.
+TEST_F(MapDiff, CarmenMapAgainstItsPgmConversion) {
+  write_grid(a_, base_grid(), kOrigin);
+  const std::string b = write_any(dir_.file("conv.pgm"), base_grid(), kOrigin);
+  ToolRun r = mapdiff({a_, b});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "A: " + a_ + "\n")) << r.output;  // a CARMEN map, named as before
+  EXPECT_TRUE(contains(r.output, "size 6 x 4 cells, resolution 0.100000001 m, offset x 1.5 y -2.25 theta 0\n"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "alignment: by OFFSET: B's cell (0, 0) is A's cell (0, 0)")) << r.output;
+  EXPECT_TRUE(contains(r.output, "class agreement 1.000000)")) << r.output;
+  r = mapdiff({"-q", "--tolerance", "1", "--min-class-agreement", "1", a_, b});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.substr(0, 17), "within tolerance:") << r.output;
+  // The other way round, and from standard input (a CARMEN map).
+  const std::string out = dir_.file("out.txt");
+  EXPECT_EQ(tooltest::run_tool_piped(a_, "mapdiff",
+                                     {"-q", "--tolerance", "1", "--min-class-agreement", "1", b, "-"}, out), 0);
+}
+
+// A picture has no resolution and no origin: it takes the other map's
+// resolution and lies at cell (0, 0); its greys give p back to 1/510.
+TEST_F(MapDiff, PictureTakesTheOtherMapsResolution) {
+  write_grid(a_, base_grid(), kOrigin);
+  const std::string b = write_any(dir_.file("pic.png"), base_grid());
+  ToolRun r = mapdiff({a_, b});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "B: " + b + " (picture for people (RGB); no resolution of its own: the other map's)"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "resolution 0.100000001 m, offset none")) << r.output;
+  EXPECT_TRUE(contains(r.output, "alignment: at cell (0, 0) (B is a picture: a .png has no origin)")) << r.output;
+  EXPECT_TRUE(contains(r.output, "known/unknown differs 0")) << r.output;
+  EXPECT_EQ(mapdiff({"-q", "--tolerance", "0.002", b, a_}).status, 0);
+  // Two pictures: both without a resolution, compared cell for cell.
+  EXPECT_EQ(mapdiff({"-q", b, write_any(dir_.file("pic2.png"), base_grid())}).output, "identical\n");
+}
+
+TEST_F(MapDiff, MapServerFilesThatCannotBeReadExitTwoNamingThem) {
+  const std::string a = write_any(dir_.file("a.pgm"), base_grid(), kOrigin);
+  ASSERT_EQ(std::remove(dir_.file("a.yaml").c_str()), 0);
+  ToolRun r = mapdiff({a_, a});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "mapdiff: ")) << r.output;
+  EXPECT_TRUE(contains(r.output, dir_.file("a.yaml"))) << r.output;
+  maptest::write_bytes(dir_.file("bad.yaml"), "image: nowhere.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  r = mapdiff({dir_.file("bad.yaml"), a_});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "nowhere.pgm")) << r.output;
+  // --png must not replace a pair's YAML.
+  const std::string p = write_any(dir_.file("p.pgm"), base_grid(), kOrigin);
+  r = mapdiff({"--png", dir_.file("p.yaml"), a_, p});
+  EXPECT_EQ(r.status, 2) << r.output;
 }
 
 }  // namespace

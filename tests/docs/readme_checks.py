@@ -356,6 +356,14 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "cpp: vasco::MapperParams params;": Check("compile", harness=CXX_HARNESS),
         "c: vasco_mapper_params p;": Check("compile", harness=C_HARNESS),
     },
+    "docs/walkthrough-bag.md": {
+        # carmen2bag and mapdiff are not among test_readme.py's tools: the test runs the block
+        # itself, each command as written, with the console scripts and the build's tools.
+        "sh: carmen2bag logs/intel.gfs.log.gz intel.mcap": Check(
+            "covered-by",
+            files=[("python/tests/test_carmen2bag.py", ["walkthrough-bag.md", "def test_walkthrough_runs",
+                                                        "shell_commands"])]),
+    },
 }
 
 

@@ -1,6 +1,9 @@
-// mapdiff — compares the GRIDMAP chunks of two CARMEN maps, for regression
+// mapdiff — compares the GRIDMAP chunks of two maps, for regression
 // suites: is today's map the same as yesterday's (bit for bit, or within
-// tolerances), and if not, where and by how much (DESIGN §4's table).
+// tolerances), and if not, where and by how much (DESIGN §4's table). Either
+// map may be in any format of the map-format table (carmen_compat/
+// map_format.h): a map_server pair's grid is compared as a GRIDMAP, its
+// origin as the OFFSET; a picture (.png) has neither resolution nor origin.
 //
 //   mapdiff [options] A B
 //
@@ -23,6 +26,7 @@
 #include "carmen_compat/error.h"
 #include "carmen_compat/image_io.h"
 #include "carmen_compat/map_file.h"
+#include "carmen_compat/map_format.h"
 #include "cli_support.h"
 #include "vasco_gpu/pipeline/outputs.h"
 #include "picture_legend.h"
@@ -49,6 +53,12 @@ struct Input {
   carmen::GridMap grid;
   std::optional<carmen::GlobalOffset> offset;
   std::string sha256;  // of the GRIDMAP payload (carmen_compat/map_digest.h): what goldens are published with
+  // The format table's row for the name; nullptr for '-' and a name the
+  // table does not know (both read as CARMEN maps).
+  const carmen::MapFormatEntry *format = nullptr;
+  bool carmen_map() const { return format == nullptr || format->kind == carmen::MapFormatKind::Carmen; }
+  bool picture() const { return format != nullptr && format->kind == carmen::MapFormatKind::Picture; }
+  bool resolution_borrowed = false;  // a picture's: the other map's resolution
 };
 
 // Where B lies on A and why; `compared` is false when the resolutions differ.
@@ -68,20 +78,47 @@ struct Verdict {
 // ---------------------------------------------------------------------------
 
 // Every failure becomes a carmen::FileError naming the file, so main can say
-// "mapdiff: PATH: what is wrong" and exit 2.
+// "mapdiff: PATH: what is wrong" and exit 2. A CARMEN map (and '-', and any
+// name the format table does not know) is read as a map file, its GRIDMAP and
+// OFFSET chunks; any other format through the table's reader
+// (carmen::read_map), its origin taken as the OFFSET.
 Input load(const std::string &path) {
-  carmen::MapFile m;
+  Input in;
+  in.path = path;
+  in.format = carmen::find_map_format(path);
   try {
-    m = carmen::read_map_file(path);
+    if (in.carmen_map()) {
+      carmen::MapFile m = carmen::read_map_file(path);
+      if (!m.gridmap) throw carmen::FileError(path, "has no GRIDMAP chunk: nothing to compare");
+      in.grid = std::move(*m.gridmap);
+      in.offset = m.offset;
+    } else {
+      carmen::MapRead m = in.format->read(path);
+      in.grid = std::move(m.grid);
+      in.offset = m.origin;
+      // A GRIDMAP stores its resolution as a float32 and a YAML's decimal
+      // reads back as a double: compared at a GRIDMAP's precision, a CARMEN
+      // map and its map_server conversion have one resolution.
+      in.grid.resolution = double(float(in.grid.resolution));
+    }
   } catch (const carmen::FileError &) {
     throw;
   } catch (const std::exception &e) {
     throw carmen::FileError(path, e.what());
   }
-  if (!m.gridmap) throw carmen::FileError(path, "has no GRIDMAP chunk: nothing to compare");
-  Input in{path, std::move(*m.gridmap), m.offset, {}};
-  in.sha256 = carmen::gridmap_payload_sha256(in.grid.size_x, in.grid.size_y, in.grid.resolution, in.grid.cells);
   return in;
+}
+
+// The digest, once the resolution is final (a picture takes the other map's).
+void digest(Input &in) {
+  in.sha256 = carmen::gridmap_payload_sha256(in.grid.size_x, in.grid.size_y, in.grid.resolution, in.grid.cells);
+}
+
+// A picture has no resolution: it is compared at the other map's.
+void borrow_resolution(Input &picture, const Input &other) {
+  if (!picture.picture() || other.picture()) return;
+  picture.grid.resolution = other.grid.resolution;
+  picture.resolution_borrowed = true;
 }
 
 // "Identical": what the GRIDMAP chunk holds — size, resolution, cells bit for
@@ -113,6 +150,9 @@ Alignment align(const Input &a, const Input &b, bool identical, bool no_offset) 
     al.how = "cell for cell (identical GRIDMAPs)";
   } else if (no_offset) {
     al.how = "at cell (0, 0) (--no-offset)";
+  } else if (a.picture() || b.picture()) {
+    const char *which = a.picture() && b.picture() ? "both are pictures" : a.picture() ? "A is a picture" : "B is a picture";
+    al.how = std::string("at cell (0, 0) (") + which + ": a .png has no origin)";
   } else if (!a.offset || !b.offset) {
     const char *missing = a.offset ? "B" : b.offset ? "A" : "either";
     al.how = std::string("at cell (0, 0) (no OFFSET chunk in ") + missing + ")";
@@ -202,10 +242,19 @@ Verdict judge(const Input &a, const Input &b, bool identical, const Alignment &a
 // ---------------------------------------------------------------------------
 
 
+// A CARMEN map's first line is its path alone; another format's names it.
+std::string format_note(const Input &in) {
+  if (in.carmen_map()) return "";
+  std::string note = std::string(" (") + in.format->what;
+  if (in.format->kind == carmen::MapFormatKind::MapServer) note += "; its origin is the offset";
+  if (in.resolution_borrowed) note += "; no resolution of its own: the other map's";
+  return note + ")";
+}
+
 void print_input(const char *label, const Input &in) {
-  std::printf("%s: %s\n   size %d x %d cells, resolution %.9g m, offset %s\n   GRIDMAP sha256 %s\n", label,
-              in.path.c_str(), in.grid.size_x, in.grid.size_y, in.grid.resolution, offset_text(in.offset).c_str(),
-              in.sha256.c_str());
+  std::printf("%s: %s%s\n   size %d x %d cells, resolution %.9g m, offset %s\n   GRIDMAP sha256 %s\n", label,
+              in.path.c_str(), format_note(in).c_str(), in.grid.size_x, in.grid.size_y, in.grid.resolution,
+              offset_text(in.offset).c_str(), in.sha256.c_str());
 }
 
 void print_cell(const carmen::CellDifference &d, const carmen::GridComparison &c) {
@@ -276,7 +325,8 @@ std::string json_input(const Input &in) {
   } else {
     j << "null";
   }
-  j << ",\"gridmap_sha256\":" << json_string(in.sha256) << "}";
+  j << ",\"gridmap_sha256\":" << json_string(in.sha256)
+    << ",\"format\":" << (in.format != nullptr ? json_string(in.format->extension) : "null") << "}";
   return j.str();
 }
 
@@ -365,6 +415,11 @@ const char kFooter[] =
     "Alignment: when both maps have an OFFSET chunk (theta 0) a whole number of\n"
     "cells apart, B is laid on A by it; otherwise at cell (0, 0). Only the overlap\n"
     "is compared; cells outside it count as differing.\n"
+    "Formats: A and B may be any map the format table reads (a CARMEN map, '-',\n"
+    "and a name of no known format are read as CARMEN maps); a map_server map's\n"
+    "origin counts as its OFFSET and its resolution is taken as a float32, as a\n"
+    "GRIDMAP stores it. A .png picture has no resolution and no origin: it takes\n"
+    "the other map's resolution and is aligned at cell (0, 0).\n"
     "Same: without tolerance options, equal size and resolution and bit-identical\n"
     "cells, and equal OFFSET chunks where both maps have one (unless --no-offset).\n"
     "With any of --tolerance, --max-status-differs, --min-class-agreement:\n"
@@ -379,7 +434,8 @@ const char kFooter[] =
 
 void add_options(CLI::App &app, Options &o) {
   app.set_version_flag("--version", [] { return std::string("mapdiff (vasco_gpu) ") + vasco::version(); });
-  app.add_option("A", o.a, "reference map (.map or .map.gz; - for standard input)")->required();
+  app.add_option("A", o.a, "reference map (" + carmen::known_map_extensions() + "; - for standard input, a CARMEN map)")
+      ->required();
   app.add_option("B", o.b, "map to compare with A (- for standard input)")->required();
   app.add_option("--top", o.top, "list the N largest differences (default 10)")
       ->type_name("N")->check(CLI::NonNegativeNumber);
@@ -402,7 +458,8 @@ void add_options(CLI::App &app, Options &o) {
 
 // Parses the command line; returns -1 to go on, else the exit status.
 int parse(int argc, char **argv, Options &o) {
-  CLI::App app{"mapdiff: compares the GRIDMAPs of two CARMEN maps (exit 0 same, 1 different, 2 error).", "mapdiff"};
+  CLI::App app{"mapdiff: compares the GRIDMAPs of two maps, CARMEN's or any format of the map table "
+                  "(exit 0 same, 1 different, 2 error).", "mapdiff"};
   add_options(app, o);
   try {
     app.parse(argc, argv);
@@ -425,14 +482,33 @@ int parse(int argc, char **argv, Options &o) {
   return -1;
 }
 
+// Every file reading a map argument reads (a .pgm's .yaml too), so that
+// --png can replace none of them.
+std::vector<std::string> input_files(const std::string &arg) {
+  if (arg == cli::kStdio || carmen::find_map_format(arg) == nullptr) return {arg};
+  try {
+    return carmen::map_input_files(arg);
+  } catch (const std::exception &) {
+    return {arg};
+  }
+}
+
 int run(const Options &o) {
   // The picture's file is checked, and both maps read, before anything is
   // written: a bad input or target leaves no picture.
-  if (o.png_given) vasco::pipeline::check_outputs({o.a, o.b}, {o.png});
+  if (o.png_given) {
+    std::vector<std::string> inputs = input_files(o.a);
+    for (const std::string &f : input_files(o.b)) inputs.push_back(f);
+    vasco::pipeline::check_outputs(inputs, {o.png});
+  }
   if (o.a == cli::kStdio && o.b == cli::kStdio)
     throw carmen::Error(carmen::ErrorCode::Usage, "A and B are both '-': standard input holds one map");
-  const Input a = load(cli::input_path(o.a));
-  const Input b = load(cli::input_path(o.b));
+  Input a = load(cli::input_path(o.a));
+  Input b = load(cli::input_path(o.b));
+  borrow_resolution(a, b);
+  borrow_resolution(b, a);
+  digest(a);
+  digest(b);
   const bool identical = identical_grids(a.grid, b.grid);
   const Alignment al = align(a, b, identical, o.no_offset);
   carmen::GridComparison c;
