@@ -323,7 +323,10 @@ def test_scans_before_the_first_transform(tmp_path, intel):
     assert len(log) == n - 10 and log.unposed_skipped == 10
     r = run_script("bag2map", "--skip-unposed", path, tmp_path / "m.map")
     assert r.returncode == 0, r.stderr
-    assert "10 scans outside the poses' time span left out" in r.stderr
+    assert "10 scans without a pose left out (--skip-unposed)" in r.stderr
+    r = run_script("bag2map", path, tmp_path / "m.map")  # the default: the edges, named as such
+    assert r.returncode == 0, r.stderr
+    assert "10 scans without a pose left out (before the first or after the last pose)" in r.stderr
 
 
 # ----------------------------------------------------------------------------------------------

@@ -94,9 +94,12 @@ void print_summary(const Options &opt, const RunResult &r) {
                (unsigned long long)ms.cell_updates);
   if (!opt.more.empty())
     std::fprintf(stderr, "%s: %zu sessions mapped into one grid\n", opt.tool.c_str(), opt.more.size() + 1);
+  // A bag's reader leaves out the scans before the first and after the last
+  // pose by default (--skip-unposed: those inside a gap too).
   if (opt.poses.file.empty() && r.input.unposed_skipped > 0)
-    std::fprintf(stderr, "%s: %llu scans outside the poses' time span left out (--skip-unposed)\n", opt.tool.c_str(),
-                 (unsigned long long)r.input.unposed_skipped);
+    std::fprintf(stderr, "%s: %llu scans without a pose left out%s\n", opt.tool.c_str(),
+                 (unsigned long long)r.input.unposed_skipped,
+                 opt.poses.match.skip_unmatched ? " (--skip-unposed)" : " (before the first or after the last pose)");
   if (!opt.poses.file.empty())
     std::fprintf(stderr, "%s: poses from %s for %llu scans%s\n", opt.tool.c_str(), opt.poses.file.c_str(),
                  (unsigned long long)r.input.posed_from_file,
