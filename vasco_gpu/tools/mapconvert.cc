@@ -195,9 +195,10 @@ int parse_args(int argc, char **argv, Args *a) {
   app.add_flag("--quiet,-q", a->quiet);
   app.add_flag("--info", a->info);
   app.add_flag("--negate", a->map_server.negate);
-  app.add_option("--mode", mode);
-  app.add_option("--free-thresh", free_thresh);
-  app.add_option("--occupied-thresh", occupied_thresh);
+  // A repeated option: the last one wins, as it always has here.
+  app.add_option("--mode", mode)->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app.add_option("--free-thresh", free_thresh)->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app.add_option("--occupied-thresh", occupied_thresh)->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   app.add_option("files", a->files);
   try {
     app.parse(argc, argv);

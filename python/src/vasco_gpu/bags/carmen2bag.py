@@ -293,10 +293,16 @@ def write_bag(log, out, *, log_path="log", cloud: bool = False, period: float | 
         inner = tmp / ("bag.bag" if ext == ".bag" else "bag")
         with _Writer(inner, ext, _Messages(ros1=ext == ".bag")) as w:
             _write_messages(w, log, ns, cloud, topic)
-        made = inner if ext == ".bag" else next(p for p in inner.iterdir() if p.suffix == ext)
+        made = inner if ext == ".bag" else next((p for p in inner.iterdir() if p.suffix == ext), None)
+        if made is None:
+            raise Carmen2BagError(out, f"cannot be written: the bag writer made no {ext} file")
         os.replace(made, out)
+    except Carmen2BagError:
+        raise
     except OSError as e:
         raise Carmen2BagError(out, f"cannot be written: {e.strerror or e}") from e
+    except Exception as e:  # rosbags' writers raise their own errors: said as this output's
+        raise Carmen2BagError(out, f"cannot be written: {e}") from e
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return Written(len(log), topic, OUTPUT_KINDS[ext][2])

@@ -183,9 +183,11 @@ def bag2carmen_main(argv: list[str] | None = None) -> int:
                 import gzip
                 sink = gzip.GzipFile(filename="", mode="wb", compresslevel=6, fileobj=raw, mtime=0) if gz else raw
                 text = io.TextIOWrapper(sink, encoding="ascii", newline="\n")
-                write_carmen_log(d["bag"], text)
-                text.flush()
-                text.detach()
+                try:
+                    write_carmen_log(d["bag"], text)
+                    text.flush()
+                finally:
+                    text.detach()  # the wrappers let go of raw whatever happened (no late flush)
                 if gz:
                     sink.close()  # the gzip trailer; raw stays open for the with
             out.commit()
