@@ -150,6 +150,12 @@ std::vector<std::string> map_format_names() {
   return names;
 }
 
+std::string known_map_format_names() {
+  std::string s;
+  for (const MapFormatEntry &f : map_formats()) s += (s.empty() ? "" : ", ") + std::string(f.extension + 1);
+  return s;
+}
+
 const MapFormatEntry *find_map_format_by_name(const std::string &name) {
   for (const MapFormatEntry &f : map_formats())
     if (name == f.extension + 1) return &f;

@@ -19,13 +19,6 @@ namespace log2map {
 
 namespace {
 
-// "map, map.gz, pgm, png+yaml, yaml, png": the formats --formats takes.
-std::string batch_format_list() {
-  std::string list;
-  for (const std::string &n : carmen::map_format_names()) list += (list.empty() ? "" : ", ") + n;
-  return list;
-}
-
 using carmen::Error;
 using carmen::ErrorCode;
 
@@ -58,7 +51,7 @@ void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchT
   app.add_option("--out-dir", opt.out_dir,
                  "batch mode: map every " + spec.input_name + " given, in one process, to DIR/NAME.FORMAT")
       ->type_name("DIR");
-  app.add_option("--formats", raw.formats, "batch mode: the outputs of each input, of " + batch_format_list() + " (default map.gz)")
+  app.add_option("--formats", raw.formats, "batch mode: the outputs of each input, of " + carmen::known_map_format_names() + " (default map.gz)")
       ->type_name("LIST");
   app.add_flag("--fail-fast", opt.fail_fast, "batch mode: stop at the first input that fails (default: report it, go on)");
   app.add_option("--jobs", opt.jobs, "batch mode: threads reading inputs and writing maps (default: all cores)")

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -14,6 +15,7 @@
 #include "carmen_compat/error.h"
 #include "cli_support.h"
 #include "vasco_gpu/pipeline/mapped.h"
+#include "vasco_gpu/pipeline/outputs.h"
 #include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/map_output.h"
 #include "vasco_gpu/version.h"
@@ -73,13 +75,10 @@ std::string basename_of(const std::string &path) {
 }
 
 std::vector<std::string> files_written(const std::vector<std::string> &outputs) {
-  std::vector<std::string> files;
-  for (const std::string &out : outputs) {
-    if (out == cli::kStdio) continue;  // standard output: nothing to replace
-    const std::vector<std::string> of_one = carmen::map_output_files(out);
-    files.insert(files.end(), of_one.begin(), of_one.end());
-  }
-  return files;
+  std::vector<std::string> named;  // standard output ('-') has nothing to replace
+  std::copy_if(outputs.begin(), outputs.end(), std::back_inserter(named),
+               [](const std::string &out) { return out != cli::kStdio; });
+  return vasco::pipeline::output_files(named);
 }
 
 vasco::BackendOptions backend_options(const Options &opt) {

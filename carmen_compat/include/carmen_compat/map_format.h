@@ -93,6 +93,8 @@ std::string known_map_extensions(MapFormatKind kind);
 // The extensions without their dot ("map", "map.gz", ...): the format names a
 // batch's --formats and Python's map_logs take (a batch writes STEM.NAME).
 std::vector<std::string> map_format_names();
+// "map, map.gz, pgm, png+yaml, yaml, png": those names for messages and help.
+std::string known_map_format_names();
 // The format named so (map_format_names()); nullptr when none is.
 const MapFormatEntry *find_map_format_by_name(const std::string &name);
 

@@ -11,19 +11,8 @@
 namespace vasco {
 namespace pipeline {
 
-namespace {
-
 using carmen::Error;
 using carmen::ErrorCode;
-
-// "map, map.gz, pgm, png+yaml, yaml, png".
-std::string format_list() {
-  std::string list;
-  for (const std::string &n : carmen::map_format_names()) list += (list.empty() ? "" : ", ") + n;
-  return list;
-}
-
-}  // namespace
 
 std::string output_stem(const std::string &input) {
   std::string name = input;
@@ -37,12 +26,12 @@ std::string output_stem(const std::string &input) {
 }
 
 std::vector<std::string> check_map_formats(const std::vector<std::string> &names, const std::string &what) {
-  if (names.empty()) throw Error(ErrorCode::Usage, what + ": at least one of " + format_list());
+  if (names.empty()) throw Error(ErrorCode::Usage, what + ": at least one of " + carmen::known_map_format_names());
   std::vector<std::pair<std::string, std::string>> files;  // (a file of STEM, its format)
   for (size_t i = 0; i < names.size(); ++i) {
     const std::string &f = names[i];
     if (carmen::find_map_format_by_name(f) == nullptr)
-      throw Error(ErrorCode::Usage, what + ": '" + carmen::printable(f) + "' is none of " + format_list());
+      throw Error(ErrorCode::Usage, what + ": '" + carmen::printable(f) + "' is none of " + carmen::known_map_format_names());
     if (std::find(names.begin(), names.begin() + static_cast<long>(i), f) != names.begin() + static_cast<long>(i))
       throw Error(ErrorCode::Usage, what + ": " + f + " is named twice");
     const std::vector<std::string> mine = carmen::map_output_files("STEM." + f);
