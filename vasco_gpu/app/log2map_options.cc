@@ -228,12 +228,12 @@ void add_pose_options(CLI::App &app, Options &opt, PoseText &raw) {
       ->allow_extra_args(false);
 }
 
-// Each vasco_* key with its meaning and vasco's default, from the one table
-// (params.h) that the README's parameter table is checked against.
+// Each vasco_* key with its meaning, vasco's default and its valid values,
+// from the one table (params.h): this help is the parameters' reference.
 void add_param_options(CLI::App &app, std::map<std::string, std::string> &raw) {
   for (const vasco::ParamSpec &p : vasco::param_table()) {
     std::ostringstream help;
-    help << p.meaning << " (default " << p.default_value << ")";
+    help << p.meaning << " (default " << p.default_value << (p.minus_one_ok ? ", all" : "") << "; " << p.rule << ")";
     app.add_option(std::string("--") + p.key, raw[p.key], help.str())->type_name("VALUE");
   }
 }
