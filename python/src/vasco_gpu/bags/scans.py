@@ -39,7 +39,7 @@ import numpy as np
 from .errors import BagError
 from .header import frame_name, stamp_ns, stamp_seconds, stamp_text
 
-__all__ = ["BagScans", "NO_RETURN_FREE"]
+__all__ = ["BagScans", "LaserReading", "NO_RETURN_FREE", "read_laser"]
 
 #: The range stored for a +inf reading with ``no_return="free"``: the largest float32 below 50.
 NO_RETURN_FREE = np.nextafter(np.float32(50.0), np.float32(0.0))
@@ -144,6 +144,48 @@ def pick_echoes(msg, echo: str, fail) -> np.ndarray:
     return out
 
 
+@dataclass
+class LaserReading:
+    """One laser message as the mapper takes it: its frame, beam geometry, maximum range and
+    float32 ranges after the range policy (module docstring)."""
+
+    frame: str
+    first_angle: float
+    angle_step: float
+    range_max: float
+    ranges: np.ndarray
+
+
+# How far len(ranges) may be from what angle_min, angle_max and angle_increment imply, in
+# beams: drivers compute angle_max as angle_min + (n - 1) * increment in float32 or from the
+# device's nominal field of view, so the quotient is a whole number give or take rounding, and
+# some drivers count one beam more or less at an edge. Two beams off is a message whose ranges
+# are not those angles' (a truncated or mis-assembled scan).
+BEAM_COUNT_SLACK = 1.5
+
+
+def read_laser(msg, *, no_return: str, counts: dict, fail, multi_echo: bool = False,
+               echo: str = "last") -> LaserReading:
+    """A sensor_msgs/LaserScan (or MultiEchoLaserScan with multi_echo, one echo a beam) as a
+    LaserReading; the one adapter of bags and the live node. counts (COUNT_KEYS) are updated;
+    fail(what) gives the exception to raise for a message that cannot be mapped, naming what."""
+    rmin, rmax = float(msg.range_min), float(msg.range_max)
+    if not rmin <= rmax:
+        raise fail(f"has range_min {rmin!r} > range_max {rmax!r}")
+    a0, da = float(msg.angle_min), float(msg.angle_increment)
+    if not (math.isfinite(a0) and math.isfinite(da)):
+        raise fail(f"has angle_min {a0!r}, angle_increment {da!r}")
+    raw = pick_echoes(msg, echo, fail) if multi_echo else msg.ranges
+    n = len(raw)
+    a1 = float(getattr(msg, "angle_max", math.nan))
+    if da != 0 and math.isfinite(a1) and n > 0 and abs((a1 - a0) / da + 1 - n) > BEAM_COUNT_SLACK:
+        raise fail(f"has {n} ranges, but angle_min {a0:.9g} to angle_max {a1:.9g} by {da:.9g} makes "
+                   f"{(a1 - a0) / da + 1:.1f} beams")
+    r = apply_rep117(raw, rmin, rmax, no_return, counts)
+    counts["messages"] += 1
+    return LaserReading(frame_name(msg.header.frame_id), a0, da, rmax, r)
+
+
 class ScanAccumulator:
     """Collects the scans of the chosen topic in bag order, applying the range policy."""
 
@@ -174,18 +216,11 @@ class ScanAccumulator:
         elif frame != self.frame_id:
             raise self._error(ns, f"is in frame {frame!r}, the first scan in {self.frame_id!r}; all scans "
                                   "of a topic must share their frame")
-        rmin, rmax = float(msg.range_min), float(msg.range_max)
-        if not rmin <= rmax:
-            raise self._error(ns, f"has range_min {rmin!r} > range_max {rmax!r}")
-        a0, da = float(msg.angle_min), float(msg.angle_increment)
-        if not (math.isfinite(a0) and math.isfinite(da)):
-            raise self._error(ns, f"has angle_min {a0!r}, angle_increment {da!r}")
-        raw = pick_echoes(msg, self.echo, lambda what: self._error(ns, what)) if self.multi_echo else msg.ranges
-        r = apply_rep117(raw, rmin, rmax, self.no_return, self.counts)
+        scan = read_laser(msg, no_return=self.no_return, counts=self.counts, multi_echo=self.multi_echo,
+                          echo=self.echo, fail=lambda what: self._error(ns, what))
         self.ns.append(ns)
-        self.first_angle.append(a0)
-        self.angle_step.append(da)
-        self.range_max.append(rmax)
-        self.beam_counts.append(len(r))
-        self.ranges.append(r)
-        self.counts["messages"] += 1
+        self.first_angle.append(scan.first_angle)
+        self.angle_step.append(scan.angle_step)
+        self.range_max.append(scan.range_max)
+        self.beam_counts.append(len(scan.ranges))
+        self.ranges.append(scan.ranges)

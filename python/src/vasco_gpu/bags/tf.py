@@ -18,8 +18,9 @@ __all__ = ["TfBuffer"]
 class _Edge:
     """One parent -> child link of tf: a static transform, or a time series of samples."""
 
-    def __init__(self, parent: str, child: str, static: bool):
+    def __init__(self, parent: str, child: str, static: bool, keep_ns: int | None = None):
         self.parent, self.child, self.static = parent, child, static
+        self.keep_ns = keep_ns
         self.ns = array("q")
         self.values = array("d")  # tx ty tz qx qy qz qw per sample
         self._arrays = None
@@ -30,6 +31,16 @@ class _Edge:
         self.ns.append(ns)
         self.values.extend((*t, *q))
         self._arrays = None
+        if self.keep_ns is not None and len(self.ns) % 256 == 0:
+            self._forget()
+
+    def _forget(self) -> None:
+        """Drops the samples older than the newest less keep_ns (a live buffer's bounded history,
+        as tf2's cache time), keeping two at least."""
+        times, vals = sorted_samples(self.ns, self.values, 7)
+        keep = times >= times[-1] - self.keep_ns
+        keep[-2:] = True
+        self.ns, self.values = array("q", times[keep].tobytes()), array("d", vals[keep].tobytes())
 
     def arrays(self):
         """(stamps (k,), translations (k, 3), quaternions (k, 4)) sorted by stamp."""
@@ -52,11 +63,15 @@ class TfBuffer:
     and at any time; then :meth:`lookup` gives ``T_target_source`` at stamps. As in tf2, each
     frame has one parent; a static link (``/tf_static``) holds its latest transform at every
     stamp, a dynamic one (``/tf``) is interpolated between its samples (linear translation,
-    slerp) and never extrapolated. Every sample is kept (a bag's whole history).
+    slerp) and never extrapolated.
 
     ``max_gap`` (seconds, default None: no limit) refuses a stamp between two samples of a link
     further apart than that: tf2's buffer keeps 10 s of history, so a live lookup across a wider
     gap finds the older sample gone.
+
+    ``keep`` (seconds, default None: every sample, a bag's whole history) bounds what a live
+    buffer holds: a link forgets its samples older than its newest less ``keep`` (tf2's cache
+    time, 10 s by default).
 
     ``file``, ``stamp_name`` and ``outside_hint`` shape the error messages only: the bag the
     transforms come from (None when fed live), what the looked-up stamps are, and a hint added
@@ -64,8 +79,9 @@ class TfBuffer:
     """
 
     def __init__(self, file=None, *, stamp_name: str = "stamp", outside_hint: str = "",
-                 max_gap: float | None = None):
+                 max_gap: float | None = None, keep: float | None = None):
         self.file = file
+        self.keep_ns = None if keep is None else int(round(keep * 1e9))
         self.stamp_name = stamp_name
         self.outside_hint = outside_hint
         self.max_gap_ns = None if max_gap is None else int(round(max_gap * 1e9))
@@ -89,7 +105,7 @@ class TfBuffer:
         ns = stamp_ns(ts.header.stamp)
         edge = self._edges.get(child)
         if edge is None:
-            edge = self._edges[child] = _Edge(parent, child, static)
+            edge = self._edges[child] = _Edge(parent, child, static, self.keep_ns)
         elif edge.parent != parent:
             was = f"{edge.parent!r} on {'/tf_static' if edge.static else '/tf'}"
             raise TfError(self.file, f"frame {child!r} has two parents in tf: {was} and {parent!r} on "

@@ -1,0 +1,183 @@
+"""LiveMap: the node's mapping session. Every scan it is given stays stored (in the Mapper, on
+the GPU for cuda, and its ranges here for a change of parameters); a Path of base poses moves
+every stored scan in its span and the whole grid is rendered again. No rclpy here: the node
+feeds it, and the tests drive it directly too.
+
+Exactness: an exact backend's grid equals a fresh map of the stored scans after every
+``render``; scans inserted one by one give the same bytes while the grid keeps its size, and a
+grid that grew renders in a frame with a margin that differs from a fresh map's in a few cells
+(docs/sessions.md). ``settle()`` renders the stored poses again when the grid grew since the
+last full render, so that a quiet stream ends in the fresh map's bytes (log2map's).
+"""
+
+from __future__ import annotations
+
+from array import array
+
+import numpy as np
+
+from .. import _core
+from ..bags.geometry import planar_compose, wrap_angle
+from ..bags.series import bracket, sorted_samples
+
+__all__ = ["LiveMap", "LiveMapError"]
+
+# Bytes stored here per scan besides its ranges: stamp, pose (3), mount (3), first angle, step.
+_SCAN_BYTES = 8 * 9
+
+
+class LiveMapError(RuntimeError):
+    """A scan or render the session refused (memory, a frame too large); the session is as before."""
+
+
+class LiveMap:
+    """A Mapper plus what the node needs to move and re-render its scans.
+
+    ``add`` stores one scan at its laser pose (with its mount in the base frame, when known, so a
+    Path of base poses can move it); ``repose`` applies a Path; ``set_params`` re-renders every
+    stored scan with new mapper parameters; ``finish`` gives the map to publish."""
+
+    def __init__(self, params: _core.Params, *, backend: str = "auto", cuda_mode: str = "float",
+                 device: int = 0, threads: int = 0, max_memory: int = 2 << 30):
+        self.max_memory = int(max_memory)
+        self._mapper_args = dict(backend=backend, cuda_mode=cuda_mode if backend in ("cuda", "auto") else None,
+                                 threads=threads, cuda_device=device, max_memory_bytes=self.max_memory)
+        self.mapper = _core.Mapper(params, **self._mapper_args)
+        self.version = 0  # changes whenever the grid does
+        self._clear()
+
+    def _clear(self) -> None:
+        self.stamps = array("q")
+        self.poses = array("d")   # laser x, y, theta per scan
+        self.mounts = array("d")  # laser in base x, y, yaw per scan; NaN: unknown
+        self.first_angle = array("d")
+        self.angle_step = array("d")
+        self.beam_counts = array("q")
+        self.ranges: list[np.ndarray] = []
+        self.bytes = 0
+        self._renders_settled = self.mapper.renders
+
+    def __len__(self) -> int:
+        return len(self.stamps)
+
+    @property
+    def backend(self) -> str:
+        return self.mapper.backend
+
+    def add(self, stamp_ns: int, pose, ranges: np.ndarray, first_angle: float, angle_step: float,
+            mount=None) -> None:
+        """Stores one scan at laser pose (x, y, theta) and applies it to the grid; LiveMapError
+        (nothing stored) when max_memory would be exceeded or the mapper refuses it."""
+        ranges = np.ascontiguousarray(ranges, dtype=np.float32)
+        more = ranges.nbytes + _SCAN_BYTES
+        if self.max_memory and self.bytes + more > self.max_memory:
+            raise LiveMapError(f"max_memory {self.max_memory} bytes reached: {len(self)} scans stored "
+                               f"({self.bytes} bytes of ranges and poses here, the grid besides)")
+        scan = _core.Scans(np.asarray(pose, dtype=np.float64).reshape(1, 3), ranges, [len(ranges)],
+                           first_angle, angle_step)
+        try:
+            self.mapper.insert(scan)
+        except (RuntimeError, MemoryError) as e:
+            raise LiveMapError(str(e)) from None
+        self.stamps.append(int(stamp_ns))
+        self.poses.extend(float(v) for v in np.asarray(pose).ravel()[:3])
+        self.mounts.extend((np.nan,) * 3 if mount is None else (float(v) for v in mount))
+        self.first_angle.append(first_angle)
+        self.angle_step.append(angle_step)
+        self.beam_counts.append(len(ranges))
+        self.ranges.append(ranges)
+        self.bytes += more
+        self.version += 1
+
+    def _pose_array(self) -> np.ndarray:
+        return np.frombuffer(self.poses, dtype=np.float64).reshape(-1, 3)
+
+    def repose(self, stamps_ns, base_poses, max_gap_ns: int) -> dict:
+        """A Path: base poses (k, 3) at stamps (k,). Every stored scan with a mount whose stamp
+        lies within the Path's span, between two poses at most max_gap_ns apart (or on one),
+        gets the interpolated base pose (linear x, y, shortest-arc yaw, as --poses interpolates)
+        composed with its mount; then the whole grid is rendered. Returns counts: moved, outside
+        (before or after the span), in_gap, no_mount."""
+        counts = {"moved": 0, "outside": 0, "in_gap": 0, "no_mount": 0}
+        n = len(self)
+        if n == 0 or len(stamps_ns) == 0:
+            return counts
+        times, vals = sorted_samples(array("q", (int(t) for t in stamps_ns)),
+                                     array("d", np.asarray(base_poses, dtype=np.float64).ravel()), 3)
+        ns = np.frombuffer(self.stamps, dtype=np.int64)
+        mounts = np.frombuffer(self.mounts, dtype=np.float64).reshape(-1, 3)
+        has_mount = np.isfinite(mounts).all(axis=1)
+        inside = (ns >= times[0]) & (ns <= times[-1])
+        counts["outside"] = int((~inside).sum())
+        counts["no_mount"] = int((inside & ~has_mount).sum())
+        take = np.flatnonzero(inside & has_mount)
+        if len(take):
+            hit, i, lo, hi, f = bracket(times, ns[take])
+            near = hit | (times[hi] - times[lo] <= max_gap_ns)
+            counts["in_gap"] = int((~near).sum())
+            take, hit, i, lo, hi, f = take[near], hit[near], i[near], lo[near], hi[near], f[near]
+            a, b = vals[lo], vals[hi]
+            base = np.empty((len(take), 3))
+            base[:, :2] = a[:, :2] + (b[:, :2] - a[:, :2]) * f[:, None]
+            base[:, 2] = a[:, 2] + wrap_angle(b[:, 2] - a[:, 2]) * f
+            base[hit] = vals[i[hit]]
+            poses = self._pose_array().copy()
+            poses[take] = planar_compose(base, mounts[take])
+            counts["moved"] = len(take)
+            self.render(poses)
+        return counts
+
+    def render(self, poses: np.ndarray) -> None:
+        """Every stored scan at new laser poses (n, 3), the grid recomputed."""
+        try:
+            self.mapper.render(poses)
+        except (RuntimeError, MemoryError) as e:
+            raise LiveMapError(str(e)) from None
+        self.poses = array("d", np.asarray(poses, dtype=np.float64).ravel())
+        self._renders_settled = self.mapper.renders
+        self.version += 1
+
+    def settle(self) -> bool:
+        """Renders the stored poses again if the grid grew since the last full render (see the
+        module docstring); True if it did."""
+        if len(self) == 0 or self.mapper.renders == self._renders_settled:
+            return False
+        self.render(self._pose_array().copy())
+        return True
+
+    def set_params(self, params: _core.Params) -> None:
+        """New mapper parameters: every stored scan mapped again with them (validated first: a
+        refusal changes nothing)."""
+        params.validate()
+        old = self.mapper.params
+        self.mapper.start_over(params)
+        if len(self) == 0:
+            self.version += 1
+            self._renders_settled = self.mapper.renders
+            return
+        scans = _core.Scans(self._pose_array(), np.concatenate(self.ranges),
+                            np.frombuffer(self.beam_counts, dtype=np.int64).astype(np.float64),
+                            np.frombuffer(self.first_angle, dtype=np.float64),
+                            np.frombuffer(self.angle_step, dtype=np.float64))
+        try:
+            self.mapper.insert(scans)
+        except (RuntimeError, MemoryError) as e:
+            self.mapper.start_over(old)
+            self.mapper.insert(scans)
+            raise LiveMapError(str(e)) from None
+        self._renders_settled = self.mapper.renders
+        self.version += 1
+
+    def reset(self) -> int:
+        """Drops every stored scan and the grid; returns how many scans were dropped."""
+        n = len(self)
+        self.mapper.start_over(self.mapper.params)
+        self._clear()
+        self.version += 1
+        return n
+
+    def finish(self) -> _core.Map | None:
+        """The map to publish (CARMEN's finish of the grid), None while no scan is stored."""
+        if len(self) == 0:
+            return None
+        return self.mapper.finish()

@@ -1,0 +1,313 @@
+"""vasco_mapper, the ROS 2 node: scans in (posed by tf, or moved by the optimizer's Path), the
+whole map out on /map within milliseconds of every Path. The mapping is LiveMap's (the same
+Mapper, parameter table and map formats as log2map, bag2map and Python), the scan adapter and
+the tf buffer the bag reader's; this file only wires them to rclpy."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import rclpy
+from nav_msgs.msg import MapMetaData, OccupancyGrid, Path
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from sensor_msgs.msg import LaserScan, MultiEchoLaserScan
+from std_srvs.srv import SetBool, Trigger
+
+from .. import _core
+from ..bags.errors import BagError
+from ..bags.geometry import planar, unit_quaternion, yaw
+from ..bags.header import frame_name, stamp_ns, stamp_text
+from ..bags.poses import static_mount
+from ..bags.scans import COUNT_KEYS, read_laser
+from ..bags.tf import TfBuffer
+from .grid import fill_grid
+from .live_map import LiveMap, LiveMapError
+from .settings import NODE_PARAMETERS, Settings, SettingsError, mapper_parameter_names
+from .tf_messages import tf_message_type
+
+__all__ = ["MappingNode"]
+
+NODE_NAME = "vasco_mapper"
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL,
+                     history=HistoryPolicy.KEEP_LAST)
+REPLAY = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
+TF = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
+TF_STATIC = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.TRANSIENT_LOCAL, history=HistoryPolicy.KEEP_LAST)
+PATH = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
+# tf history kept: tf2's buffer default (10 s), which covers every scan's wait.
+TF_KEEP_S = 10.0
+
+
+class Refused(Exception):
+    """A message the node does not map; the text names the topic and stamp."""
+
+
+class _Pending:
+    """A scan waiting for its transform until the deadline (monotonic seconds)."""
+
+    __slots__ = ("topic", "ns", "reading", "deadline")
+
+    def __init__(self, topic, ns, reading, deadline):
+        self.topic, self.ns, self.reading, self.deadline = topic, ns, reading, deadline
+
+
+class MappingNode(Node):
+    """The node; construction raises SettingsError for a bad parameter (nothing started)."""
+
+    def __init__(self, **node_kwargs):
+        super().__init__(NODE_NAME, **node_kwargs)
+        self._declare()
+        self.settings = Settings.from_values(self._node_values(), self._mapper_values())
+        s = self.settings
+        self.live = LiveMap(s.params, backend=s.backend, cuda_mode=s.cuda_mode, device=s.device,
+                            threads=s.threads, max_memory=s.max_memory)
+        self.tf = TfBuffer(stamp_name="scan stamp", keep=TF_KEEP_S)
+        self.paused = False
+        self.pending: list[_Pending] = []
+        self.range_counts = dict.fromkeys(COUNT_KEYS, 0)
+        self.refused: dict[tuple[str, str], int] = {}
+        self._mounts: dict[str, np.ndarray | None] = {}
+        self._published = -1
+        self._last_scan = 0.0
+        self._subscribe()
+        self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
+        self.meta_pub = self.create_publisher(MapMetaData, "map_metadata", LATCHED)
+        self.create_service(Trigger, "~/save_map", self._save_map)
+        self.create_service(Trigger, "~/reset", self._reset)
+        self.create_service(SetBool, "~/pause", self._pause)
+        self._timer = self.create_timer(s.map_update_interval, self._publish_if_changed)
+        self.create_timer(0.02, self._pose_pending)
+        self.add_on_set_parameters_callback(self._on_parameters)
+        self.get_logger().info(
+            f"ready: backend {self.live.backend}, scans on {', '.join(s.scan_topics + s.multi_echo_topics)}, "
+            f"poses from tf {s.map_frame} -> the scans' frames and from the Path on "
+            f"{self.resolve_topic_name(s.path_topic) if s.path_topic else '(none)'}")
+
+    # -- parameters -------------------------------------------------------------------------
+    def _declare(self) -> None:
+        for p in NODE_PARAMETERS:
+            self.declare_parameter(p.name, p.default, ParameterDescriptor(
+                description=p.meaning, dynamic_typing=True, read_only=not p.dynamic))
+        for name in mapper_parameter_names():  # unset unless given: param_file and defaults apply
+            self.declare_parameter(name, None, ParameterDescriptor(
+                description=f"vasco_{name} (log2map --help lists its meaning)", dynamic_typing=True))
+
+    def _node_values(self, changed=()) -> dict:
+        values = {p.name: self.get_parameter(p.name).value for p in NODE_PARAMETERS}
+        values.update({c.name: c.value for c in changed if c.name in values})
+        return values
+
+    def _mapper_values(self, changed=()) -> dict:
+        values = {n: self.get_parameter(n).value for n in mapper_parameter_names()}
+        values.update({c.name: c.value for c in changed if c.name in values})
+        return {k: v for k, v in values.items() if v is not None}
+
+    def _on_parameters(self, changed) -> SetParametersResult:
+        try:
+            new = Settings.from_values(self._node_values(changed), self._mapper_values(changed))
+            if new.params != self.settings.params:
+                self.live.set_params(new.params)
+        except (SettingsError, LiveMapError, ValueError) as e:
+            return SetParametersResult(successful=False, reason=str(e))
+        if new.map_update_interval != self.settings.map_update_interval:
+            self._timer.timer_period_ns = int(new.map_update_interval * 1e9)
+        mode_changed = (new.map_mode, new.free_thresh, new.occupied_thresh) != (
+            self.settings.map_mode, self.settings.free_thresh, self.settings.occupied_thresh)
+        self.settings = new
+        if mode_changed:
+            self._published = -1
+        return SetParametersResult(successful=True)
+
+    # -- inputs -----------------------------------------------------------------------------
+    def _subscribe(self) -> None:
+        s = self.settings
+        qos = qos_profile_sensor_data if s.scan_qos == "sensor_data" else REPLAY
+        for topic in s.scan_topics:
+            self.create_subscription(LaserScan, topic, lambda m, t=topic: self._on_scan(m, t, False), qos)
+        for topic in s.multi_echo_topics:
+            self.create_subscription(MultiEchoLaserScan, topic, lambda m, t=topic: self._on_scan(m, t, True), qos)
+        tf_type = tf_message_type()
+        self.create_subscription(tf_type, "/tf", lambda m: self._on_tf(m, False), TF)
+        self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
+        if s.path_topic:
+            self.create_subscription(Path, s.path_topic, self._on_path, PATH)
+
+    def _refuse(self, topic: str, cause: str, text: str) -> None:
+        """Counts a message not mapped; logs the first of each (topic, cause)."""
+        key = (topic, cause)
+        self.refused[key] = self.refused.get(key, 0) + 1
+        if self.refused[key] == 1:
+            self.get_logger().warning(f"{text} (further {cause} on {topic} are counted, not logged)")
+
+    def _on_tf(self, msg, static: bool) -> None:
+        topic = "/tf_static" if static else "/tf"
+        try:
+            self.tf.add_message(msg, static)
+        except BagError as e:
+            self._refuse(topic, "bad transforms", f"{topic}: {e.message}")
+            return
+        if static:
+            self._mounts.clear()
+        self._pose_pending()
+
+    def _on_scan(self, msg, topic: str, multi_echo: bool) -> None:
+        if self.paused:
+            self.refused[(topic, "paused")] = self.refused.get((topic, "paused"), 0) + 1
+            return
+        ns = stamp_ns(msg.header.stamp)
+        where = f"{self.resolve_topic_name(topic)}: scan at stamp {stamp_text(ns)}"
+        try:
+            reading = read_laser(msg, no_return=self.settings.no_return, counts=self.range_counts,
+                                 multi_echo=multi_echo, echo=self.settings.echo,
+                                 fail=lambda what: Refused(f"{where} {what}"))
+        except Refused as e:
+            self._refuse(topic, "bad scans", f"{e}; not mapped")
+            return
+        self.pending.append(_Pending(topic, ns, reading, time.monotonic() + self.settings.transform_timeout))
+        self._pose_pending()
+
+    def _mount(self, frame: str):
+        """The laser frame in base_frame from /tf_static (cached until /tf_static changes)."""
+        if frame not in self._mounts:
+            try:
+                self._mounts[frame] = static_mount(None, self.tf, self.settings.base_frame, frame)
+            except BagError:
+                self._mounts[frame] = None
+        return self._mounts[frame]
+
+    def _pose_pending(self) -> None:
+        """Maps every waiting scan whose transform is there; drops those past their deadline."""
+        if not self.pending:
+            return
+        now, keep = time.monotonic(), []
+        for p in self.pending:
+            try:
+                t, q = self.tf.lookup(self.settings.map_frame, p.reading.frame, [p.ns])
+                pose = planar(None, t, q, f"the laser frame {p.reading.frame!r} in {self.settings.map_frame!r}")[0]
+            except BagError as e:
+                if now < p.deadline:
+                    keep.append(p)
+                else:
+                    where = f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)}"
+                    self._refuse(p.topic, "scans without a transform",
+                                 f"{where} not mapped: no transform within transform_timeout "
+                                 f"{self.settings.transform_timeout:g} s: {e.message}")
+                continue
+            self._insert(p, pose)
+        self.pending = keep
+
+    def _insert(self, p: _Pending, pose) -> None:
+        r = p.reading
+        try:
+            self.live.add(p.ns, pose, r.ranges, r.first_angle, r.angle_step, self._mount(r.frame))
+        except LiveMapError as e:
+            self._refuse(p.topic, "scans over max_memory",
+                         f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)} not mapped: {e}")
+            return
+        self._last_scan = time.monotonic()
+        if self._mount(r.frame) is None:
+            self._refuse(p.topic, "scans without a mount",
+                         f"{self.resolve_topic_name(p.topic)}: no /tf_static chain {self.settings.base_frame} -> "
+                         f"{r.frame}: its scans are mapped at their tf pose, a Path cannot move them")
+
+    def _on_path(self, msg) -> None:
+        start = time.perf_counter()
+        try:
+            stamps, poses = self._path_poses(msg)
+        except Refused as e:
+            self._refuse(self.settings.path_topic, "bad paths", f"{e}; ignored")
+            return
+        try:
+            counts = self.live.repose(stamps, poses, int(self.settings.pose_max_gap * 1e9))
+        except LiveMapError as e:
+            self._refuse(self.settings.path_topic, "paths not rendered", f"Path not rendered: {e}")
+            return
+        self._publish_if_changed(settle=False)
+        self.get_logger().debug(f"Path of {len(stamps)} poses: {counts}, published in "
+                                f"{(time.perf_counter() - start) * 1e3:.1f} ms")
+
+    def _path_poses(self, msg):
+        """(stamps (k,) int64 ns, base poses (k, 3)) of a nav_msgs/Path; Refused naming the topic
+        and stamp for a Path in another frame, a pose in another frame or not a number."""
+        topic = self.resolve_topic_name(self.settings.path_topic)
+        frame, want = frame_name(msg.header.frame_id), self.settings.map_frame
+        if frame != want:
+            raise Refused(f"{topic}: Path at stamp {stamp_text(stamp_ns(msg.header.stamp))} is in frame "
+                          f"{frame!r}, not map_frame {want!r}")
+        stamps, poses = np.empty(len(msg.poses), dtype=np.int64), np.empty((len(msg.poses), 3))
+        for k, ps in enumerate(msg.poses):
+            ns = stamp_ns(ps.header.stamp)
+            where = f"{topic}: pose {k} (stamp {stamp_text(ns)})"
+            if ps.header.frame_id and frame_name(ps.header.frame_id) != want:
+                raise Refused(f"{where} is in frame {frame_name(ps.header.frame_id)!r}, not {want!r}")
+            p, o = ps.pose.position, ps.pose.orientation
+            if not np.isfinite([p.x, p.y, p.z]).all():
+                raise Refused(f"{where} has position ({p.x}, {p.y}, {p.z})")
+            try:
+                q = unit_quaternion((o.x, o.y, o.z, o.w), where, None)
+            except BagError as e:
+                raise Refused(e.message) from None
+            stamps[k], poses[k] = ns, (p.x, p.y, float(yaw(q[None])[0]))
+        return stamps, poses
+
+    # -- outputs ----------------------------------------------------------------------------
+    def _publish_if_changed(self, settle: bool = True) -> None:
+        """Publishes /map and /map_metadata when the grid changed since the last publication. A
+        grown grid is rendered once more when the stream has paused for an interval (LiveMap)."""
+        quiet = time.monotonic() - self._last_scan > self.settings.map_update_interval
+        if settle and quiet:
+            try:
+                self.live.settle()
+            except LiveMapError as e:
+                self.get_logger().warning(f"grid not rendered again after growing: {e}")
+        if self.live.version == self._published:
+            return
+        m = self.live.finish()
+        self._published = self.live.version
+        if m is None:
+            return
+        s = self.settings
+        msg = OccupancyGrid()
+        fill_grid(msg, m, mode=s.map_mode, frame=s.map_frame, stamp=self.get_clock().now().to_msg(),
+                  free_thresh=s.free_thresh, occupied_thresh=s.occupied_thresh)
+        self.map_pub.publish(msg)
+        self.meta_pub.publish(msg.info)
+
+    def _save_map(self, request, response):
+        paths = self.settings.save_map_path
+        m = self.live.finish()
+        if not paths or m is None:
+            response.success = False
+            response.message = "save_map_path is empty: set it to the files to write" if not paths else \
+                "no scan mapped yet: nothing to save"
+            return response
+        try:
+            _core._write_maps(paths, m, self.settings.map_mode)
+        except (OSError, ValueError, RuntimeError) as e:
+            response.success, response.message = False, f"not saved: {e}"
+            return response
+        response.success, response.message = True, f"wrote {', '.join(paths)}"
+        self.get_logger().info(response.message)
+        return response
+
+    def _reset(self, request, response):
+        n = self.live.reset()
+        self.pending.clear()
+        response.success, response.message = True, f"dropped {n} scans and the grid"
+        self.get_logger().info(response.message)
+        return response
+
+    def _pause(self, request, response):
+        self.paused = bool(request.data)
+        response.success = True
+        response.message = "paused: new scans are not mapped" if self.paused else "mapping new scans"
+        self.get_logger().info(response.message)
+        return response
+
+    def summary(self) -> str:
+        refused = ", ".join(f"{n} {cause} on {topic}" for (topic, cause), n in sorted(self.refused.items()))
+        return f"{len(self.live)} scans mapped" + (f"; not mapped: {refused}" if refused else "")

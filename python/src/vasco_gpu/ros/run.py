@@ -1,0 +1,39 @@
+"""Starting and stopping the node: rclpy's context, the executor, a clean exit on SIGINT or
+SIGTERM (the DDS participant destroyed, so no shared-memory segment is left behind), and a bad
+parameter refused before anything starts."""
+
+from __future__ import annotations
+
+import sys
+
+import rclpy
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+
+from .settings import SettingsError
+from .tf_messages import MissingMessages
+
+
+def main(argv=None) -> int:
+    args = sys.argv if argv is None else argv
+    rclpy.init(args=args)
+    node = None
+    try:
+        from .node import MappingNode
+
+        try:
+            node = MappingNode()
+        except (SettingsError, MissingMessages) as e:
+            print(f"vasco_mapper: {e}", file=sys.stderr)
+            return 2
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        try:
+            executor.spin()
+        except (KeyboardInterrupt, ExternalShutdownException):
+            pass
+        print(f"vasco_mapper: {node.summary()}", file=sys.stderr)
+        return 0
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()

@@ -1,0 +1,141 @@
+"""The ROS 2 node's session (vasco_gpu.ros.live_map), its OccupancyGrid values and its
+parameter schema, without ROS: scans fed one at a time reach CARMEN's golden bytes, a Path moves
+the scans it spans as --poses would, refusals leave the session as it was."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import vasco_gpu as vg
+from conftest import golden_cases, gridmap_digest
+from vasco_gpu.ros.grid import grid_values
+from vasco_gpu.ros.live_map import LiveMap, LiveMapError
+from vasco_gpu.ros.settings import Settings, SettingsError, mapper_parameter_names
+
+CASES = {name: (log, ini, digest) for name, log, ini, digest in golden_cases()}
+
+
+def feed(live, scans, stamps, mount=None):
+    for s in range(len(scans)):
+        r = scans.ranges_of(s)
+        live.add(int(stamps[s]), scans.poses[s], r, float(scans.first_angle[s]), float(scans.angle_step[s]),
+                 mount)
+
+
+@pytest.mark.parametrize("name", ["intel.gfs__vasco_default_ds4", "edge_cases__paper"])
+def test_one_scan_at_a_time_then_settled_is_carmens_golden(name):
+    log_path, ini, digest = CASES[name]
+    log = vg.load_log(log_path, param_file=ini)
+    live = LiveMap(log.params, backend="cpu_double")
+    feed(live, log.scans, np.arange(len(log)) * 10**8)
+    grew = live.settle()
+    m = live.finish()
+    assert gridmap_digest(m.cells, m.resolution) == digest, f"settled after growing: {grew}"
+    assert not live.settle()  # nothing grew since
+
+
+def laser_of(base, mount):
+    """base o mount, written out here (not the library's planar_compose)."""
+    x, y, t = base
+    mx, my, mt = mount
+    return (x + math.cos(t) * mx - math.sin(t) * my, y + math.sin(t) * mx + math.cos(t) * my, t + mt)
+
+
+def test_a_path_moves_the_scans_it_spans_as_a_fresh_map_of_the_moved_poses():
+    log = vg.load_log(CASES["intel.gfs__vasco_default_ds4"][0])
+    scans = log.scans.select(0, 300)
+    stamps = 10**9 + np.arange(300, dtype=np.int64) * 200_000_000
+    mount = (0.1, -0.05, 0.02)
+    live = LiveMap(log.params, backend="cpu_double")
+    feed(live, scans, stamps, mount)
+    rng = np.random.default_rng(7)
+    # A Path of base poses at every other scan stamp from scan 50 to 250; scans between two
+    # samples take the interpolation, the rest keep their pose.
+    k = np.arange(50, 251, 2)
+    base = scans.poses[k] + rng.normal(0, [0.05, 0.05, 0.01], (len(k), 3))
+    counts = live.repose(stamps[k], base, max_gap_ns=5 * 10**9)
+    assert counts == {"moved": 201, "outside": 99, "in_gap": 0, "no_mount": 0}
+    want = scans.poses.copy()
+    for j, s in enumerate(k):
+        want[s] = laser_of(base[j], mount)
+    for s in range(51, 250, 2):  # half way between two samples
+        a, b = base[(s - 50) // 2], base[(s - 50) // 2 + 1]
+        mid = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2, a[2] + math.remainder(b[2] - a[2], 2 * math.pi) / 2)
+        want[s] = laser_of(mid, mount)
+    np.testing.assert_allclose(live.mapper.poses, want, rtol=0, atol=1e-12)
+    fresh = vg.Mapper(log.params, backend="cpu_double")
+    fresh.insert(vg.Scans(live.mapper.poses, scans.ranges, scans.beam_counts, scans.first_angle, scans.angle_step))
+    assert live.finish().sha256() == fresh.finish().sha256()
+
+
+def test_path_rules_gap_and_no_mount_and_outside():
+    log = vg.load_log(CASES["intel.gfs__vasco_default_ds4"][0])
+    scans = log.scans.select(0, 20)
+    stamps = np.arange(20, dtype=np.int64) * 10**9
+    live = LiveMap(log.params, backend="cpu_double")
+    feed(live, scans.select(0, 10), stamps[:10], (0, 0, 0))
+    feed(live, scans.select(10, 10), stamps[10:], None)  # no mount: a Path cannot move them
+    before = live.mapper.poses
+    # samples at 2 s and 9 s (7 s apart: more than pose_max_gap 5 s) and at 12 s
+    counts = live.repose([2 * 10**9, 9 * 10**9, 12 * 10**9], [[0, 0, 0], [1, 1, 0], [2, 2, 0]], 5 * 10**9)
+    assert counts == {"moved": 2, "outside": 9, "in_gap": 6, "no_mount": 3}
+    after = live.mapper.poses
+    assert np.array_equal(after[[2, 9]], [[0, 0, 0], [1, 1, 0]])
+    unchanged = [s for s in range(20) if s not in (2, 9)]
+    assert np.array_equal(after[unchanged], before[unchanged])
+
+
+def test_max_memory_refusal_leaves_the_session_as_it_was():
+    log = vg.load_log(CASES["intel.gfs__vasco_default_ds4"][0])
+    scans = log.scans.select(0, 5)
+    one = scans.ranges_of(0).nbytes + 72
+    live = LiveMap(log.params, backend="cpu_double", max_memory=10 * 2**20)
+    live.max_memory = 3 * one  # our own store's bound (the grid has the mapper's)
+    feed(live, scans.select(0, 3), [0, 1, 2])
+    m = live.finish().sha256()
+    with pytest.raises(LiveMapError, match="max_memory"):
+        feed(live, scans.select(3, 1), [3])
+    assert len(live) == 3 and live.mapper.num_scans == 3 and live.finish().sha256() == m
+
+
+def test_new_parameters_map_every_stored_scan_again():
+    log = vg.load_log(CASES["intel.gfs__vasco_default_ds4"][0])
+    live = LiveMap(log.params, backend="cpu_threads")
+    feed(live, log.scans.select(0, 100), np.arange(100))
+    p = vg.Params(resolution=0.05, p_occ=0.7)
+    live.set_params(p)
+    fresh = vg.Mapper(p, backend="cpu_double")
+    fresh.insert(log.scans.select(0, 100))
+    assert live.finish().sha256() == fresh.finish().sha256()
+    n = live.reset()
+    assert n == 100 and len(live) == 0 and live.finish() is None
+
+
+def test_grid_values_by_hand():
+    # cells[x, y], x-major: 3 wide, 2 high; values exact in float32
+    cells = np.array([[-1.0, 0.125], [0.5, 0.6875], [0.1875, 0.0625]], dtype=np.float32)
+    # rows from y = 0: (x0, x1, x2) = (-1, 0.5, 0.1875), then (0.125, 0.6875, 0.0625)
+    assert grid_values(cells, "scale").tolist() == [-1, 50, 19, 13, 69, 6]  # 12.5 rounds up
+    assert grid_values(cells, "trinary").tolist() == [-1, -1, 0, 0, 100, 0]
+    assert grid_values(cells, "trinary", 0.1, 0.7).tolist() == [-1, -1, -1, -1, -1, 0]
+
+
+def test_settings_refuse_naming_the_parameter(tmp_path):
+    assert "resolution" in mapper_parameter_names() and "p_occ" in mapper_parameter_names()
+    s = Settings.from_values({}, {})
+    assert s.scan_topics == ["scan"] and s.map_mode == "trinary" and s.params == vg.Params()
+    for node, mapper, word in [({"map_mode": "ternary"}, {}, "map_mode"), ({"scan_topics": "scan"}, {}, "scan_topics"),
+                               ({"transform_timeout": -1.0}, {}, "transform_timeout"),
+                               ({"backend": "gpu9"}, {}, "backend"), ({}, {"p_occ": 1.5}, "p_occ"),
+                               ({}, {"resolutoin": 0.1}, "resolutoin"),
+                               ({"free_thresh": 0.7}, {}, "free_thresh"),
+                               ({"param_file": str(tmp_path / "none.ini")}, {}, "param_file")]:
+        with pytest.raises(SettingsError, match=word):
+            Settings.from_values(node, mapper)
+    ini = tmp_path / "carmen.ini"
+    ini.write_text("[*]\nvasco_resolution 0.1\nvasco_p_occ 0.8\n")
+    s = Settings.from_values({"param_file": str(ini)}, {"p_occ": 0.6})
+    assert s.params.resolution == 0.1 and s.params.p_occ == 0.6  # given over the file
