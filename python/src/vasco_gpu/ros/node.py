@@ -43,7 +43,11 @@ TF_KEEP_S = 10.0
 
 
 class Refused(Exception):
-    """A message the node does not map; the text names the topic and stamp."""
+    """A message the node does not map; the text names the topic and stamp, cause the kind."""
+
+    def __init__(self, text: str, cause: str = "bad messages"):
+        super().__init__(text)
+        self.cause = cause
 
 
 class _Pending:
@@ -165,7 +169,7 @@ class MappingNode(Node):
                                  multi_echo=multi_echo, echo=self.settings.echo,
                                  fail=lambda what: Refused(f"{where} {what}"))
         except Refused as e:
-            self._refuse(topic, "bad scans", f"{e}; not mapped")
+            self._refuse(topic, "bad scans", f"{e}; not mapped")  # the first of each topic
             return
         self.pending.append(_Pending(topic, ns, reading, time.monotonic() + self.settings.transform_timeout))
         self._pose_pending()
@@ -219,7 +223,7 @@ class MappingNode(Node):
         try:
             stamps, poses = self._path_poses(msg)
         except Refused as e:
-            self._refuse(self.settings.path_topic, "bad paths", f"{e}; ignored")
+            self._refuse(self.settings.path_topic, e.cause, f"{e}; ignored")
             return
         try:
             counts = self.live.repose(stamps, poses, int(self.settings.pose_max_gap * 1e9))
@@ -237,20 +241,21 @@ class MappingNode(Node):
         frame, want = frame_name(msg.header.frame_id), self.settings.map_frame
         if frame != want:
             raise Refused(f"{topic}: Path at stamp {stamp_text(stamp_ns(msg.header.stamp))} is in frame "
-                          f"{frame!r}, not map_frame {want!r}")
+                          f"{frame!r}, not map_frame {want!r}", "paths in another frame")
         stamps, poses = np.empty(len(msg.poses), dtype=np.int64), np.empty((len(msg.poses), 3))
         for k, ps in enumerate(msg.poses):
             ns = stamp_ns(ps.header.stamp)
             where = f"{topic}: pose {k} (stamp {stamp_text(ns)})"
             if ps.header.frame_id and frame_name(ps.header.frame_id) != want:
-                raise Refused(f"{where} is in frame {frame_name(ps.header.frame_id)!r}, not {want!r}")
+                raise Refused(f"{where} is in frame {frame_name(ps.header.frame_id)!r}, not {want!r}",
+                              "paths in another frame")
             p, o = ps.pose.position, ps.pose.orientation
             if not np.isfinite([p.x, p.y, p.z]).all():
-                raise Refused(f"{where} has position ({p.x}, {p.y}, {p.z})")
+                raise Refused(f"{where} has position ({p.x}, {p.y}, {p.z})", "paths with a bad pose")
             try:
                 q = unit_quaternion((o.x, o.y, o.z, o.w), where, None)
             except BagError as e:
-                raise Refused(e.message) from None
+                raise Refused(e.message, "paths with a bad pose") from None
             stamps[k], poses[k] = ns, (p.x, p.y, float(yaw(q[None])[0]))
         return stamps, poses
 

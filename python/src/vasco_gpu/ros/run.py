@@ -15,7 +15,11 @@ from .tf_messages import MissingMessages
 
 def main(argv=None) -> int:
     args = sys.argv if argv is None else argv
-    rclpy.init(args=args)
+    try:
+        rclpy.init(args=args)
+    except Exception as e:  # rclpy's RCLError and friends: no DDS participant, bad --ros-args
+        print(f"vasco_mapper: ROS 2 did not start: {e}", file=sys.stderr)
+        return 1
     node = None
     try:
         from .node import MappingNode

@@ -1,0 +1,376 @@
+"""The ROS 2 node as a process, over a real DDS (Fast DDS, shared memory only: ros_support.py):
+the bundled intel log replayed as LaserScan + /tf + /tf_static, the latched /map against the
+log's own map, a Path of moved poses, the services, bad messages, a late subscriber, a clean
+exit and no UDP socket off loopback.
+
+How close /map is to the log's map: the LaserScans carry float32 angles (test_bags.py's module
+docstring bounds what that moves: at most 0.5 % of the map's cells), and the poses pass through
+tf's quaternions (a few ulps of heading). The map's size, origin and known cells are compared
+exactly, the values (scale mode: round(100 p)) in all but that share of the cells."""
+
+from __future__ import annotations
+
+import math
+import os
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ros_support  # noqa: F401  (the ROS environment, before rclpy starts)
+from ros_support import NodeProcess, is_loopback, udp_sockets
+
+rclpy = pytest.importorskip("rclpy", reason="the ROS 2 extra is not installed: pip install '.[ros]' ./ros/tf2_msgs")
+pytest.importorskip("tf2_msgs", reason="tf2_msgs is not installed: pip install ./ros/tf2_msgs")
+
+import vasco_gpu as vg  # noqa: E402
+from geometry_msgs.msg import PoseStamped, TransformStamped  # noqa: E402
+from nav_msgs.msg import OccupancyGrid, Path as PathMsg  # noqa: E402
+from rclpy.executors import SingleThreadedExecutor  # noqa: E402
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy  # noqa: E402
+from sensor_msgs.msg import LaserScan  # noqa: E402
+from std_srvs.srv import SetBool, Trigger  # noqa: E402
+from tf2_msgs.msg import TFMessage  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+INTEL = ROOT / "logs" / "intel.gfs.log.gz"
+ANGLE_BOUND = 0.005  # test_bags.py's bound on cells moved by float32 angles
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+RELIABLE = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+
+
+def stamp_of(ns: int):
+    from builtin_interfaces.msg import Time
+
+    return Time(sec=ns // 10**9, nanosec=ns % 10**9)
+
+
+def quat(theta: float):
+    return 0.0, 0.0, math.sin(theta / 2), math.cos(theta / 2)
+
+
+class Player:
+    """The test's own node: publishes scans, tf and Paths, records /map, calls the services."""
+
+    def __init__(self):
+        self.node = rclpy.create_node("vasco_test_player")
+        n = self.node
+        self.scan = n.create_publisher(LaserScan, "scan", RELIABLE)
+        self.tf = n.create_publisher(TFMessage, "/tf", RELIABLE)
+        self.tf_static = n.create_publisher(TFMessage, "/tf_static", LATCHED)
+        self.path = n.create_publisher(PathMsg, "trajectory", QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE))
+        self.maps: list[tuple[float, OccupancyGrid]] = []
+        self.lock = threading.Lock()
+        n.create_subscription(OccupancyGrid, "map", self._on_map, LATCHED)
+        self.executor = SingleThreadedExecutor()
+        self.executor.add_node(n)
+        self.thread = threading.Thread(target=self.executor.spin, daemon=True)
+        self.thread.start()
+
+    def _on_map(self, msg):
+        with self.lock:
+            self.maps.append((time.monotonic(), msg))
+
+    def map_count(self) -> int:
+        with self.lock:
+            return len(self.maps)
+
+    def latest(self):
+        with self.lock:
+            return self.maps[-1][1] if self.maps else None
+
+    def transform(self, parent, child, ns, pose):
+        t = TransformStamped()
+        t.header.frame_id, t.child_frame_id, t.header.stamp = parent, child, stamp_of(ns)
+        t.transform.translation.x, t.transform.translation.y = float(pose[0]), float(pose[1])
+        r = t.transform.rotation
+        r.x, r.y, r.z, r.w = quat(float(pose[2]))
+        return t
+
+    def laser_scan(self, ns, ranges, a0, da, frame="laser"):
+        m = LaserScan()
+        m.header.frame_id, m.header.stamp = frame, stamp_of(ns)
+        m.angle_min, m.angle_increment = float(a0), float(da)
+        m.angle_max = float(np.float32(a0) + np.float32(da) * np.float32(len(ranges) - 1))
+        m.range_min, m.range_max = 0.0, 81.91
+        m.ranges = ranges.astype(np.float32).tolist()
+        return m
+
+    def wait_matched(self, timeout=20.0):
+        """Until the node's subscriptions match our publishers (messages sent before are lost)."""
+        end = time.monotonic() + timeout
+        pubs = (self.scan, self.tf, self.tf_static, self.path)
+        while time.monotonic() < end:
+            if all(p.get_subscription_count() > 0 for p in pubs):
+                return
+            time.sleep(0.02)
+        raise AssertionError("the node's subscriptions did not match within 20 s")
+
+    def replay(self, scans, stamps, rate_hz=500.0):
+        """map -> base_link on /tf and a LaserScan in 'laser' at every scan's stamp."""
+        self.wait_matched()
+        self.tf_static.publish(TFMessage(transforms=[self.transform("base_link", "laser", 0, (0, 0, 0))]))
+        period = 1.0 / rate_hz
+        for s in range(len(scans)):
+            ns = int(stamps[s])
+            self.tf.publish(TFMessage(transforms=[self.transform("map", "base_link", ns, scans.poses[s])]))
+            self.scan.publish(self.laser_scan(ns, scans.ranges_of(s), scans.first_angle[s], scans.angle_step[s]))
+            time.sleep(period)
+
+    def publish_path(self, stamps, poses, frame="map"):
+        msg = PathMsg()
+        msg.header.frame_id = frame
+        for ns, p in zip(stamps, poses):
+            ps = PoseStamped()
+            ps.header.frame_id, ps.header.stamp = frame, stamp_of(int(ns))
+            ps.pose.position.x, ps.pose.position.y = float(p[0]), float(p[1])
+            o = ps.pose.orientation
+            o.x, o.y, o.z, o.w = quat(float(p[2]))
+            msg.poses.append(ps)
+        self.path.publish(msg)
+
+    def call(self, srv_type, name, request, timeout=10.0):
+        client = self.node.create_client(srv_type, name)
+        try:
+            assert client.wait_for_service(timeout_sec=timeout), f"service {name} not there"
+            future = client.call_async(request)
+            end = time.monotonic() + timeout
+            while not future.done() and time.monotonic() < end:
+                time.sleep(0.01)
+            assert future.done(), f"{name}: no answer within {timeout} s"
+            return future.result()
+        finally:
+            self.node.destroy_client(client)
+
+    def wait_map(self, after: int, match=None, timeout=30.0):
+        """The first /map received after the after-th that satisfies match (or any)."""
+        end = time.monotonic() + timeout
+        seen = after
+        while time.monotonic() < end:
+            with self.lock:
+                new = self.maps[seen:]
+                seen = len(self.maps)
+            for _, m in new:
+                if match is None or match(m):
+                    return m
+            time.sleep(0.02)
+        return None
+
+    def close(self):
+        self.executor.shutdown()
+        self.thread.join(10)
+        self.node.destroy_node()
+
+
+def as_map_values(m) -> np.ndarray:
+    """A finished Map as the node's scale-mode values, computed here: round(100 p) half up,
+    row-major from the lower-left cell."""
+    p = m.cells.T.astype(np.float64)
+    return np.where((p >= 0) & (p <= 1), np.floor(p * 100 + 0.5), -1).astype(np.int8).ravel()
+
+
+def assert_grid_matches(msg, want, bound=ANGLE_BOUND):
+    info = msg.info
+    assert (info.width, info.height) == want.shape
+    assert math.isclose(info.resolution, want.resolution, rel_tol=1e-6)
+    assert (info.origin.position.x, info.origin.position.y) == pytest.approx(want.origin[:2], abs=1e-9)
+    got, exp = np.frombuffer(bytes(msg.data), dtype=np.int8), as_map_values(want)
+    assert np.array_equal(got == -1, exp == -1), "known cells differ"
+    differ = int((got != exp).sum())
+    assert differ <= bound * got.size, (differ, got.size)
+    return differ
+
+
+def grid_equals(want):
+    exp = as_map_values(want)
+
+    def match(msg):
+        if (msg.info.width, msg.info.height) != want.shape:
+            return False
+        got = np.frombuffer(bytes(msg.data), dtype=np.int8)
+        return np.array_equal(got == -1, exp == -1) and int((got != exp).sum()) <= ANGLE_BOUND * got.size
+    return match
+
+
+@pytest.fixture(scope="module")
+def intel():
+    return vg.load_log(INTEL)
+
+
+@pytest.fixture(scope="module")
+def ros():
+    rclpy.init()
+    player = Player()
+    yield player
+    player.close()
+    rclpy.try_shutdown()
+
+
+@pytest.fixture(scope="module")
+def node(tmp_path_factory):
+    out = tmp_path_factory.mktemp("saved")
+    shm = set(os.listdir("/dev/shm"))
+    proc = NodeProcess({"backend": "cpu_double", "map_mode": "scale", "scan_qos": "reliable",
+                        "map_update_interval": 0.2, "transform_timeout": 1.0,
+                        "save_map_path": [str(out / "live.map.gz"), str(out / "live.pgm")]})
+    proc.wait_for("ready")
+    proc.saved, proc.shm_before = out, shm
+    yield proc
+    proc.kill()
+
+
+def test_replay_gives_the_logs_map_then_a_path_moves_it(ros, node, intel):
+    stamps = 10**12 + np.arange(len(intel), dtype=np.int64) * 100_000_000
+    before = ros.map_count()
+    ros.replay(intel.scans, stamps)
+    want = vg.Mapper(intel.params, backend="cpu_double")
+    want.insert(intel.scans)
+    want_map = want.finish()
+    got = ros.wait_map(before, grid_equals(want_map), timeout=60)
+    assert got is not None, f"no /map equal to the log's map; last:\n{node.output[-2000:]}"
+    assert got.header.frame_id == "map"
+    assert_grid_matches(got, want_map)
+
+    # A Path of perturbed base poses at every scan's stamp: /map = log2map --poses of them (the
+    # same reader through load_log: a g2o file, matched in order).
+    rng = np.random.default_rng(3)
+    moved = intel.poses + rng.normal(0, [0.03, 0.03, 0.005], intel.poses.shape)
+    g2o = node.saved.parent / "moved.g2o"
+    g2o.write_text("".join(f"VERTEX_SE2 {i} {x:.17g} {y:.17g} {t:.17g}\n" for i, (x, y, t) in enumerate(moved)))
+    by_file = vg.load_log(INTEL, poses=g2o, pose_match="order")
+    want = vg.Mapper(by_file.params, backend="cpu_double")
+    want.insert(by_file.scans)
+    moved_map = want.finish()
+    before = ros.map_count()
+    t0 = time.monotonic()
+    ros.publish_path(stamps, moved)
+    got = ros.wait_map(before, timeout=30)
+    assert got is not None, node.output[-2000:]
+    latency = time.monotonic() - t0
+    assert_grid_matches(got, moved_map)
+    print(f"Path of {len(intel)} poses -> /map in {latency * 1e3:.0f} ms (cpu_double, this machine)")
+
+    # A late subscriber gets the latched map.
+    late = []
+    sub = ros.node.create_subscription(OccupancyGrid, "map", late.append, LATCHED)
+    end = time.monotonic() + 10
+    while not late and time.monotonic() < end:
+        time.sleep(0.02)
+    ros.node.destroy_subscription(sub)
+    assert late and bytes(late[0].data) == bytes(got.data)
+
+    # save_map: the files of save_map_path, one transaction; the map read back is the one published.
+    r = ros.call(Trigger, "/vasco_mapper/save_map", Trigger.Request())
+    assert r.success, r.message
+    saved = vg.read_map(node.saved / "live.map.gz")
+    assert np.array_equal(as_map_values(saved), np.frombuffer(bytes(got.data), dtype=np.int8))
+    assert (node.saved / "live.pgm").is_file() and (node.saved / "live.yaml").is_file()
+    assert sorted(p.name for p in node.saved.iterdir()) == ["live.map.gz", "live.pgm", "live.yaml"]
+
+
+def set_parameter(ros, name, value):
+    from rcl_interfaces.msg import Parameter as ParameterMsg
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter
+
+    req = SetParameters.Request(parameters=[Parameter(name, value=value).to_parameter_msg()])
+    assert isinstance(req.parameters[0], ParameterMsg)
+    return ros.call(SetParameters, "/vasco_mapper/set_parameters", req).results[0]
+
+
+def test_a_parameter_change_maps_every_stored_scan_again(ros, node, intel):
+    bad = set_parameter(ros, "p_occ", 1.5)
+    assert not bad.successful and "p_occ" in bad.reason
+    assert not set_parameter(ros, "scan_topics", ["other"]).successful  # read-only
+    n = ros.map_count()
+    assert set_parameter(ros, "resolution", 0.05).successful
+    got = ros.wait_map(n, timeout=30)
+    assert got is not None and math.isclose(got.info.resolution, 0.05 * 4, rel_tol=1e-6), node.output[-2000:]
+    n = ros.map_count()
+    assert set_parameter(ros, "resolution", 0.025).successful
+    assert ros.wait_map(n, timeout=30).info.resolution == pytest.approx(0.1)
+
+
+def test_bad_messages_are_refused_by_name_and_nothing_is_lost(ros, node, intel):
+    last = ros.latest()
+    assert last is not None
+    n = ros.map_count()
+    ns = 2 * 10**12
+    # ranges that disagree with the angles
+    bad = ros.laser_scan(ns, intel.scans.ranges_of(0), -1.0, 0.01)
+    bad.angle_max = 1.0  # 201 beams by the angles, 180 ranges
+    ros.scan.publish(bad)
+    node.wait_for("has 180 ranges, but angle_min")
+    # a Path in another frame, and one with a NaN pose
+    ros.publish_path([ns], [(0, 0, 0)], frame="odom")
+    node.wait_for("is in frame 'odom', not map_frame 'map'")
+    ros.publish_path([ns, ns + 1], [(0, 0, 0), (math.nan, 0, 0)])
+    node.wait_for("has position (nan")
+    # a frame that never appears in tf: dropped after transform_timeout, logged once
+    for k in range(3):
+        ros.scan.publish(ros.laser_scan(ns + k, intel.scans.ranges_of(0), -1.0, 0.5 * math.pi / 180, frame="ghost"))
+    line = node.wait_for("no transform within transform_timeout")
+    assert "/scan: scan at stamp 2000.000000000" in line and "'ghost'" in line
+    time.sleep(1.5)
+    assert sum("ghost" in ln for ln in node.lines) == 1, node.output[-2000:]
+    assert node.proc.poll() is None
+    assert ros.map_count() == n  # nothing changed the map
+    assert bytes(ros.latest().data) == bytes(last.data)
+
+
+def test_pause_and_reset(ros, node, intel):
+    r = ros.call(SetBool, "/vasco_mapper/pause", SetBool.Request(data=True))
+    assert r.success and "paused" in r.message
+    n = ros.map_count()
+    ros.replay(intel.scans.select(0, 20), 3 * 10**12 + np.arange(20) * 10**8)
+    time.sleep(1.0)
+    assert ros.map_count() == n  # paused: scans not mapped
+    assert ros.call(SetBool, "/vasco_mapper/pause", SetBool.Request(data=False)).success
+    r = ros.call(Trigger, "/vasco_mapper/reset", Trigger.Request())
+    assert r.success and f"dropped {len(intel)} scans" in r.message, r.message
+    first = intel.scans.select(0, 30)
+    ros.replay(first, 4 * 10**12 + np.arange(30) * 10**8)
+    small = vg.Mapper(intel.params, backend="cpu_double")
+    small.insert(first)
+    got = ros.wait_map(n, grid_equals(small.finish()), timeout=30)
+    assert got is not None, node.output[-2000:]
+
+
+def test_no_udp_socket_off_loopback(node):
+    sockets = udp_sockets(node.proc.pid)
+    assert not [s for s in sockets if not is_loopback(s)], sockets
+
+
+def test_a_clean_exit_within_a_second_leaving_no_shared_memory():
+    # A node alone in a domain of its own: a peer that is still running keeps the segments it
+    # shares with the node open (Fast DDS removes a segment with its last user).
+    shm = set(os.listdir("/dev/shm"))
+    alone = NodeProcess({"backend": "cpu_double"}, env={"ROS_DOMAIN_ID": str(int(ros_support.ROS_ENV["ROS_DOMAIN_ID"]) + 50)})
+    alone.wait_for("ready")
+    assert not [s for s in udp_sockets(alone.proc.pid) if not is_loopback(s)]
+    rc, took = alone.interrupt()
+    assert rc == 0, alone.output[-2000:]
+    assert took < 1.0, f"took {took:.2f} s to exit"
+    assert "0 scans mapped" in alone.output
+    left = set(os.listdir("/dev/shm")) - shm
+    assert not left, left
+
+
+def test_the_node_under_test_exits_cleanly_too(node):
+    rc, took = node.interrupt()
+    assert rc == 0 and took < 1.0, (rc, took, node.output[-2000:])
+    assert f"vasco_mapper: 30 scans mapped; not mapped:" in node.output
+
+
+def test_a_bad_parameter_stops_the_node_at_start_up():
+    proc = NodeProcess({"map_mode": "ternary"})
+    rc = proc.proc.wait(30)
+    proc._reader.join(2)
+    assert rc == 2
+    assert "map_mode: 'ternary' is not one of trinary, scale" in proc.output
+    proc = NodeProcess({"p_occ": 1.5})
+    assert proc.proc.wait(30) == 2
+    proc._reader.join(2)
+    assert "p_occ" in proc.output
