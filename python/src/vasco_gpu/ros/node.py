@@ -6,6 +6,7 @@ the tf buffer the bag reader's; this file only wires them to rclpy."""
 from __future__ import annotations
 
 import time
+from array import array
 
 import numpy as np
 import rclpy
@@ -18,13 +19,14 @@ from std_srvs.srv import SetBool, Trigger
 
 from .. import _core
 from ..bags.errors import BagError
-from ..bags.geometry import planar, unit_quaternion, yaw
+from ..bags.geometry import QUAT_TOL, planar, yaw
 from ..bags.header import frame_name, stamp_ns, stamp_text
 from ..bags.poses import static_mount
 from ..bags.scans import COUNT_KEYS, read_laser
 from ..bags.tf import TfBuffer
 from .grid import fill_grid
 from .live_map import LiveMap, LiveMapError
+from .path_cdr import read_path
 from .settings import NODE_PARAMETERS, Settings, SettingsError, mapper_parameter_names
 from .tf_messages import tf_message_type
 
@@ -53,10 +55,11 @@ class Refused(Exception):
 class _Pending:
     """A scan waiting for its transform until the deadline (monotonic seconds)."""
 
-    __slots__ = ("topic", "ns", "reading", "deadline")
+    __slots__ = ("topic", "ns", "reading", "deadline", "received")
 
-    def __init__(self, topic, ns, reading, deadline):
+    def __init__(self, topic, ns, reading, deadline, received):
         self.topic, self.ns, self.reading, self.deadline = topic, ns, reading, deadline
+        self.received = received  # perf_counter() when the callback took it
 
 
 class MappingNode(Node):
@@ -77,6 +80,8 @@ class MappingNode(Node):
         self._mounts: dict[str, np.ndarray | None] = {}
         self._published = -1
         self._last_scan = 0.0
+        self.scan_ms = array("d")  # callback -> scan in the grid, per scan
+        self.path_ms: list[float] = []  # callback -> /map published, per Path
         self._subscribe()
         self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
         self.meta_pub = self.create_publisher(MapMetaData, "map_metadata", LATCHED)
@@ -137,8 +142,8 @@ class MappingNode(Node):
         tf_type = tf_message_type()
         self.create_subscription(tf_type, "/tf", lambda m: self._on_tf(m, False), TF)
         self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
-        if s.path_topic:
-            self.create_subscription(Path, s.path_topic, self._on_path, PATH)
+        if s.path_topic:  # as bytes: path_cdr.py reads them far faster than rclpy's objects
+            self.create_subscription(Path, s.path_topic, self._on_path, PATH, raw=True)
 
     def _refuse(self, topic: str, cause: str, text: str) -> None:
         """Counts a message not mapped; logs the first of each (topic, cause)."""
@@ -171,7 +176,8 @@ class MappingNode(Node):
         except Refused as e:
             self._refuse(topic, "bad scans", f"{e}; not mapped")  # the first of each topic
             return
-        self.pending.append(_Pending(topic, ns, reading, time.monotonic() + self.settings.transform_timeout))
+        self.pending.append(_Pending(topic, ns, reading, time.monotonic() + self.settings.transform_timeout,
+                                     time.perf_counter()))
         self._pose_pending()
 
     def _mount(self, frame: str):
@@ -213,15 +219,16 @@ class MappingNode(Node):
                          f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)} not mapped: {e}")
             return
         self._last_scan = time.monotonic()
+        self.scan_ms.append((time.perf_counter() - p.received) * 1e3)
         if self._mount(r.frame) is None:
             self._refuse(p.topic, "scans without a mount",
                          f"{self.resolve_topic_name(p.topic)}: no /tf_static chain {self.settings.base_frame} -> "
                          f"{r.frame}: its scans are mapped at their tf pose, a Path cannot move them")
 
-    def _on_path(self, msg) -> None:
+    def _on_path(self, raw: bytes) -> None:
         start = time.perf_counter()
         try:
-            stamps, poses = self._path_poses(msg)
+            stamps, poses = self._path_poses(raw)
         except Refused as e:
             self._refuse(self.settings.path_topic, e.cause, f"{e}; ignored")
             return
@@ -231,33 +238,37 @@ class MappingNode(Node):
             self._refuse(self.settings.path_topic, "paths not rendered", f"Path not rendered: {e}")
             return
         self._publish_if_changed(settle=False)
-        self.get_logger().debug(f"Path of {len(stamps)} poses: {counts}, published in "
-                                f"{(time.perf_counter() - start) * 1e3:.1f} ms")
+        self.path_ms.append((time.perf_counter() - start) * 1e3)
+        self.get_logger().debug(f"Path of {len(stamps)} poses: {counts}, published in {self.path_ms[-1]:.1f} ms")
 
-    def _path_poses(self, msg):
-        """(stamps (k,) int64 ns, base poses (k, 3)) of a nav_msgs/Path; Refused naming the topic
-        and stamp for a Path in another frame, a pose in another frame or not a number."""
+    def _path_poses(self, raw: bytes):
+        """(stamps (k,) int64 ns, base poses (k, 3)) of a serialized nav_msgs/Path; Refused
+        naming the topic and stamp for a Path in another frame, a pose in another frame or not
+        a number."""
         topic = self.resolve_topic_name(self.settings.path_topic)
-        frame, want = frame_name(msg.header.frame_id), self.settings.map_frame
+        try:
+            path = read_path(raw, Path)
+        except ValueError as e:
+            raise Refused(f"{topic}: {e}", "paths not readable") from None
+        frame, want = frame_name(path.frame_id), self.settings.map_frame
         if frame != want:
-            raise Refused(f"{topic}: Path at stamp {stamp_text(stamp_ns(msg.header.stamp))} is in frame "
-                          f"{frame!r}, not map_frame {want!r}", "paths in another frame")
-        stamps, poses = np.empty(len(msg.poses), dtype=np.int64), np.empty((len(msg.poses), 3))
-        for k, ps in enumerate(msg.poses):
-            ns = stamp_ns(ps.header.stamp)
-            where = f"{topic}: pose {k} (stamp {stamp_text(ns)})"
-            if ps.header.frame_id and frame_name(ps.header.frame_id) != want:
-                raise Refused(f"{where} is in frame {frame_name(ps.header.frame_id)!r}, not {want!r}",
-                              "paths in another frame")
-            p, o = ps.pose.position, ps.pose.orientation
-            if not np.isfinite([p.x, p.y, p.z]).all():
-                raise Refused(f"{where} has position ({p.x}, {p.y}, {p.z})", "paths with a bad pose")
-            try:
-                q = unit_quaternion((o.x, o.y, o.z, o.w), where, None)
-            except BagError as e:
-                raise Refused(e.message, "paths with a bad pose") from None
-            stamps[k], poses[k] = ns, (p.x, p.y, float(yaw(q[None])[0]))
-        return stamps, poses
+            raise Refused(f"{topic}: Path at stamp {stamp_text(path.stamp_ns)} is in frame {frame!r}, not "
+                          f"map_frame {want!r}", "paths in another frame")
+        other = [k for k, f in enumerate(path.frame_ids) if f and frame_name(f) != want]
+        if other:
+            k = other[0]
+            raise Refused(f"{topic}: pose {k} (stamp {stamp_text(int(path.stamps[k]))}) is in frame "
+                          f"{frame_name(path.frame_ids[k])!r}, not {want!r}", "paths in another frame")
+        bad = ~np.isfinite(path.positions).all(axis=1)
+        norm = np.sqrt((path.orientations ** 2).sum(axis=1))
+        bad |= ~np.isfinite(norm) | (norm < 1e-6)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise Refused(f"{topic}: pose {k} (stamp {stamp_text(int(path.stamps[k]))}) has position "
+                          f"{tuple(path.positions[k].tolist())}, orientation {tuple(path.orientations[k].tolist())}",
+                          "paths with a bad pose")
+        q = np.where(np.abs(norm - 1.0)[:, None] <= QUAT_TOL, path.orientations, path.orientations / norm[:, None])
+        return path.stamps, np.column_stack([path.positions[:, :2], yaw(q)])
 
     # -- outputs ----------------------------------------------------------------------------
     def _publish_if_changed(self, settle: bool = True) -> None:
@@ -314,5 +325,11 @@ class MappingNode(Node):
         return response
 
     def summary(self) -> str:
+        """What the node did: scans mapped, what it refused, and its own latencies."""
         refused = ", ".join(f"{n} {cause} on {topic}" for (topic, cause), n in sorted(self.refused.items()))
-        return f"{len(self.live)} scans mapped" + (f"; not mapped: {refused}" if refused else "")
+        text = f"{len(self.live)} scans mapped" + (f"; not mapped: {refused}" if refused else "")
+        for what, ms in (("scan -> grid", self.scan_ms), ("Path -> /map published", self.path_ms)):
+            if len(ms):
+                p50, p99 = np.percentile(np.asarray(ms), [50, 99])
+                text += f"; {what}: p50 {p50:.2f} ms, p99 {p99:.2f} ms ({len(ms)})"
+        return text
