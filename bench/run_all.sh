@@ -5,11 +5,13 @@
 # tables are quoted from such a file (docs/performance.md names it), never
 # copied by hand.
 #   bench/run_all.sh BUILD_DIR [STEP...]   (BUILD_DIR absolute or from the repository root;
-#                                          steps: parse oracle mapping large scaling session batch)
+#                                          steps: parse oracle mapping large scaling session batch;
+#                                          ros, the ROS 2 node, only when named: it needs the [ros] extra)
 # COST_MODEL_OUT=FILE: batch_bench also writes auto's measured constants there
 # (vasco_gpu/app/backend_cost_model.txt is such a file); BATCH_ARGS: more of
 # batch_bench's options; BENCH_COMMIT: the commit to name where the tree is
-# a copy without its git history.
+# a copy without its git history; PYTHON: the interpreter of the ros step (one with vasco_gpu,
+# rclpy and tf2_msgs), ROS_BENCH_ARGS: more of ros_node_bench.py's options.
 set -euo pipefail
 build=${1:?usage: bench/run_all.sh BUILD_DIR [STEP...]}
 shift
@@ -42,6 +44,7 @@ for step in $steps; do
     session) run "$build/bin/session_bench" ;;
     batch) run python3 bench/batch_bench.py --bin "$build/bin" ${BATCH_ARGS:-} \
              ${COST_MODEL_OUT:+--cost-model-out "$COST_MODEL_OUT"} ;;
+    ros) run "${PYTHON:-python3}" bench/ros_node_bench.py ${ROS_BENCH_ARGS:-} ;;
     *) echo "bench/run_all.sh: unknown step '$step'" >&2; exit 2 ;;
   esac
 done

@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""The ROS 2 node live: each log replayed as LaserScan + /tf at the sensor's rate (40 Hz) and
+then faster than real time, then a nav_msgs/Path of every pose published again and again,
+for each backend. Printed as a table, ratios in the same run:
+
+  scans       mapped / sent (a replay over reliable QoS loses none while the node keeps up)
+  CPU 40 Hz   the node process's CPU time over wall time while scans arrive at 40 Hz (%
+              of one core: callbacks, tf, conversion, DDS threads, the insert)
+  CPU fast    the same at --fast-rate
+  scan p50/p99  the node's own: callback entry -> scan in the grid (ms)
+  Path->/map  publish() of the serialized Path -> the new /map in this process's subscriber
+              (ms, median and best of --paths), the whole loop a SLAM back end sees
+  vs cpu_double  cpu_double's Path->/map over this one: against rebuilding the map from
+              every scan on the CPU, as a CPU mapper does after a loop closure
+
+Every ROS process runs on Fast DDS's shared-memory transport in a domain of its own
+(python/tests/ros_support.py). Needs the [ros] extra and tf2_msgs (docs/ros.md).
+  bench/ros_node_bench.py [--logs LOG...] [--backends B...] [--resolution 0.05 --downsample 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "python" / "tests"))
+import ros_support  # noqa: E402,F401  (the environment, before rclpy starts)
+from ros_support import NodeProcess  # noqa: E402
+
+import numpy as np  # noqa: E402
+import rclpy  # noqa: E402
+from rclpy.serialization import serialize_message  # noqa: E402
+
+import vasco_gpu as vg  # noqa: E402
+from ros_player import Player  # noqa: E402
+
+BACKENDS = {"cuda float": {"backend": "cuda", "cuda_mode": "float"},
+            "cuda exact": {"backend": "cuda", "cuda_mode": "exact"},
+            "cpu_threads": {"backend": "cpu_threads"}, "cpu_double": {"backend": "cpu_double"}}
+LOGS = ["logs/fr079-complete.gfs.log.gz", "logs/fr101.carmen.log.gz"]
+
+
+def cpu_seconds(pid: int) -> float:
+    fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def replay_measured(player, proc, scans, stamps, rate):
+    """Replays at rate; the node's CPU share over the replay."""
+    c0, t0 = cpu_seconds(proc.proc.pid), time.monotonic()
+    player.replay(scans, stamps, rate_hz=rate)
+    return (cpu_seconds(proc.proc.pid) - c0) / (time.monotonic() - t0)
+
+
+def wait_quiet(player, quiet_s: float, limit_s: float = 300.0) -> None:
+    """Until no /map has come for quiet_s: the node has mapped every scan sent and settled, so
+    the next /map is the Path's."""
+    end, n, since = time.monotonic() + limit_s, player.map_count(), time.monotonic()
+    while time.monotonic() - since < quiet_s and time.monotonic() < end:
+        time.sleep(0.05)
+        if player.map_count() != n:
+            n, since = player.map_count(), time.monotonic()
+
+
+def path_latencies(player, raw: bytes, repeats: int) -> list[float]:
+    out = []
+    for _ in range(repeats):
+        wait_quiet(player, 1.0)
+        n = player.map_count()
+        t0 = time.monotonic()
+        player.path.publish(raw)
+        while player.map_count() == n:
+            if time.monotonic() - t0 > 120:
+                raise RuntimeError("no /map within 120 s of a Path")
+            time.sleep(0.0002)
+        out.append((player.maps[n][0] - t0) * 1e3)  # the subscriber callback's own clock reading
+    return out
+
+
+def summary_value(line: str, what: str) -> str:
+    if what not in line:
+        return "-"
+    part = line.split(what + ": ", 1)[1].split(";")[0]
+    p50 = part.split("p50 ")[1].split(" ms")[0]
+    p99 = part.split("p99 ")[1].split(" ms")[0]
+    return f"{p50}/{p99}"
+
+
+def bench_one(player, log, name, args, stamps, raw_path):
+    params = {**BACKENDS[name], "scan_qos": "reliable", "map_update_interval": 0.5, "transform_timeout": 2.0,
+              "resolution": args.resolution, "downsample": args.downsample}
+    proc = NodeProcess(params)
+    try:
+        proc.wait_for("ready", timeout=120)
+        live = min(args.live_scans, len(log))
+        cpu_live = replay_measured(player, proc, log.scans.select(0, live), stamps[:live], args.rate)
+        rest = log.scans.select(live, len(log) - live)
+        cpu_fast = replay_measured(player, proc, rest, stamps[live:], args.fast_rate) if len(rest) else 0.0
+        wait_quiet(player, 2.0)  # every scan mapped, the grid settled, the last map out
+        lat = path_latencies(player, raw_path, args.paths)
+        rc, _ = proc.interrupt(timeout=60)
+        line = next((ln for ln in proc.lines if "scans mapped" in ln), "")
+        mapped = line.split("vasco_mapper: ", 1)[1].split(" scans mapped")[0] if line else "?"
+        return {"scans": f"{mapped}/{len(log)}", "cpu_live": cpu_live, "cpu_fast": cpu_fast,
+                "scan": summary_value(line, "scan -> grid"), "path_p50": float(np.median(lat)),
+                "path_min": float(min(lat)), "rc": rc}
+    finally:
+        proc.kill()
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--logs", nargs="+", default=LOGS)
+    ap.add_argument("--backends", nargs="+", default=None, help=f"of {', '.join(BACKENDS)}")
+    ap.add_argument("--rate", type=float, default=40.0, help="the live replay's rate (Hz)")
+    ap.add_argument("--live-scans", type=int, default=400, help="scans replayed at --rate")
+    ap.add_argument("--fast-rate", type=float, default=400.0, help="the rest's rate (Hz)")
+    ap.add_argument("--paths", type=int, default=5, help="Paths published, one after the other")
+    ap.add_argument("--resolution", type=float, default=0.05, help="vasco_resolution (m)")
+    ap.add_argument("--downsample", type=int, default=1, help="vasco_downsample (1: /map at --resolution)")
+    args = ap.parse_args()
+    names = args.backends or [b for b in BACKENDS if vg.cuda_available() or not b.startswith("cuda")]
+    rclpy.init()
+    player = Player()
+    try:
+        print(f"# map cell {args.resolution * args.downsample:g} m; {args.live_scans} scans at {args.rate:g} Hz, "
+              f"the rest at {args.fast_rate:g} Hz; Path -> /map over {args.paths} Paths")
+        print(f"{'log':<24} {'backend':<12} {'scans':>11} {'CPU 40 Hz':>9} {'CPU fast':>8} "
+              f"{'scan p50/p99 ms':>16} {'Path->/map ms':>13} {'best':>7} {'vs cpu_double':>13}")
+        for path in args.logs:
+            log = vg.load_log(ROOT / path)
+            stamps = 10**12 + np.arange(len(log), dtype=np.int64) * int(1e9 / args.rate)
+            raw = serialize_message(player.path_message(stamps, log.poses))
+            rows = {name: bench_one(player, log, name, args, stamps, raw) for name in names}
+            ref = rows.get("cpu_double", {}).get("path_p50")
+            for name, r in rows.items():
+                ratio = f"{ref / r['path_p50']:.1f}x" if ref else "-"
+                print(f"{Path(path).name:<24} {name:<12} {r['scans']:>11} {100 * r['cpu_live']:>8.1f}% "
+                      f"{100 * r['cpu_fast']:>7.1f}% {r['scan']:>16} {r['path_p50']:>13.1f} {r['path_min']:>7.1f} "
+                      f"{ratio:>13}", flush=True)
+    finally:
+        player.close()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

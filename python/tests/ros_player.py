@@ -1,0 +1,146 @@
+"""The ROS 2 tests' and the node benchmark's own node: publishes scans, tf and Paths, records
+/map, calls the node's services. Import ros_support first (the environment)."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+
+import numpy as np
+import rclpy
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import PoseStamped, TransformStamped
+from nav_msgs.msg import OccupancyGrid
+from nav_msgs.msg import Path as PathMsg
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import LaserScan
+from tf2_msgs.msg import TFMessage
+
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+RELIABLE = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+
+
+def stamp_of(ns: int):
+    return Time(sec=ns // 10**9, nanosec=ns % 10**9)
+
+
+def quat(theta: float):
+    return 0.0, 0.0, math.sin(theta / 2), math.cos(theta / 2)
+
+
+class Player:
+    """The test's own node: publishes scans, tf and Paths, records /map, calls the services."""
+
+    def __init__(self):
+        self.node = rclpy.create_node("vasco_test_player")
+        n = self.node
+        self.scan = n.create_publisher(LaserScan, "scan", RELIABLE)
+        self.tf = n.create_publisher(TFMessage, "/tf", RELIABLE)
+        self.tf_static = n.create_publisher(TFMessage, "/tf_static", LATCHED)
+        self.path = n.create_publisher(PathMsg, "trajectory", QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE))
+        self.maps: list[tuple[float, OccupancyGrid]] = []
+        self.lock = threading.Lock()
+        n.create_subscription(OccupancyGrid, "map", self._on_map, LATCHED)
+        self.executor = SingleThreadedExecutor()
+        self.executor.add_node(n)
+        self.thread = threading.Thread(target=self.executor.spin, daemon=True)
+        self.thread.start()
+
+    def _on_map(self, msg):
+        with self.lock:
+            self.maps.append((time.monotonic(), msg))
+
+    def map_count(self) -> int:
+        with self.lock:
+            return len(self.maps)
+
+    def latest(self):
+        with self.lock:
+            return self.maps[-1][1] if self.maps else None
+
+    def transform(self, parent, child, ns, pose):
+        t = TransformStamped()
+        t.header.frame_id, t.child_frame_id, t.header.stamp = parent, child, stamp_of(ns)
+        t.transform.translation.x, t.transform.translation.y = float(pose[0]), float(pose[1])
+        r = t.transform.rotation
+        r.x, r.y, r.z, r.w = quat(float(pose[2]))
+        return t
+
+    def laser_scan(self, ns, ranges, a0, da, frame="laser"):
+        m = LaserScan()
+        m.header.frame_id, m.header.stamp = frame, stamp_of(ns)
+        m.angle_min, m.angle_increment = float(a0), float(da)
+        m.angle_max = float(np.float32(a0) + np.float32(da) * np.float32(len(ranges) - 1))
+        m.range_min, m.range_max = 0.0, 81.91
+        m.ranges = ranges.astype(np.float32).tolist()
+        return m
+
+    def wait_matched(self, timeout=20.0):
+        """Until the node's subscriptions match our publishers (messages sent before are lost)."""
+        end = time.monotonic() + timeout
+        pubs = (self.scan, self.tf, self.tf_static, self.path)
+        while time.monotonic() < end:
+            if all(p.get_subscription_count() > 0 for p in pubs):
+                return
+            time.sleep(0.02)
+        raise AssertionError("the node's subscriptions did not match within 20 s")
+
+    def replay(self, scans, stamps, rate_hz=500.0):
+        """map -> base_link on /tf and a LaserScan in 'laser' at every scan's stamp."""
+        self.wait_matched()
+        self.tf_static.publish(TFMessage(transforms=[self.transform("base_link", "laser", 0, (0, 0, 0))]))
+        period, start = 1.0 / rate_hz, time.monotonic()
+        for s in range(len(scans)):
+            ns = int(stamps[s])
+            self.tf.publish(TFMessage(transforms=[self.transform("map", "base_link", ns, scans.poses[s])]))
+            self.scan.publish(self.laser_scan(ns, scans.ranges_of(s), scans.first_angle[s], scans.angle_step[s]))
+            time.sleep(max(0.0, start + (s + 1) * period - time.monotonic()))  # the rate, not a gap
+
+    def publish_path(self, stamps, poses, frame="map"):
+        self.path.publish(self.path_message(stamps, poses, frame))
+
+    def path_message(self, stamps, poses, frame="map"):
+        msg = PathMsg()
+        msg.header.frame_id = frame
+        for ns, p in zip(stamps, poses):
+            ps = PoseStamped()
+            ps.header.frame_id, ps.header.stamp = frame, stamp_of(int(ns))
+            ps.pose.position.x, ps.pose.position.y = float(p[0]), float(p[1])
+            o = ps.pose.orientation
+            o.x, o.y, o.z, o.w = quat(float(p[2]))
+            msg.poses.append(ps)
+        return msg
+
+    def call(self, srv_type, name, request, timeout=10.0):
+        client = self.node.create_client(srv_type, name)
+        try:
+            assert client.wait_for_service(timeout_sec=timeout), f"service {name} not there"
+            future = client.call_async(request)
+            end = time.monotonic() + timeout
+            while not future.done() and time.monotonic() < end:
+                time.sleep(0.01)
+            assert future.done(), f"{name}: no answer within {timeout} s"
+            return future.result()
+        finally:
+            self.node.destroy_client(client)
+
+    def wait_map(self, after: int, match=None, timeout=30.0):
+        """The first /map received after the after-th that satisfies match (or any)."""
+        end = time.monotonic() + timeout
+        seen = after
+        while time.monotonic() < end:
+            with self.lock:
+                new = self.maps[seen:]
+                seen = len(self.maps)
+            for _, m in new:
+                if match is None or match(m):
+                    return m
+            time.sleep(0.02)
+        return None
+
+    def close(self):
+        self.executor.shutdown()
+        self.thread.join(10)
+        self.node.destroy_node()
