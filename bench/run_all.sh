@@ -30,8 +30,13 @@ trap 'rm -f "$tmp"' EXIT
   echo "# GPU: $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -1 || true)"
 } > "$tmp"
 run() {
+  run_as "$*" "$@"
+}
+run_as() {  # run_as LABEL COMMAND...: the section is headed by LABEL (no interpreter's path)
+  local label=$1
+  shift
   echo >> "$tmp"
-  echo "## $*" >> "$tmp"
+  echo "## $label" >> "$tmp"
   "$@" 2>&1 | tee -a "$tmp"
 }
 for step in $steps; do
@@ -44,7 +49,8 @@ for step in $steps; do
     session) run "$build/bin/session_bench" ;;
     batch) run python3 bench/batch_bench.py --bin "$build/bin" ${BATCH_ARGS:-} \
              ${COST_MODEL_OUT:+--cost-model-out "$COST_MODEL_OUT"} ;;
-    ros) run "${PYTHON:-python3}" bench/ros_node_bench.py ${ROS_BENCH_ARGS:-} ;;
+    ros) run_as "python3 bench/ros_node_bench.py ${ROS_BENCH_ARGS:-}" \
+           "${PYTHON:-python3}" bench/ros_node_bench.py ${ROS_BENCH_ARGS:-} ;;
     *) echo "bench/run_all.sh: unknown step '$step'" >&2; exit 2 ;;
   esac
 done

@@ -1,6 +1,6 @@
 """What the ROS 2 tests share: the environment every ROS process here runs in (Fast DDS over
-shared memory only, a domain of this test run's own), the node started as a process, and a
-test node that replays a CARMEN log as LaserScan + /tf + /tf_static.
+shared memory only, a domain of this test run's own), the node started as a process, the
+skip (or, in CI, failure) when ROS 2 is not installed, the node's UDP sockets.
 
 The network rule: FASTDDS_BUILTIN_TRANSPORTS=SHM keeps Fast DDS off UDP (its default transport
 sends multicast discovery out of the network interface; ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
@@ -24,6 +24,20 @@ ROS_ENV = {"FASTDDS_BUILTIN_TRANSPORTS": "SHM", "ROS_DOMAIN_ID": str(100 + os.ge
 os.environ.update(ROS_ENV)
 os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE", None)
 os.environ.pop("ROS_STATIC_PEERS", None)
+
+
+def import_or_skip(module: str):
+    """pytest.importorskip with the install hint; with VASCO_REQUIRE_ROS_TESTS=1 (CI) a missing
+    module fails the test run instead of skipping it."""
+    import pytest
+
+    how = "the ROS 2 extra is not installed: pip install '.[ros]' ./ros/tf2_msgs"
+    if os.environ.get("VASCO_REQUIRE_ROS_TESTS") == "1":
+        try:
+            return __import__(module)
+        except ImportError as e:
+            pytest.fail(f"VASCO_REQUIRE_ROS_TESTS=1 and {module} does not import ({e}): {how}", pytrace=False)
+    return pytest.importorskip(module, reason=how)
 
 
 class NodeProcess:

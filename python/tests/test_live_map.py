@@ -5,6 +5,10 @@ the scans it spans as --poses would, refusals leave the session as it was."""
 from __future__ import annotations
 
 import math
+import re
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +17,7 @@ import vasco_gpu as vg
 from conftest import golden_cases, gridmap_digest
 from vasco_gpu.ros.grid import grid_values
 from vasco_gpu.ros.live_map import LiveMap, LiveMapError
-from vasco_gpu.ros.settings import Settings, SettingsError, mapper_parameter_names
+from vasco_gpu.ros.settings import NODE_PARAMETERS, Settings, SettingsError, mapper_parameter_names
 
 CASES = {name: (log, ini, digest) for name, log, ini, digest in golden_cases()}
 
@@ -139,3 +143,45 @@ def test_settings_refuse_naming_the_parameter(tmp_path):
     ini.write_text("[*]\nvasco_resolution 0.1\nvasco_p_occ 0.8\n")
     s = Settings.from_values({"param_file": str(ini)}, {"p_occ": 0.6})
     assert s.params.resolution == 0.1 and s.params.p_occ == 0.6  # given over the file
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _docs_rows():
+    """The rows of docs/ros.md's table of the node's own parameters: name -> (default, meaning)."""
+    text = (ROOT / "docs" / "ros.md").read_text()
+    table = text.split("| parameter | default | meaning |", 1)[1].split("\n\n", 1)[0]
+    rows = {}
+    for line in table.splitlines()[2:]:
+        name, default, meaning = (c.strip() for c in line.strip("|").split("|"))
+        rows[name.strip("`")] = (default.strip("`"), meaning)
+    return rows
+
+
+def test_the_docs_table_is_the_nodes_schema():
+    rows = _docs_rows()
+    assert list(rows) == [p.name for p in NODE_PARAMETERS]
+    for p in NODE_PARAMETERS:
+        default, meaning = rows[p.name]
+        want = "[" + ", ".join(p.default) + "]" if isinstance(p.default, list) else \
+            ("''" if p.default == "" else str(p.default))
+        assert default == want, p.name
+        assert meaning == p.meaning + (" (may change while running)" if p.dynamic else ""), p.name
+
+
+def test_the_launch_example_names_parameters_the_node_has():
+    text = (ROOT / "examples" / "ros" / "vasco_with_slam_toolbox.launch.py").read_text()
+    compile(text, "vasco_with_slam_toolbox.launch.py", "exec")
+    names = re.findall(r'"([a-z_]+):=', text)
+    assert len(names) >= 8
+    known = {p.name for p in NODE_PARAMETERS} | set(mapper_parameter_names())
+    assert not set(names) - known, set(names) - known
+
+
+def test_without_rclpy_the_node_says_how_to_install_it():
+    code = ("import sys; sys.modules['rclpy'] = None\n"
+            "from vasco_gpu.ros import main\nsys.exit(main())")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1
+    assert "rclpy does not import" in r.stderr and "pip install '.[ros]' ./ros/tf2_msgs" in r.stderr

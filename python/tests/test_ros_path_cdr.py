@@ -8,7 +8,7 @@ import pytest
 
 import ros_support  # noqa: F401  (the ROS environment)
 
-pytest.importorskip("rclpy", reason="the ROS 2 extra is not installed: pip install '.[ros]' ./ros/tf2_msgs")
+ros_support.import_or_skip("rclpy")
 
 from geometry_msgs.msg import PoseStamped  # noqa: E402
 from nav_msgs.msg import Path  # noqa: E402

@@ -356,6 +356,18 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "cpp: vasco::MapperParams params;": Check("compile", harness=CXX_HARNESS),
         "c: vasco_mapper_params p;": Check("compile", harness=C_HARNESS),
     },
+    "docs/ros.md": {
+        'sh: pip install ".[ros]" ./ros/tf2_msgs': Check(
+            "covered-by", files=[(".ci/run", ['pip install ".[dask,ros]"', "pip install ./ros/tf2_msgs",
+                                              "VASCO_REQUIRE_ROS_TESTS=1"])]),
+        "sh: export FASTDDS_BUILTIN_TRANSPORTS=SHM ROS_DOMAIN_ID=42": Check(
+            "covered-by", files=[("python/tests/test_ros_node.py", ["docs/ros.md", "def test_the_docs_command_runs"])]),
+        "sh: ros2 launch examples/ros/vasco_with_slam_toolbox.launch.py b": Check(
+            "skip", reason="needs ros2 launch and slam_toolbox (a system ROS 2); python/tests/test_live_map.py "
+                           "compiles the launch file and checks the node parameters it sets"),
+        "text: log backend scans CPU 40 Hz CPU fast scan p50/p99 ms Path->/": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-04-2core.txt"),
+    },
     "docs/walkthrough-bag.md": {
         # carmen2bag and mapdiff are not among test_readme.py's tools: the test runs the block
         # itself, each command as written, with the console scripts and the build's tools.

@@ -10,7 +10,15 @@ __all__ = ["main"]
 
 
 def main(argv=None) -> int:
-    """Runs the node until SIGINT or SIGTERM; 0 on a clean exit, 2 for a bad parameter."""
-    from .run import main as run
+    """Runs the node until SIGINT or SIGTERM; 0 on a clean exit, 2 for a bad parameter, 1 when
+    ROS 2 is not there."""
+    import sys
 
+    try:
+        from .run import main as run
+    except ImportError as e:  # rclpy or a message package
+        print(f"vasco_map_node: {e.name or e} does not import: install the ROS 2 extra (pip install "
+              "'.[ros]' ./ros/tf2_msgs from the repository, Python 3.10 or newer) or source a ROS 2 "
+              "installation (docs/ros.md)", file=sys.stderr)
+        return 1
     return run(argv)

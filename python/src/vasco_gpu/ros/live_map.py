@@ -40,9 +40,9 @@ class LiveMap:
     def __init__(self, params: _core.Params, *, backend: str = "auto", cuda_mode: str = "float",
                  device: int = 0, threads: int = 0, max_memory: int = 2 << 30):
         self.max_memory = int(max_memory)
-        self._mapper_args = dict(backend=backend, cuda_mode=cuda_mode if backend in ("cuda", "auto") else None,
-                                 threads=threads, cuda_device=device, max_memory_bytes=self.max_memory)
-        self.mapper = _core.Mapper(params, **self._mapper_args)
+        # cuda_mode and device are ignored by the CPU backends
+        self.mapper = _core.Mapper(params, backend=backend, cuda_mode=cuda_mode, threads=threads, cuda_device=device,
+                                   max_memory_bytes=self.max_memory)
         self.version = 0  # changes whenever the grid does
         self._clear()
 

@@ -70,8 +70,11 @@ class MappingNode(Node):
         self._declare()
         self.settings = Settings.from_values(self._node_values(), self._mapper_values())
         s = self.settings
-        self.live = LiveMap(s.params, backend=s.backend, cuda_mode=s.cuda_mode, device=s.device,
-                            threads=s.threads, max_memory=s.max_memory)
+        try:
+            self.live = LiveMap(s.params, backend=s.backend, cuda_mode=s.cuda_mode, device=s.device,
+                                threads=s.threads, max_memory=s.max_memory)
+        except (RuntimeError, ValueError) as e:  # e.g. cuda without a usable GPU
+            raise SettingsError(f"backend {s.backend!r}: {e}") from None
         self.tf = TfBuffer(stamp_name="scan stamp", keep=TF_KEEP_S)
         self.paused = False
         self.pending: list[_Pending] = []

@@ -22,11 +22,11 @@ def main(argv=None) -> int:
         return 1
     node = None
     try:
-        from .node import MappingNode
-
         try:
+            from .node import MappingNode  # nav_msgs, sensor_msgs, std_srvs
+
             node = MappingNode()
-        except (SettingsError, MissingMessages) as e:
+        except (SettingsError, MissingMessages, ImportError) as e:
             print(f"vasco_mapper: {e}", file=sys.stderr)
             return 2
         executor = SingleThreadedExecutor()
