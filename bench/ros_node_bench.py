@@ -56,20 +56,10 @@ def replay_measured(player, proc, scans, stamps, rate):
     return (cpu_seconds(proc.proc.pid) - c0) / (time.monotonic() - t0)
 
 
-def wait_quiet(player, quiet_s: float, limit_s: float = 300.0) -> None:
-    """Until no /map has come for quiet_s: the node has mapped every scan sent and settled, so
-    the next /map is the Path's."""
-    end, n, since = time.monotonic() + limit_s, player.map_count(), time.monotonic()
-    while time.monotonic() - since < quiet_s and time.monotonic() < end:
-        time.sleep(0.05)
-        if player.map_count() != n:
-            n, since = player.map_count(), time.monotonic()
-
-
 def path_latencies(player, raw: bytes, repeats: int) -> list[float]:
     out = []
     for _ in range(repeats):
-        wait_quiet(player, 1.0)
+        player.wait_quiet(1.0)
         n = player.map_count()
         t0 = time.monotonic()
         player.path.publish(raw)
@@ -100,7 +90,7 @@ def bench_one(player, log, name, args, stamps, raw_path):
         cpu_live = replay_measured(player, proc, log.scans.select(0, live), stamps[:live], args.rate)
         rest = log.scans.select(live, len(log) - live)
         cpu_fast = replay_measured(player, proc, rest, stamps[live:], args.fast_rate) if len(rest) else 0.0
-        wait_quiet(player, 2.0)  # every scan mapped, the grid settled, the last map out
+        player.wait_quiet(2.0)  # every scan mapped, the grid settled, the last map out
         lat = path_latencies(player, raw_path, args.paths)
         rc, _ = proc.interrupt(timeout=60)
         line = next((ln for ln in proc.lines if "scans mapped" in ln), "")

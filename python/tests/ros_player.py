@@ -15,7 +15,7 @@ from nav_msgs.msg import OccupancyGrid
 from nav_msgs.msg import Path as PathMsg
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import LaserScan, PointCloud2, PointField
 from tf2_msgs.msg import TFMessage
 
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -39,6 +39,7 @@ class Player:
         self.scan = n.create_publisher(LaserScan, "scan", RELIABLE)
         self.tf = n.create_publisher(TFMessage, "/tf", RELIABLE)
         self.tf_static = n.create_publisher(TFMessage, "/tf_static", LATCHED)
+        self.cloud = n.create_publisher(PointCloud2, "points", RELIABLE)
         self.path = n.create_publisher(PathMsg, "trajectory", QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE))
         self.maps: list[tuple[float, OccupancyGrid]] = []
         self.lock = threading.Lock()
@@ -87,15 +88,30 @@ class Player:
             time.sleep(0.02)
         raise AssertionError("the node's subscriptions did not match within 20 s")
 
-    def replay(self, scans, stamps, rate_hz=500.0):
-        """map -> base_link on /tf and a LaserScan in 'laser' at every scan's stamp."""
+    def point_cloud(self, ns, points, frame="laser"):
+        """A PointCloud2 of (k, 3) float32 points x, y, z."""
+        m = PointCloud2()
+        m.header.frame_id, m.header.stamp = frame, stamp_of(ns)
+        m.height, m.width, m.is_bigendian, m.is_dense = 1, len(points), False, True
+        m.fields = [PointField(name=n, offset=4 * j, datatype=PointField.FLOAT32, count=1) for j, n in enumerate("xyz")]
+        m.point_step, m.row_step = 12, 12 * len(points)
+        m.data = np.ascontiguousarray(points, dtype="<f4").tobytes()
+        return m
+
+    def replay(self, scans, stamps, rate_hz=500.0, points_of=None):
+        """map -> base_link on /tf and a LaserScan in 'laser' at every scan's stamp; with points_of,
+        a PointCloud2 of points_of(ranges, first_angle, angle_step) on 'points' instead."""
         self.wait_matched()
         self.tf_static.publish(TFMessage(transforms=[self.transform("base_link", "laser", 0, (0, 0, 0))]))
         period, start = 1.0 / rate_hz, time.monotonic()
         for s in range(len(scans)):
             ns = int(stamps[s])
             self.tf.publish(TFMessage(transforms=[self.transform("map", "base_link", ns, scans.poses[s])]))
-            self.scan.publish(self.laser_scan(ns, scans.ranges_of(s), scans.first_angle[s], scans.angle_step[s]))
+            r, a0, da = scans.ranges_of(s), float(scans.first_angle[s]), float(scans.angle_step[s])
+            if points_of is None:
+                self.scan.publish(self.laser_scan(ns, r, a0, da))
+            else:
+                self.cloud.publish(self.point_cloud(ns, points_of(r, a0, da).reshape(-1, 3)))
             time.sleep(max(0.0, start + (s + 1) * period - time.monotonic()))  # the rate, not a gap
 
     def publish_path(self, stamps, poses, frame="map"):
@@ -125,6 +141,15 @@ class Player:
             return future.result()
         finally:
             self.node.destroy_client(client)
+
+    def wait_quiet(self, quiet_s: float = 1.0, limit_s: float = 300.0) -> None:
+        """Until no /map has come for quiet_s: the node has mapped what it was sent and settled,
+        so the next /map answers what is sent next."""
+        end, n, since = time.monotonic() + limit_s, self.map_count(), time.monotonic()
+        while time.monotonic() - since < quiet_s and time.monotonic() < end:
+            time.sleep(0.05)
+            if self.map_count() != n:
+                n, since = self.map_count(), time.monotonic()
 
     def wait_map(self, after: int, match=None, timeout=30.0):
         """The first /map received after the after-th that satisfies match (or any)."""

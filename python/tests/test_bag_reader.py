@@ -470,7 +470,7 @@ def test_named_topic_missing_or_not_a_scan(tmp_path):
     p = make(tmp_path, "rosbag1", tf_poses=base_poses(5), static_mount=(0, 0, 0))
     with pytest.raises(vb.BagError) as e:
         vb.read_bag(p, scan_topic="/front_scan")
-    assert "'/front_scan'" in str(e.value) and "LaserScan topics: '/scan'" in str(e.value)
+    assert "'/front_scan'" in str(e.value) and "scan topics: '/scan'" in str(e.value)
     assert e.value.topic == "/front_scan"
     with pytest.raises(vb.BagError) as e:
         vb.read_bag(p, scan_topic="/tf")
@@ -490,11 +490,11 @@ def test_no_scan_topic_and_empty_bag(tmp_path, fmt):
     p = make(tmp_path, fmt, "tfonly", scan_topic=None, tf_poses=base_poses(5))
     with pytest.raises(vb.BagError) as e:
         vb.read_bag(p)
-    assert "no sensor_msgs/LaserScan or MultiEchoLaserScan topic (topics: '/tf' (tf2_msgs/TFMessage))" in str(e.value)
+    assert "no sensor_msgs/LaserScan, MultiEchoLaserScan or PointCloud2 topic (topics: '/tf' (tf2_msgs/TFMessage))" in str(e.value)
     q = make(tmp_path, fmt, "empty", stamps=[], ranges=[], scan_topic=None)
     with pytest.raises(vb.BagError) as e:
         vb.read_bag(q)
-    assert q.name in str(e.value) and "no sensor_msgs/LaserScan or MultiEchoLaserScan topic" in str(e.value)
+    assert q.name in str(e.value) and "no sensor_msgs/LaserScan, MultiEchoLaserScan or PointCloud2 topic" in str(e.value)
 
 
 def test_not_a_bag(tmp_path):
@@ -807,15 +807,15 @@ def test_multi_echo_scans(tmp_path, fmt):
 def test_a_bag_whose_only_sensor_is_not_a_laser(tmp_path):
     rec = bm.Recording("mcap")
     T = rec.messages.T
-    cloud = T["sensor_msgs/msg/PointCloud2"](
-        header=rec.messages.header(T0, "velodyne"), height=1, width=0, fields=[], is_bigendian=False,
-        point_step=16, row_step=0, data=np.zeros(0, dtype=np.uint8), is_dense=True)
-    rec.add(T0, "/points", "sensor_msgs/msg/PointCloud2", cloud)
-    rec.tf(T0, "map", "velodyne", 0.0, 0.0, 0.0, static=True)
+    image = T["sensor_msgs/msg/Image"](
+        header=rec.messages.header(T0, "camera"), height=0, width=0, encoding="16UC1", is_bigendian=0, step=0,
+        data=np.zeros(0, dtype=np.uint8))
+    rec.add(T0, "/depth", "sensor_msgs/msg/Image", image)
+    rec.tf(T0, "map", "camera", 0.0, 0.0, 0.0, static=True)
     p = rec.write(bm.bag_path(tmp_path, "mcap"))
     with pytest.raises(vb.BagError) as e:
         vb.read_bag(p)
     text = str(e.value)
-    assert p.name in text and "'/points' (sensor_msgs/PointCloud2)" in text and "pointcloud_to_laserscan" in text
-    with pytest.raises(vb.BagError, match="pointcloud_to_laserscan"):
-        vb.read_bag(p, scan_topic="/points")
+    assert p.name in text and "'/depth' (sensor_msgs/Image)" in text and "depthimage_to_laserscan" in text
+    with pytest.raises(vb.BagError, match="depthimage_to_laserscan"):
+        vb.read_bag(p, scan_topic="/depth")

@@ -164,7 +164,7 @@ def test_the_docs_table_is_the_nodes_schema():
     assert list(rows) == [p.name for p in NODE_PARAMETERS]
     for p in NODE_PARAMETERS:
         default, meaning = rows[p.name]
-        want = "[" + ", ".join(p.default) + "]" if isinstance(p.default, list) else \
+        want = "[" + ", ".join(str(v) for v in p.default) + "]" if isinstance(p.default, list) else \
             ("''" if p.default == "" else str(p.default))
         assert default == want, p.name
         assert meaning == p.meaning + (" (may change while running)" if p.dynamic else ""), p.name

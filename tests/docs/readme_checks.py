@@ -248,7 +248,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "python", fixture="logs", outputs=["intel.png"]),
     },
     "docs/DESIGN.md": {
-        "text: python/ (vasco_gpu, nanobind) log2map mapdiff mapconvert": Check(
+        "text: vasco_gpu.ros (ROS 2 node: LiveMap over Mapper; bags' scan a": Check(
             "skip", reason="a diagram of the libraries (DESIGN §1), not a command"),
     },
     "docs/backends-and-accuracy.md": {
@@ -263,6 +263,9 @@ CHECKS: Dict[str, Dict[str, Check]] = {
                    ("Makefile", ["golden_check --golden $(GOLDEN_DIR)"])]),
     },
     "docs/bags-and-poses.md": {
+        "sh: bag2map --z-band 0.25,1.0 cloud.mcap cloud.map.gz": Check(
+            "covered-by", files=[("python/tests/test_bag_clouds.py", [
+                'run_script("bag2map", "--z-band", "0.25,1.0", str(cloud_bag), str(out))  # docs/bags-and-poses.md'])]),
         "sh: log2map --poses optimized.g2o intel.log.gz after.map.gz": Check(
             "run", fixture="poses", outputs=["after.map.gz"]),
         "sh: bag2map run.mcap map.pgm map.map.gz": Check(

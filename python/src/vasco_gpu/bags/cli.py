@@ -40,13 +40,13 @@ class BagOption:
 
 # bag2map's options beyond log2map's, and bag2carmen's bag options.
 BAG_OPTIONS = (
-    BagOption("scan-topic", "scan_topic", "a sensor_msgs/LaserScan or MultiEchoLaserScan topic (default: the "
-              "only one); repeat it (or separate names by commas) to map several lasers together, each "
+    BagOption("scan-topic", "scan_topic", "a sensor_msgs/LaserScan, MultiEchoLaserScan or PointCloud2 topic "
+              "(default: the only one); repeat it (or separate names by commas) to map several lasers together, each "
               "at its own mount, their scans in stamp order", "TOPIC"),
     BagOption("fixed-frame", "fixed_frame", "the frame the map is in: the root of the tf chain to each scan "
               "(default: map), or the frame of --pose-topic's poses", "FRAME"),
-    BagOption("base-frame", "base_frame", "the robot's frame for --pose-topic (default: the odometry's child "
-              "frame, else base_link)", "FRAME"),
+    BagOption("base-frame", "base_frame", "the robot's frame for --pose-topic and a point cloud's height band "
+              "(default: the odometry's child frame, else base_link)", "FRAME"),
     BagOption("pose-topic", "pose_topic", "the robot's poses from a nav_msgs/Odometry, geometry_msgs/PoseStamped "
               "or PoseWithCovarianceStamped topic instead of /tf (the laser mount from /tf_static or "
               "--laser-mount)", "TOPIC"),
@@ -55,6 +55,12 @@ BAG_OPTIONS = (
               default="skip"),
     BagOption("echo", "echo", "the echo a MultiEchoLaserScan beam gives: first, last (default) or strongest "
               "(the largest intensity)", "first|last|strongest", default="last"),
+    BagOption("z-band", "z_band", "point clouds: the heights kept, in metres in the base frame (--base-frame), "
+              "MIN,MAX (default 0.2,1.8: the floor and the ceiling out)", "MIN,MAX"),
+    BagOption("cloud-angle-step", "cloud_angle_step", "point clouds: the beams' angle step in degrees, the "
+              "nearest point of the band per step (default 0.25)", "DEGREES"),
+    BagOption("cloud-range-max", "cloud_range_max", "point clouds: points farther than this (m) are no return "
+              "(default 50)", "M"),
     BagOption("stamp", "stamp", "a scan's time: its header stamp (default) or the time the bag received it "
               "(receive: for a laser driver whose clock is wrong)", "header|receive", default="header"),
 )

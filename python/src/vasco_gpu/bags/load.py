@@ -39,7 +39,7 @@ def edge_warning(b) -> str | None:
 
 def read_for_engine(path, *, scan_topic=None, fixed_frame=None, base_frame=None, pose_topic=None, laser_mount=None,
                     no_return="skip", need_poses=True, skip_unposed=False, progress=None, echo="last",
-                    stamp="header"):
+                    stamp="header", z_band=None, cloud_angle_step=None, cloud_range_max=None):
     """The bag's scans as the engine takes them: {'scans', 'stamps', 'mounts', 'unposed', 'edges',
     'warnings', 'bag'}. The scans before the first and after the last pose of their chain are
     left out and counted ('unposed', and 'edges': before, after), with one warning; a scan in a
@@ -50,7 +50,8 @@ def read_for_engine(path, *, scan_topic=None, fixed_frame=None, base_frame=None,
                         fixed_frame=fixed_frame if fixed_frame is not None else ("map" if pose_topic is None else None),
                         base_frame=base_frame, pose_topic=pose_topic, laser_mount=laser_mount,
                         pose_source="auto" if need_poses else "none", no_return=no_return, progress=progress,
-                        outside_span=outside, echo=echo, stamp=stamp)
+                        outside_span=outside, echo=echo, stamp=stamp, z_band=z_band,
+                        cloud_angle_step=cloud_angle_step, cloud_range_max=cloud_range_max)
     keep = np.isfinite(b.poses).all(axis=1) if need_poses else np.ones(len(b.stamps), dtype=bool)
     if need_poses and not keep.any():
         raise BagError(os.fspath(path), _none_posed_text(b, len(keep), stamp), topic=b.topic)
@@ -83,11 +84,14 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
              param_file: str | os.PathLike | None = None, robot: str = "",
              overrides: dict[str, float | int] | None = None,
              progress: Callable[[int, int], Any] | None = None, echo: str = "last", stamp: str = "header",
-             **pose_keywords) -> _core.Log:
+             z_band: tuple[float, float] | None = None, cloud_angle_step: float | None = None,
+             cloud_range_max: float | None = None, **pose_keywords) -> _core.Log:
     """Reads a ROS 1 ``.bag``, a ROS 2 bag (sqlite3 or MCAP) or an ``.mcap`` into a :class:`Log`.
 
     Scans are the ``sensor_msgs/LaserScan`` (or ``MultiEchoLaserScan``: ``echo`` ``first``,
-    ``last`` or ``strongest``) messages of ``scan_topic`` (default: the only such topic; a list
+    ``last`` or ``strongest``; or ``PointCloud2``: the points in ``z_band`` (min, max) metres of
+    the base frame, default (0.2, 1.8), nearest point per ``cloud_angle_step`` degrees, default
+    0.25, up to ``cloud_range_max`` m, default 50) messages of ``scan_topic`` (default: the only such topic; a list
     of topics maps several lasers together, each in its own frame, merged in stamp order),
     stamped by their header (``stamp='receive'``: by the time the bag received them), ranges mapped to CARMEN's semantics by REP 117 (see docs/bags-and-poses.md, "REP 117 ranges, in CARMEN's terms";
     ``no_return='free'`` makes +inf clear free space). The laser pose at each scan's stamp comes
@@ -112,7 +116,8 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     options = dict(scan_topic=scan_topic, fixed_frame=fixed_frame, base_frame=base_frame, pose_topic=pose_topic,
                    laser_mount=laser_mount, no_return=no_return, need_poses=need_poses,
                    skip_unposed=bool(pose_keywords.pop("skip_unposed", False)) if need_poses else False,
-                   progress=progress, echo=echo, stamp=stamp)
+                   progress=progress, echo=echo, stamp=stamp, z_band=z_band, cloud_angle_step=cloud_angle_step,
+                   cloud_range_max=cloud_range_max)
     if len(sessions) > 1 and pose_keywords.get("poses") is not None:
         raise _core_usage_error("poses= applies to one input: write each session's poses into it first")
     d = None

@@ -11,6 +11,7 @@ Importing this module raises ImportError when rosbags is not installed.
 
 from __future__ import annotations
 
+import math
 import os
 from typing import Callable
 
@@ -18,12 +19,14 @@ import numpy as np
 
 from .errors import BagError
 from .geometry import check_mount
-from .header import stamp_seconds
+from .cloud import CLOUD_DEFAULTS, check_cloud_options
+from .header import stamp_seconds, stamp_text
 from .poses import PoseSeries, poses_for
 from .scans import ECHO_MODES, NO_RETURN_MODES, STAMP_MODES, BagScans, ScanAccumulator
 from .storage import open_bag, read_messages
 from .tf import TfBuffer
-from .topics import MULTI_ECHO, check_pose_topic, choose_pose_source, norm_type, pick_scan_topics, tf_topics
+from .topics import (MULTI_ECHO, POINT_CLOUD2, check_pose_topic, choose_pose_source, norm_type, pick_scan_topics,
+                     tf_topics)
 
 __all__ = ["read_bag"]
 
@@ -77,7 +80,8 @@ def _check_arguments(pose_source, no_return, pose_topic, outside_span="error", e
 
 def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_topic=None,
              laser_mount=None, pose_source="auto", no_return="skip", progress=None,
-             outside_span="error", echo="last", stamp="header") -> BagScans:
+             outside_span="error", echo="last", stamp="header", z_band=None, cloud_angle_step=None,
+             cloud_range_max=None) -> BagScans:
     """The scans of the bag's laser scan topics at path, with the laser pose at each stamp.
 
     scan_topic: the sensor_msgs/LaserScan or MultiEchoLaserScan topic; None takes the only one;
@@ -98,7 +102,10 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     counted in ``edges``, while a gap stays a BagError ("edges"). echo: the echo a
     MultiEchoLaserScan beam gives, "first", "last" (default) or "strongest". stamp: a scan's
     stamp is its "header" stamp (default) or the time the bag received it ("receive", for a
-    driver whose clock is wrong); the poses are looked up at it.
+    driver whose clock is wrong); the poses are looked up at it. A sensor_msgs/PointCloud2 topic
+    is read as a scan (:mod:`vasco_gpu.bags.cloud`): z_band (min, max) in metres in the base
+    frame, cloud_angle_step in degrees (default 0.25), cloud_range_max in metres (default 50); each
+    may be given as text too (bag2map's options: "0.2,1.8").
 
     Raises BagError for anything about the bag, ValueError for arguments that are wrong in
     themselves.
@@ -115,13 +122,16 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
             if topics[name].msgcount == 0:
                 raise BagError(path, f"scan topic {name!r} has no messages", topic=name)
         source = choose_pose_source(path, topics, pose_source, pose_topic)
-        accs = [ScanAccumulator(path, name, no_return, norm_type(topics[name].msgtype) == MULTI_ECHO, echo, stamp)
-                for name in names]
-        handlers = {acc.topic: acc.add for acc in accs}
         tf = None
         if tf_topics(topics):
             tf = TfBuffer(path, stamp_name="scan stamp", max_gap=TF_MAX_GAP,
                           outside_hint="skip_unposed / --skip-unposed leaves such scans out")
+        cloud = cloud_options(path, tf, base_frame, z_band, cloud_angle_step, cloud_range_max)
+        accs = [ScanAccumulator(path, name, no_return, norm_type(topics[name].msgtype) == MULTI_ECHO, echo, stamp,
+                                cloud if norm_type(topics[name].msgtype) == POINT_CLOUD2 else None)
+                for name in names]
+        handlers = {acc.topic: acc.add for acc in accs}
+        if tf is not None:
             for name in tf_topics(topics):
                 static = name.rstrip("/").endswith("tf_static")
                 if static or source == "tf":  # /tf only when it gives the poses
@@ -149,6 +159,45 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
                 e.args = (e.args[0] + f" (scans of {acc.topic!r})",)
             raise
     return _merge(path, parts)
+
+
+def _numbers(value, what: str) -> list[float]:
+    """A number, or text of numbers separated by commas, as floats; ValueError naming what."""
+    try:
+        return [float(v) for v in value.split(",")] if isinstance(value, str) else [float(value)]
+    except ValueError:
+        raise ValueError(f"{what}: {value!r} is not a number") from None
+
+
+def cloud_options(path, tf, base_frame, z_band, angle_step, range_max) -> dict:
+    """read_cloud's keywords for a bag: the band, the bins, the range, and mount_of(frame, ns),
+    the cloud frame's transform in the base frame from what /tf_static has given by then."""
+    if isinstance(z_band, str):
+        z_band = _numbers(z_band, "z_band (--z-band MIN,MAX)")
+    options = {"z_band": tuple(float(v) for v in (CLOUD_DEFAULTS["z_band"] if z_band is None else z_band)),
+               "angle_step": CLOUD_DEFAULTS["angle_step"] if angle_step is None else
+               math.radians(_numbers(angle_step, "cloud_angle_step (--cloud-angle-step DEGREES)")[0]),
+               "range_max": CLOUD_DEFAULTS["range_max"] if range_max is None else
+               _numbers(range_max, "cloud_range_max (--cloud-range-max M)")[0]}
+    check_cloud_options(**options)
+    base = base_frame or "base_link"
+
+    def mount_of(frame: str, ns: int):
+        if frame == base:
+            return None
+        try:
+            if tf is None:
+                raise BagError(path, "the bag has no /tf_static")
+            t, q = tf.lookup(base, frame, np.zeros(1, dtype=np.int64), static_only=True)
+        except BagError as e:
+            raise BagError(path, f"the point clouds' height band is in the base frame {base!r}: no static "
+                                 f"chain {base} -> {frame!r} on /tf_static before the first cloud (stamp "
+                                 f"{stamp_text(ns)}): {e.message}; pass --base-frame {frame} (base_frame="
+                                 f"{frame!r}) to take heights in the cloud's own frame", stamp=stamp_seconds(ns)) from None
+        return t[0], q[0]
+
+    options["mount_of"] = mount_of
+    return options
 
 
 def _merge(path, parts) -> BagScans:

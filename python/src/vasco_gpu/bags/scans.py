@@ -187,12 +187,17 @@ def read_laser(msg, *, no_return: str, counts: dict, fail, multi_echo: bool = Fa
 
 
 class ScanAccumulator:
-    """Collects the scans of the chosen topic in bag order, applying the range policy."""
+    """Collects the scans of the chosen topic in bag order, applying the range policy. cloud:
+    the topic is a PointCloud2's, read by read_cloud with these keywords (z_band, angle_step,
+    range_max) and ``mount_of(frame, ns)``, which gives the cloud frame's static transform in
+    the base frame at the first cloud."""
 
     def __init__(self, path, topic: str, no_return: str, multi_echo: bool = False, echo: str = "last",
-                 stamp: str = "header"):
+                 stamp: str = "header", cloud: dict | None = None):
         self.path, self.topic, self.no_return = path, topic, no_return
         self.multi_echo, self.echo, self.receive = multi_echo, echo, stamp == "receive"
+        self.cloud = dict(cloud) if cloud is not None else None
+        self._cloud_mount = None
         self.frame_id: str | None = None
         self.ns = array("q")
         self.first_angle = array("d")
@@ -216,8 +221,18 @@ class ScanAccumulator:
         elif frame != self.frame_id:
             raise self._error(ns, f"is in frame {frame!r}, the first scan in {self.frame_id!r}; all scans "
                                   "of a topic must share their frame")
-        scan = read_laser(msg, no_return=self.no_return, counts=self.counts, multi_echo=self.multi_echo,
-                          echo=self.echo, fail=lambda what: self._error(ns, what))
+        fail = lambda what: self._error(ns, what)  # noqa: E731
+        if self.cloud is not None:
+            from .cloud import read_cloud
+
+            if not self.ns:  # the first cloud: its frame's mount, for the height band
+                self._cloud_mount = self.cloud["mount_of"](frame, ns)
+            options = {k: v for k, v in self.cloud.items() if k != "mount_of"}
+            scan = read_cloud(msg, no_return=self.no_return, counts=self.counts, fail=fail,
+                              mount=self._cloud_mount, **options)
+        else:
+            scan = read_laser(msg, no_return=self.no_return, counts=self.counts, multi_echo=self.multi_echo,
+                              echo=self.echo, fail=fail)
         self.ns.append(ns)
         self.first_angle.append(scan.first_angle)
         self.angle_step.append(scan.angle_step)

@@ -1,4 +1,5 @@
-"""The bag's topics: message type names, the scan topics to read (LaserScan, MultiEchoLaserScan;
+"""The bag's topics: message type names, the scan topics to read (LaserScan, MultiEchoLaserScan,
+PointCloud2;
 a clear word on sensors that are neither), the tf topics, the pose source (tf or a pose topic)
 and the pose topic's type."""
 
@@ -8,14 +9,14 @@ from .errors import BagError
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
 MULTI_ECHO = "sensor_msgs/msg/MultiEchoLaserScan"
-SCAN_TYPES = (LASER_SCAN, MULTI_ECHO)
+POINT_CLOUD2 = "sensor_msgs/msg/PointCloud2"
+SCAN_TYPES = (LASER_SCAN, MULTI_ECHO, POINT_CLOUD2)
 # Sensors a bag may hold that are not laser scans: why each is not mapped, and what turns it into
 # a LaserScan.
-_CLOUD = "a 3-D point cloud; pointcloud_to_laserscan turns it into a LaserScan"
 _DEPTH = "an image; depthimage_to_laserscan turns a depth image into a LaserScan"
 UNSUPPORTED_SENSORS = {
-    "sensor_msgs/msg/PointCloud2": _CLOUD,
-    "sensor_msgs/msg/PointCloud": _CLOUD,
+    "sensor_msgs/msg/PointCloud": "a point cloud of the old type (sensor_msgs/PointCloud): "
+                                  "point_cloud_converter turns it into a PointCloud2",
     "sensor_msgs/msg/Image": _DEPTH,
     "sensor_msgs/msg/CompressedImage": _DEPTH,
     "sensor_msgs/msg/Range": "one range a message (a sonar or infrared ranger), not a scan",
@@ -88,17 +89,17 @@ def _unsupported_text(name: str, msgtype: str | None) -> str:
 
 def _no_scan_text(topics) -> str:
     """Why a bag has nothing to map: its topics, and its sensors that are not laser scans."""
-    text = f"no sensor_msgs/LaserScan or MultiEchoLaserScan topic (topics: {topic_listing(topics)})"
+    text = f"no sensor_msgs/LaserScan, MultiEchoLaserScan or PointCloud2 topic (topics: {topic_listing(topics)})"
     sensors = [name for name, info in sorted(topics.items()) if norm_type(info.msgtype) in UNSUPPORTED_SENSORS]
     if sensors:
         listed = "; ".join(_unsupported_text(name, topics[name].msgtype) for name in sensors)
-        text += f"; its sensor topics are not laser scans, which are all that is mapped: {listed}"
+        text += f"; its sensor topics are neither laser scans nor point clouds, which are all that is mapped: {listed}"
     return text
 
 
 def pick_scan_topics(path, topics, scan_topic) -> list[str]:
-    """The scan topics to read: the named ones (each a LaserScan or MultiEchoLaserScan), or the
-    only one. scan_topic as :func:`scan_topic_names` takes it."""
+    """The scan topics to read: the named ones (each a LaserScan, MultiEchoLaserScan or
+    PointCloud2), or the only one. scan_topic as :func:`scan_topic_names` takes it."""
     scans = topics_of_type(topics, SCAN_TYPES)
     listing = ", ".join(repr(t) for t in scans) or "none"
     names = scan_topic_names(scan_topic)
@@ -113,12 +114,13 @@ def pick_scan_topics(path, topics, scan_topic) -> list[str]:
     for wanted in names:
         name = resolve_topic(wanted, topics)
         if name is None:
-            raise BagError(path, f"no topic {wanted!r} in the bag (LaserScan topics: {listing})", topic=wanted)
+            raise BagError(path, f"no topic {wanted!r} in the bag (scan topics: {listing})", topic=wanted)
         if name not in scans:
             kind = short_type(topics[name].msgtype)
             hint = UNSUPPORTED_SENSORS.get(norm_type(topics[name].msgtype) or "")
-            raise BagError(path, f"topic {name!r} is {kind}, not sensor_msgs/LaserScan or MultiEchoLaserScan"
-                                 f"{' (' + hint + ')' if hint else ''} (LaserScan topics: {listing})", topic=name)
+            raise BagError(path, f"topic {name!r} is {kind}, not sensor_msgs/LaserScan, MultiEchoLaserScan or "
+                                 "PointCloud2"
+                                 f"{' (' + hint + ')' if hint else ''} (scan topics: {listing})", topic=name)
         if name not in chosen:
             chosen.append(name)
     return chosen

@@ -5,6 +5,7 @@ the tf buffer the bag reader's; this file only wires them to rclpy."""
 
 from __future__ import annotations
 
+import math
 import time
 from array import array
 
@@ -14,7 +15,7 @@ from nav_msgs.msg import MapMetaData, OccupancyGrid, Path
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
-from sensor_msgs.msg import LaserScan, MultiEchoLaserScan
+from sensor_msgs.msg import LaserScan, MultiEchoLaserScan, PointCloud2
 from std_srvs.srv import SetBool, Trigger
 
 from .. import _core
@@ -22,6 +23,7 @@ from ..bags.errors import BagError
 from ..bags.geometry import QUAT_TOL, planar, yaw
 from ..bags.header import frame_name, stamp_ns, stamp_text
 from ..bags.poses import static_mount
+from ..bags.cloud import read_cloud
 from ..bags.scans import COUNT_KEYS, read_laser
 from ..bags.tf import TfBuffer
 from .grid import fill_grid
@@ -36,12 +38,13 @@ NODE_NAME = "vasco_mapper"
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL,
                      history=HistoryPolicy.KEEP_LAST)
 REPLAY = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
-TF = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
+# tf's queue and history are deeper than tf2's (100 messages, 10 s): a node busy for a moment, or
+# a replay faster than real time, must find the transforms of the scans still queued for it.
+TF = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
 TF_STATIC = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL, history=HistoryPolicy.KEEP_LAST)
 PATH = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
-# tf history kept: tf2's buffer default (10 s), which covers every scan's wait.
-TF_KEEP_S = 10.0
+TF_KEEP_S = 60.0  # seconds of stamps each /tf link keeps
 
 
 class Refused(Exception):
@@ -55,11 +58,12 @@ class Refused(Exception):
 class _Pending:
     """A scan waiting for its transform until the deadline (monotonic seconds)."""
 
-    __slots__ = ("topic", "ns", "reading", "deadline", "received")
+    __slots__ = ("topic", "ns", "reading", "deadline", "received", "cloud")
 
-    def __init__(self, topic, ns, reading, deadline, received):
+    def __init__(self, topic, ns, reading, deadline, received, cloud=None):
         self.topic, self.ns, self.reading, self.deadline = topic, ns, reading, deadline
         self.received = received  # perf_counter() when the callback took it
+        self.cloud = cloud  # a PointCloud2 waiting for its mount (reading is None until read)
 
 
 class MappingNode(Node):
@@ -142,6 +146,8 @@ class MappingNode(Node):
             self.create_subscription(LaserScan, topic, lambda m, t=topic: self._on_scan(m, t, False), qos)
         for topic in s.multi_echo_topics:
             self.create_subscription(MultiEchoLaserScan, topic, lambda m, t=topic: self._on_scan(m, t, True), qos)
+        for topic in s.cloud_topics:
+            self.create_subscription(PointCloud2, topic, lambda m, t=topic: self._on_cloud(m, t), qos)
         tf_type = tf_message_type()
         self.create_subscription(tf_type, "/tf", lambda m: self._on_tf(m, False), TF)
         self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
@@ -183,6 +189,42 @@ class MappingNode(Node):
                                      time.perf_counter()))
         self._pose_pending()
 
+    def _on_cloud(self, msg, topic: str) -> None:
+        """A PointCloud2: read once its frame's mount is known (the height band is in base_frame)."""
+        if self.paused:
+            self.refused[(topic, "paused")] = self.refused.get((topic, "paused"), 0) + 1
+            return
+        self.pending.append(_Pending(topic, stamp_ns(msg.header.stamp), None,
+                                     time.monotonic() + self.settings.transform_timeout, time.perf_counter(), msg))
+        self._pose_pending()
+
+    def _read_cloud(self, p: _Pending) -> bool:
+        """Turns a waiting cloud into its reading; False while its mount is not known yet.
+        Raises Refused for a cloud that cannot be read."""
+        s, frame = self.settings, frame_name(p.cloud.header.frame_id)
+        mount = None
+        if frame != s.base_frame:
+            try:
+                t, q = self.tf.lookup(s.base_frame, frame, [0], static_only=True)
+            except BagError as e:
+                if time.monotonic() < p.deadline:
+                    return False
+                raise Refused(f"{self._where(p)} not mapped: its height band is in {s.base_frame!r}, and "
+                              f"there is no /tf_static chain {s.base_frame} -> {frame!r} within "
+                              f"transform_timeout: {e.message}", "clouds without a mount") from None
+            mount = (t[0], q[0])
+        where = self._where(p)
+        p.reading = read_cloud(p.cloud, no_return=s.no_return, counts=self.range_counts,
+                               fail=lambda what: Refused(f"{where} {what}; not mapped", "bad clouds"),
+                               z_band=tuple(float(v) for v in s.z_band),
+                               angle_step=math.radians(s.cloud_angle_step), range_max=float(s.cloud_range_max),
+                               mount=mount)
+        p.cloud = None
+        return True
+
+    def _where(self, p: _Pending) -> str:
+        return f"{self.resolve_topic_name(p.topic)}: {'cloud' if p.cloud is not None else 'scan'} at stamp {stamp_text(p.ns)}"
+
     def _mount(self, frame: str):
         """The laser frame in base_frame from /tf_static (cached until /tf_static changes)."""
         if frame not in self._mounts:
@@ -198,6 +240,14 @@ class MappingNode(Node):
             return
         now, keep = time.monotonic(), []
         for p in self.pending:
+            if p.cloud is not None:
+                try:
+                    if not self._read_cloud(p):
+                        keep.append(p)
+                        continue
+                except Refused as e:
+                    self._refuse(p.topic, e.cause, str(e))
+                    continue
             try:
                 t, q = self.tf.lookup(self.settings.map_frame, p.reading.frame, [p.ns])
                 pose = planar(None, t, q, f"the laser frame {p.reading.frame!r} in {self.settings.map_frame!r}")[0]

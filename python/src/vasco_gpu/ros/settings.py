@@ -14,6 +14,7 @@ import os
 from dataclasses import dataclass, field
 
 from .. import _core
+from ..bags.cloud import check_cloud_options
 
 __all__ = ["NODE_PARAMETERS", "NodeParameter", "Settings", "SettingsError", "mapper_parameter_names"]
 
@@ -74,6 +75,11 @@ def _string(name, v):
         raise SettingsError(f"{name}: {v!r} must be a string")
 
 
+def _band(name, v):
+    if not (isinstance(v, (list, tuple)) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v)):
+        raise SettingsError(f"{name}: {v!r} must be two heights [min, max]")
+
+
 def _paths(name, v):
     if not isinstance(v, (list, tuple)) or not all(isinstance(t, str) and t for t in v):
         raise SettingsError(f"{name}: {v!r} must be a list of file names")
@@ -84,6 +90,10 @@ NODE_PARAMETERS = (
     NodeParameter("scan_topics", ["scan"], "sensor_msgs/LaserScan topics"),
     NodeParameter("multi_echo_topics", [], "sensor_msgs/MultiEchoLaserScan topics (one echo a beam: echo)"),
     NodeParameter("echo", "last", "the echo a MultiEchoLaserScan beam gives: first, last or strongest"),
+    NodeParameter("cloud_topics", [], "sensor_msgs/PointCloud2 topics (3-D lidar: the points in z_band as beams)"),
+    NodeParameter("z_band", [0.2, 1.8], "clouds: the heights kept, min and max, in metres in base_frame"),
+    NodeParameter("cloud_angle_step", 0.25, "clouds: the beams' angle step in degrees (nearest point per step)"),
+    NodeParameter("cloud_range_max", 50.0, "clouds: points farther than this (m) are no return"),
     NodeParameter("scan_qos", "sensor_data", "the scans' QoS: sensor_data (best effort, depth 5) or "
                                              "reliable (reliable, depth 1000: a replay loses no scan)"),
     NodeParameter("no_return", "skip", "+inf ranges (REP 117 no return): skip, or free (clears up to "
@@ -111,6 +121,7 @@ NODE_PARAMETERS = (
 
 _CHECKS = {
     "scan_topics": _topics, "multi_echo_topics": _topics, "echo": _choice("first", "last", "strongest"),
+    "cloud_topics": _topics, "z_band": _band, "cloud_angle_step": _positive, "cloud_range_max": _positive,
     "scan_qos": _choice("sensor_data", "reliable"), "no_return": _choice("skip", "free"),
     "map_frame": _frame, "base_frame": _frame, "path_topic": _string,
     "transform_timeout": _positive, "pose_max_gap": _positive, "map_update_interval": _positive,
@@ -154,8 +165,15 @@ class Settings:
         if not node["free_thresh"] < node["occupied_thresh"]:
             raise SettingsError(f"free_thresh {node['free_thresh']} must be below occupied_thresh "
                                 f"{node['occupied_thresh']}")
-        if not node["scan_topics"] and not node["multi_echo_topics"]:
-            raise SettingsError("scan_topics and multi_echo_topics are both empty: no scans to map")
+        if not node["scan_topics"] and not node["multi_echo_topics"] and not node["cloud_topics"]:
+            raise SettingsError("scan_topics, multi_echo_topics and cloud_topics are all empty: nothing to map")
+        try:
+            check_cloud_options(tuple(float(v) for v in node["z_band"]), math.radians(node["cloud_angle_step"]),
+                                float(node["cloud_range_max"]))
+        except ValueError as e:
+            raise SettingsError(str(e).replace("z_band (--z-band MIN,MAX)", "z_band").replace(
+                "cloud_angle_step (--cloud-angle-step)", "cloud_angle_step").replace(
+                "cloud_range_max (--cloud-range-max)", "cloud_range_max")) from None
         return cls(node, _mapper_params(node, mapper_values), dict(mapper_values))
 
 

@@ -1,0 +1,103 @@
+"""sensor_msgs/PointCloud2 as a planar scan: the 3-D lidar's points in a height band become
+beams from the sensor's origin, one per angle bin, as pointcloud_to_laserscan makes them. The
+one adapter of bags and the live node (beside read_laser for LaserScans).
+
+What a cloud's beam means
+-------------------------
+A bin's beam is the nearest point of the band in it (the range in the sensor's xy plane): a hit,
+and free space up to it, as a LaserScan beam. A bin with no point in the band is "no return"
+(+inf), which ``no_return`` decides as for LaserScans: skipped (the default), or free up to
+``cloud_range_max`` — only for a sensor that truly sees nothing there (open space), never for
+one whose returns the band or the range left out. Points beyond ``cloud_range_max`` count as no
+return; NaN points are skipped. Bin k is centred on ``-pi + k * angle_step`` (a point exactly on
+a centre stays in its bin whatever the rounding), so a cloud made of a LaserScan's beam ends at
+the same angles gives that LaserScan back.
+
+The band is in the base frame (the floor and the ceiling out): each point goes through the
+sensor's mount (its static transform in the base frame) before its height is compared; the
+beams are then taken in the sensor's own frame, whose planar pose the scan gets.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .header import frame_name
+from .scans import LaserReading, apply_rep117
+
+__all__ = ["CLOUD_DEFAULTS", "check_cloud_options", "cloud_points_xyz", "read_cloud"]
+
+#: z band (m, in the base frame), angle step (rad), farthest point used (m): the defaults.
+CLOUD_DEFAULTS = {"z_band": (0.2, 1.8), "angle_step": math.radians(0.25), "range_max": 50.0}
+
+_FLOAT32, _FLOAT64 = 7, 8  # sensor_msgs/PointField datatypes
+
+
+def check_cloud_options(z_band, angle_step, range_max) -> None:
+    """ValueError naming the option for a band, step or range no cloud could make sense of."""
+    if len(z_band) != 2 or not all(math.isfinite(v) for v in z_band) or not z_band[0] < z_band[1]:
+        raise ValueError(f"z_band (--z-band MIN,MAX) must be two finite heights, MIN < MAX, not {tuple(z_band)!r}")
+    if not (math.isfinite(angle_step) and math.radians(0.01) <= angle_step <= math.radians(10)):
+        raise ValueError(f"cloud_angle_step (--cloud-angle-step) must be between 0.01 and 10 degrees, not "
+                         f"{math.degrees(angle_step):g}")
+    if not (math.isfinite(range_max) and 0 < range_max <= 1000):
+        raise ValueError(f"cloud_range_max (--cloud-range-max) must be above 0 and at most 1000 m, not {range_max!r}")
+
+
+def cloud_points_xyz(msg, fail) -> np.ndarray:
+    """(n, 3) float64 x, y, z of a PointCloud2's points (organised or not, any point layout with
+    float32 or float64 x, y and z fields), NaN points kept. fail(what) gives the error to raise."""
+    fields = {f.name: f for f in msg.fields}
+    missing = [n for n in "xyz" if n not in fields]
+    if missing:
+        raise fail(f"has no field {missing[0]!r} (fields: {', '.join(fields) or 'none'})")
+    order = ">" if msg.is_bigendian else "<"
+    formats = []
+    for n in "xyz":
+        kind = {_FLOAT32: "f4", _FLOAT64: "f8"}.get(int(fields[n].datatype))
+        if kind is None:
+            raise fail(f"field {n!r} has datatype {fields[n].datatype}, not float32 (7) or float64 (8)")
+        formats.append(order + kind)
+    width, height, step, row = int(msg.width), int(msg.height), int(msg.point_step), int(msg.row_step)
+    data = bytes(msg.data) if not isinstance(msg.data, (bytes, np.ndarray)) else msg.data
+    data = np.frombuffer(data, dtype=np.uint8) if not isinstance(data, np.ndarray) else data.view(np.uint8)
+    size = max(int(fields[n].offset) + int(formats[i][2]) for i, n in enumerate("xyz"))
+    if step < size or row < width * step or len(data) < height * row:
+        raise fail(f"has {len(data)} bytes for {height} rows of {row} bytes, {width} points of {step} "
+                   f"bytes (x, y, z need {size})")
+    dtype = np.dtype({"names": list("xyz"), "formats": formats,
+                      "offsets": [int(fields[n].offset) for n in "xyz"], "itemsize": step})
+    rows = data[:height * row].reshape(height, row)[:, :width * step]
+    pts = np.ascontiguousarray(rows).view(dtype).reshape(-1)
+    return np.column_stack([pts["x"], pts["y"], pts["z"]]).astype(np.float64)
+
+
+def read_cloud(msg, *, no_return: str, counts: dict, fail, z_band=CLOUD_DEFAULTS["z_band"],
+               angle_step: float = CLOUD_DEFAULTS["angle_step"], range_max: float = CLOUD_DEFAULTS["range_max"],
+               mount=None) -> LaserReading:
+    """A PointCloud2 as a LaserReading (module docstring). mount: (t (3,), q (4,)) of the
+    cloud's frame in the base frame (None: the cloud is in the base frame). counts: read_laser's
+    COUNT_KEYS, plus ``points`` (in the band and range) and ``bins_empty``."""
+    p = cloud_points_xyz(msg, fail)
+    finite = np.isfinite(p).all(axis=1)
+    z = p[:, 2]
+    if mount is not None:
+        t, q = mount
+        x, y, w = q[0], q[1], q[3]
+        # z of R(q) p + t: the third row of the rotation matrix
+        z = (2 * (q[0] * q[2] - w * q[1])) * p[:, 0] + (2 * (q[1] * q[2] + w * q[0])) * p[:, 1] + \
+            (1 - 2 * (x * x + y * y)) * p[:, 2] + t[2]
+    r = np.hypot(p[:, 0], p[:, 1])
+    keep = finite & (z >= z_band[0]) & (z <= z_band[1]) & (r > 0) & (r <= range_max)
+    n = int(round(2 * math.pi / angle_step))
+    a0 = -math.pi
+    k = np.floor((np.arctan2(p[keep, 1], p[keep, 0]) - a0) / angle_step + 0.5).astype(np.int64) % n
+    ranges = np.full(n, np.inf)
+    np.minimum.at(ranges, k, r[keep])
+    counts["points"] = counts.get("points", 0) + int(keep.sum())
+    counts["bins_empty"] = counts.get("bins_empty", 0) + int(np.isinf(ranges).sum())
+    out = apply_rep117(ranges.astype(np.float32), 0.0, float(np.float32(range_max)), no_return, counts)
+    counts["messages"] += 1
+    return LaserReading(frame_name(msg.header.frame_id), a0, angle_step, float(range_max), out)
