@@ -819,3 +819,50 @@ def test_a_bag_whose_only_sensor_is_not_a_laser(tmp_path):
     assert p.name in text and "'/depth' (sensor_msgs/Image)" in text and "depthimage_to_laserscan" in text
     with pytest.raises(vb.BagError, match="depthimage_to_laserscan"):
         vb.read_bag(p, scan_topic="/depth")
+
+
+def path_bag(tmp_path, fmt="mcap", name="pathbag", mount=(0.2, 0.0, 0.0)):
+    """Five scans in 'laser'; base_link -> laser on /tf_static; two nav_msgs/Path messages on
+    /path: a first guess, then the final trajectory at every other scan stamp and beyond."""
+    rec = bm.Recording(fmt)
+    T = rec.messages.T
+    t = stamps_of(5)
+    rec.tf(t[0], "base_link", "laser", *mount, static=True)
+    for k, s in enumerate(t):
+        rec.scan("/scan", s, "laser", plain_ranges(1, seed=k)[0], ANGLE_MIN, ANGLE_STEP, RMIN, RMAX)
+
+    def path(stamp, samples):
+        return T["nav_msgs/msg/Path"](header=rec.messages.header(stamp, "map"), poses=[
+            rec.messages.pose_stamped(ts, "map", *p) for ts, p in samples])
+
+    rec.add(t[2], "/path", "nav_msgs/msg/Path", path(t[2], [(t[0], (9.0, 9.0, 0.0)), (t[2], (9.0, 9.0, 0.0))]))
+    final = [(t[0], (0.0, 0.0, 0.0)), (t[2], (2.0, 1.0, 0.5)), (t[4], (4.0, 1.0, 1.0))]
+    rec.add(t[4] + 0.01, "/path", "nav_msgs/msg/Path", path(t[4] + 0.01, final))
+    return rec.write(bm.bag_path(tmp_path, fmt, name)), final
+
+
+def test_a_path_topic_gives_the_poses_of_its_last_message(tmp_path):
+    p, final = path_bag(tmp_path)
+    b = vb.read_bag(p, pose_topic="/path")
+    assert b.pose_source == "topic:/path"
+    ns = [bm.stamp_ns(t) for t in stamps_of(5)]  # the stamps as the bag holds them (ns)
+    f1, f3 = (ns[1] - ns[0]) / (ns[2] - ns[0]), (ns[3] - ns[2]) / (ns[4] - ns[2])  # ~0.5
+    base = [(0.0, 0.0, 0.0), (2.0 * f1, 1.0 * f1, 0.5 * f1), (2.0, 1.0, 0.5),
+            (2.0 + 2.0 * f3, 1.0, 0.5 + 0.5 * f3), (4.0, 1.0, 1.0)]
+    want = [(x + 0.2 * math.cos(th), y + 0.2 * math.sin(th), th) for x, y, th in base]  # the mount, by hand
+    np.testing.assert_allclose(b.poses, want, rtol=0, atol=1e-12)
+
+
+def test_a_robot_that_does_not_move(tmp_path):
+    p = make(tmp_path, "mcap", name="still")  # scans only: no tf, no pose topic
+    with pytest.raises(vb.BagError) as e:
+        vb.read_bag(p)
+    assert "--static-pose X,Y,THETA" in str(e.value) and "--pose-topic" in str(e.value)
+    b = vb.read_bag(p, static_pose=(1.0, 2.0, 0.5))
+    assert b.pose_source == "static" and np.array_equal(b.poses, np.tile([1.0, 2.0, 0.5], (5, 1)))
+    b = vb.read_bag(p, static_pose="1,2,0", laser_mount=(0.5, 0.0, 0.25))  # text, and a mount
+    assert np.allclose(b.poses, np.tile([1.5, 2.0, 0.25], (5, 1)), rtol=0, atol=1e-15)
+    with pytest.raises(ValueError, match="static_pose"):
+        vb.read_bag(p, static_pose=(1.0, math.nan, 0.0))
+    with pytest.raises(ValueError, match="static_pose"):
+        vb.read_bag(p, static_pose=(1.0, 2.0, 0.0), pose_topic="/odom")

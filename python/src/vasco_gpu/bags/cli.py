@@ -48,8 +48,11 @@ BAG_OPTIONS = (
     BagOption("base-frame", "base_frame", "the robot's frame for --pose-topic and a point cloud's height band "
               "(default: the odometry's child frame, else base_link)", "FRAME"),
     BagOption("pose-topic", "pose_topic", "the robot's poses from a nav_msgs/Odometry, geometry_msgs/PoseStamped "
-              "or PoseWithCovarianceStamped topic instead of /tf (the laser mount from /tf_static or "
+              "or PoseWithCovarianceStamped topic, or a nav_msgs/Path topic (its last message: a LIO or SLAM "
+              "back end's final trajectory), instead of /tf (the laser mount from /tf_static or "
               "--laser-mount)", "TOPIC"),
+    BagOption("static-pose", "static_pose", "a robot that does not move: every scan at this robot pose "
+              "(the laser mount from /tf_static or --laser-mount; without one, the laser's pose)", "X,Y,THETA"),
     BagOption("no-return", "no_return", "what a +inf range (REP 117: no return) does: skip (default; CARMEN's "
               "max-range readings) or free (clears up to vasco_range_max, as ROS mappers do)", "skip|free",
               default="skip"),

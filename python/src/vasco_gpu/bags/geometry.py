@@ -139,11 +139,12 @@ def planar_uncompose(laser: np.ndarray, mount: np.ndarray) -> np.ndarray:
     return out
 
 
-def check_mount(laser_mount) -> np.ndarray | None:
-    """laser_mount as a float64 (3,) array of finite x, y, yaw, or None; else ValueError."""
+def check_mount(laser_mount, what: str = "laser_mount") -> np.ndarray | None:
+    """laser_mount (or another planar pose, named what) as a float64 (3,) array of finite x, y,
+    yaw, or None; else ValueError."""
     if laser_mount is None:
         return None
     m = np.asarray(laser_mount, dtype=np.float64)
     if m.shape != (3,) or not np.isfinite(m).all():
-        raise ValueError(f"laser_mount must be three finite numbers x, y, yaw, not {laser_mount!r}")
+        raise ValueError(f"{what} must be three finite numbers x, y, yaw, not {laser_mount!r}")
     return m

@@ -39,7 +39,7 @@ def edge_warning(b) -> str | None:
 
 def read_for_engine(path, *, scan_topic=None, fixed_frame=None, base_frame=None, pose_topic=None, laser_mount=None,
                     no_return="skip", need_poses=True, skip_unposed=False, progress=None, echo="last",
-                    stamp="header", z_band=None, cloud_angle_step=None, cloud_range_max=None):
+                    stamp="header", z_band=None, cloud_angle_step=None, cloud_range_max=None, static_pose=None):
     """The bag's scans as the engine takes them: {'scans', 'stamps', 'mounts', 'unposed', 'edges',
     'warnings', 'bag'}. The scans before the first and after the last pose of their chain are
     left out and counted ('unposed', and 'edges': before, after), with one warning; a scan in a
@@ -51,7 +51,7 @@ def read_for_engine(path, *, scan_topic=None, fixed_frame=None, base_frame=None,
                         base_frame=base_frame, pose_topic=pose_topic, laser_mount=laser_mount,
                         pose_source="auto" if need_poses else "none", no_return=no_return, progress=progress,
                         outside_span=outside, echo=echo, stamp=stamp, z_band=z_band,
-                        cloud_angle_step=cloud_angle_step, cloud_range_max=cloud_range_max)
+                        cloud_angle_step=cloud_angle_step, cloud_range_max=cloud_range_max, static_pose=static_pose)
     keep = np.isfinite(b.poses).all(axis=1) if need_poses else np.ones(len(b.stamps), dtype=bool)
     if need_poses and not keep.any():
         raise BagError(os.fspath(path), _none_posed_text(b, len(keep), stamp), topic=b.topic)
@@ -85,7 +85,8 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
              overrides: dict[str, float | int] | None = None,
              progress: Callable[[int, int], Any] | None = None, echo: str = "last", stamp: str = "header",
              z_band: tuple[float, float] | None = None, cloud_angle_step: float | None = None,
-             cloud_range_max: float | None = None, **pose_keywords) -> _core.Log:
+             cloud_range_max: float | None = None, static_pose: tuple[float, float, float] | None = None,
+             **pose_keywords) -> _core.Log:
     """Reads a ROS 1 ``.bag``, a ROS 2 bag (sqlite3 or MCAP) or an ``.mcap`` into a :class:`Log`.
 
     Scans are the ``sensor_msgs/LaserScan`` (or ``MultiEchoLaserScan``: ``echo`` ``first``,
@@ -97,8 +98,9 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     ``no_return='free'`` makes +inf clear free space). The laser pose at each scan's stamp comes
     from ``/tf`` + ``/tf_static`` (the chain from ``fixed_frame``, default ``map``, to the scan's
     frame, interpolated in time), or from ``pose_topic`` (Odometry, PoseStamped,
-    PoseWithCovarianceStamped) and the mount (``/tf_static`` or ``laser_mount``), or from a pose
-    file: ``poses=FILE`` and the other pose keywords of :func:`load_log`, matched by stamp.
+    PoseWithCovarianceStamped, or a Path: its last message) and the mount (``/tf_static`` or
+    ``laser_mount``), or ``static_pose`` (x, y, yaw of a robot that does not move, with the mount),
+    or from a pose file: ``poses=FILE`` and the other pose keywords of :func:`load_log`, matched by stamp.
     The scans before the first and after the last pose of the chain are left out and counted
     (``Log.unposed_skipped``) with one :class:`BagWarning`; a scan in a gap of the poses is an
     error, unless ``skip_unposed=True`` (without a pose file) leaves out every scan without one. ``add=[bag, (bag,
@@ -117,7 +119,7 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
                    laser_mount=laser_mount, no_return=no_return, need_poses=need_poses,
                    skip_unposed=bool(pose_keywords.pop("skip_unposed", False)) if need_poses else False,
                    progress=progress, echo=echo, stamp=stamp, z_band=z_band, cloud_angle_step=cloud_angle_step,
-                   cloud_range_max=cloud_range_max)
+                   cloud_range_max=cloud_range_max, static_pose=static_pose)
     if len(sessions) > 1 and pose_keywords.get("poses") is not None:
         raise _core_usage_error("poses= applies to one input: write each session's poses into it first")
     d = None

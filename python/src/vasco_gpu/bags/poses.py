@@ -25,6 +25,9 @@ class PoseSeries:
         self.values = array("d")
 
     def add(self, msg, receive_ns: int | None = None) -> None:
+        if self.msgtype == "nav_msgs/msg/Path":
+            self._add_path(msg)
+            return
         ns = stamp_ns(msg.header.stamp)
         frame = frame_name(msg.header.frame_id)
         if self.fixed_frame is None:
@@ -42,6 +45,30 @@ class PoseSeries:
         q = unit_quaternion((o.x, o.y, o.z, o.w), what, self.path)
         self.ns.append(ns)
         self.values.extend((float(pose.position.x), float(pose.position.y), float(yaw(q))))
+
+    def _add_path(self, msg) -> None:
+        """A nav_msgs/Path: its poses replace the ones before (a LIO or SLAM back end republishes
+        its whole trajectory, so the bag's last Path is the final one)."""
+        ns = stamp_ns(msg.header.stamp)
+        frame = frame_name(msg.header.frame_id)
+        if self.fixed_frame is None:
+            self.fixed_frame = frame
+        elif frame != self.fixed_frame:
+            raise BagError(self.path, f"Path on {self.topic!r} at stamp {stamp_text(ns)} is in frame {frame!r}, "
+                                      f"not the fixed frame {self.fixed_frame!r}", topic=self.topic,
+                           stamp=stamp_seconds(ns))
+        del self.ns[:], self.values[:]
+        for k, ps in enumerate(msg.poses):
+            pns = stamp_ns(ps.header.stamp)
+            if ps.header.frame_id and frame_name(ps.header.frame_id) != frame:
+                raise BagError(self.path, f"Path on {self.topic!r} at stamp {stamp_text(ns)}: pose {k} is in "
+                                          f"frame {frame_name(ps.header.frame_id)!r}, not {frame!r}",
+                               topic=self.topic, stamp=stamp_seconds(pns))
+            o = ps.pose.orientation
+            q = unit_quaternion((o.x, o.y, o.z, o.w), f"pose {k} of the Path on {self.topic!r} at stamp "
+                                                      f"{stamp_text(ns)}", self.path)
+            self.ns.append(pns)
+            self.values.extend((float(ps.pose.position.x), float(ps.pose.position.y), float(yaw(q))))
 
     def _check_child(self, child: str, ns: int) -> None:
         """Odometry's child_frame_id is the base frame; it must agree with base_frame if given."""
@@ -115,8 +142,12 @@ def _edges(ns: np.ndarray, span) -> dict | None:
             "last": span[1]}
 
 
-def poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mount_arg, outside_span="error"):
+def poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, mount_arg, outside_span="error",
+              static_pose=None):
     """(poses (n, 3), mounts (n, 3) or None, pose_source label, edges) for the scans' stamps.
+
+    source "static": every scan at static_pose (the robot's x, y, yaw) composed with the mount
+    (laser_mount, else /tf_static's chain base -> laser, else none: static_pose is the laser's).
 
     outside_span: "error" (a stamp without a pose is a BagError), "edges" (NaN rows for the
     scans before the first and after the last pose of the chain, counted in edges; a stamp in a
@@ -150,6 +181,11 @@ def poses_for(path, source, scans, ns, tf, series, fixed_frame, base_frame, moun
             inside = np.zeros(n, dtype=bool) if span is None else (ns >= span[0]) & (ns <= span[1])
         poses = _inside(ns, inside, lambda t: planar_compose(series.at(t), mount))
         label = f"topic:{series.topic}"
+    elif source == "static":
+        mount = mount_arg if mount_arg is not None else static_mount(path, tf, base_frame or "base_link", frame)
+        poses = planar_compose(np.tile(np.asarray(static_pose, dtype=np.float64), (n, 1)),
+                               np.zeros(3) if mount is None else mount)
+        label = "static"
     else:
         poses = np.full((n, 3), np.nan)
         mount = mount_arg if mount_arg is not None else static_mount(path, tf, base_frame or "base_link", frame)

@@ -30,7 +30,7 @@ from .topics import (MULTI_ECHO, POINT_CLOUD2, check_pose_topic, choose_pose_sou
 
 __all__ = ["read_bag"]
 
-POSE_SOURCES = ("auto", "tf", "topic", "none")
+POSE_SOURCES = ("auto", "tf", "topic", "static", "none")
 
 
 class Progress:
@@ -81,7 +81,7 @@ def _check_arguments(pose_source, no_return, pose_topic, outside_span="error", e
 def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_topic=None,
              laser_mount=None, pose_source="auto", no_return="skip", progress=None,
              outside_span="error", echo="last", stamp="header", z_band=None, cloud_angle_step=None,
-             cloud_range_max=None) -> BagScans:
+             cloud_range_max=None, static_pose=None) -> BagScans:
     """The scans of the bag's laser scan topics at path, with the laser pose at each stamp.
 
     scan_topic: the sensor_msgs/LaserScan or MultiEchoLaserScan topic; None takes the only one;
@@ -91,7 +91,9 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     frame's tree; with a pose topic, None accepts the topic's frame). base_frame: the robot's
     frame (default Odometry's child_frame_id, else "base_link"). pose_topic: a
     nav_msgs/Odometry, geometry_msgs/PoseStamped or PoseWithCovarianceStamped topic of base
-    poses. laser_mount: (x, y, yaw) of the laser in the base frame, instead of /tf_static (one
+    poses, or a nav_msgs/Path topic (its last message: the final trajectory of a LIO or SLAM
+    back end). static_pose: (x, y, yaw) of a robot that does not move, every scan at it (with
+    the mount; text "X,Y,THETA" too); pose_source "static" then, the bag needs no poses. laser_mount: (x, y, yaw) of the laser in the base frame, instead of /tf_static (one
     topic only). pose_source: "auto" (pose_topic if given, else tf), "tf", "topic" or "none"
     (NaN poses; the caller brings them). no_return: "skip" or "free" (see
     :mod:`vasco_gpu.bags.scans`). progress: progress(done_messages, total_messages).
@@ -110,6 +112,15 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     Raises BagError for anything about the bag, ValueError for arguments that are wrong in
     themselves.
     """
+    if static_pose is not None:
+        if isinstance(static_pose, str):
+            static_pose = _numbers(static_pose, "static_pose (--static-pose X,Y,THETA)")
+        static_pose = check_mount(static_pose, "static_pose (--static-pose X,Y,THETA)")
+        if pose_source == "none":
+            raise ValueError("static_pose (--static-pose) and a pose file (--poses) both pose the scans: pass one")
+        if pose_source not in ("auto", "static") or pose_topic is not None:
+            raise ValueError("static_pose (--static-pose) poses every scan: it takes neither pose_topic nor tf")
+        pose_source = "static"
     _check_arguments(pose_source, no_return, pose_topic, outside_span, echo, stamp)
     mount_arg = check_mount(laser_mount)
     with open_bag(path) as reader:
@@ -152,7 +163,7 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
         ns = np.frombuffer(acc.ns, dtype=np.int64).copy()
         try:
             parts.append((acc, ns) + poses_for(path, source, acc, ns, tf, series, fixed_frame, base_frame,
-                                               mount_arg, outside_span))
+                                               mount_arg, outside_span, static_pose))
         except BagError as e:
             if len(accs) > 1 and e.topic != acc.topic:  # say which laser's scans
                 e.message += f" (scans of {acc.topic!r})"

@@ -26,6 +26,7 @@ TF_TYPES = ("tf2_msgs/msg/TFMessage", "tf/msg/tfMessage")  # ROS 2 / ROS 1 tf2, 
 TF_TOPICS = ("/tf", "/tf_static")
 POSE_TYPES = (
     "nav_msgs/msg/Odometry",
+    "nav_msgs/msg/Path",
     "geometry_msgs/msg/PoseStamped",
     "geometry_msgs/msg/PoseWithCovarianceStamped",
 )
@@ -144,8 +145,11 @@ def choose_pose_source(path, topics, pose_source: str, pose_topic: str | None) -
             return "topic"
         if tf_topics(topics):
             return "tf"
-        raise BagError(path, "no /tf and no pose topic to take the laser poses from (pass pose_topic "
-                             "(--pose-topic) or a pose file (--poses FILE))")
+        candidates = topics_of_type(topics, POSE_TYPES)
+        found = f"; its pose topics: {', '.join(repr(t) for t in candidates)}" if candidates else ""
+        raise BagError(path, "no /tf and no pose topic to take the laser poses from: pass pose_topic "
+                             "(--pose-topic TOPIC) for a topic of robot poses, a pose file (--poses FILE), or "
+                             f"static_pose (--static-pose X,Y,THETA) for a sensor that does not move{found}")
     if pose_source == "tf" and not tf_topics(topics):
         raise BagError(path, f"pose_source 'tf' but the bag has no /tf or /tf_static messages (topics: "
                              f"{topic_listing(topics)})")
