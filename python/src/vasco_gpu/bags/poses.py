@@ -29,14 +29,7 @@ class PoseSeries:
             self._add_path(msg)
             return
         ns = stamp_ns(msg.header.stamp)
-        frame = frame_name(msg.header.frame_id)
-        if self.fixed_frame is None:
-            self.fixed_frame = frame
-        elif frame != self.fixed_frame:
-            raise BagError(self.path, f"pose on {self.topic!r} at stamp {stamp_text(ns)} is in frame "
-                                      f"{frame!r}, not the fixed frame {self.fixed_frame!r} (pass "
-                                      f"fixed_frame={frame!r}, or None to accept the topic's frame)",
-                           topic=self.topic, stamp=stamp_seconds(ns))
+        frame = self._fixed(msg, ns, "pose")
         if self.msgtype == "nav_msgs/msg/Odometry":
             self._check_child(frame_name(msg.child_frame_id), ns)
         pose = msg.pose if self.msgtype == "geometry_msgs/msg/PoseStamped" else msg.pose.pose
@@ -46,17 +39,23 @@ class PoseSeries:
         self.ns.append(ns)
         self.values.extend((float(pose.position.x), float(pose.position.y), float(yaw(q))))
 
-    def _add_path(self, msg) -> None:
-        """A nav_msgs/Path: its poses replace the ones before (a LIO or SLAM back end republishes
-        its whole trajectory, so the bag's last Path is the final one)."""
-        ns = stamp_ns(msg.header.stamp)
+    def _fixed(self, msg, ns: int, what: str) -> str:
+        """The message's frame, which must be the fixed frame (the first message's when None)."""
         frame = frame_name(msg.header.frame_id)
         if self.fixed_frame is None:
             self.fixed_frame = frame
         elif frame != self.fixed_frame:
-            raise BagError(self.path, f"Path on {self.topic!r} at stamp {stamp_text(ns)} is in frame {frame!r}, "
-                                      f"not the fixed frame {self.fixed_frame!r}", topic=self.topic,
-                           stamp=stamp_seconds(ns))
+            raise BagError(self.path, f"{what} on {self.topic!r} at stamp {stamp_text(ns)} is in frame "
+                                      f"{frame!r}, not the fixed frame {self.fixed_frame!r} (pass "
+                                      f"fixed_frame={frame!r}, or None to accept the topic's frame)",
+                           topic=self.topic, stamp=stamp_seconds(ns))
+        return frame
+
+    def _add_path(self, msg) -> None:
+        """A nav_msgs/Path: its poses replace the ones before (a LIO or SLAM back end republishes
+        its whole trajectory, so the bag's last Path is the final one)."""
+        ns = stamp_ns(msg.header.stamp)
+        frame = self._fixed(msg, ns, "Path")
         del self.ns[:], self.values[:]
         for k, ps in enumerate(msg.poses):
             pns = stamp_ns(ps.header.stamp)
