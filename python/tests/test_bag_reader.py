@@ -866,3 +866,24 @@ def test_a_robot_that_does_not_move(tmp_path):
         vb.read_bag(p, static_pose=(1.0, math.nan, 0.0))
     with pytest.raises(ValueError, match="static_pose"):
         vb.read_bag(p, static_pose=(1.0, 2.0, 0.0), pose_topic="/odom")
+
+
+def test_a_pose_that_is_not_a_number_is_an_error_not_a_dropped_scan(tmp_path):
+    t = stamps_of(3)
+    rec = bm.Recording("mcap")
+    for k, s in enumerate(t):
+        rec.scan("/scan", s, "base_link", plain_ranges(1, seed=k)[0], ANGLE_MIN, ANGLE_STEP, RMIN, RMAX)
+        rec.tf(s, "map", "base_link", math.nan if k == 1 else float(k), 0.0, 0.0)
+    p = rec.write(bm.bag_path(tmp_path, "mcap", "nan_tf"))
+    with pytest.raises(vb.TfError) as e:
+        vb.read_bag(p)
+    assert "tf map -> base_link at stamp" in str(e.value) and "has translation (nan" in str(e.value)
+    assert p.name in str(e.value) and e.value.stamp == pytest.approx(t[1])
+    rec = bm.Recording("mcap")
+    for k, s in enumerate(t):
+        rec.scan("/scan", s, "base_link", plain_ranges(1, seed=k)[0], ANGLE_MIN, ANGLE_STEP, RMIN, RMAX)
+        rec.add(s, "/pose", "geometry_msgs/msg/PoseStamped",
+                rec.messages.pose_stamped(s, "map", math.inf if k == 2 else 0.0, 0.0, 0.0))
+    p = rec.write(bm.bag_path(tmp_path, "mcap", "inf_pose"))
+    with pytest.raises(vb.BagError, match=r"pose on '/pose' at stamp .* has position \(inf"):
+        vb.read_bag(p, pose_topic="/pose")

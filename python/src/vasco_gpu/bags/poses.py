@@ -3,6 +3,7 @@ pose topic's base poses (PoseSeries) and the laser mount, or none (a pose file f
 
 from __future__ import annotations
 
+import math
 from array import array
 
 import numpy as np
@@ -35,9 +36,15 @@ class PoseSeries:
         pose = msg.pose if self.msgtype == "geometry_msgs/msg/PoseStamped" else msg.pose.pose
         o = pose.orientation
         what = f"pose on {self.topic!r} at stamp {stamp_text(ns)}"
+        self._check_position(pose.position, what, ns)
         q = unit_quaternion((o.x, o.y, o.z, o.w), what, self.path)
         self.ns.append(ns)
         self.values.extend((float(pose.position.x), float(pose.position.y), float(yaw(q))))
+
+    def _check_position(self, p, what: str, ns: int) -> None:
+        if not all(math.isfinite(float(v)) for v in (p.x, p.y, p.z)):
+            raise BagError(self.path, f"{what} has position ({p.x}, {p.y}, {p.z})", topic=self.topic,
+                           stamp=stamp_seconds(ns))
 
     def _fixed(self, msg, ns: int, what: str) -> str:
         """The message's frame, which must be the fixed frame (the first message's when None)."""
@@ -64,8 +71,9 @@ class PoseSeries:
                                           f"frame {frame_name(ps.header.frame_id)!r}, not {frame!r}",
                                topic=self.topic, stamp=stamp_seconds(pns))
             o = ps.pose.orientation
-            q = unit_quaternion((o.x, o.y, o.z, o.w), f"pose {k} of the Path on {self.topic!r} at stamp "
-                                                      f"{stamp_text(ns)}", self.path)
+            what = f"pose {k} of the Path on {self.topic!r} at stamp {stamp_text(ns)}"
+            self._check_position(ps.pose.position, what, pns)
+            q = unit_quaternion((o.x, o.y, o.z, o.w), what, self.path)
             self.ns.append(pns)
             self.values.extend((float(ps.pose.position.x), float(ps.pose.position.y), float(yaw(q))))
 

@@ -135,7 +135,7 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
         source = choose_pose_source(path, topics, pose_source, pose_topic)
         tf = None
         if tf_topics(topics):
-            tf = TfBuffer(path, stamp_name="scan stamp", max_gap=TF_MAX_GAP,
+            tf = TfBuffer(path, stamp_name="scan stamp", max_gap=TF_MAX_GAP, refuse_repeats=True,
                           outside_hint="skip_unposed / --skip-unposed leaves such scans out")
         cloud = cloud_options(path, tf, base_frame, z_band, cloud_angle_step, cloud_range_max)
         accs = [ScanAccumulator(path, name, no_return, norm_type(topics[name].msgtype) == MULTI_ECHO, echo, stamp,

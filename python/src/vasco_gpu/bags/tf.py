@@ -3,6 +3,7 @@ ROS 2 node's subscriptions) and looks up the transform between two frames at giv
 
 from __future__ import annotations
 
+import math
 from array import array
 
 import numpy as np
@@ -18,9 +19,10 @@ __all__ = ["TfBuffer"]
 class _Edge:
     """One parent -> child link of tf: a static transform, or a time series of samples."""
 
-    def __init__(self, parent: str, child: str, static: bool, keep_ns: int | None = None):
+    def __init__(self, parent: str, child: str, static: bool, keep_ns: int | None = None,
+                 file=None, refuse_repeats: bool = False):
         self.parent, self.child, self.static = parent, child, static
-        self.keep_ns = keep_ns
+        self.keep_ns, self.file, self.refuse_repeats = keep_ns, file, refuse_repeats
         self.ns = array("q")
         self.values = array("d")  # tx ty tz qx qy qz qw per sample
         self._arrays = None
@@ -43,11 +45,27 @@ class _Edge:
         self.ns, self.values = array("q", times[keep].tobytes()), array("d", vals[keep].tobytes())
 
     def arrays(self):
-        """(stamps (k,), translations (k, 3), quaternions (k, 4)) sorted by stamp."""
+        """(stamps (k,), translations (k, 3), quaternions (k, 4)) sorted by stamp; two samples
+        at one stamp that differ are a TfError when the buffer refuses repeats (a bag's: two
+        publishers of one link), else the later one is taken (a live buffer, as tf2 goes on)."""
         if self._arrays is None:
+            if self.refuse_repeats:
+                self._check_repeats()
             times, vals = sorted_samples(self.ns, self.values, 7)
             self._arrays = (times, vals[:, :3].copy(), vals[:, 3:].copy())
         return self._arrays
+
+    def _check_repeats(self) -> None:
+        times = np.frombuffer(self.ns, dtype=np.int64)
+        vals = np.frombuffer(self.values, dtype=np.float64).reshape(-1, 7)
+        order = np.argsort(times, kind="stable")
+        t, v = times[order], vals[order]
+        differ = (t[1:] == t[:-1]) & (v[1:] != v[:-1]).any(axis=1)
+        if differ.any():
+            k = int(np.argmax(differ))
+            raise TfError(self.file, f"tf {self.parent} -> {self.child} has two different samples at stamp "
+                                     f"{stamp_text(int(t[k]))}: {tuple(v[k].tolist())} and {tuple(v[k + 1].tolist())} "
+                                     "(two publishers of one link?)", topic="/tf", stamp=stamp_seconds(int(t[k])))
 
     def span_text(self) -> str:
         ns = self.arrays()[0]
@@ -73,14 +91,18 @@ class TfBuffer:
     buffer holds: a link forgets its samples older than its newest less ``keep`` (tf2's cache
     time, 10 s by default).
 
+    ``refuse_repeats``: two samples of a link at one stamp that differ are a TfError (a bag's
+    recording of two publishers of one link) instead of the later one winning.
+
     ``file``, ``stamp_name`` and ``outside_hint`` shape the error messages only: the bag the
     transforms come from (None when fed live), what the looked-up stamps are, and a hint added
     to the error for a stamp outside a link's samples (or in a gap). Errors are :class:`TfError`.
     """
 
     def __init__(self, file=None, *, stamp_name: str = "stamp", outside_hint: str = "",
-                 max_gap: float | None = None, keep: float | None = None):
+                 max_gap: float | None = None, keep: float | None = None, refuse_repeats: bool = False):
         self.file = file
+        self.refuse_repeats = refuse_repeats
         self.keep_ns = None if keep is None else int(round(keep * 1e9))
         self.stamp_name = stamp_name
         self.outside_hint = outside_hint
@@ -103,9 +125,16 @@ class TfBuffer:
             topic = "/tf_static" if static else "/tf"
         parent, child = frame_name(ts.header.frame_id), frame_name(ts.child_frame_id)
         ns = stamp_ns(ts.header.stamp)
+        tr, rot = ts.transform.translation, ts.transform.rotation
+        what = f"tf {parent} -> {child} at stamp {stamp_text(ns)} on {topic}"
+        t = (float(tr.x), float(tr.y), float(tr.z))
+        if not all(math.isfinite(v) for v in t):
+            raise TfError(self.file, f"{what} has translation {t}", topic=topic, stamp=stamp_seconds(ns))
+        q = unit_quaternion((rot.x, rot.y, rot.z, rot.w), what, self.file, TfError)
         edge = self._edges.get(child)
         if edge is None:
-            edge = self._edges[child] = _Edge(parent, child, static, self.keep_ns)
+            edge = self._edges[child] = _Edge(parent, child, static, self.keep_ns, self.file,
+                                              self.refuse_repeats)
         elif edge.parent != parent:
             was = f"{edge.parent!r} on {'/tf_static' if edge.static else '/tf'}"
             raise TfError(self.file, f"frame {child!r} has two parents in tf: {was} and {parent!r} on "
@@ -115,10 +144,7 @@ class TfBuffer:
             raise TfError(self.file, f"tf {parent} -> {child} is on both /tf and /tf_static (stamp "
                                      f"{stamp_text(ns)} on {topic}); a link is either static or not",
                           topic=topic, stamp=stamp_seconds(ns))
-        tr, rot = ts.transform.translation, ts.transform.rotation
-        what = f"tf {parent} -> {child} at stamp {stamp_text(ns)}"
-        q = unit_quaternion((rot.x, rot.y, rot.z, rot.w), what, self.file, TfError)
-        edge.add(ns, (float(tr.x), float(tr.y), float(tr.z)), q)
+        edge.add(ns, t, q)
 
     def frames(self) -> list[str]:
         """Every frame named by a link, sorted."""
@@ -163,7 +189,8 @@ class TfBuffer:
         """(frames from source up to the common ancestor, frames from target up to it); a
         TfError naming the missing link when the two are not in one tree."""
         up_s, up_t = self.up(source), self.up(target)
-        common = next((f for f in up_s if f in set(up_t)), None)
+        on_t = set(up_t)  # once: a deep chain is linear, not quadratic
+        common = next((f for f in up_s if f in on_t), None)
         if common is None:
             raise TfError(self.file, self._no_chain_text(target, source))
         return up_s[: up_s.index(common) + 1], up_t[: up_t.index(common) + 1]
