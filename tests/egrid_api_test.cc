@@ -117,6 +117,37 @@ TEST_F(EgridApi, LaterScansAreRelativeToTheFirstPose) {
   EXPECT_EQ(g.prob[14][12], kOcc1);
 }
 
+TEST_F(EgridApi, ABadScanIsRefusedWithAMessageAndChangesNothing) {
+  float r[3] = {1.0f, 2.0f, 3.0f};
+  carmen_mapper_update_evidence_grid(&g, 10, 10, 0, 3, r, 0.1, -0.1);
+  const int before = known();
+  ASSERT_GT(before, 0);
+  struct Case {
+    int n;
+    float *ranges;
+    float *angles;
+    bool general;
+    const char *message;
+  } cases[] = {
+      {-1, r, nullptr, false, "carmen_mapper_update_evidence_grid: -1 readings: scan ignored\n"},
+      {3, nullptr, nullptr, false, "carmen_mapper_update_evidence_grid: 3 readings and laser_range NULL: scan ignored\n"},
+      {-5, r, r, true, "carmen_mapper_update_evidence_grid_general: -5 readings: scan ignored\n"},
+      {3, r, nullptr, true, "carmen_mapper_update_evidence_grid_general: 3 readings and laser_angle NULL: scan ignored\n"},
+  };
+  for (const Case &c : cases) {
+    testing::internal::CaptureStderr();
+    if (c.general)
+      carmen_mapper_update_evidence_grid_general(&g, 12, 10, 0, c.n, c.ranges, c.angles, 0.1, -0.1);
+    else
+      carmen_mapper_update_evidence_grid(&g, 12, 10, 0, c.n, c.ranges, 0.1, -0.1);
+    EXPECT_EQ(testing::internal::GetCapturedStderr(), c.message);
+    EXPECT_EQ(known(), before);
+  }
+  testing::internal::CaptureStderr();
+  carmen_mapper_update_evidence_grid(nullptr, 0, 0, 0, 3, r, 0.1, 0);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "carmen_mapper_update_evidence_grid: grid is NULL: scan ignored\n");
+}
+
 TEST_F(EgridApi, ClearSetsThePrior) {
   carmen_mapper_clear_evidence_grid(&g);
   EXPECT_EQ(g.prob[0][0], 0.5f);

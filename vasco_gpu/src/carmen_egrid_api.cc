@@ -172,10 +172,16 @@ vasco::egrid::SensorModel<double> model_of(const evidence_grid *g) {
 
 // The update shared by both entry points, on the oracle.
 template <class AngleOf>
-void update(evidence_grid *g, double x, double y, double theta, int n, const float *range,
+void update(const char *who, evidence_grid *g, double x, double y, double theta, int n, const float *range,
             AngleOf &&angle_of) {
-  if (g == nullptr || g->prob == nullptr) return;
-  if (n < 0 || (n > 0 && range == nullptr)) return;
+  if (g == nullptr || g->prob == nullptr) {  // a failed allocation was reported when it happened
+    if (g == nullptr) std::fprintf(stderr, "%s: grid is NULL: scan ignored\n", who);
+    return;
+  }
+  if (n < 0 || (n > 0 && range == nullptr)) {
+    std::fprintf(stderr, "%s: %d readings%s: scan ignored\n", who, n, n > 0 ? " and laser_range NULL" : "");
+    return;
+  }
   vasco::oracle::GridFrame frame = frame_of(g);
   vasco::oracle::update_scan(g->prob[0], frame, model_of(g), g->wall_thickness,
                              g->distance_table_size, g->distance_table, x, y, theta, n, range,
@@ -294,7 +300,7 @@ void carmen_mapper_update_evidence_grid(evidence_grid *grid, double laser_x, dou
       drop_session(grid);
     }
   }
-  update(grid, laser_x, laser_y, laser_theta, num_readings, laser_range,
+  update("carmen_mapper_update_evidence_grid", grid, laser_x, laser_y, laser_theta, num_readings, laser_range,
          vasco::oracle::SteppedAngles{first_beam_angle, angular_resolution});
 }
 
@@ -303,9 +309,14 @@ void carmen_mapper_update_evidence_grid_general(evidence_grid *grid, double lase
                                                 int num_readings, float *laser_range,
                                                 float *laser_angle, double /*angular_resolution*/,
                                                 double /*first_beam_angle*/) {
-  if (laser_angle == nullptr) return;
+  if (laser_angle == nullptr) {
+    if (num_readings != 0)
+      std::fprintf(stderr, "carmen_mapper_update_evidence_grid_general: %d readings and laser_angle NULL: scan "
+                           "ignored\n", num_readings);
+    return;
+  }
   drop_session(grid);  // per-beam angles: the oracle, from now on (g->prob is current)
-  update(grid, laser_x, laser_y, laser_theta, num_readings, laser_range,
+  update("carmen_mapper_update_evidence_grid_general", grid, laser_x, laser_y, laser_theta, num_readings, laser_range,
          [&](int i, double theta, double *angle) { *angle = theta + laser_angle[i]; });
 }
 
