@@ -105,6 +105,25 @@ TEST(Log2MapBatch, ABadLogIsReportedAndSkippedItsOutputsUntouched) {
   EXPECT_EQ(names_in(out), (std::vector<std::string>{"garbage.map.gz", "intel.gfs.map.gz"}));
 }
 
+TEST(Log2MapBatch, AFailedBatchLeavesNoDirectoryOfItsOwn) {
+  TempDir dir;
+  maptest::write_bytes(dir.file("garbage.log"), "PARAM\n");
+  // Every input fails: the directory the batch made goes again.
+  ToolRun r = log2map({"--backend", "cpu_threads", "--out-dir", dir.file("made"), dir.file("garbage.log"),
+                       dir.file("missing.log")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_FALSE(exists(dir.file("made"))) << r.output;
+  // A directory that was there stays, empty or not.
+  std::filesystem::create_directory(dir.file("there"));
+  r = log2map({"--backend", "cpu_threads", "--out-dir", dir.file("there"), dir.file("garbage.log")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(exists(dir.file("there")));
+  // One input mapped: the directory holds its map.
+  r = log2map({"--backend", "cpu_threads", "-q", "--out-dir", dir.file("some"), dir.file("garbage.log"), kIntel});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_EQ(names_in(dir.file("some")), (std::vector<std::string>{"intel.gfs.map.gz"}));
+}
+
 TEST(Log2MapBatch, FailFastStopsAtTheFirstBadLog) {
   TempDir dir;
   maptest::write_bytes(dir.file("garbage.log"), "PARAM\n");

@@ -1,6 +1,7 @@
 #include "log2map_batch.h"
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -30,16 +31,32 @@ namespace {
 using carmen::Error;
 using carmen::ErrorCode;
 
-// The output directory, made when missing (its parent must exist).
-void make_out_dir(const std::string &dir) {
-  struct stat st;
-  if (::stat(dir.c_str(), &st) == 0) {
-    if (!S_ISDIR(st.st_mode)) throw carmen::FileError(dir, "--out-dir: not a directory", ErrorCode::Io);
-    return;
+// The output directory, made when missing (its parent must exist); one the
+// batch made is removed again at the end when nothing was written into it (a
+// batch that failed, or threw, leaves no directory of its own behind).
+class OutDir {
+ public:
+  explicit OutDir(const std::string &dir) : dir_(dir) {
+    struct stat st;
+    if (::stat(dir.c_str(), &st) == 0) {
+      if (!S_ISDIR(st.st_mode)) throw carmen::FileError(dir, "--out-dir: not a directory", ErrorCode::Io);
+      return;
+    }
+    if (::mkdir(dir.c_str(), 0777) != 0)
+      throw carmen::FileError(dir, std::string("--out-dir: cannot make the directory: ") + std::strerror(errno),
+                              ErrorCode::Io);
+    made_ = true;
   }
-  if (::mkdir(dir.c_str(), 0777) != 0)
-    throw carmen::FileError(dir, std::string("--out-dir: cannot make the directory: ") + std::strerror(errno), ErrorCode::Io);
-}
+  ~OutDir() {
+    if (made_) ::rmdir(dir_.c_str());  // fails, harmlessly, unless it is empty
+  }
+  OutDir(const OutDir &) = delete;
+  OutDir &operator=(const OutDir &) = delete;
+
+ private:
+  std::string dir_;
+  bool made_ = false;
+};
 
 // DIR/STEM.FORMAT for each of opt.formats.
 std::vector<std::string> outputs_of(const Options &opt, const std::string &input) {
@@ -250,7 +267,7 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
   for (const BatchEntry &e : entries)
     for (const std::string &f : files_written(e.outputs)) files.push_back(f);
   if (opt.json) cli::check_stdout_writable("--json");
-  make_out_dir(opt.out_dir);
+  const OutDir out_dir(opt.out_dir);
   vasco::pipeline::check_outputs(inputs, files);
 
   BatchReport report(opt, std::move(entries));
