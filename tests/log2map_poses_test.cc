@@ -175,6 +175,38 @@ TEST_F(Log2MapPoses, AScanWithoutAPoseIsNamedOrSkippedWhenAsked) {
   EXPECT_TRUE(contains(skip.output, "\"unposed_skipped\":455")) << skip.output;
 }
 
+TEST_F(Log2MapPoses, SkipUnposedLeavesOutScansOfTheSelectedRunNotBeforeIt) {
+  // Poses for scans 100-199 only (g2o vertices 0-99 matched by id); the run is
+  // scans 20-219 of the log: its 100 scans with a pose are mapped, the map of
+  // a log of scans 100-199 (before the fix the unposed scans went first, and
+  // the run became the posed scans 20-99 of what was left: 80 scans).
+  std::string g2o, ids;
+  for (size_t k = 0; k < 100; ++k) {
+    const Flaser &f = moved_[100 + k];
+    g2o += "VERTEX_SE2 " + std::to_string(k) + " " + g17(f.get(0)) + " " + g17(f.get(1)) + " " + g17(f.get(2)) + "\n";
+    ids += std::to_string(k) + " " + std::to_string(100 + k) + "\n";
+  }
+  maptest::write_bytes(dir_.file("part.g2o"), g2o);
+  maptest::write_bytes(dir_.file("part.ids"), ids);
+  maptest::write_bytes(dir_.file("part.log"), log_text(moved_, 100, 200));
+  ASSERT_EQ(log2map({"--backend", "cpu_double", "-q", dir_.file("part.log"), dir_.file("want.map")}).status, 0);
+  const ToolRun r = log2map({"--backend", "cpu_double", "--json", "--poses", dir_.file("part.g2o"), "--pose-match",
+                             "id", "--pose-ids", dir_.file("part.ids"), "--skip-unposed", "--vasco_first_scan", "20",
+                             "--vasco_num_scans", "200", kIntel, dir_.file("got.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"posed_from_file\":100")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"unposed_skipped\":100")) << r.output;
+  EXPECT_EQ(differing(gridmap_of(dir_.file("got.map")), gridmap_of(dir_.file("want.map"))), 0u);
+  // A run with no scan that has a pose says so, naming the file.
+  const ToolRun none = log2map({"--poses", dir_.file("part.g2o"), "--pose-match", "id", "--pose-ids",
+                                dir_.file("part.ids"), "--skip-unposed", "--vasco_num_scans", "50", kIntel,
+                                dir_.file("none.map")});
+  EXPECT_EQ(none.status, 1) << none.output;
+  EXPECT_TRUE(contains(none.output, "part.g2o")) << none.output;
+  EXPECT_TRUE(contains(none.output, "none of the 50 scans")) << none.output;
+  EXPECT_TRUE(contains(none.output, "in the selected run")) << none.output;
+}
+
 TEST_F(Log2MapPoses, BadPoseOptionsAreUsageErrors) {
   EXPECT_EQ(log2map({"--pose-tolerance", "0.5", kIntel, dir_.file("x.map")}).status, 2);
   EXPECT_EQ(log2map({"--pose-max-gap", "2", kIntel, dir_.file("x.map")}).status, 2);  // without --poses

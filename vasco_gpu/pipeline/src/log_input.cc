@@ -1,5 +1,6 @@
 #include "vasco_gpu/pipeline/log_input.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -42,9 +43,12 @@ Pose2 laser_pose_of(const Pose2 &robot, const StampedScans &scans, size_t s, con
 }
 
 // Replaces the scans' poses by the pose file's (DESIGN §3 step 1 gets its
-// poses from elsewhere); scans without one are left out when asked.
-void apply_pose_file(StampedScans &scans, const PoseSource &src, const std::string &source, LogInput *in) {
-  if (src.file.empty()) return;
+// poses from elsewhere). Returns which scans have one (empty: all do); those
+// without are left out by keep_posed once the run is selected, so that
+// vasco_first_scan and vasco_num_scans count the log's laser messages
+// whatever the pose file lacks.
+std::vector<uint8_t> apply_pose_file(StampedScans &scans, const PoseSource &src, const std::string &source) {
+  if (src.file.empty()) return {};
   PoseFile file = read_pose_file(src.file, src.format);
   PoseMatchOptions match = src.match;
   if (!src.id_map_file.empty()) match.id_map = read_pose_id_map(src.id_map_file);
@@ -57,12 +61,31 @@ void apply_pose_file(StampedScans &scans, const PoseSource &src, const std::stri
     b.y[s] = p.y;
     b.theta[s] = p.theta;
   }
-  in->posed_from_file = b.num_scans() - m.unmatched;
-  in->unposed_skipped += m.unmatched;
-  if (m.unmatched > 0 && m.unmatched == b.num_scans())
-    throw carmen::FileError(src.file, "none of the " + std::to_string(b.num_scans()) + " scans of " + source +
+  std::vector<uint8_t> matched(b.num_scans(), 1);
+  for (size_t s = 0; s < b.num_scans(); ++s) matched[s] = m.matched[s];
+  return matched;
+}
+
+// The selected run's scans without a pose from the file left out (and
+// counted); none left is an error naming the file.
+void keep_posed(LogInput &in, const std::vector<uint8_t> &matched, size_t first, const PoseSource &src,
+                const std::string &source) {
+  if (matched.empty()) return;  // no pose file
+  const size_t n = in.batch.num_scans();
+  std::vector<uint8_t> run(matched.begin() + static_cast<std::ptrdiff_t>(first),
+                           matched.begin() + static_cast<std::ptrdiff_t>(first + n));
+  const size_t unmatched = static_cast<size_t>(std::count(run.begin(), run.end(), uint8_t{0}));
+  in.posed_from_file = n - unmatched;
+  in.unposed_skipped += unmatched;
+  if (unmatched == 0) return;
+  if (unmatched == n)
+    throw carmen::FileError(src.file, "none of the " + std::to_string(n) + " scans of " + source +
+                                          (n < matched.size() ? " in the selected run" : std::string()) +
                                           " has a pose in this file (all left out by --skip-unposed)");
-  if (m.unmatched > 0) scans.keep_only(m.matched);
+  StampedScans kept{std::move(in.batch), std::move(in.stamps), {}, {}, 0};
+  kept.keep_only(run);
+  in.batch = std::move(kept.batch);
+  in.stamps = std::move(kept.stamps);
 }
 
 // The stamps of the scans select() keeps.
@@ -88,12 +111,15 @@ void check_downsample(const LogInput &in, const carmen::ParamFile &params, const
 // the effective parameters, the selected run, the grid.
 LogInput finish_input(StampedScans scans, carmen::ParamFile &params, const LogInputOptions &options,
                       LogInput in, const std::string &scan_kind) {
-  apply_pose_file(scans, options.poses, options.log, &in);
+  const std::vector<uint8_t> matched = apply_pose_file(scans, options.poses, options.log);
   in.params = MapperParams::from_params(params, &in.warnings);
   const long laser_messages = in.load.laser_messages;
+  const size_t first = std::min<size_t>(static_cast<size_t>(std::max(in.params.first_scan, 0L)),
+                                        scans.batch.num_scans());
   in.stamps = std::move(scans.stamps);
   in.batch = std::move(scans.batch).select(in.params.first_scan, in.params.num_scans);  // no copy of the ranges
   select_stamps(in.stamps, in.params.first_scan, in.batch.num_scans());
+  keep_posed(in, matched, first, options.poses, options.log);
   in.load.scans_used = static_cast<long>(in.batch.num_scans());
   if (in.batch.num_scans() == 0)
     throw carmen::FileError(
