@@ -350,13 +350,27 @@ void check_replaceable(const std::string &path) {
   check_existing_target(path, dir, dir_st);
 }
 
+TargetKey target_key(const std::string &path) {
+  TargetKey k;
+  struct stat st;
+  if (::stat(path.c_str(), &st) == 0) {
+    k.has_file = true;
+    k.file_dev = static_cast<unsigned long long>(st.st_dev);
+    k.file_ino = static_cast<unsigned long long>(st.st_ino);
+  }
+  if (::stat(directory_of(path).c_str(), &st) == 0) {
+    k.has_place = true;
+    k.dir_dev = static_cast<unsigned long long>(st.st_dev);
+    k.dir_ino = static_cast<unsigned long long>(st.st_ino);
+    k.name = file_name_of(path);
+  }
+  return k;
+}
+
 bool same_target(const std::string &a, const std::string &b) {
-  struct stat fa, fb;
-  if (::stat(a.c_str(), &fa) == 0 && ::stat(b.c_str(), &fb) == 0 && fa.st_dev == fb.st_dev && fa.st_ino == fb.st_ino)
-    return true;
-  struct stat da, db;
-  return file_name_of(a) == file_name_of(b) && ::stat(directory_of(a).c_str(), &da) == 0 &&
-         ::stat(directory_of(b).c_str(), &db) == 0 && da.st_dev == db.st_dev && da.st_ino == db.st_ino;
+  const TargetKey ka = target_key(a), kb = target_key(b);
+  if (ka.has_file && kb.has_file && ka.file_dev == kb.file_dev && ka.file_ino == kb.file_ino) return true;
+  return ka.has_place && kb.has_place && ka.name == kb.name && ka.dir_dev == kb.dir_dev && ka.dir_ino == kb.dir_ino;
 }
 
 void AtomicOutput::set_name_source_for_testing(std::function<std::string()> source) {

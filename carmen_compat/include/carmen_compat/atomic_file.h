@@ -137,6 +137,19 @@ void check_replaceable(const std::string &path);
 // symlinks). Paths that do not resolve are compared by nothing else: false.
 bool same_target(const std::string &a, const std::string &b);
 
+// What same_target compares, taken once a path (two or three stat calls), so
+// that many paths are told apart in one pass: the file's device and inode
+// where it exists, its place (its directory's device and inode, and its name)
+// where the directory exists. Two paths are one target when either agrees.
+struct TargetKey {
+  bool has_file = false;
+  unsigned long long file_dev = 0, file_ino = 0;
+  bool has_place = false;
+  unsigned long long dir_dev = 0, dir_ino = 0;
+  std::string name;
+};
+TargetKey target_key(const std::string &path);
+
 // Writes `contents` to `path` atomically (binary). Throws carmen::FileError.
 void write_file_atomically(const std::string &path, std::string_view contents, bool durable = false);
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <map>
+#include <tuple>
 #include <utility>
 
 #include "carmen_compat/atomic_file.h"
@@ -73,16 +74,54 @@ std::vector<std::string> output_files(const std::vector<std::string> &outputs) {
   return files;
 }
 
+namespace {
+
+// Paths by target (carmen::TargetKey): each path is looked at once and found
+// in a map, so a batch of thousands of outputs is checked in one pass, not
+// pair by pair.
+class TargetIndex {
+ public:
+  // The index given with an earlier path of the same target, or -1.
+  long find(const carmen::TargetKey &k) const {
+    if (k.has_file) {
+      const auto f = files_.find({k.file_dev, k.file_ino});
+      if (f != files_.end()) return static_cast<long>(f->second);
+    }
+    if (k.has_place) {
+      const auto p = places_.find(std::make_tuple(k.dir_dev, k.dir_ino, k.name));
+      if (p != places_.end()) return static_cast<long>(p->second);
+    }
+    return -1;
+  }
+  void add(const carmen::TargetKey &k, size_t index) {
+    if (k.has_file) files_.emplace(std::make_pair(k.file_dev, k.file_ino), index);
+    if (k.has_place) places_.emplace(std::make_tuple(k.dir_dev, k.dir_ino, k.name), index);
+  }
+
+ private:
+  std::map<std::pair<unsigned long long, unsigned long long>, size_t> files_;
+  std::map<std::tuple<unsigned long long, unsigned long long, std::string>, size_t> places_;
+};
+
+}  // namespace
+
 void check_outputs(const std::vector<std::string> &inputs, const std::vector<std::string> &output_files,
                    bool replaceable) {
+  TargetIndex read, written;
+  for (size_t i = 0; i < inputs.size(); ++i)
+    if (!inputs[i].empty()) read.add(carmen::target_key(inputs[i]), i);
   for (size_t i = 0; i < output_files.size(); ++i) {
     const std::string &out = output_files[i];
-    for (const std::string &in : inputs)
-      if (!in.empty() && carmen::same_target(out, in))
-        throw Error(ErrorCode::Usage, out + ": is the input " + in + ": an output must not overwrite what is read");
-    for (size_t j = 0; j < i; ++j)
-      if (carmen::same_target(output_files[j], out))
-        throw Error(ErrorCode::Usage, out + ": the same file as the output " + output_files[j] + ": give each output once");
+    const carmen::TargetKey key = carmen::target_key(out);
+    const long in = read.find(key);
+    if (in >= 0)
+      throw Error(ErrorCode::Usage, out + ": is the input " + inputs[static_cast<size_t>(in)] +
+                                        ": an output must not overwrite what is read");
+    const long earlier = written.find(key);
+    if (earlier >= 0)
+      throw Error(ErrorCode::Usage, out + ": the same file as the output " +
+                                        output_files[static_cast<size_t>(earlier)] + ": give each output once");
+    written.add(key, i);
   }
   if (!replaceable) return;
   for (const std::string &out : output_files) carmen::check_replaceable(out);
