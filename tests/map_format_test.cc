@@ -3,6 +3,8 @@
 #include "carmen_compat/map_format.h"
 
 #include <gtest/gtest.h>
+
+#include <fstream>
 #include <png.h>
 
 #include <cstring>
@@ -122,6 +124,23 @@ TEST_P(MapFormatRoundTrip, CellsAndOriginComeBack) {
 INSTANTIATE_TEST_SUITE_P(EveryFormat, MapFormatRoundTrip,
                          ::testing::Values(".map", ".map.gz", ".pgm", ".png", ".png+yaml", ".yaml", ".MAP.GZ", ".PNG",
                                            ".Pgm", ".PNG+YAML"));
+
+TEST(MapFormat, AResolutionAFloat32CannotHoldIsRefusedBeforeWriting) {
+  TempDir dir;
+  for (double res : {1e-300, 1e300, 0.0, -0.05}) {
+    carmen::MapToWrite m = sample();
+    m.grid.resolution = res;
+    for (const char *name : {"m.map", "m.map.gz"}) {
+      try {
+        carmen::write_map(dir.file(name), m);
+        ADD_FAILURE() << res << " " << name << " written";
+      } catch (const carmen::FileError &e) {
+        EXPECT_NE(std::string(e.what()).find("does not fit a CARMEN map"), std::string::npos) << e.what();
+      }
+      EXPECT_FALSE(std::ifstream(dir.file(name)).good()) << res;
+    }
+  }
+}
 
 TEST(MapFormat, UpperCaseGzIsReallyGzip) {
   TempDir dir;

@@ -3,7 +3,9 @@
 
 #include <climits>
 #include <cstdint>
+#include <cmath>
 #include <cstring>
+#include <sstream>
 #include <stdexcept>
 
 #include "carmen_compat/error.h"
@@ -57,6 +59,16 @@ void write_carmen(OutputTransaction &tx, const std::string &path, const MapToWri
                         std::to_string(kMaxCarmenMapCells) +
                         " cells (2 GiB); write a .pgm instead, or finish at a larger vasco_downsample",
                     ErrorCode::TooLarge);
+  // The GRIDMAP header holds the resolution as a float32: one that is not a
+  // positive finite float32 would be written as 0 or inf, which no reader
+  // (ours included) takes back.
+  const float res = static_cast<float>(m.grid.resolution);
+  if (!std::isfinite(res) || res <= 0 || !std::isnormal(res)) {
+    std::ostringstream os;
+    os << "a resolution of " << m.grid.resolution
+       << " m per cell does not fit a CARMEN map (a float32 there: 1.2e-38 to 3.4e38 m)";
+    throw FileError(path, os.str(), ErrorCode::TooLarge);
+  }
   write_map_file(tx.add(path), carmen_file_of(m));
 }
 
