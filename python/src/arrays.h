@@ -24,17 +24,18 @@ using Array1 = nb::ndarray<nb::numpy, T, nb::ndim<1>, nb::c_contig>;
 template <typename T>
 using Array2 = nb::ndarray<nb::numpy, T, nb::ndim<2>>;
 
-// A 1-D view of `v` kept alive by `owner`; writable.
-template <typename T>
-Array1<T> view1(std::vector<T> &v, nb::handle owner) {
-  return Array1<T>(v.data(), {v.size()}, owner);
-}
+// The NumPy views alive of an object's vectors, counted by the object's
+// address: an operation that would move the memory they show (Scans.extend)
+// refuses while any is alive, rather than leave them pointing at freed memory.
+// counted_owner is the views' owner: it keeps `owner` alive and counts the
+// view under `key` until NumPy lets go of it. Both run under the GIL.
+nb::capsule counted_owner(const void *key, nb::handle owner);
+long live_views(const void *key);
 
-// A read-only 1-D view (numpy writeable=False, and it cannot be set back):
-// for arrays whose values the object's other arrays depend on.
+// A 1-D view of n elements at data, kept alive by `owner`, counted under `key`.
 template <typename T>
-Array1<const T> view1_ro(const std::vector<T> &v, nb::handle owner) {
-  return Array1<const T>(v.data(), {v.size()}, owner);
+Array1<T> counted_view1(T *data, size_t n, const void *key, nb::handle owner) {
+  return Array1<T>(data, {n}, counted_owner(key, owner));
 }
 
 // A vector moved into a capsule: an array that owns it, no copy.

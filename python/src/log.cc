@@ -111,7 +111,11 @@ void bind_log(nb::module_ &m) {
           "poses", [](const LogInput &in) { return poses_of(in.batch); }, nb::rv_policy::reference,
           "(n, 3) float64 laser poses (x, y, theta): a new array.")
       .def_prop_ro(
-          "ranges", [](nb::handle_t<LogInput> self) { return view1(nb::cast<LogInput &>(self).batch.range, self); },
+          "ranges",
+          [](nb::handle_t<LogInput> self) {
+            vasco::ScanBatch &b = nb::cast<LogInput &>(self).batch;  // counted as Log.scans' views are
+            return counted_view1(b.range.data(), b.range.size(), &b, self);
+          },
           nb::rv_policy::reference, "All ranges, float32 (a view; see Scans).")
       .def_prop_ro(
           "stamps", [](const LogInput &in) { return owned(std::vector<double>(in.stamps), {in.stamps.size()}); },

@@ -89,7 +89,7 @@ Array1<float> ranges_of(nb::handle_t<ScanBatch> self, long s) {
   if (s < 0) s += static_cast<long>(b.num_scans());
   if (s < 0 || static_cast<size_t>(s) >= b.num_scans()) throw nb::index_error("scan index out of range");
   float *first = const_cast<float *>(b.checked_ranges_of(static_cast<size_t>(s)));
-  return Array1<float>(first, {static_cast<size_t>(b.beams_in(s))}, self);
+  return counted_view1(first, static_cast<size_t>(b.beams_in(s)), &b, self);
 }
 
 constexpr const char *kScansDoc =
@@ -121,7 +121,11 @@ void bind_scans_constructor(nb::class_<ScanBatch> &cls) {
 template <typename T>
 void view_property(nb::class_<ScanBatch> &cls, const char *name, std::vector<T> ScanBatch::*field, const char *doc) {
   cls.def_prop_ro(
-      name, [field](nb::handle_t<ScanBatch> self) { return view1(nb::cast<ScanBatch &>(self).*field, self); },
+      name,
+      [field](nb::handle_t<ScanBatch> self) {
+        ScanBatch &b = nb::cast<ScanBatch &>(self);
+        return counted_view1((b.*field).data(), (b.*field).size(), &b, self);
+      },
       nb::rv_policy::reference, doc);
 }
 
@@ -135,7 +139,10 @@ void bind_scans_views(nb::class_<ScanBatch> &cls) {
   view_property(cls, "lines", &ScanBatch::line, "Line of each scan in its log (a view).");
   cls.def_prop_ro(
       "beam_offsets",
-      [](nb::handle_t<ScanBatch> self) { return view1_ro(nb::cast<ScanBatch &>(self).beam_offset, self); },
+      [](nb::handle_t<ScanBatch> self) {
+        const ScanBatch &b = nb::cast<ScanBatch &>(self);
+        return counted_view1(b.beam_offset.data(), b.beam_offset.size(), &b, self);
+      },
       nb::rv_policy::reference,
       "Scan s owns ranges[beam_offsets[s]:beam_offsets[s + 1]] (uint64, n + 1 entries, a read-only view).");
 }
@@ -167,8 +174,18 @@ void bind_scans_methods(nb::class_<ScanBatch> &cls) {
           "+ cos(a) y, theta' = theta + a for the transform (x0, y0, a) of this session into the shared frame\n"
           "of several (the identity changes no bit).")
       .def(
-          "extend", [](ScanBatch &b, const ScanBatch &other) { b.append(other); }, "other"_a,
-          "Appends other's scans (copied) after this batch's: several sessions into one batch.")
+          "extend",
+          [](ScanBatch &b, const ScanBatch &other) {
+            if (const long n = live_views(&b))
+              throw Error(ErrorCode::State,
+                          "Scans.extend: " + std::to_string(n) + " NumPy view" + (n == 1 ? " is" : "s are") +
+                              " alive of these scans' arrays (ranges, x, ..., ranges_of, or Log.ranges): extending "
+                              "moves the memory they show; delete them first, or extend a copy (scans.select(0))");
+            b.append(other);
+          },
+          "other"_a,
+          "Appends other's scans (copied) after this batch's: several sessions into one batch. Refused\n"
+          "(RuntimeError) while a NumPy view of this batch's arrays is alive: it would point at moved memory.")
       .def("select", [](const ScanBatch &b, long first, long count) { return b.select(first, count); }, "first"_a, "count"_a = -1,
            "Scans [first, first + count) as new Scans (count -1: to the end), clipped to the batch.")
       .def("__repr__", [](const ScanBatch &b) {

@@ -333,3 +333,31 @@ def test_params_docstring_lists_every_key_with_its_default():
     for key, value in defaults.items():
         assert f"{key}: " in vg.Params.__doc__ and f"default {value:g}" in vg.Params.__doc__, key
         assert getattr(vg.Params, key).__doc__.startswith(f"vasco_{key}: "), key
+
+
+def test_extend_is_refused_while_a_view_of_the_scans_is_alive():
+    """A view of Scans' arrays points into memory extend would move (reading it crashed, writing
+    it corrupted the heap): extend refuses while one is alive, and works once it is gone."""
+    import gc
+
+    log = vg.load_log(ROOT / "logs" / "intel.gfs.log.gz")
+    more = log.scans.select(10, 5)
+    for take in (lambda s: s.ranges, lambda s: s.x, lambda s: s.lines, lambda s: s.ranges_of(2),
+                 lambda s: s.beam_offsets):
+        s = log.scans.select(0, 10)
+        view = take(s)
+        with pytest.raises(RuntimeError, match="1 NumPy view is alive"):
+            s.extend(more)
+        assert len(s) == 10 and view[0] == view[0]  # unchanged, and the view still reads
+        del view
+        gc.collect()
+        s.extend(more)
+        assert len(s) == 15
+    view = log.ranges  # Log.ranges is a view of Log.scans' memory
+    with pytest.raises(RuntimeError, match="NumPy view"):
+        log.scans.extend(more)
+    del view
+    gc.collect()
+    n = len(log.scans)
+    log.scans.extend(more)
+    assert len(log.scans) == n + 5
