@@ -175,6 +175,29 @@ TEST_F(Log2MapPoses, AScanWithoutAPoseIsNamedOrSkippedWhenAsked) {
   EXPECT_TRUE(contains(skip.output, "\"unposed_skipped\":455")) << skip.output;
 }
 
+TEST_F(Log2MapPoses, TheTransformAppliesToThePoseFilesPosesToo) {
+  // --transform takes the session into the shared frame; the pose file's poses
+  // are in the log's own frame, as the log's were (before the fix the file
+  // replaced the transformed poses: the map came out untransformed, exit 0).
+  std::string g2o;
+  for (size_t i = 0; i < moved_.size(); ++i)
+    g2o += "VERTEX_SE2 " + std::to_string(i) + " " + g17(moved_[i].get(0)) + " " + g17(moved_[i].get(1)) + " " +
+           g17(moved_[i].get(2)) + "\n";
+  maptest::write_bytes(dir_.file("opt.g2o"), g2o);
+  const ToolRun want = log2map({"--backend", "cpu_double", "-q", "--transform", "1.5,-2,0.5", dir_.file("moved.log"),
+                                dir_.file("want_t.map")});
+  ASSERT_EQ(want.status, 0) << want.output;
+  const ToolRun got = log2map({"--backend", "cpu_double", "-q", "--transform", "1.5,-2,0.5", "--poses",
+                               dir_.file("opt.g2o"), kIntel, dir_.file("got_t.map")});
+  ASSERT_EQ(got.status, 0) << got.output;
+  const carmen::MapFile a = carmen::read_map_file(dir_.file("want_t.map")), b = carmen::read_map_file(dir_.file("got_t.map"));
+  ASSERT_TRUE(a.offset && b.offset);
+  EXPECT_EQ(a.offset->x, b.offset->x);
+  EXPECT_EQ(a.offset->y, b.offset->y);
+  EXPECT_EQ(differing(gridmap_of(dir_.file("got_t.map")), gridmap_of(dir_.file("want_t.map"))), 0u);
+  EXPECT_NE(differing(gridmap_of(dir_.file("got_t.map")), want_), 0u);  // not the untransformed map
+}
+
 TEST_F(Log2MapPoses, SkipUnposedLeavesOutScansOfTheSelectedRunNotBeforeIt) {
   // Poses for scans 100-199 only (g2o vertices 0-99 matched by id); the run is
   // scans 20-219 of the log: its 100 scans with a pose are mapped, the map of

@@ -47,8 +47,10 @@ Pose2 laser_pose_of(const Pose2 &robot, const StampedScans &scans, size_t s, con
 // without are left out by keep_posed once the run is selected, so that
 // vasco_first_scan and vasco_num_scans count the log's laser messages
 // whatever the pose file lacks.
-std::vector<uint8_t> apply_pose_file(StampedScans &scans, const PoseSource &src, const std::string &source) {
+std::vector<uint8_t> apply_pose_file(StampedScans &scans, const PoseSource &src, const std::string &source,
+                                     const Pose2 &transform) {
   if (src.file.empty()) return {};
+  const bool moved = transform.x != 0 || transform.y != 0 || transform.theta != 0;
   PoseFile file = read_pose_file(src.file, src.format);
   PoseMatchOptions match = src.match;
   if (!src.id_map_file.empty()) match.id_map = read_pose_id_map(src.id_map_file);
@@ -56,7 +58,8 @@ std::vector<uint8_t> apply_pose_file(StampedScans &scans, const PoseSource &src,
   ScanBatch &b = scans.batch;
   for (size_t s = 0; s < b.num_scans(); ++s) {
     if (!m.matched[s]) continue;
-    const Pose2 p = src.robot_frame ? laser_pose_of(m.pose[s], scans, s, src, source) : m.pose[s];
+    Pose2 p = src.robot_frame ? laser_pose_of(m.pose[s], scans, s, src, source) : m.pose[s];
+    if (moved) p = compose(transform, p);  // the file's poses are in the log's own frame, as its own were
     b.x[s] = p.x;
     b.y[s] = p.y;
     b.theta[s] = p.theta;
@@ -111,7 +114,7 @@ void check_downsample(const LogInput &in, const carmen::ParamFile &params, const
 // the effective parameters, the selected run, the grid.
 LogInput finish_input(StampedScans scans, carmen::ParamFile &params, const LogInputOptions &options,
                       LogInput in, const std::string &scan_kind) {
-  const std::vector<uint8_t> matched = apply_pose_file(scans, options.poses, options.log);
+  const std::vector<uint8_t> matched = apply_pose_file(scans, options.poses, options.log, options.transform);
   in.params = MapperParams::from_params(params, &in.warnings);
   const long laser_messages = in.load.laser_messages;
   const size_t first = std::min<size_t>(static_cast<size_t>(std::max(in.params.first_scan, 0L)),
