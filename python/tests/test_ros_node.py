@@ -249,6 +249,21 @@ def test_a_clean_exit_within_a_second_leaving_no_shared_memory():
     assert not left, left
 
 
+@pytest.mark.parametrize("after", [0.0, 0.05, 0.2, 0.5])
+def test_a_signal_while_starting_is_a_clean_exit_too(after):
+    # Once the node's main has begun (rclpy's library loaded: before that, Python is importing
+    # vasco_gpu itself, as for any program): while rclpy loads, while the node declares its
+    # parameters, while the executor is made: the exit status is 0, no traceback printed.
+    early = NodeProcess({"backend": "cpu_double"}, env={"ROS_DOMAIN_ID": str(int(ros_support.ROS_ENV["ROS_DOMAIN_ID"]) + 50)})
+    end = time.monotonic() + 30
+    while "librcl" not in open(f"/proc/{early.proc.pid}/maps").read() and time.monotonic() < end:
+        time.sleep(0.005)
+    time.sleep(after)
+    rc, _ = early.interrupt()
+    assert rc == 0, early.output
+    assert "Traceback" not in early.output, early.output
+
+
 def test_the_node_under_test_exits_cleanly_too(node):
     rc, took = node.interrupt()
     assert rc == 0 and took < 1.0, (rc, took, node.output[-2000:])

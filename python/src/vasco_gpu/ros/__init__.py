@@ -16,6 +16,8 @@ def main(argv=None) -> int:
 
     try:
         from .run import main as run
+    except KeyboardInterrupt:  # SIGINT while rclpy loads: nothing started yet
+        return 0
     except ImportError as e:  # rclpy or a message package
         print(f"vasco_map_node: {e.name or e} does not import: install the ROS 2 extra (pip install "
               "'.[ros]' ./ros/tf2_msgs from the repository, Python 3.10 or newer) or source a ROS 2 "

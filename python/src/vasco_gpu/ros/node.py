@@ -98,9 +98,14 @@ class MappingNode(Node):
         self._timer = self.create_timer(s.map_update_interval, self._publish_if_changed)
         self.create_timer(0.02, self._pose_pending)
         self.add_on_set_parameters_callback(self._on_parameters)
+
+    def announce_ready(self) -> None:
+        """The 'ready' line (tests and launch files wait for it), once the executor spins."""
+        s = self.settings
+        topics = s.scan_topics + s.multi_echo_topics + s.cloud_topics
         self.get_logger().info(
-            f"ready: backend {self.live.backend}, scans on {', '.join(s.scan_topics + s.multi_echo_topics)}, "
-            f"poses from tf {s.map_frame} -> the scans' frames and from the Path on "
+            f"ready: backend {self.live.backend}, scans on {', '.join(topics)}, poses from tf {s.map_frame} -> "
+            f"the scans' frames and from the Path on "
             f"{self.resolve_topic_name(s.path_topic) if s.path_topic else '(none)'}")
 
     # -- parameters -------------------------------------------------------------------------

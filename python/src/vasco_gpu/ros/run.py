@@ -14,9 +14,13 @@ from .tf_messages import MissingMessages
 
 
 def main(argv=None) -> int:
+    """0 after SIGINT or SIGTERM at any point (also while starting), 1 when ROS 2 does not start,
+    2 for a bad parameter or a missing message package."""
     args = sys.argv if argv is None else argv
     try:
         rclpy.init(args=args)
+    except KeyboardInterrupt:
+        return 0
     except Exception as e:  # rclpy's RCLError and friends: no DDS participant, bad --ros-args
         print(f"vasco_mapper: ROS 2 did not start: {e}", file=sys.stderr)
         return 1
@@ -31,13 +35,13 @@ def main(argv=None) -> int:
             return 2
         executor = SingleThreadedExecutor()
         executor.add_node(node)
-        try:
-            executor.spin()
-        except (KeyboardInterrupt, ExternalShutdownException):
-            pass
-        print(f"vasco_mapper: {node.summary()}", file=sys.stderr)
-        return 0
+        node.announce_ready()  # only now: a signal from here on ends the spin cleanly
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
     finally:
         if node is not None:
+            print(f"vasco_mapper: {node.summary()}", file=sys.stderr)
             node.destroy_node()
         rclpy.try_shutdown()
+    return 0
