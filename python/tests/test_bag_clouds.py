@@ -157,3 +157,13 @@ def test_a_cloud_frame_without_a_mount_is_an_error_that_says_what_to_do(cloud_ba
     text = str(e.value)
     assert "no static chain body -> 'laser'" in text and "--base-frame laser" in text
     load(cloud_bag, base_frame="laser", z_band=(0.25, 1.0))  # heights in the cloud's own frame
+
+
+def test_errors_name_the_bag_once_and_guess_a_mistyped_name(tmp_path, cloud_bag):
+    r = run_script("bag2map", "--scan-topic", "/pointz", str(cloud_bag), str(tmp_path / "x.map"))
+    assert r.returncode == 1
+    assert r.stderr.count(str(cloud_bag)) == 1, r.stderr
+    assert "no topic '/pointz' in the bag: did you mean '/points'?" in r.stderr
+    r = run_script("bag2map", "--fixed-frame", "mapp", str(cloud_bag), str(tmp_path / "x.map"))
+    assert r.returncode == 1 and "did you mean 'map'?" in r.stderr, r.stderr
+    assert r.stderr.count(str(cloud_bag)) == 1, r.stderr

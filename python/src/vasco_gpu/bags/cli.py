@@ -91,7 +91,12 @@ def _tool_reader(path: str, values: dict, progress) -> dict:
     """bag2map's reader of one input: `values` holds the options given, as text by flag."""
     keywords = {o.keyword: values[o.flag] for o in BAG_OPTIONS if o.flag in values}
     keywords.update({keyword: value(values[flag]) for flag, keyword, value in HANDED_ON if flag in values})
-    d = read_for_engine(path, progress=progress, **keywords)
+    try:
+        d = read_for_engine(path, progress=progress, **keywords)
+    except BagError as e:  # the command line names the input before the message: not twice
+        if e.file is None or os.fspath(e.file) != os.fspath(path):
+            raise
+        raise type(e)(None, e.message, topic=e.topic, stamp=e.stamp) from None
     _warn(d.pop("warnings", []))
     return d
 

@@ -12,6 +12,7 @@ from .errors import TfError
 from .geometry import compose, inverse, is_identity, slerp, unit_quaternion
 from .header import frame_name, stamp_ns, stamp_seconds, stamp_text
 from .series import bracket, first_outside, sorted_samples
+from .topics import did_you_mean
 
 __all__ = ["TfBuffer"]
 
@@ -183,7 +184,9 @@ class TfBuffer:
         else:
             why = f"{self._reach_text(source)}, {self._reach_text(target)}"
         frames = ", ".join(sorted(known))
-        return f"no transform chain from {target!r} to {source!r}: {why} (frames in /tf: {frames})"
+        missing = [f for f in (source, target) if f not in known]
+        hint = did_you_mean(missing[0], known) if missing else ""
+        return f"no transform chain from {target!r} to {source!r}: {why}{hint} (frames in /tf: {frames})"
 
     def _path_between(self, target: str, source: str) -> tuple[list[str], list[str]]:
         """(frames from source up to the common ancestor, frames from target up to it); a

@@ -5,6 +5,8 @@ and the pose topic's type."""
 
 from __future__ import annotations
 
+import difflib
+
 from .errors import BagError
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
@@ -30,6 +32,12 @@ POSE_TYPES = (
     "geometry_msgs/msg/PoseStamped",
     "geometry_msgs/msg/PoseWithCovarianceStamped",
 )
+
+
+def did_you_mean(name: str, names) -> str:
+    """': did you mean '/scan'?' for the closest of names to a mistyped one, else ''."""
+    close = difflib.get_close_matches(name, list(names), n=1, cutoff=0.6)
+    return f": did you mean {close[0]!r}?" if close else ""
 
 
 def norm_type(msgtype: str | None) -> str | None:
@@ -115,7 +123,8 @@ def pick_scan_topics(path, topics, scan_topic) -> list[str]:
     for wanted in names:
         name = resolve_topic(wanted, topics)
         if name is None:
-            raise BagError(path, f"no topic {wanted!r} in the bag (scan topics: {listing})", topic=wanted)
+            raise BagError(path, f"no topic {wanted!r} in the bag{did_you_mean(wanted, topics)} (scan topics: "
+                                 f"{listing})", topic=wanted)
         if name not in scans:
             kind = short_type(topics[name].msgtype)
             hint = UNSUPPORTED_SENSORS.get(norm_type(topics[name].msgtype) or "")
@@ -160,7 +169,8 @@ def check_pose_topic(path, topics, pose_topic: str) -> tuple[str, str]:
     """(topic, normalised type) of the pose topic, which must exist and have a supported type."""
     name = resolve_topic(pose_topic, topics)
     if name is None:
-        raise BagError(path, f"no pose topic {pose_topic!r} in the bag (topics: {topic_listing(topics)})",
+        raise BagError(path, f"no pose topic {pose_topic!r} in the bag{did_you_mean(pose_topic, topics)} (topics: "
+                             f"{topic_listing(topics)})",
                        topic=pose_topic)
     msgtype = norm_type(topics[name].msgtype)
     if msgtype not in POSE_TYPES:
