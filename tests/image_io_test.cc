@@ -699,7 +699,7 @@ TEST(MapImageLimits, AnImageThatIsNotARegularFileIsRefused) {
     });
     ASSERT_TRUE(r.ran) << "the reader blocked on the FIFO";
     EXPECT_EQ(r.code, int(carmen::ErrorCode::Io)) << r.what;
-    EXPECT_EQ(r.what, fifo + ": is not a regular file");
+    EXPECT_EQ(r.what, fifo + ": is a FIFO, not a regular file: an image is read whole; give a file");
   }
 }
 

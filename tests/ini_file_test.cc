@@ -7,8 +7,12 @@
 #include <cstdlib>
 
 #include <clocale>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
+
+#include "temp_dir.h"
 
 namespace {
 
@@ -233,7 +237,7 @@ TEST(IniFile, MissingFileIsAnErrorNamingIt) {
 
 TEST(IniFile, DirectoryIsAnError) {
   const std::string msg = error_of([] { ParamFile::load(kDir); });
-  EXPECT_TRUE(contains(msg, kDir + ": cannot ")) << msg;
+  EXPECT_TRUE(contains(msg, kDir + ": is a directory, not a regular file")) << msg;
 }
 
 // ---------------------------------------------------------------------------
@@ -659,12 +663,27 @@ namespace {
 
 // A device that never ends (or a huge file) is refused at 16 MiB instead of
 // being read into memory without bound.
-TEST(IniLimits, AnEndlessFileIsRefusedAtTheSizeCap) {
+TEST(IniLimits, AnEndlessDeviceIsRefusedBeforeAnyRead) {
+  // Not a regular file: refused by what it is (the 16 MiB cap is for files).
   try {
     carmen::ParamFile::load("/dev/zero");
     ADD_FAILURE() << "no error";
   } catch (const carmen::FileError &e) {
     EXPECT_EQ(e.file(), "/dev/zero");
+    EXPECT_NE(std::string(e.what()).find("is a character device, not a regular file"), std::string::npos) << e.what();
+  }
+}
+
+TEST(IniLimits, AFileOverTheSizeCapIsRefused) {
+  TempDir dir;
+  const std::string big = dir.file("big.ini");
+  { std::ofstream(big) << "[*]\n"; }
+  std::filesystem::resize_file(big, (16u << 20) + 1);  // sparse: no 16 MiB written
+  try {
+    carmen::ParamFile::load(big);
+    ADD_FAILURE() << "no error";
+  } catch (const carmen::FileError &e) {
+    EXPECT_EQ(e.file(), big);
     EXPECT_NE(std::string(e.what()).find("larger than 16 MiB"), std::string::npos) << e.what();
   }
 }

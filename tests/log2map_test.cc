@@ -380,6 +380,22 @@ TEST(Log2Map, OneDirectorySpelledTwoWaysDoesNotHang) {
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"alias", "x.map", "x.png", "y.png", "z.png"}));
 }
 
+// A carmen.ini or a pose file is read whole: a FIFO nobody writes blocked the
+// open for ever; it is refused at once, named (a log may be a FIFO: the
+// reader waits for its first byte, with a limit).
+TEST(Log2Map, AFifoAsParamFileOrPoseFileIsRefusedNotWaitedFor) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo(dir.file("carmen.ini").c_str(), 0600), 0);
+  ASSERT_EQ(::mkfifo(dir.file("poses.g2o").c_str(), 0600), 0);
+  const ToolRun ini = log2map_few({"--param-file", dir.file("carmen.ini"), kIntel, dir.file("x.map")});
+  EXPECT_EQ(ini.status, 1) << ini.output;
+  EXPECT_TRUE(contains(ini.output, "carmen.ini: is a FIFO, not a regular file: a carmen.ini is read whole")) << ini.output;
+  const ToolRun poses = log2map_few({"--poses", dir.file("poses.g2o"), kIntel, dir.file("x.map")});
+  EXPECT_EQ(poses.status, 1) << poses.output;
+  EXPECT_TRUE(contains(poses.output, "poses.g2o: is a FIFO, not a regular file: a pose file is read whole")) << poses.output;
+  EXPECT_FALSE(maptest::file_exists(dir.file("x.map")));
+}
+
 // A device, a FIFO or a link to a device is not an output: refused before
 // any work, and left as it was.
 TEST(Log2Map, SpecialFilesAreNeverReplaced) {

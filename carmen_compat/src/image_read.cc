@@ -17,6 +17,7 @@
 #include <string>
 
 #include "carmen_compat/error.h"
+#include "carmen_compat/input_file.h"
 #include "carmen_compat/image_io.h"
 
 namespace carmen {
@@ -50,8 +51,7 @@ uint64_t regular_file_size(const std::string &path) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0)
     throw FileError(path, std::string("cannot open: ") + std::strerror(errno), ErrorCode::Io);
-  if (!S_ISREG(st.st_mode)) throw FileError(path, "is not a regular file", ErrorCode::Io);
-  return uint64_t(st.st_size);
+  return require_regular_file(path, "an image");
 }
 
 // std::bad_alloc from `read` as a FileError naming the file.

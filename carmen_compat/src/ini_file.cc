@@ -1,6 +1,7 @@
 // carmen.ini reader: syntax, sections and robot selection as CARMEN 0.7.4's
 // param_daemon has them, typed values as its clients read them (C locale).
 #include "carmen_compat/ini_file.h"
+#include "carmen_compat/input_file.h"
 
 #include <algorithm>
 #include <cctype>
@@ -319,6 +320,7 @@ std::string ParamWarning::str() const { return FileError::format(file, line, mes
 // Reading
 
 ParamFile ParamFile::load(const std::string &path, const std::string &robot) {
+  require_regular_file(path, "a carmen.ini");  // a FIFO would block fopen for ever
   std::FILE *fp = std::fopen(path.c_str(), "rb");
   if (fp == nullptr) throw FileError(path, std::string("cannot open: ") + std::strerror(errno));
   std::string text;

@@ -18,6 +18,7 @@
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/file_names.h"
+#include "carmen_compat/input_file.h"
 #include "carmen_compat/log_reader.h"
 #include "vasco_gpu/scan_batch.h"
 
@@ -59,10 +60,8 @@ std::string quoted(std::string_view field) {
 class TextLines {
  public:
   explicit TextLines(const std::string &path) : path_(path) {
-    // A directory opens, then reads as empty: say what it is instead.
-    struct stat st;
-    if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-      throw FileError(path, "cannot read: is a directory", ErrorCode::Io);
+    // A directory opens, then reads as empty; a FIFO blocks the open: say what it is instead.
+    carmen::require_regular_file(path, "a pose file");
     in_.open(path, std::ios::binary);
     if (!in_) throw FileError(path, std::string("cannot open: ") + std::strerror(errno), ErrorCode::Io);
   }
