@@ -30,6 +30,7 @@
 #include <tuple>
 
 #include "carmen_compat/error.h"
+#include "carmen_compat/input_file.h"
 
 namespace carmen {
 namespace {
@@ -163,14 +164,7 @@ int exchange_names(const std::string &a, const std::string &b) {
 }
 
 // --- What a rename cannot or must not replace --------------------------------
-const char *kind_of_file(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
-}
+const char *kind_of_file(mode_t mode) { return file_kind_text(static_cast<unsigned>(mode)); }
 
 // "/a/b\040c" in /proc/self/mountinfo is "/a/b c".
 std::string unescape_mount_path(const std::string &s) {

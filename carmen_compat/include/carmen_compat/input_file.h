@@ -17,6 +17,10 @@ namespace carmen {
 // whose error says so. Returns the file's size when it exists, else 0.
 uint64_t require_regular_file(const std::string &path, const std::string &what);
 
+// "a FIFO", "a directory", "a character device", ... for a stat st_mode that
+// is not a regular file's (the one wording of inputs and outputs).
+const char *file_kind_text(unsigned mode);
+
 }  // namespace carmen
 
 #endif  // CARMEN_COMPAT_INPUT_FILE_H
