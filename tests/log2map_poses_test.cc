@@ -230,6 +230,32 @@ TEST_F(Log2MapPoses, SkipUnposedLeavesOutScansOfTheSelectedRunNotBeforeIt) {
   EXPECT_TRUE(contains(none.output, "in the selected run")) << none.output;
 }
 
+TEST_F(Log2MapPoses, HugePosesAreBlamedOnThePoseFile) {
+  // A pose of 1e300 m matched exactly: the grid cannot hold it, and the error
+  // names the pose file (it named the log's line).
+  std::string tum;
+  for (size_t i = 0; i < moved_.size(); ++i)
+    tum += g17(moved_[i].stamp()) + " " + (i == 5 ? std::string("1e300") : g17(moved_[i].get(0))) + " " +
+           g17(moved_[i].get(1)) + " 0 0 0 0 1\n";
+  maptest::write_bytes(dir_.file("huge.txt"), tum);
+  const ToolRun huge = log2map({"--poses", dir_.file("huge.txt"), kIntel, dir_.file("x.map")});
+  EXPECT_EQ(huge.status, 1) << huge.output;
+  EXPECT_TRUE(contains(huge.output, dir_.file("huge.txt") + ": ")) << huge.output;
+  EXPECT_FALSE(contains(huge.output, kIntel)) << huge.output;
+  // Two poses whose difference overflows: the scan between them has no pose,
+  // and the error says why, naming the file and the two lines.
+  const double t0 = std::min(moved_[0].stamp(), moved_[1].stamp()) - 0.5;
+  const double t1 = std::max(moved_[0].stamp(), moved_[1].stamp()) + 0.5;
+  maptest::write_bytes(dir_.file("over.txt"), g17(t0) + " -1e308 0 0 0 0 0 1\n" + g17(t1) + " 1e308 0 0 0 0 0 1\n");
+  const ToolRun over = log2map({"--poses", dir_.file("over.txt"), "--vasco_num_scans", "2", "--pose-max-gap", "100",
+                                kIntel, dir_.file("x.map")});
+  EXPECT_EQ(over.status, 1) << over.output;
+  EXPECT_TRUE(contains(over.output, dir_.file("over.txt") + ": no pose for ")) << over.output;
+  EXPECT_TRUE(contains(over.output, "the poses of lines 1 and 2 around it interpolate to a pose that is not finite"))
+      << over.output;
+  EXPECT_FALSE(maptest::file_exists(dir_.file("x.map")));
+}
+
 TEST_F(Log2MapPoses, BadPoseOptionsAreUsageErrors) {
   EXPECT_EQ(log2map({"--pose-tolerance", "0.5", kIntel, dir_.file("x.map")}).status, 2);
   EXPECT_EQ(log2map({"--pose-max-gap", "2", kIntel, dir_.file("x.map")}).status, 2);  // without --poses

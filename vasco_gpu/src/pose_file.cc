@@ -407,8 +407,9 @@ std::string seconds_text(double d, double limit) {
   return number_text(d);
 }
 
-// How a scan's stamp was matched.
-enum class StampMatch { None, Exact, Interpolated, Nearest };
+// How a scan's stamp was matched; Invalid: two poses whose interpolation is
+// not a number (coordinates so large that their difference overflows).
+enum class StampMatch { None, Exact, Interpolated, Nearest, Invalid };
 
 // The pose at stamp t (PoseMatchOptions: exact, interpolated within a gap
 // of at most max_gap, else the nearest pose within tolerance), or None with
@@ -443,7 +444,10 @@ StampMatch pose_at(const std::vector<StampedPose> &poses, double t, const PoseMa
   const double gap = p1.stamp - p0.stamp;
   if (gap <= o.max_gap) {
     pose = interpolate(p0, p1, t);
-    return StampMatch::Interpolated;
+    if (std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.theta)) return StampMatch::Interpolated;
+    why = "the poses of lines " + std::to_string(p0.line) + " and " + std::to_string(p1.line) +
+          " around it interpolate to a pose that is not finite: their coordinates are too large";
+    return StampMatch::Invalid;
   }
   // A hole in the trajectory: its sides are ends, as the trajectory's are.
   const double d0 = t - p0.stamp, d1 = p1.stamp - t;
@@ -472,6 +476,7 @@ void match_by_time(const PoseFile &file, const Scans &scans, const PoseMatchOpti
   for (size_t s = 0; s < scans.count; ++s) {
     std::string why = "the file has no poses";
     const StampMatch how = poses.empty() ? StampMatch::None : pose_at(poses, scans.stamps[s], options, m.pose[s], why);
+    if (how == StampMatch::Invalid) throw FileError(file.path, "no pose for " + scan_name(scans, s) + ": " + why);
     if (how != StampMatch::None) {
       m.matched[s] = 1;
       m.interpolated += how == StampMatch::Interpolated;

@@ -134,6 +134,9 @@ LogInput finish_input(StampedScans scans, carmen::ParamFile &params, const LogIn
   try {
     in.geo = size_grid(in.batch, in.params);  // the frame a Mapper's first insert of in.batch takes
   } catch (const carmen::Error &e) {
+    // The poses came from the pose file where one was given: it is the file to name.
+    if (!options.poses.file.empty())
+      throw carmen::FileError(options.poses.file, std::string(e.what()) + " (with the poses of this file)", e.code());
     throw carmen::FileError(options.log, e.what(), e.code());
   }
   check_downsample(in, params, options.log);
