@@ -153,6 +153,24 @@ TEST_P(MapIo, WriteAllThenReadEveryChunk) {
   EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_HMAP_CHUNK), 0);
 }
 
+// A run that mapped nothing hands write_all a 0 x 0 grid: refused, with a
+// message, before anything is written (it left a comment and a header).
+TEST_P(MapIo, WriteAllOfAnEmptyGridWritesNothing) {
+  const std::string file = path("empty");
+  carmen_FILE *fp = carmen_fopen(file.c_str(), "w");
+  ASSERT_NE(fp, nullptr);
+  float *no_rows[1] = {nullptr};
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(carmen_map_write_all(fp, no_rows, 0, 0, 0.1, "log.clf", "empty", "o", "d", nullptr, 0, nullptr, 0,
+                                 nullptr, 0),
+            -1);
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_NE(said.find("carmen_map_write_all"), std::string::npos) << said;
+  EXPECT_NE(said.find("invalid map size 0 x 0"), std::string::npos) << said;
+  ASSERT_EQ(carmen_fclose(fp), 0);
+  if (GetParam() == std::string(".map")) EXPECT_EQ(read_bytes(file), "");
+}
+
 TEST_P(MapIo, CommentBlockIsCarmenReadable) {
   const std::string file = path("comments");
   carmen_FILE *fp = carmen_fopen(file.c_str(), "w");

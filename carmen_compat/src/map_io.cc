@@ -351,30 +351,36 @@ extern "C" {
 // CARMEN's bytes (map_file.h, standard_map_comments): the author is
 // getlogin(), or "UNKNOWN" when it has none; a NULL origin or description is
 // written "(null)", as glibc's printf writes CARMEN's NULL.
+// The bytes of CARMEN's comment lines and creator chunk, as its writers make them.
+static std::string comment_bytes(int size_x, int size_y, double resolution, const char *origin,
+                                 const char *description) {
+  return carmen::encode_comment_lines(carmen::standard_map_comments(
+      size_x, size_y, resolution, origin ? origin : "(null)", description ? description : "(null)", login_name(),
+      static_cast<int64_t>(std::time(nullptr))));
+}
+
+static std::string creator_bytes(const char *name, const char *origin, const char *description) {
+  carmen::CreatorInfo c;
+  c.user = login_name();
+  c.origin = origin ? origin : "";
+  c.description = description ? description : "";
+  c.time = static_cast<int64_t>(std::time(nullptr));
+  c.time_bytes = static_cast<int>(sizeof(time_t));
+  return carmen::encode_creator_chunk(c, name ? name : "");
+}
+
 int carmen_map_write_comment_chunk(carmen_FILE *fp, int size_x, int size_y, double resolution,
                                    const char *origin, const char *description) {
   const char *const fn = __func__;
-  return guarded(fn, nullptr, [&] {
-    const auto lines = carmen::standard_map_comments(
-        size_x, size_y, resolution, origin ? origin : "(null)", description ? description : "(null)",
-        login_name(), static_cast<int64_t>(std::time(nullptr)));
-    return write_bytes(fp, carmen::encode_comment_lines(lines), fn);
-  });
+  return guarded(fn, nullptr,
+                 [&] { return write_bytes(fp, comment_bytes(size_x, size_y, resolution, origin, description), fn); });
 }
 
 int carmen_map_write_id(carmen_FILE *fp) { return write_bytes(fp, carmen::encode_map_id(), __func__); }
 
 static int write_creator(const char *fn, carmen_FILE *fp, const char *name, const char *origin,
                          const char *description) {
-  return guarded(fn, nullptr, [&] {
-    carmen::CreatorInfo c;
-    c.user = login_name();
-    c.origin = origin ? origin : "";
-    c.description = description ? description : "";
-    c.time = static_cast<int64_t>(std::time(nullptr));
-    c.time_bytes = static_cast<int>(sizeof(time_t));
-    return write_bytes(fp, carmen::encode_creator_chunk(c, name ? name : ""), fn);
-  });
+  return guarded(fn, nullptr, [&] { return write_bytes(fp, creator_bytes(name, origin, description), fn); });
 }
 int carmen_map_write_creator_chunk(carmen_FILE *fp, const char *origin, const char *description) {
   return write_creator(__func__, fp, nullptr, origin, description);
@@ -434,20 +440,20 @@ int carmen_map_write_all(carmen_FILE *fp, float **prob, int size_x, int size_y, 
                          const char *creator_origin, const char *creator_description, carmen_place_p places,
                          int num_places, carmen_offlimits_p offlimits_list, int offlimits_num_items,
                          carmen_laser_scan_p scan_list, int num_scans) {
-  if (carmen_map_write_comment_chunk(fp, size_x, size_y, resolution, comment_origin, comment_description) <
-          0 ||
-      carmen_map_write_id(fp) < 0 ||
-      carmen_map_write_creator_chunk(fp, creator_origin, creator_description) < 0 ||
-      carmen_map_write_gridmap_chunk(fp, prob, size_x, size_y, resolution) < 0) {
-    return -1;
-  }
-  if (num_places > 0 && carmen_map_write_places_chunk(fp, places, num_places) < 0) return -1;
-  if (offlimits_num_items > 0 &&
-      carmen_map_write_offlimits_chunk(fp, offlimits_list, offlimits_num_items) < 0) {
-    return -1;
-  }
-  if (num_scans > 0 && carmen_map_write_laserscans_chunk(fp, scan_list, num_scans) < 0) return -1;
-  return 0;
+  // Every chunk is encoded before a byte is written: a map that cannot be
+  // written (a 0 x 0 grid from a run that mapped nothing) leaves the file as
+  // it was, not a comment and a header without a grid.
+  const char *const fn = __func__;
+  return guarded(fn, nullptr, [&] {
+    std::string bytes = comment_bytes(size_x, size_y, resolution, comment_origin, comment_description) +
+                        carmen::encode_map_id() + creator_bytes(nullptr, creator_origin, creator_description) +
+                        carmen::encode_gridmap_chunk(grid_from(prob, size_x, size_y, resolution), "");
+    if (num_places > 0) bytes += carmen::encode_places_chunk(places_from(places, num_places), "");
+    if (offlimits_num_items > 0)
+      bytes += carmen::encode_offlimits_chunk(offlimits_from(offlimits_list, offlimits_num_items), "");
+    if (num_scans > 0) bytes += carmen::encode_laserscans_chunk(scans_from(scan_list, num_scans), "");
+    return write_bytes(fp, bytes, fn);
+  });
 }
 
 // ---------------------------------------------------------------------------
