@@ -185,6 +185,29 @@ TEST(MapAtomicOutput, SignalsRemoveTheTemporaries) {
   EXPECT_TRUE(dir.entries().empty());
 }
 
+// A directory of our own (log2map's for the output '-') registered with its
+// file and an output being written in it: a signal removes all three, the
+// directory after what is in it, whatever the order they were registered in.
+TEST(MapAtomicOutput, SignalsRemoveOurDirectoriesToo) {
+  TempDir dir;
+  const std::string own = dir.file("own");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    carmen::remove_temporaries_on_signals();
+    if (::mkdir(own.c_str(), 0700) != 0) ::_exit(4);
+    carmen::TemporaryOnSignal d(own), f(own + "/stdout.map");
+    write_text(own + "/stdout.map", "done map");
+    carmen::AtomicOutput late(own + "/more.map");
+    ::raise(SIGTERM);
+    ::_exit(3);  // not reached
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+  EXPECT_TRUE(dir.entries().empty()) << (dir.entries().empty() ? "" : dir.entries()[0]);
+}
+
 TEST(MapOutputTransaction, AFailureBeforeCommitTouchesNoOutput) {
   TempDir dir;
   write_text(dir.file("keep.map"), "old map");

@@ -125,6 +125,8 @@ void unregister_temp(int slot) {
 extern "C" void remove_temporaries_and_die(int sig) {
   for (int i = 0; i < kSlots; ++i)
     if (slot_used[i]) ::unlink(slot_path[i]);  // async-signal-safe
+  for (int i = 0; i < kSlots; ++i)
+    if (slot_used[i]) ::rmdir(slot_path[i]);  // the directories, now that their files are gone
   ::signal(sig, SIG_DFL);
   ::raise(sig);
 }
@@ -371,6 +373,9 @@ void AtomicOutput::set_name_source_for_testing(std::function<std::string()> sour
   std::lock_guard<std::mutex> lock(name_mutex);
   name_source() = std::move(source);
 }
+
+TemporaryOnSignal::TemporaryOnSignal(const std::string &path) : slot_(register_temp(path)) {}
+TemporaryOnSignal::~TemporaryOnSignal() { unregister_temp(slot_); }
 
 AtomicOutput::AtomicOutput(std::string final_path) : final_path_(std::move(final_path)) {
   check_replaceable(final_path_);  // before a temporary appears beside a device or in a directory we cannot use

@@ -106,6 +106,8 @@ StdoutFile::StdoutFile(const std::string &extension) {
                                                    std::string(std::strerror(errno)));
   dir_ = pattern;
   path_ = dir_ + "/stdout" + extension;
+  dir_on_signal_ = std::make_unique<carmen::TemporaryOnSignal>(dir_);
+  path_on_signal_ = std::make_unique<carmen::TemporaryOnSignal>(path_);
 }
 
 StdoutFile::~StdoutFile() {

@@ -7,8 +7,11 @@
 #include <chrono>
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "carmen_compat/atomic_file.h"
 
 namespace cli {
 
@@ -52,6 +55,9 @@ class StdoutFile {
 
  private:
   std::string dir_, path_;
+  // Both go if a signal kills the process while the map is made or sent
+  // (remove_temporaries_on_signals): the directory after its file.
+  std::unique_ptr<carmen::TemporaryOnSignal> dir_on_signal_, path_on_signal_;
 };
 
 // Throws carmen::Error(Io) when standard output is closed or read-only, so

@@ -159,6 +159,20 @@ void write_file_atomically(const std::string &path, std::string_view contents, b
 // Idempotent.
 void remove_temporaries_on_signals();
 
+// A path of our own making that a fatal signal must not leave behind (a file,
+// or a directory, removed once empty), registered with the temporaries above
+// for the life of this object; what removes it otherwise is the owner's job.
+class TemporaryOnSignal {
+ public:
+  explicit TemporaryOnSignal(const std::string &path);
+  ~TemporaryOnSignal();
+  TemporaryOnSignal(const TemporaryOnSignal &) = delete;
+  TemporaryOnSignal &operator=(const TemporaryOnSignal &) = delete;
+
+ private:
+  int slot_;
+};
+
 }  // namespace carmen
 
 #endif  // CARMEN_COMPAT_ATOMIC_FILE_H
