@@ -92,8 +92,8 @@ void keep_posed(LogInput &in, const std::vector<uint8_t> &matched, size_t first,
 }
 
 // The stamps of the scans select() keeps.
-void select_stamps(std::vector<double> &stamps, long first_scan, size_t kept) {
-  const size_t begin = std::min<size_t>(static_cast<size_t>(std::max(first_scan, 0L)), stamps.size());
+void select_stamps(std::vector<double> &stamps, size_t first, size_t kept) {
+  const size_t begin = std::min(first, stamps.size());
   stamps.erase(stamps.begin(), stamps.begin() + static_cast<std::ptrdiff_t>(begin));
   stamps.resize(kept);
 }
@@ -121,7 +121,7 @@ LogInput finish_input(StampedScans scans, carmen::ParamFile &params, const LogIn
                                         scans.batch.num_scans());
   in.stamps = std::move(scans.stamps);
   in.batch = std::move(scans.batch).select(in.params.first_scan, in.params.num_scans);  // no copy of the ranges
-  select_stamps(in.stamps, in.params.first_scan, in.batch.num_scans());
+  select_stamps(in.stamps, first, in.batch.num_scans());
   keep_posed(in, matched, first, options.poses, options.log);
   in.load.scans_used = static_cast<long>(in.batch.num_scans());
   if (in.batch.num_scans() == 0)

@@ -27,7 +27,7 @@ import numpy as np
 from .header import frame_name
 from .scans import LaserReading, apply_rep117
 
-__all__ = ["CLOUD_DEFAULTS", "check_cloud_options", "cloud_points_xyz", "read_cloud"]
+__all__ = ["CLOUD_DEFAULTS", "check_cloud_options", "cloud_mount", "cloud_points_xyz", "read_cloud"]
 
 #: z band (m, in the base frame), angle step (rad), farthest point used (m): the defaults.
 CLOUD_DEFAULTS = {"z_band": (0.2, 1.8), "angle_step": math.radians(0.25), "range_max": 50.0}
@@ -44,6 +44,16 @@ def check_cloud_options(z_band, angle_step, range_max) -> None:
                          f"{math.degrees(angle_step):g}")
     if not (math.isfinite(range_max) and 0 < range_max <= 1000):
         raise ValueError(f"cloud_range_max (--cloud-range-max) must be above 0 and at most 1000 m, not {range_max!r}")
+
+
+def cloud_mount(tf, base: str, frame: str):
+    """The cloud frame's transform in the base frame, (t (3,), q (4,)), from static tf links
+    (read_cloud's mount); None when the cloud is in the base frame. A TfError when tf has no
+    static chain between them."""
+    if frame == base:
+        return None
+    t, q = tf.lookup(base, frame, np.zeros(1, dtype=np.int64), static_only=True)
+    return t[0], q[0]
 
 
 def cloud_points_xyz(msg, fail) -> np.ndarray:

@@ -107,13 +107,20 @@ class PoseSeries:
                                       f"[{stamp_text(times[0])}, {stamp_text(times[-1])}] of pose topic "
                                       f"{self.topic!r} (skip_unposed / --skip-unposed leaves such scans out)",
                            topic=self.topic, stamp=stamp_seconds(bad))
-        hit, i, lo, hi, f = bracket(times, ns)
-        a, b = vals[lo], vals[hi]
-        out = np.empty((len(ns), 3))
-        out[:, :2] = a[:, :2] + (b[:, :2] - a[:, :2]) * f[:, None]
-        out[:, 2] = a[:, 2] + wrap_angle(b[:, 2] - a[:, 2]) * f
-        out[hit] = vals[i[hit]]  # exact hits: the sample unchanged
-        return out
+        return planar_at(times, vals, ns)
+
+
+def planar_at(times: np.ndarray, vals: np.ndarray, ns: np.ndarray) -> np.ndarray:
+    """(n, 3) planar poses at stamps ns (within the span of the sorted samples times, vals):
+    the sample on an exact hit, else linear x, y and shortest-arc yaw between the bracketing
+    samples (the --poses rule; a pose topic's and the live node's Path)."""
+    hit, i, lo, hi, f = bracket(times, ns)
+    a, b = vals[lo], vals[hi]
+    out = np.empty((len(ns), 3))
+    out[:, :2] = a[:, :2] + (b[:, :2] - a[:, :2]) * f[:, None]
+    out[:, 2] = a[:, 2] + wrap_angle(b[:, 2] - a[:, 2]) * f
+    out[hit] = vals[i[hit]]  # exact hits: the sample unchanged
+    return out
 
 
 def static_mount(path, tf: TfBuffer | None, base: str, frame: str) -> np.ndarray | None:

@@ -19,7 +19,7 @@ import numpy as np
 
 from .errors import BagError
 from .geometry import check_mount
-from .cloud import CLOUD_DEFAULTS, check_cloud_options
+from .cloud import CLOUD_DEFAULTS, check_cloud_options, cloud_mount
 from .header import stamp_seconds, stamp_text
 from .poses import PoseSeries, poses_for
 from .scans import ECHO_MODES, NO_RETURN_MODES, STAMP_MODES, BagScans, ScanAccumulator
@@ -194,18 +194,15 @@ def cloud_options(path, tf, base_frame, z_band, angle_step, range_max) -> dict:
     base = base_frame or "base_link"
 
     def mount_of(frame: str, ns: int):
-        if frame == base:
-            return None
         try:
-            if tf is None:
+            if tf is None and frame != base:
                 raise BagError(path, "the bag has no /tf_static")
-            t, q = tf.lookup(base, frame, np.zeros(1, dtype=np.int64), static_only=True)
+            return cloud_mount(tf, base, frame)
         except BagError as e:
             raise BagError(path, f"the point clouds' height band is in the base frame {base!r}: no static "
                                  f"chain {base} -> {frame!r} on /tf_static before the first cloud (stamp "
                                  f"{stamp_text(ns)}): {e.message}; pass --base-frame {frame} (base_frame="
                                  f"{frame!r}) to take heights in the cloud's own frame", stamp=stamp_seconds(ns)) from None
-        return t[0], q[0]
 
     options["mount_of"] = mount_of
     return options

@@ -17,7 +17,8 @@ from array import array
 import numpy as np
 
 from .. import _core
-from ..bags.geometry import planar_compose, wrap_angle
+from ..bags.geometry import planar_compose
+from ..bags.poses import planar_at
 from ..bags.series import bracket, sorted_samples
 
 __all__ = ["LiveMap", "LiveMapError"]
@@ -112,17 +113,12 @@ class LiveMap:
         counts["no_mount"] = int((inside & ~has_mount).sum())
         take = np.flatnonzero(inside & has_mount)
         if len(take):
-            hit, i, lo, hi, f = bracket(times, ns[take])
+            hit, _, lo, hi, _ = bracket(times, ns[take])
             near = hit | (times[hi] - times[lo] <= max_gap_ns)
             counts["in_gap"] = int((~near).sum())
-            take, hit, i, lo, hi, f = take[near], hit[near], i[near], lo[near], hi[near], f[near]
-            a, b = vals[lo], vals[hi]
-            base = np.empty((len(take), 3))
-            base[:, :2] = a[:, :2] + (b[:, :2] - a[:, :2]) * f[:, None]
-            base[:, 2] = a[:, 2] + wrap_angle(b[:, 2] - a[:, 2]) * f
-            base[hit] = vals[i[hit]]
+            take = take[near]
             poses = self._pose_array().copy()
-            poses[take] = planar_compose(base, mounts[take])
+            poses[take] = planar_compose(planar_at(times, vals, ns[take]), mounts[take])
             counts["moved"] = len(take)
             self.render(poses)
         return counts

@@ -23,7 +23,7 @@ from ..bags.errors import BagError
 from ..bags.geometry import QUAT_TOL, planar, yaw
 from ..bags.header import frame_name, stamp_ns, stamp_text
 from ..bags.poses import static_mount
-from ..bags.cloud import read_cloud
+from ..bags.cloud import cloud_mount, read_cloud
 from ..bags.scans import COUNT_KEYS, read_laser
 from ..bags.tf import TfBuffer
 from .grid import fill_grid
@@ -177,9 +177,14 @@ class MappingNode(Node):
             self._mounts.clear()
         self._pose_pending()
 
-    def _on_scan(self, msg, topic: str, multi_echo: bool) -> None:
+    def _paused_on(self, topic: str) -> bool:
+        """While paused, a message on topic is counted and not mapped."""
         if self.paused:
             self.refused[(topic, "paused")] = self.refused.get((topic, "paused"), 0) + 1
+        return self.paused
+
+    def _on_scan(self, msg, topic: str, multi_echo: bool) -> None:
+        if self._paused_on(topic):
             return
         ns = stamp_ns(msg.header.stamp)
         where = f"{self.resolve_topic_name(topic)}: scan at stamp {stamp_text(ns)}"
@@ -196,8 +201,7 @@ class MappingNode(Node):
 
     def _on_cloud(self, msg, topic: str) -> None:
         """A PointCloud2: read once its frame's mount is known (the height band is in base_frame)."""
-        if self.paused:
-            self.refused[(topic, "paused")] = self.refused.get((topic, "paused"), 0) + 1
+        if self._paused_on(topic):
             return
         self.pending.append(_Pending(topic, stamp_ns(msg.header.stamp), None,
                                      time.monotonic() + self.settings.transform_timeout, time.perf_counter(), msg))
@@ -207,17 +211,14 @@ class MappingNode(Node):
         """Turns a waiting cloud into its reading; False while its mount is not known yet.
         Raises Refused for a cloud that cannot be read."""
         s, frame = self.settings, frame_name(p.cloud.header.frame_id)
-        mount = None
-        if frame != s.base_frame:
-            try:
-                t, q = self.tf.lookup(s.base_frame, frame, [0], static_only=True)
-            except BagError as e:
-                if time.monotonic() < p.deadline:
-                    return False
-                raise Refused(f"{self._where(p)} not mapped: its height band is in {s.base_frame!r}, and "
-                              f"there is no /tf_static chain {s.base_frame} -> {frame!r} within "
-                              f"transform_timeout: {e.message}", "clouds without a mount") from None
-            mount = (t[0], q[0])
+        try:
+            mount = cloud_mount(self.tf, s.base_frame, frame)
+        except BagError as e:
+            if time.monotonic() < p.deadline:
+                return False
+            raise Refused(f"{self._where(p)} not mapped: its height band is in {s.base_frame!r}, and "
+                          f"there is no /tf_static chain {s.base_frame} -> {frame!r} within "
+                          f"transform_timeout: {e.message}", "clouds without a mount") from None
         where = self._where(p)
         p.reading = read_cloud(p.cloud, no_return=s.no_return, counts=self.range_counts,
                                fail=lambda what: Refused(f"{where} {what}; not mapped", "bad clouds"),
