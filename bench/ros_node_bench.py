@@ -82,7 +82,7 @@ def summary_value(line: str, what: str) -> str:
 
 def bench_one(player, log, name, args, stamps, raw_path):
     params = {**BACKENDS[name], "scan_qos": "reliable", "map_update_interval": 0.5, "transform_timeout": 2.0,
-              "resolution": args.resolution, "downsample": args.downsample}
+              "resolution": args.resolution, "vasco_downsample": args.downsample}
     proc = NodeProcess(params)
     try:
         proc.wait_for("ready", timeout=120)
@@ -110,14 +110,15 @@ def main() -> int:
     ap.add_argument("--live-scans", type=int, default=400, help="scans replayed at --rate")
     ap.add_argument("--fast-rate", type=float, default=400.0, help="the rest's rate (Hz)")
     ap.add_argument("--paths", type=int, default=5, help="Paths published, one after the other")
-    ap.add_argument("--resolution", type=float, default=0.05, help="vasco_resolution (m)")
-    ap.add_argument("--downsample", type=int, default=1, help="vasco_downsample (1: /map at --resolution)")
+    ap.add_argument("--resolution", type=float, default=0.05, help="the map's cell (m): the node's resolution")
+    ap.add_argument("--downsample", type=int, default=1,
+                    help="vasco_downsample (1: the evidence grid at --resolution too)")
     args = ap.parse_args()
     names = args.backends or [b for b in BACKENDS if vg.cuda_available() or not b.startswith("cuda")]
     rclpy.init()
     player = Player()
     try:
-        print(f"# map cell {args.resolution * args.downsample:g} m; {args.live_scans} scans at {args.rate:g} Hz, "
+        print(f"# map cell {args.resolution:g} m (evidence grid {args.resolution / args.downsample:g} m); {args.live_scans} scans at {args.rate:g} Hz, "
               f"the rest at {args.fast_rate:g} Hz; Path -> /map over {args.paths} Paths")
         print(f"{'log':<24} {'backend':<12} {'scans':>11} {'CPU 40 Hz':>9} {'CPU fast':>8} "
               f"{'scan p50/p99 ms':>16} {'Path->/map ms':>13} {'best':>7} {'vs cpu_double':>13}")

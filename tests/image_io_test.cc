@@ -110,6 +110,20 @@ TEST(MapImagePgm, TrinaryPixelsAndYaml) {
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"tiny.pgm", "tiny.yaml"}));
 }
 
+// Numbers as people write them (issue: ROS conventions): a resolution
+// computed as 0.03 / 7 * 7 (not 0.03 in double) and origins with 17 digits
+// come out as the shortest text of their nearest float.
+TEST(MapImagePgm, YamlNumbersAreTheShortestTextOfTheirFloat) {
+  TempDir dir;
+  carmen::GridMap m = tiny_map();
+  m.resolution = 0.03 / 7 * 7;
+  ASSERT_NE(m.resolution, 0.03);  // else this test would not see a long resolution
+  carmen::write_pgm_with_yaml(dir.file("n.pgm"), m, carmen::GlobalOffset{-13.499734000000002, 1234.5678901234, 0});
+  const auto yaml = read_yaml(dir.file("n.yaml"));
+  EXPECT_EQ(yaml.at("resolution"), "0.03");
+  EXPECT_EQ(yaml.at("origin"), "[-13.499734, 1234.5679, 0]");  // 1234.5679f is the float nearest 1234.5678901234
+}
+
 TEST(MapImagePgm, ScaleAndRawModes) {
   TempDir dir;
   carmen::write_pgm_with_yaml(dir.file("s.pgm"), tiny_map(), {}, carmen::PgmMode::Scale);

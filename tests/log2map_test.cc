@@ -188,6 +188,45 @@ TEST(Log2Map, LogParamsSelectScansBelowIniAndCommandLine) {
   EXPECT_EQ(scans({"--param-file", ini, "--vasco_num_scans", "7"}), 7);
 }
 
+// --resolution M: the written map's cell, by params.h's one rule. The maps
+// it makes are compared with maps made by CARMEN's own keys, set by hand to
+// what the rule says (0.1 = 0.025 x 4: vasco's defaults; 0.05 = 0.025 x 2;
+// a given downsample 1: 0.05 x 1).
+TEST(Log2Map, ResolutionSetsTheWrittenCellByOneRule) {
+  TempDir dir;
+  const auto grid = [&](const std::string &name, std::vector<std::string> args) {
+    args.insert(args.begin(), {"--backend", "cpu_threads", "-q", kIntel, dir.file(name)});
+    const ToolRun r = log2map(args);
+    EXPECT_EQ(r.status, 0) << r.output;
+    return *carmen::read_map_file(dir.file(name)).gridmap;
+  };
+  const auto same = [](const carmen::GridMap &a, const carmen::GridMap &b) {
+    return a.size_x == b.size_x && a.size_y == b.size_y && float(a.resolution) == float(b.resolution) &&
+           a.cells == b.cells;
+  };
+  EXPECT_TRUE(same(grid("a.map", {"--resolution", "0.1"}), grid("b.map", {})));
+  const carmen::GridMap c = grid("c.map", {"--resolution", "0.05", dir.file("c.pgm")});
+  EXPECT_FLOAT_EQ(float(c.resolution), 0.05f);
+  EXPECT_TRUE(same(c, grid("d.map", {"--vasco_downsample", "2"})));
+  EXPECT_TRUE(contains(maptest::read_bytes(dir.file("c.yaml")), "\nresolution: 0.05\n"));
+  const std::string ini = write_text(dir, "one.ini", "[*]\nvasco_downsample 1\n");
+  EXPECT_TRUE(same(grid("e.map", {"--param-file", ini, "--resolution", "0.05"}),
+                   grid("f.map", {"--vasco_resolution", "0.05", "--vasco_downsample", "1"})));
+
+  for (const std::vector<std::string> &bad : {std::vector<std::string>{"--resolution", "0"},
+                                              {"--resolution", "abc"},
+                                              {"--resolution", "inf"},
+                                              {"--resolution", "1e-9"},
+                                              {"--resolution", "0.05", "--vasco_resolution", "0.01"}}) {
+    std::vector<std::string> args = bad;
+    args.insert(args.end(), {kIntel, dir.file("bad.map")});
+    const ToolRun r = log2map(args);
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "resolution")) << r.output;
+  }
+  EXPECT_FALSE(maptest::file_exists(dir.file("bad.map")));
+}
+
 TEST(Log2Map, PosesTooFarApartNameTheLogAndLines) {
   TempDir dir;
   const std::string log = write_text(dir, "far.log",

@@ -189,5 +189,69 @@ TEST(ParamTable, IniErrorsAreFileErrorsOfBadInputAndOverridesAreUsage) {
   }
 }
 
+// --resolution's rule (docs/parameters.md): the expected values are worked
+// out by hand from the rule, and 0.1 and 0.05 must land on CARMEN's own
+// evidence cell (0.025) exactly, so that a default map stays CARMEN's bytes.
+TEST(MapResolution, KeepsTheEvidenceCellWhenABlockFits) {
+  MapperParams p;
+  p.set_map_resolution(0.1, false);
+  EXPECT_EQ(p.downsample, 4);
+  EXPECT_EQ(p.resolution, 0.025);  // 0.1 / 4 is exact: dividing by 4 only shifts the exponent
+  p.set_map_resolution(0.05, false);
+  EXPECT_EQ(p.downsample, 2);
+  EXPECT_EQ(p.resolution, 0.025);
+  EXPECT_EQ(p.map_resolution(), 0.05);
+  p = MapperParams{};
+  p.set_map_resolution(0.03, false);  // round(1.2) = 1: the evidence cell is the map's
+  EXPECT_EQ(p.downsample, 1);
+  EXPECT_EQ(p.resolution, 0.03);
+  p = MapperParams{};
+  p.set_map_resolution(0.01, false);  // round(0.4) = 0: at least one cell a block
+  EXPECT_EQ(p.downsample, 1);
+  EXPECT_EQ(p.resolution, 0.01);
+  p = MapperParams{};
+  p.set_map_resolution(0.2, false);
+  EXPECT_EQ(p.downsample, 8);
+  EXPECT_EQ(p.resolution, 0.025);
+}
+
+TEST(MapResolution, AGivenDownsampleStays) {
+  MapperParams p;
+  p.downsample = 1;
+  p.set_map_resolution(0.05, true);
+  EXPECT_EQ(p.downsample, 1);
+  EXPECT_EQ(p.resolution, 0.05);
+  p.downsample = 3;
+  p.set_map_resolution(0.05, true);
+  EXPECT_EQ(p.downsample, 3);
+  EXPECT_EQ(p.resolution, 0.05 / 3);
+}
+
+TEST(MapResolution, BadCellsAreRefusedAndLeaveTheParamsAsTheyWere) {
+  for (double bad : {0.0, -0.1, std::nan(""), HUGE_VAL, 1e-9, 1e9}) {
+    MapperParams p;
+    p.range_max = 10;
+    try {
+      p.set_map_resolution(bad, true);
+      ADD_FAILURE() << bad << " was taken";
+    } catch (const ParamError &e) {
+      EXPECT_EQ(e.key(), "map_resolution");
+      EXPECT_NE(std::string(e.what()).find("map resolution"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(p.resolution, MapperParams{}.resolution);
+    EXPECT_EQ(p.downsample, MapperParams{}.downsample);
+  }
+  // An evidence cell too fine for the distance table: the message names the keys it made.
+  MapperParams p;
+  p.downsample = 1000;
+  try {
+    p.set_map_resolution(0.1, true);
+    ADD_FAILURE() << "a 0.0001 m evidence cell with range_max 10 was taken";
+  } catch (const ParamError &e) {
+    EXPECT_NE(std::string(e.what()).find("vasco_downsample 1000"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("32767"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace vasco

@@ -83,6 +83,15 @@ std::string number_text(double v) {
   return buf;
 }
 
+// A YAML's resolution and origin as people write them: the shortest text of
+// the nearest float (0.05, -13.49973, not 0.050000000000000003 or
+// -13.499734000000002). A float says 7 significant digits: an origin 1 km
+// out moves by at most 61 µm, far below any cell; the resolution is a float
+// in a CARMEN map and in ROS's MapMetaData anyway.
+std::string float_number_text(double v) {
+  return number_text(static_cast<double>(static_cast<float>(v)));
+}
+
 std::string file_name_of(const std::string &path) {
   const size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
@@ -286,9 +295,9 @@ void write_map_server_pair(AtomicOutput &image, AtomicOutput &yaml_out, const Gr
   std::string yaml;
   yaml += "image: " + yaml_quoted(file_name_of(image.final_path())) + "\n";
   yaml += "mode: " + std::string(pgm_mode_name(o.mode)) + "\n";
-  yaml += "resolution: " + number_text(map.resolution) + "\n";
-  yaml += "origin: [" + number_text(origin_of_cell00.x) + ", " + number_text(origin_of_cell00.y) + ", " +
-          number_text(origin_of_cell00.theta) + "]\n";
+  yaml += "resolution: " + float_number_text(map.resolution) + "\n";
+  yaml += "origin: [" + float_number_text(origin_of_cell00.x) + ", " + float_number_text(origin_of_cell00.y) + ", " +
+          float_number_text(origin_of_cell00.theta) + "]\n";
   yaml += std::string("negate: ") + (o.negate ? "1" : "0") + "\n";
   yaml += "occupied_thresh: " + number_text(o.occupied_thresh) + "\n";
   yaml += "free_thresh: " + number_text(o.free_thresh) + "\n";

@@ -29,7 +29,7 @@ def generate_launch_description():
                  "-p", ["backend:=", backend], "-p", "cuda_mode:=float",
                  "-p", "scan_topics:=[scan]", "-p", ["path_topic:=", path_topic],
                  "-p", "map_frame:=map", "-p", "base_frame:=base_link",
-                 "-p", "resolution:=0.05", "-p", "downsample:=1",
+                 "-p", "resolution:=0.05", "-p", "vasco_downsample:=1",
                  "-p", "save_map_path:=[maps/vasco.pgm, maps/vasco.map.gz]"],
             output="screen"),
     ])

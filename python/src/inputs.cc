@@ -50,10 +50,19 @@ vasco::Pose2 pose_triple(nb::handle h, const char *what) {
   return vasco::Pose2{v[0], v[1], v[2]};
 }
 
+// map_resolution=M: a finite number > 0 (the written map's cell in metres).
+double map_resolution_of(nb::handle v) {
+  double cell = 0;
+  if (!nb::try_cast(v, cell) || PyBool_Check(v.ptr()) || !std::isfinite(cell) || !(cell > 0))
+    throw Error(ErrorCode::Usage, "map_resolution: expected the written map's cell size in metres, a finite number > 0, "
+                                  "not " + nb::cast<std::string>(nb::repr(v)));
+  return cell;
+}
+
 const std::set<std::string> &input_keywords() {
   static const std::set<std::string> k = {"poses",        "pose_format", "pose_match",  "pose_tolerance",
                                           "pose_max_gap", "pose_ids",    "skip_unposed", "pose_frame",
-                                          "laser_mount",  "transform",   "add"};
+                                          "laser_mount",  "transform",   "add",          "map_resolution"};
   return k;
 }
 
@@ -120,6 +129,7 @@ vasco::LogInput log_from_scans(nb::handle scans, const std::string &source, std:
                                const std::string &robot, std::optional<nb::dict> overrides, nb::kwargs kwargs) {
   vasco::LogInputOptions o;
   fill_input_options(o, source, param_file, robot, overrides, kwargs);
+  o.default_map_resolution = vasco::kRosMapResolution;  // scans read elsewhere come from ROS (bags)
   if (!o.more_logs.empty()) throw Error(ErrorCode::Usage, "add: not for scans read elsewhere: append the scans first");
   vasco::StampedScans s = stamped_scans_of(scans);
   nb::gil_scoped_release release;
@@ -149,8 +159,10 @@ vasco::StampedScans call_reader(nb::handle reader, const std::string &path, cons
 
 int run_tool(const std::vector<std::string> &argv, const std::string &name, const std::string &summary,
              const std::string &input_name, const std::string &input_help,
-             const std::vector<std::tuple<std::string, std::string, std::string>> &extra, nb::object reader) {
+             const std::vector<std::tuple<std::string, std::string, std::string>> &extra, nb::object reader,
+             double default_map_resolution) {
   log2map::ToolSpec spec;
+  spec.default_map_resolution = default_map_resolution;
   spec.name = name;
   spec.summary = summary;
   spec.input_name = input_name;
@@ -187,6 +199,7 @@ void fill_input_options(vasco::LogInputOptions &o, const std::string &path, std:
     if (!input_keywords().count(key)) throw nb::type_error(("unexpected keyword argument '" + key + "'").c_str());
     if (v.is_none()) continue;
     if (key == "transform") o.transform = pose_triple(v, "transform");
+    else if (key == "map_resolution") o.map_resolution = map_resolution_of(v);
     else if (key == "add") o.more_logs = sessions_of(v);
     else {
       set_pose_options(o.poses, key, v);
@@ -205,10 +218,14 @@ void fill_input_options(vasco::LogInputOptions &o, const std::string &path, std:
 void bind_inputs(nb::module_ &m) {
   m.def("_log_from_scans", &log_from_scans, "scans"_a, "source"_a, "param_file"_a = nb::none(), "robot"_a = "",
         "overrides"_a = nb::none(), "kwargs"_a,
-        "A Log from scans read elsewhere: {'scans': Scans, 'stamps': (n,), 'mounts': (n, 3) or None}; the\n"
-        "parameters from param_file and overrides, the pose keywords of load_log.");
+        "A Log from scans read elsewhere (a bag): {'scans': Scans, 'stamps': (n,), 'mounts': (n, 3) or None};\n"
+        "the parameters from param_file and overrides, the pose keywords of load_log; the map cell\n"
+        "ROS_MAP_RESOLUTION unless map_resolution or vasco_resolution says otherwise.");
+  m.attr("ROS_MAP_RESOLUTION") = vasco::kRosMapResolution;
   m.def("_run_tool", &run_tool, "argv"_a, "name"_a, "summary"_a, "input_name"_a, "input_help"_a, "extra"_a,
-        "reader"_a, "log2map's command line with another reader of its inputs; returns the exit status.");
+        "reader"_a, "default_map_resolution"_a = vasco::kRosMapResolution,
+        "log2map's command line with another reader of its inputs (ROS's: default --resolution\n"
+        "ROS_MAP_RESOLUTION unless vasco_resolution is set); returns the exit status.");
 }
 
 }  // namespace vasco_py

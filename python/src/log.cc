@@ -85,7 +85,10 @@ const char *load_log_doc() {
     "nearest pose if at most ``pose_tolerance`` seconds (0.1) away; ``pose_ids`` a file of 'id scan' pairs;\n"
     "``skip_unposed`` leave out scans without a pose; ``pose_frame`` 'laser' | 'robot'; ``laser_mount``\n"
     "(x, y, theta) of the laser on the robot. Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared\n"
-    "frame, ``add`` further logs, each a path or (path, (x, y, theta)).";
+    "frame, ``add`` further logs, each a path or (path, (x, y, theta)).\n\n"
+    "``map_resolution``: the written map's cell in metres (log2map --resolution; ROS's resolution), set over\n"
+    "the keys by Params.map_resolution's rule (vasco_downsample kept where the ini, the log or overrides set\n"
+    "it). None: CARMEN's keys alone (0.025 x 4 = 0.1 m).";
   return doc.c_str();
 }
 
@@ -141,7 +144,8 @@ void bind_log(nb::module_ &m) {
                 "skip_unposed: bool | None = None, pose_frame: str | None = None, "
                 "laser_mount: tuple[float, float, float] | None = None, "
                 "transform: tuple[float, float, float] | None = None, "
-                "add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float]]] | None = None) -> Log"),
+                "add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float]]] | None = None, "
+                "map_resolution: float | None = None) -> Log"),
         load_log_doc());
 }
 

@@ -42,15 +42,35 @@ std::string params_repr(const MapperParams &p) {
   return s + ")";
 }
 
+// map_resolution=M over the other keys (MapperParams::set_map_resolution):
+// ValueError naming it for a bad value; `downsample_given` keeps the block.
+void apply_map_resolution(MapperParams &p, nb::handle v, bool downsample_given) {
+  double cell = 0;
+  if (PyBool_Check(v.ptr()) || !nb::try_cast(v, cell))
+    throw nb::type_error(("map_resolution: expected a number of metres, not " + nb::cast<std::string>(nb::repr(v))).c_str());
+  try {
+    p.set_map_resolution(cell, downsample_given);
+  } catch (const vasco::ParamError &e) {
+    throw nb::value_error(e.what());
+  }
+}
+
 MapperParams params_from_ini(const fs::path &path, const std::string &robot, nb::kwargs overrides) {
   carmen::ParamFile pf = carmen::ParamFile::load(path.string(), robot);
+  nb::object cell;
   for (auto [k, v] : overrides) {
     std::string name = nb::cast<std::string>(k);
+    if (name == "map_resolution") {
+      cell = nb::borrow(v);
+      continue;
+    }
     check_param(name, v);
     if (name.rfind("vasco_", 0) != 0) name = "vasco_" + name;
     pf.set_override(name, nb::cast<std::string>(nb::str(v)));
   }
-  return MapperParams::from_params(pf, nullptr);
+  MapperParams p = MapperParams::from_params(pf, nullptr);
+  if (cell.is_valid()) apply_map_resolution(p, cell, pf.has("vasco_downsample"));
+  return p;
 }
 
 // Params' constructors (keywords, from_ini) and keys().
@@ -59,17 +79,29 @@ void bind_params_constructors(nb::class_<MapperParams> &cls) {
          "__init__",
          [](MapperParams *self, nb::kwargs kwargs) {
            MapperParams p;
-           for (auto [k, v] : kwargs) set_param(p, nb::cast<std::string>(k), v);
+           nb::object cell;
+           bool downsample_given = false;
+           for (auto [k, v] : kwargs) {
+             const std::string name = nb::cast<std::string>(k);
+             if (name == "map_resolution") {
+               cell = nb::borrow(v);
+               continue;
+             }
+             set_param(p, name, v);
+             downsample_given |= name == "downsample" || name == "vasco_downsample";
+           }
            p.validate();
+           if (cell.is_valid()) apply_map_resolution(p, cell, downsample_given);
            new (self) MapperParams(p);
          },
          nb::sig("def __init__(self, **params: float | int) -> None"),
          "Parameters from keywords (ini key names, with or without ``vasco_``); the rest keep vasco's\n"
-         "defaults. Validated.")
+         "defaults. Validated. ``map_resolution=M`` sets the written map's cell (see the property).")
       .def_static("from_ini", &params_from_ini, "path"_a, "robot"_a = "", "overrides"_a,
                   nb::sig("def from_ini(path: str | os.PathLike, robot: str = '', **overrides: float | int) -> Params"),
                   "Parameters from a carmen.ini (sections [*], [expert] and the robot's, as CARMEN's param_daemon\n"
-                  "reads them), keywords overriding the file. Errors raise FileError naming FILE:LINE.")
+                  "reads them), keywords overriding the file (``map_resolution=M`` too). Errors raise FileError\n"
+                  "naming FILE:LINE.")
       .def_static(
           "keys", []() { return vasco::mapper_param_keys(); },
           "The ini keys the mapper understands (vasco_resolution, ...).");
@@ -77,6 +109,10 @@ void bind_params_constructors(nb::class_<MapperParams> &cls) {
 
 // Params' methods: validate, to_dict, repr, equality and copies.
 void bind_params_methods(nb::class_<MapperParams> &cls) {
+  cls.def_prop_ro("map_resolution", &MapperParams::map_resolution,
+                  "The written map's cell size in metres, resolution x downsample: ROS's resolution. Given as\n"
+                  "``Params(map_resolution=M)`` (log2map --resolution), it sets resolution = M / downsample, with\n"
+                  "the downsample given, else the one nearest resolution: max(1, round(M / resolution)).");
   cls.def("validate", &MapperParams::validate, "Raises ValueError naming the key when a value is out of range.")
       .def("to_dict", &params_dict, "The parameters as a dict (keys without ``vasco_``).")
       .def("__repr__", &params_repr)

@@ -4,6 +4,7 @@ files, compare, threads."""
 from __future__ import annotations
 
 import gzip
+import math
 import os
 import pickle
 import subprocess
@@ -121,6 +122,33 @@ def test_params_from_ini(tmp_path):
     with pytest.raises(vg.FileError) as e:
         vg.Params.from_ini(bad)
     assert e.value.file == str(bad) and e.value.line == 3 and "vasco_p_emp" in str(e.value)
+
+
+def test_map_resolution_is_log2maps_rule(tmp_path):
+    """Params(map_resolution=M) (log2map --resolution): values worked out by hand from the rule
+    in docs/cli.md, "Map resolution"."""
+    assert vg.Params().map_resolution == pytest.approx(0.1)
+    assert vg.Params(map_resolution=0.1) == vg.Params()  # CARMEN's 0.025 x 4 exactly
+    p = vg.Params(map_resolution=0.05)
+    assert (p.resolution, p.downsample, p.map_resolution) == (0.025, 2, 0.05)
+    p = vg.Params(map_resolution=0.05, downsample=1)  # a given block stays
+    assert (p.resolution, p.downsample) == (0.05, 1)
+    p = vg.Params(map_resolution=0.4, resolution=0.1)  # round(4.0): the evidence cell kept
+    assert (p.resolution, p.downsample) == (0.1, 4)
+    for bad in (0, -0.1, math.nan, math.inf, 1e-9):
+        with pytest.raises(ValueError, match="map resolution"):
+            vg.Params(map_resolution=bad)
+    with pytest.raises(TypeError, match="map_resolution"):
+        vg.Params(map_resolution="fine")
+    ini = tmp_path / "one.ini"
+    ini.write_text("[*]\nvasco_downsample 1\n")
+    p = vg.Params.from_ini(ini, map_resolution=0.05)
+    assert (p.resolution, p.downsample) == (0.05, 1)
+    log = vg.load_log(INTEL, map_resolution=0.05)
+    assert log.params == vg.load_log(INTEL, overrides={"downsample": 2}).params
+    with pytest.raises(vg.UsageError, match="map_resolution"):
+        vg.load_log(INTEL, map_resolution=0)
+    assert vg.ROS_MAP_RESOLUTION == 0.05
 
 
 def test_mapper_validates_changed_params():

@@ -64,23 +64,28 @@ def tool_bin():
     return Path(found).parent if found and shutil.which("mapdiff") else None
 
 
+# A bag's default map cell (bag2map's --resolution): ROS's 0.05 m, where the log's keys give 0.1.
+BAG_CELL = 0.05
+
+
 @pytest.fixture(scope="module")
 def intel():
     return vg.load_log(INTEL)
 
 
 @pytest.fixture(scope="module")
-def log_map(intel, tmp_path_factory):
-    """log2map's map of intel: the program's when built, else the same engine through the
-    package (what log2map writes on an exact backend)."""
+def log_map(tmp_path_factory):
+    """log2map's map of intel at a bag's default cell: the program's when built, else the same
+    engine through the package (what log2map writes on an exact backend)."""
     bin_dir = tool_bin()
     if bin_dir is not None:
         out = tmp_path_factory.mktemp("log2map") / "intel.map.gz"
-        subprocess.run([str(bin_dir / "log2map"), "-q", "--backend", "cpu_threads", str(INTEL), str(out)],
-                       check=True, capture_output=True, timeout=300)
+        subprocess.run([str(bin_dir / "log2map"), "-q", "--backend", "cpu_threads", "--resolution", str(BAG_CELL),
+                        str(INTEL), str(out)], check=True, capture_output=True, timeout=300)
         return vg.read_map(out)
-    m = vg.Mapper(intel.params, backend="cpu_double")
-    m.insert(intel.scans)
+    log = vg.load_log(INTEL, map_resolution=BAG_CELL)
+    m = vg.Mapper(log.params, backend="cpu_double")
+    m.insert(log.scans)
     return m.finish()
 
 

@@ -128,21 +128,31 @@ def test_grid_values_by_hand():
 
 
 def test_settings_refuse_naming_the_parameter(tmp_path):
-    assert "resolution" in mapper_parameter_names() and "p_occ" in mapper_parameter_names()
+    assert "vasco_resolution" in mapper_parameter_names() and "vasco_p_occ" in mapper_parameter_names()
     s = Settings.from_values({}, {})
-    assert s.scan_topics == ["scan"] and s.map_mode == "trinary" and s.params == vg.Params()
+    assert s.scan_topics == ["scan"] and s.map_mode == "trinary"
+    # resolution 0.05 by default, ROS's cell: CARMEN's 0.025 m evidence grid in blocks of 2
+    assert (s.params.resolution, s.params.downsample, s.params.map_resolution) == (0.025, 2, 0.05)
+    assert s.params == vg.Params(downsample=2)
     for node, mapper, word in [({"map_mode": "ternary"}, {}, "map_mode"), ({"scan_topics": "scan"}, {}, "scan_topics"),
                                ({"transform_timeout": -1.0}, {}, "transform_timeout"),
-                               ({"backend": "gpu9"}, {}, "backend"), ({}, {"p_occ": 1.5}, "p_occ"),
-                               ({}, {"resolutoin": 0.1}, "resolutoin"),
+                               ({"backend": "gpu9"}, {}, "backend"), ({}, {"vasco_p_occ": 1.5}, "vasco_p_occ"),
+                               ({}, {"vasco_resolutoin": 0.1}, "vasco_resolutoin"), ({}, {"p_occ": 0.6}, "p_occ"),
+                               ({"resolution": -0.05}, {}, "resolution"), ({"resolution": 1e-9}, {}, "resolution"),
+                               ({}, {"vasco_resolution": 0.05}, "vasco_resolution and resolution"),
                                ({"free_thresh": 0.7}, {}, "free_thresh"),
                                ({"param_file": str(tmp_path / "none.ini")}, {}, "param_file")]:
         with pytest.raises(SettingsError, match=word):
             Settings.from_values(node, mapper)
+    assert Settings.from_values({"resolution": 0}, {"vasco_resolution": 0.05}).params.map_resolution == 0.2
+    one = Settings.from_values({"resolution": 0.05}, {"vasco_downsample": 1}).params  # a given block stays
+    assert (one.resolution, one.downsample) == (0.05, 1)
     ini = tmp_path / "carmen.ini"
     ini.write_text("[*]\nvasco_resolution 0.1\nvasco_p_occ 0.8\n")
-    s = Settings.from_values({"param_file": str(ini)}, {"p_occ": 0.6})
+    s = Settings.from_values({"param_file": str(ini), "resolution": 0}, {"vasco_p_occ": 0.6})
     assert s.params.resolution == 0.1 and s.params.p_occ == 0.6  # given over the file
+    s = Settings.from_values({"param_file": str(ini)}, {})  # resolution over the file's vasco_resolution
+    assert (s.params.resolution, s.params.downsample, s.params.p_occ) == (0.05, 1, 0.8)  # round(0.05 / 0.1) = 1
 
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -71,7 +71,8 @@ def grid_equals(want):
 
 @pytest.fixture(scope="module")
 def intel():
-    return vg.load_log(INTEL)
+    """The log at the node's default map cell, ROS's 0.05 m (the log's own keys give 0.1)."""
+    return vg.load_log(INTEL, map_resolution=0.05)
 
 
 @pytest.fixture(scope="module")
@@ -114,7 +115,7 @@ def test_replay_gives_the_logs_map_then_a_path_moves_it(ros, node, intel):
     moved = intel.poses + rng.normal(0, [0.03, 0.03, 0.005], intel.poses.shape)
     g2o = node.saved.parent / "moved.g2o"
     g2o.write_text("".join(f"VERTEX_SE2 {i} {x:.17g} {y:.17g} {t:.17g}\n" for i, (x, y, t) in enumerate(moved)))
-    by_file = vg.load_log(INTEL, poses=g2o, pose_match="order")
+    by_file = vg.load_log(INTEL, poses=g2o, pose_match="order", map_resolution=0.05)
     want = vg.Mapper(by_file.params, backend="cpu_double")
     want.insert(by_file.scans)
     moved_map = want.finish()
@@ -157,16 +158,19 @@ def set_parameter(ros, name, value):
 
 
 def test_a_parameter_change_maps_every_stored_scan_again(ros, node, intel):
-    bad = set_parameter(ros, "p_occ", 1.5)
-    assert not bad.successful and "p_occ" in bad.reason
+    bad = set_parameter(ros, "vasco_p_occ", 1.5)
+    assert not bad.successful and "vasco_p_occ" in bad.reason
     assert not set_parameter(ros, "scan_topics", ["other"]).successful  # read-only
+    both = set_parameter(ros, "vasco_resolution", 0.05)  # resolution (0.05) says the cell already
+    assert not both.successful and "resolution" in both.reason
+    n, fine = ros.map_count(), ros.latest()
+    assert set_parameter(ros, "resolution", 0.1).successful
+    got = ros.wait_map(n, timeout=30)
+    assert got is not None and math.isclose(got.info.resolution, 0.1, rel_tol=1e-6), node.output[-2000:]
+    assert got.info.width < 0.6 * fine.info.width  # cells twice as large: about half as many a row
     n = ros.map_count()
     assert set_parameter(ros, "resolution", 0.05).successful
-    got = ros.wait_map(n, timeout=30)
-    assert got is not None and math.isclose(got.info.resolution, 0.05 * 4, rel_tol=1e-6), node.output[-2000:]
-    n = ros.map_count()
-    assert set_parameter(ros, "resolution", 0.025).successful
-    assert ros.wait_map(n, timeout=30).info.resolution == pytest.approx(0.1)
+    assert ros.wait_map(n, timeout=30).info.resolution == pytest.approx(0.05)
 
 
 def test_bad_messages_are_refused_by_name_and_nothing_is_lost(ros, node, intel):
@@ -276,7 +280,7 @@ def test_a_bad_parameter_stops_the_node_at_start_up():
     proc._reader.join(2)
     assert rc == 2
     assert "map_mode: 'ternary' is not one of trinary, scale" in proc.output
-    proc = NodeProcess({"p_occ": 1.5})
+    proc = NodeProcess({"vasco_p_occ": 1.5})
     assert proc.proc.wait(30) == 2
     proc._reader.join(2)
     assert "p_occ" in proc.output

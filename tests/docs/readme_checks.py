@@ -243,7 +243,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "make-target", mentions={"test": ["-DVASCO_GPU_CUDA=OFF", "ctest"]}),
         # The tour.
         "sh: log2map logs/intel.gfs.log.gz intel.map.gz intel.pgm intel.p": Check(
-            "run", fixture="logs", outputs=["intel.map.gz", "intel.pgm", "intel.yaml", "intel.png", "coarse.map.gz"]),
+            "run", fixture="logs", outputs=["intel.map.gz", "intel.pgm", "intel.yaml", "intel.png", "fine.map.gz"]),
         'python: log = vg.load_log("logs/intel.gfs.log.gz")': Check(
             "python", fixture="logs", outputs=["intel.png"]),
     },

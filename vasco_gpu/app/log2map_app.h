@@ -30,6 +30,9 @@ struct ToolSpec {
   std::string input_name = "LOG";    // the positional input, as the help names it
   std::string input_help;
   std::vector<ExtraOption> extra_options;
+  // The written map's cell (m) when --resolution is not given and nothing
+  // sets vasco_resolution (bag2map: 0.05, ROS's usual); 0: CARMEN's keys alone.
+  double default_map_resolution = 0;
   // Reads one input (the first or one given with --add) into scans with
   // their stamps and mounts; `values` holds the extra options given (by
   // name), `progress(done, total)` drives the progress bar. Empty: the

@@ -230,7 +230,19 @@ void add_pose_options(CLI::App &app, Options &opt, PoseText &raw) {
 
 // Each vasco_* key with its meaning, vasco's default and its valid values,
 // from the one table (params.h): this help is the parameters' reference.
-void add_param_options(CLI::App &app, std::map<std::string, std::string> &raw) {
+// --resolution first: the written map's cell, as ROS says resolution.
+void add_param_options(CLI::App &app, const ToolSpec &spec, std::map<std::string, std::string> &raw) {
+  const vasco::MapperParams defaults;
+  std::ostringstream def;
+  if (spec.default_map_resolution > 0)
+    def << spec.default_map_resolution << " unless vasco_resolution is set";
+  else
+    def << "vasco_resolution x vasco_downsample, " << defaults.map_resolution();
+  app.add_option("--resolution", raw["resolution"],
+                 "the written map's cell size (m), as ROS's resolution (default " + def.str() +
+                     "): sets vasco_resolution = M / vasco_downsample, the downsample kept where given, else "
+                     "max(1, round(M / vasco_resolution))")
+      ->type_name("M");
   for (const vasco::ParamSpec &p : vasco::param_table()) {
     std::ostringstream help;
     help << p.meaning << " (default " << p.default_value << (p.minus_one_ok ? ", all" : "") << "; " << p.rule << ")";
@@ -330,6 +342,20 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
   warn_about_idle_options(app, opt);
 }
 
+// --resolution M: a finite number > 0, and not with --vasco_resolution (two
+// answers to one question).
+void finish_resolution_option(const CLI::App &app, const std::string &text, Options &opt) {
+  if (app.count("--resolution") == 0) return;
+  double cell = 0;
+  if (!parse_double(text, &cell) || !std::isfinite(cell) || !(cell > 0))
+    throw Error(ErrorCode::Usage, "--resolution '" + carmen::printable(text) + "': expected a cell size in metres, a "
+                                  "finite number > 0");
+  if (app.count("--vasco_resolution"))
+    throw Error(ErrorCode::Usage, "--resolution and --vasco_resolution both set the cell size: give one (--resolution: "
+                                  "the written map's; --vasco_resolution: the evidence grid's, before vasco_downsample)");
+  opt.map_resolution = cell;
+}
+
 // Options that change nothing for the chosen backend: a warning each (the
 // run goes on), printed at once and carried by --json.
 void warn_about_idle_options(const CLI::App &app, Options &opt) {
@@ -421,7 +447,7 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
   MapServerText raw_map_server;
   add_map_server_options(app, *opt, raw_map_server);
   std::map<std::string, std::string> raw;
-  add_param_options(app, raw);
+  add_param_options(app, spec, raw);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError &e) {
@@ -429,11 +455,12 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
     return rc == 0 ? 0 : 2;
   }
   for (const auto &kv : raw)
-    if (app.count("--" + kv.first) > 0) opt->overrides[kv.first] = kv.second;
+    if (app.count("--" + kv.first) > 0 && kv.first != "resolution") opt->overrides[kv.first] = kv.second;
   for (const auto &kv : extra)
     if (app.count("--" + kv.first) > 0) opt->extra[kv.first] = kv.second;
   try {
     finish_options(app, spec, raw_poses, max_memory, *opt);
+    finish_resolution_option(app, raw["resolution"], *opt);
     finish_batch_options(app, raw_batch, *opt);
     finish_map_server_options(app, raw_map_server, *opt);
   } catch (const carmen::Error &e) {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,7 @@ struct Options {
   uint64_t max_memory_bytes = 0;
   bool lenient = false, json = false, quiet = false;
   std::map<std::string, std::string> overrides;  // --vasco_KEY VALUE
+  std::optional<double> map_resolution;          // --resolution M: the written map's cell
   vasco::Pose2 transform;                        // --transform: the first input into the shared frame
   std::vector<vasco::SessionInput> more;         // --add INPUT[@X,Y,THETA]
   vasco::PoseSource poses;                       // --poses FILE and its options

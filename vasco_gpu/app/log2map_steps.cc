@@ -124,6 +124,8 @@ vasco::LogInput read_input_once(const Options &opt, const std::string &log, cons
   in.param_file = opt.param_file;
   in.robot = opt.robot;
   in.overrides = opt.overrides;
+  in.map_resolution = opt.map_resolution;
+  in.default_map_resolution = spec.default_map_resolution;
   in.lenient = opt.lenient;
   in.memory_budget = opt.max_memory_bytes;  // the scans alone may not pass what the map may use
   in.budget_option = "--max-memory";

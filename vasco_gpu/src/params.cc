@@ -3,6 +3,7 @@
 
 #include <cctype>
 #include <climits>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -38,7 +39,7 @@ using P = MapperParams;
 const std::vector<ParamSpec> &table() {
   static const std::vector<ParamSpec> rows = {
     {"vasco_resolution", "resolution", &P::resolution, nullptr, 0.025, kMinResolution, kMaxResolution, false,
-     false, false, "must be between 1e-6 and 1e6 m per cell", "cell size (m)"},
+     false, false, "must be between 1e-6 and 1e6 m per cell", "evidence grid cell size (m; the map's is this x vasco_downsample)"},
     {"vasco_p_prior", "p_prior", &P::p_prior, nullptr, 0.5, 0, 1, true, true, false,
      "must be strictly between 0 and 1", "prior occupancy"},
     {"vasco_p_occ", "p_occ", &P::p_occ, nullptr, 0.55, 0, 1, true, true, false,
@@ -127,6 +128,25 @@ const std::vector<std::string> &mapper_param_keys() {
 
 int MapperParams::table_size() const {
   return oracle::distance_table_size(range_max, resolution);
+}
+
+void MapperParams::set_map_resolution(double cell, bool keep_downsample) {
+  const std::string what = "map resolution " + fmt(cell) + " m";
+  if (!(std::isfinite(cell) && cell > 0)) throw ParamError("map_resolution", what + ": must be a finite number > 0");
+  MapperParams p = *this;
+  if (!keep_downsample) {
+    const double blocks = std::round(cell / resolution);  // resolution is valid: > 0
+    const ParamSpec &ds = *find_param("downsample");
+    p.downsample = static_cast<long>(std::min(std::max(blocks, ds.lo), ds.hi));
+  }
+  p.resolution = cell / static_cast<double>(p.downsample);
+  try {
+    p.validate();
+  } catch (const ParamError &e) {
+    throw ParamError("map_resolution", what + " (vasco_resolution = " + fmt(p.resolution) + " m per cell x vasco_downsample " +
+                                           std::to_string(p.downsample) + "): " + e.what());
+  }
+  *this = p;
 }
 
 void MapperParams::validate() const {

@@ -50,6 +50,21 @@ struct MapperParams {
 
   // Number of distance-table entries per axis: (int)(range_max / resolution).
   int table_size() const;
+
+  // The written map's cell size in metres, resolution × downsample: what a
+  // map_server YAML, an OccupancyGrid and ROS's `resolution` call resolution.
+  double map_resolution() const { return resolution * static_cast<double>(downsample); }
+
+  // Makes the written map's cells `cell` metres: the one rule from ROS's
+  // resolution to CARMEN's two keys (docs/parameters.md). A downsample that
+  // was given (keep_downsample) stays and resolution = cell / downsample;
+  // otherwise the evidence grid stays as near `resolution` as a whole block
+  // allows: downsample = max(1, round(cell / resolution)), then resolution =
+  // cell / downsample. With vasco's defaults, 0.1 gives exactly 0.025 × 4
+  // and 0.05 gives 0.025 × 2. Throws ParamError (key "map_resolution") for a
+  // cell that is not a finite number > 0 or whose evidence cell breaks the
+  // table's rules; *this is unchanged then.
+  void set_map_resolution(double cell, bool keep_downsample);
 };
 
 // A parameter value out of its range: code Usage, and the key (vasco_p_occ)

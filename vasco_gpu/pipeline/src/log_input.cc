@@ -13,13 +13,27 @@ namespace vasco {
 
 namespace {
 
+// options.map_resolution (or the tool's default) over the keys: the one
+// rule of MapperParams::set_map_resolution. A usage error when it cannot be.
+void apply_map_resolution(MapperParams &p, const LogInputOptions &options, const carmen::ParamFile &params) {
+  double cell = options.map_resolution.value_or(0);
+  if (!options.map_resolution && !params.has("vasco_resolution")) cell = options.default_map_resolution;
+  if (!options.map_resolution && cell == 0) return;
+  try {
+    p.set_map_resolution(cell, params.has("vasco_downsample"));
+  } catch (const ParamError &e) {
+    throw carmen::Error(carmen::ErrorCode::Usage, e.what());
+  }
+}
+
 // The ini and the command line, validated now, before a long log is read.
 carmen::ParamFile command_line_params(const LogInputOptions &options, std::vector<std::string> *warnings) {
   carmen::ParamFile params;
   if (!options.param_file.empty()) params = carmen::ParamFile::load(options.param_file, options.robot);
   for (const auto &kv : options.overrides) params.set_override(kv.first, kv.second);
   for (const auto &w : params.warnings()) warnings->push_back(w.str());
-  MapperParams::from_params(params, nullptr);
+  MapperParams p = MapperParams::from_params(params, nullptr);
+  apply_map_resolution(p, options, params);
   return params;
 }
 
@@ -116,6 +130,7 @@ LogInput finish_input(StampedScans scans, carmen::ParamFile &params, const LogIn
                       LogInput in, const std::string &scan_kind) {
   const std::vector<uint8_t> matched = apply_pose_file(scans, options.poses, options.log, options.transform);
   in.params = MapperParams::from_params(params, &in.warnings);
+  apply_map_resolution(in.params, options, params);  // the log's PARAM lines may have set vasco_downsample
   const long laser_messages = in.load.laser_messages;
   const size_t first = std::min<size_t>(static_cast<size_t>(std::max(in.params.first_scan, 0L)),
                                         scans.batch.num_scans());

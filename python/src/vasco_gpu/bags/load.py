@@ -105,7 +105,9 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     (``Log.unposed_skipped``) with one :class:`BagWarning`; a scan in a gap of the poses is an
     error, unless ``skip_unposed=True`` (without a pose file) leaves out every scan without one. ``add=[bag, (bag,
     (x, y, theta))]`` and ``transform=`` put several sessions into one grid, as in load_log.
-    The parameters come from ``param_file`` and ``overrides`` (a bag has no PARAM lines). Errors
+    The parameters come from ``param_file`` and ``overrides`` (a bag has no PARAM lines); the map's
+    cell is ROS's 0.05 m (``vasco_gpu.ROS_MAP_RESOLUTION``, bag2map's default too) unless
+    ``map_resolution=M`` or a vasco_resolution in them says otherwise (see load_log). Errors
     name the bag, and the topic and stamp where one is at fault (:class:`FileError`).
     """
     from .._errors import FileError

@@ -115,7 +115,7 @@ class MappingNode(Node):
                 description=p.meaning, dynamic_typing=True, read_only=not p.dynamic))
         for name in mapper_parameter_names():  # unset unless given: param_file and defaults apply
             self.declare_parameter(name, None, ParameterDescriptor(
-                description=f"vasco_{name} (log2map --help lists its meaning)", dynamic_typing=True))
+                description=f"{name} (log2map --help lists its meaning)", dynamic_typing=True))
 
     def _node_values(self, changed=()) -> dict:
         values = {p.name: self.get_parameter(p.name).value for p in NODE_PARAMETERS}

@@ -1,6 +1,7 @@
 """The node's parameters, one schema: the node's own (topics, frames, QoS, publishing, the
-session's backend) and every key of the mapper's parameter table under its Python keyword
-name (``resolution``, ``p_occ``, ...; read from ``vasco_gpu.Params``, never listed here).
+session's backend, ``resolution``: the map's cell as ROS says it) and every key of the mapper's
+parameter table under its carmen.ini name, as log2map's flags spell them (``vasco_p_occ``,
+``vasco_downsample``, ...; read from ``vasco_gpu.Params``, never listed here).
 
 ``Settings.from_values`` validates a whole set at once, so that a bad value is refused before
 anything starts and a dynamic change is taken whole or not at all. No rclpy here: the node
@@ -80,6 +81,12 @@ def _band(name, v):
         raise SettingsError(f"{name}: {v!r} must be two heights [min, max]")
 
 
+def _cell(name, v):
+    if isinstance(v, bool) or not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+        raise SettingsError(f"{name}: {v!r} must be a cell size in metres > 0 (0: vasco_resolution x "
+                            f"vasco_downsample)")
+
+
 def _paths(name, v):
     if not isinstance(v, (list, tuple)) or not all(isinstance(t, str) and t for t in v):
         raise SettingsError(f"{name}: {v!r} must be a list of file names")
@@ -96,6 +103,10 @@ NODE_PARAMETERS = (
     NodeParameter("cloud_range_max", 50.0, "clouds: points farther than this (m) are no return"),
     NodeParameter("scan_qos", "sensor_data", "the scans' QoS: sensor_data (best effort, depth 5) or "
                                              "reliable (reliable, depth 1000: a replay loses no scan)"),
+    NodeParameter("resolution", _core.ROS_MAP_RESOLUTION, "the map's cell size (m), /map's info.resolution, as log2map --resolution "
+                                      "sets it (vasco_resolution = resolution / vasco_downsample; the downsample "
+                                      "kept where given, else max(1, round(resolution / vasco_resolution))); 0: "
+                                      "vasco_resolution x vasco_downsample alone", dynamic=True),
     NodeParameter("no_return", "skip", "+inf ranges (REP 117 no return): skip, or free (clears up to "
                                        "range_max)", dynamic=False),
     NodeParameter("map_frame", "map", "the fixed frame: the map's frame and the poses' frame"),
@@ -121,7 +132,7 @@ NODE_PARAMETERS = (
 
 _CHECKS = {
     "scan_topics": _topics, "multi_echo_topics": _topics, "echo": _choice("first", "last", "strongest"),
-    "cloud_topics": _topics, "z_band": _band, "cloud_angle_step": _positive, "cloud_range_max": _positive,
+    "resolution": _cell, "cloud_topics": _topics, "z_band": _band, "cloud_angle_step": _positive, "cloud_range_max": _positive,
     "scan_qos": _choice("sensor_data", "reliable"), "no_return": _choice("skip", "free"),
     "map_frame": _frame, "base_frame": _frame, "path_topic": _string,
     "transform_timeout": _positive, "pose_max_gap": _positive, "map_update_interval": _positive,
@@ -132,8 +143,9 @@ _CHECKS = {
 
 
 def mapper_parameter_names() -> list[str]:
-    """The mapper's keys as keyword names (resolution, p_occ, ...), from the parameter table."""
-    return [k[len("vasco_"):] for k in _core.Params.keys()]
+    """The mapper's keys as the node's parameter names (vasco_resolution, vasco_p_occ, ...), from
+    the parameter table."""
+    return list(_core.Params.keys())
 
 
 @dataclass
@@ -178,16 +190,21 @@ class Settings:
 
 
 def _mapper_params(node: dict, given: dict) -> _core.Params:
-    """The mapper's Params: given keys over the param_file over the defaults."""
+    """The mapper's Params: given keys over the param_file over the defaults, then resolution
+    (the map's cell) by log2map --resolution's rule."""
     unknown = sorted(set(given) - set(mapper_parameter_names()))
     if unknown:
         raise SettingsError(f"{unknown[0]}: not a mapper parameter ({', '.join(mapper_parameter_names())})")
+    cell = {"map_resolution": node["resolution"]} if node["resolution"] > 0 else {}
+    if cell and "vasco_resolution" in given:
+        raise SettingsError(f"vasco_resolution and resolution {node['resolution']} both set the cell size: set "
+                            f"resolution (the map's cell), or resolution 0 to take vasco_resolution x vasco_downsample")
     try:
         if node["param_file"]:
             if not os.path.isfile(node["param_file"]):
                 raise SettingsError(f"param_file: {node['param_file']!r} is not a file")
-            return _core.Params.from_ini(node["param_file"], node["robot"], **given)
-        return _core.Params(**given)
+            return _core.Params.from_ini(node["param_file"], node["robot"], **given, **cell)
+        return _core.Params(**given, **cell)
     except (TypeError, ValueError) as e:
         if isinstance(e, SettingsError):
             raise

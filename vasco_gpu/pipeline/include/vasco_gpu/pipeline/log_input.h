@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,12 @@ struct StampedScans {
   void keep_only(const std::vector<uint8_t> &keep);
 };
 
+// ROS's usual map cell in metres (map_saver's examples, slam_toolbox's and
+// cartographer's occupancy grid node's default): the default map resolution
+// of inputs that come from ROS (bags, the ROS 2 node), where CARMEN logs keep
+// CARMEN's keys (0.025 x 4 = 0.1).
+inline constexpr double kRosMapResolution = 0.05;
+
 struct LogInputOptions {
   std::string log;                               // .log, .clf, gzipped if .gz
   Pose2 transform;                               // of `log` into the shared frame (identity: as read)
@@ -70,6 +77,13 @@ struct LogInputOptions {
   std::string param_file;                        // carmen.ini; empty: none
   std::string robot;                             // robot section of the ini
   std::map<std::string, std::string> overrides;  // vasco_KEY -> value (command line)
+  // The written map's cell in metres (--resolution), applied over the keys
+  // by MapperParams::set_map_resolution (vasco_downsample stays where the
+  // ini, the log or an override sets it). default_map_resolution: a tool's
+  // own default (bag2map: 0.05), taken when map_resolution is not given and
+  // nothing sets vasco_resolution; 0: none (CARMEN's keys alone).
+  std::optional<double> map_resolution;
+  double default_map_resolution = 0;
   bool lenient = false;                          // skip bad lines instead of stopping
   std::function<void(uint64_t, uint64_t)> progress;  // (bytes read, file size)
   // Bytes the scans and PARAM lines kept from the log may take (0: no limit),
