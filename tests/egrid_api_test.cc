@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <type_traits>
 
 #include <cmath>
@@ -164,6 +166,24 @@ TEST_F(EgridApi, FinishDownsamplesAndCrops) {
   EXPECT_EQ(g.size_x, 1);
   EXPECT_EQ(g.size_y, 0);
   EXPECT_EQ(g.resolution, 2.0);
+}
+
+// A run that mapped nothing (an empty or scan-less log): CARMEN's finish
+// sizes the map max - min = 4 border + 1 - n blocks, negative for a grid of
+// more blocks, and dies "Out of memory" before its caller writes a map. Ours
+// stops there too, saying why, so that no half-written map file follows.
+TEST_F(EgridApi, FinishingAGridThatMappedNothingStopsAsCarmenDoes) {
+  EXPECT_EXIT(carmen_mapper_finish_evidence_grid(&g, 1, 2), ::testing::ExitedWithCode(EXIT_FAILURE),
+              "no cell of the 20 x 20 grid was updated");
+}
+
+TEST_F(EgridApi, ASmallGridThatMappedNothingFinishesAsCarmensDoes) {
+  // 20 blocks <= 4 x 5 + 1: CARMEN's bounds (14, 5) move out by the border
+  // to (9, 10): a 1 x 1 map (4 x 5 + 1 - 20), its cell unknown.
+  carmen_mapper_finish_evidence_grid(&g, 1, 5);
+  EXPECT_EQ(g.size_x, 1);
+  EXPECT_EQ(g.size_y, 1);
+  EXPECT_EQ(g.prob[0][0], -1.0f);
 }
 
 // CARMEN 0.7.4's prototypes exactly (DESIGN §2): a CARMEN program that keeps

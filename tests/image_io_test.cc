@@ -667,6 +667,36 @@ TEST(MapImageLimits, APngClaimingMorePixelsThanItsDataCanHoldIsRefused) {
   check(run_in_child(1024, [&] { carmen::read_image_with_yaml(png, dir.file("huge.yaml")); }));
 }
 
+// A 1-bit PNG just over 2^28 pixels: 33 KB of deflated zeros, as much as
+// such data compresses, so the deflate-ratio check passes; decoding it would
+// take over 1 GiB as RGBA and as a grid. Refused by its declared size against
+// the map budget (1 GiB, as a CARMEN map's chunks), before any allocation.
+TEST(MapImageLimits, APngBeyondTheMapBudgetIsRefusedBeforeDecoding) {
+  TempDir dir;
+  const uint32_t w = 16385, h = 16384;  // 2^28 + 2^14 pixels: 4 bytes each is over 1 GiB
+  const std::string ihdr = be32(w) + be32(h) + std::string("\x01\x00\x00\x00\x00", 5);  // 1-bit grey
+  const std::string raw(size_t(h) * (1 + (w + 7) / 8), '\0');                       // filter byte + row
+  uLongf n = compressBound(uLong(raw.size()));
+  std::string idat(n, '\0');
+  compress2(reinterpret_cast<Bytef *>(&idat[0]), &n, reinterpret_cast<const Bytef *>(raw.data()), uLong(raw.size()), 9);
+  idat.resize(n);
+  const std::string png = dir.file("wide.png");
+  maptest::write_bytes(png, std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + png_chunk("IDAT", idat) +
+                                png_chunk("IEND", ""));
+  ASSERT_GT(read_bytes(png).size() * 1032, uint64_t(w) * h / 8) << "the deflate-ratio check alone would refuse it";
+  maptest::write_bytes(dir.file("wide.yaml"), std::string("image: wide.png\n") + kYaml);
+  const auto check = [&](const ChildRun &r) {
+    ASSERT_TRUE(r.ran);
+    EXPECT_EQ(r.code, int(carmen::ErrorCode::TooLarge)) << r.what;
+    EXPECT_EQ(r.what.rfind(png + ": ", 0), 0u) << r.what;
+    EXPECT_NE(r.what.find("16385 x 16384"), std::string::npos) << r.what;
+    EXPECT_NE(r.what.find("1024 MiB a map may hold"), std::string::npos) << r.what;
+    EXPECT_LT(r.rss_growth_mib, 64) << "nothing the size of the image may be allocated";
+  };
+  check(run_in_child(3072, [&] { carmen::read_png(png); }));
+  check(run_in_child(3072, [&] { carmen::read_map_server_yaml(dir.file("wide.yaml")); }));
+}
+
 // The bound is deflate's ratio on the file's own pixel format: a real
 // uniform map, as compressible as PNGs get, still reads.
 TEST(MapImageLimits, AHighlyCompressibleRealPngStillReads) {

@@ -19,6 +19,7 @@
 #include "carmen_compat/error.h"
 #include "carmen_compat/input_file.h"
 #include "carmen_compat/image_io.h"
+#include "carmen_compat/map_file.h"
 
 namespace carmen {
 namespace {
@@ -26,6 +27,13 @@ namespace {
 // Images larger than this are refused before their pixels are allocated
 // (the bound of CARMEN's own grids: 2^30 cells of 4 bytes).
 constexpr uint64_t kMaxImagePixels = uint64_t(1) << 30;
+// A map read from an image holds 4 bytes a pixel as a grid, and as much
+// again while a PNG is decoded (RGBA): the grid may take what a CARMEN map's
+// chunks may (MapReadOptions::max_kept_bytes, 1 GiB), checked against the
+// declared size before anything is allocated. A 1-bit 32768 x 32768 PNG of
+// 130 KB is a valid image (deflate does shrink zeros that far), but not one
+// to decode into 4 GiB.
+constexpr uint64_t kBytesPerMapCell = sizeof(float);
 constexpr uint64_t kMaxYamlBytes = 1 << 20;
 
 // Deflate's largest expansion: a compressed stream of n bytes inflates to at
@@ -43,6 +51,18 @@ void check_image_size(const std::string &path, uint64_t width, uint64_t height) 
     throw FileError(path, "image of " + std::to_string(width) + " x " + std::to_string(height) +
                               " pixels: not a map this reader takes (1 to 2^30 pixels)",
                     too_many ? ErrorCode::TooLarge : ErrorCode::BadInput);
+}
+
+// An image of a plausible size whose grid would still pass the map budget
+// (kBytesPerMapCell); after check_image_size (no wrap: at most 2^30 pixels).
+void check_map_budget(const std::string &path, uint64_t width, uint64_t height) {
+  const uint64_t budget = MapReadOptions{}.max_kept_bytes;
+  if (width * height > budget / kBytesPerMapCell)
+    throw FileError(path, "image of " + std::to_string(width) + " x " + std::to_string(height) + " pixels: as a map " +
+                              std::to_string(width * height * kBytesPerMapCell >> 20) + " MiB, more than the " +
+                              std::to_string(budget >> 20) + " MiB a map may hold (as a CARMEN map's chunks): "
+                              "refused before its pixels are decoded",
+                    ErrorCode::TooLarge);
 }
 
 // The size of a file to be read, which must be a regular one (a FIFO or a
@@ -133,6 +153,7 @@ PgmImage read_pgm(const std::string &path) {
     throw FileError(path, "is cut short: " + std::to_string(width) + " x " + std::to_string(height) +
                               " pixels need " + std::to_string(width * height) + " bytes, " +
                               std::to_string(bytes.size() - at) + " follow the header");
+  check_map_budget(path, width, height);
   PgmImage img{int(width), int(height), std::vector<uint8_t>(bytes.begin() + long(at), bytes.begin() + long(at + width * height))};
   if (maxval != 255)
     for (uint8_t &v : img.rows) v = uint8_t(std::lround(255.0 * std::min<uint64_t>(v, maxval) / double(maxval)));
@@ -203,6 +224,7 @@ Rgba read_png_file_rgba(const std::string &path) {
                                 " pixels in only " + std::to_string(file_size) +
                                 " bytes: more than its compressed data can hold (the header is damaged)",
                       ErrorCode::BadInput);
+    check_map_budget(path, img.width, img.height);
     out.px.resize(size_t(img.width) * size_t(img.height) * 4);  // PNG_IMAGE_SIZE is 32-bit: wraps at 2^30
   } catch (...) {
     png_image_free(&img);

@@ -95,6 +95,19 @@ for kind in global_static global_shared; do
   run_and_compare "$tmp/$kind" "$kind"
   grep -q "fake libglobal: carmen_fopen($log)" "$tmp/$kind.err" || fail "$kind: libglobal's carmen_fopen was not used"
 done
+# CARMEN's own Makefiles' order, -lglobal last: the first library that
+# defines carmen_stdio gives it (an archive member is not pulled in for a
+# symbol already defined), so ours is used, libglobal's callers included;
+# still no duplicate-symbol error and the same map (docs: carmen_stdio and libglobal).
+cc -std=c99 -o "$tmp/global_last_static" "$client" "${static_names[@]}" -L"$tmp" -lglobal \
+  $(pkg-config --libs vasco_gpu-static)
+cc -std=c99 -o "$tmp/global_last_shared" "$client" "${carmen_flags[@]}" -L"$tmp" -lglobal -Wl,-rpath,"$lib" -lz -lm
+for kind in global_last_static global_last_shared; do
+  run_and_compare "$tmp/$kind" "$kind"
+  if grep -q "fake libglobal: carmen_fopen" "$tmp/$kind.err"; then
+    fail "$kind: libglobal's carmen_fopen was used after our libraries (the docs say ours is)"
+  fi
+done
 # 5. A CMake project in C alone: find_package + the static target, nothing more.
 cmake -S "$src/tests/install/c_project" -B "$tmp/c_project" -DCMAKE_PREFIX_PATH="$prefix" \
   -DCMAKE_BUILD_TYPE=Release > "$tmp/c_project.log" 2>&1 || { cat "$tmp/c_project.log" >&2; fail "C project: configure"; }

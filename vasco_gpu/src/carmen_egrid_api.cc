@@ -4,6 +4,7 @@
 #include "carmen/egrid.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -220,6 +221,23 @@ void update_on_session(evidence_grid *g, Session &s, double x, double y, double 
   }
 }
 
+// CARMEN's finish of a grid without a known block: its bounds start at
+// (n - border - 1, border), nothing widens them, and for n > 4 border + 1
+// blocks the size max - min comes out negative; CARMEN's allocation of it
+// fails and it dies "Out of memory" before its caller writes a map. True
+// when CARMEN would: the caller must not go on to write a header without a
+// grid (the half-written map file of a run that mapped nothing).
+bool carmen_dies_finishing(const evidence_grid *g, int downsample, int border) {
+  if (downsample < 1 || border < 0) return false;  // refused with its own message
+  const int64_t nx = g->size_x / downsample, ny = g->size_y / downsample;
+  const int64_t widest = 4 * static_cast<int64_t>(border) + 1;
+  if (nx <= widest && ny <= widest) return false;
+  for (int64_t x = 0; x < nx * downsample; ++x)
+    for (int64_t y = 0; y < ny * downsample; ++y)
+      if (g->prob[x][y] != -1.0f) return false;
+  return true;
+}
+
 }  // namespace
 
 extern "C" {
@@ -346,6 +364,14 @@ void carmen_mapper_clear_evidence_grid(evidence_grid *grid) {
 void carmen_mapper_finish_evidence_grid(evidence_grid *grid, int downsample, int border) {
   if (grid == nullptr || grid->prob == nullptr) return;
   drop_session(grid);  // g->prob is current; the finished grid is CARMEN's alone
+  if (carmen_dies_finishing(grid, downsample, border)) {
+    std::fprintf(stderr,
+                 "carmen_mapper_finish_evidence_grid: no cell of the %d x %d grid was updated (an empty or "
+                 "scan-less log?): there is no map to finish. CARMEN stops here (\"Out of memory\"); so does "
+                 "this library, before a map file is begun\n",
+                 grid->size_x, grid->size_y);
+    std::exit(EXIT_FAILURE);
+  }
   vasco::FinishedMap m;
   try {
     m = vasco::finish_grid(grid->prob[0], grid->size_x, grid->size_y, grid->resolution, downsample,
