@@ -256,6 +256,21 @@ TEST_F(Log2MapPoses, HugePosesAreBlamedOnThePoseFile) {
   EXPECT_FALSE(maptest::file_exists(dir_.file("x.map")));
 }
 
+// --max-memory covers the pose file too: a 2.4 MB TUM file of 150,000 poses
+// (about 14 MiB as poses) under --max-memory 8 is refused naming the file
+// and the line that passed the budget, and nothing is written.
+TEST_F(Log2MapPoses, APoseFileBeyondMaxMemoryIsRefusedNamingItsLine) {
+  std::string tum;
+  tum.reserve(150000 * 16);
+  for (int i = 0; i < 150000; ++i) tum += std::to_string(i) + " 0 0 0 0 0 0 1\n";
+  maptest::write_bytes(dir_.file("long.txt"), tum);
+  const ToolRun r = log2map({"--max-memory", "8", "--poses", dir_.file("long.txt"), kIntel, dir_.file("x.map")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, dir_.file("long.txt") + ":")) << r.output;
+  EXPECT_TRUE(contains(r.output, "(--max-memory)")) << r.output;
+  EXPECT_FALSE(maptest::file_exists(dir_.file("x.map")));
+}
+
 TEST_F(Log2MapPoses, BadPoseOptionsAreUsageErrors) {
   EXPECT_EQ(log2map({"--pose-tolerance", "0.5", kIntel, dir_.file("x.map")}).status, 2);
   EXPECT_EQ(log2map({"--pose-max-gap", "2", kIntel, dir_.file("x.map")}).status, 2);  // without --poses

@@ -386,6 +386,40 @@ TEST(PoseFileRead, G2oErrorsNameFileAndLine) {
   EXPECT_CONTAINS(e.what, e.path + ": no poses: no VERTEX_SE2 lines");
 }
 
+// Pose files count against the run's memory budget while they are read: the
+// pose that passes it is refused at its line, before the rest is read.
+// Each pose is charged 2 x sizeof(StampedPose) (pose_file.cc says why), so a
+// budget of 100 poses' worth takes 100 and refuses line 101 (or 101 + the
+// comment line).
+TEST(PoseFileRead, APoseFileBeyondTheMemoryBudgetIsRefusedAtTheLineThatPassesIt) {
+  TempDir dir;
+  std::string tum = "# t x y z qx qy qz qw\n", g2o, log;
+  for (int i = 0; i < 1000; ++i) {
+    tum += std::to_string(i) + " 0 0 0 0 0 0 1\n";
+    g2o += "VERTEX_SE2 " + std::to_string(i) + " 0 0 0\n";
+    log += "FLASER 1 1.0 0 0 0 0 0 0 " + std::to_string(i) + " h 0\n";
+  }
+  write_file(dir.file("t.txt"), tum);
+  write_file(dir.file("v.g2o"), g2o);
+  write_file(dir.file("l.log"), log);
+  vasco::PoseReadLimits limits;
+  limits.budget_option = "--max-memory";
+  limits.memory_budget = 100 * 2 * sizeof(vasco::StampedPose);
+  std::string what = error_of([&] { vasco::read_pose_file(dir.file("t.txt"), PoseFileFormat::Auto, limits); },
+                              ErrorCode::OutOfMemory);
+  EXPECT_CONTAINS(what, dir.file("t.txt") + ":102: ");
+  EXPECT_CONTAINS(what, "(--max-memory)");
+  what = error_of([&] { vasco::read_pose_file(dir.file("l.log"), PoseFileFormat::Auto, limits); },
+                  ErrorCode::OutOfMemory);
+  EXPECT_CONTAINS(what, dir.file("l.log") + ":101: ");
+  what = error_of([&] { vasco::read_pose_file(dir.file("v.g2o"), PoseFileFormat::Auto, limits); },
+                  ErrorCode::OutOfMemory);
+  EXPECT_CONTAINS(what, dir.file("v.g2o") + ":");  // before line 101: the id index is charged too
+  limits.memory_budget = 1000 * 2 * sizeof(vasco::StampedPose);
+  EXPECT_EQ(vasco::read_pose_file(dir.file("t.txt"), PoseFileFormat::Auto, limits).poses.size(), 1000u);
+  EXPECT_EQ(vasco::read_pose_file(dir.file("v.g2o")).poses.size(), 1000u);  // no budget: no limit
+}
+
 TEST(PoseFileRead, UnreadableFileIsAnIoError) {
   TempDir dir;
   const std::string missing = dir.file("missing.txt");

@@ -98,6 +98,35 @@ class TextLines {
   long number_ = 0;
 };
 
+// Counts the poses read against PoseReadLimits. A pose is charged twice its
+// size (the vector's growth, and the sorted copy time matching makes), plus
+// what an index of it takes (g2o's ids).
+class PoseBudget {
+ public:
+  PoseBudget(const std::string &path, const PoseReadLimits &limits, uint64_t index_bytes = 0)
+      : path_(path), limits_(limits), per_pose_(2 * sizeof(StampedPose) + index_bytes) {}
+
+  void charge(long line) {
+    used_ += per_pose_;
+    if (limits_.memory_budget == 0 || used_ <= limits_.memory_budget) return;
+    throw FileError(path_, line,
+                    "the poses up to here take more than the " + mebibytes(limits_.memory_budget) +
+                        " MiB the run may use (" + limits_.budget_option + "): refused before the rest is read",
+                    ErrorCode::OutOfMemory);
+  }
+
+ private:
+  static std::string mebibytes(uint64_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", static_cast<double>(bytes) / (1 << 20));
+    return text;
+  }
+  const std::string &path_;
+  const PoseReadLimits &limits_;
+  uint64_t per_pose_;
+  uint64_t used_ = 0;
+};
+
 // The fields of a line, split at spaces and tabs.
 std::vector<std::string_view> split_fields(const std::string &line) {
   std::vector<std::string_view> fields;
@@ -208,13 +237,15 @@ StampedPose tum_pose(const std::string &path, long line, const std::vector<std::
   return p;
 }
 
-std::vector<StampedPose> read_tum(const std::string &path) {
+std::vector<StampedPose> read_tum(const std::string &path, const PoseReadLimits &limits) {
   TextLines lines(path);
+  PoseBudget budget(path, limits);
   std::vector<StampedPose> poses;
   std::string line;
   while (lines.next(line)) {
     const auto fields = split_fields(line);
     if (is_comment_or_blank(fields)) continue;
+    budget.charge(lines.number());
     poses.push_back(tum_pose(path, lines.number(), fields));
   }
   if (poses.empty()) throw FileError(path, "no poses: expected TUM lines 't x y z qx qy qz qw'");
@@ -237,14 +268,17 @@ StampedPose g2o_vertex(const std::string &path, long line, const std::vector<std
   return p;
 }
 
-std::vector<StampedPose> read_g2o(const std::string &path) {
+std::vector<StampedPose> read_g2o(const std::string &path, const PoseReadLimits &limits) {
   TextLines lines(path);
   std::vector<StampedPose> poses;
   std::unordered_map<long, long> line_of_id;
+  // An id's node in line_of_id: the pair, the bucket's pointer and the node's own.
+  PoseBudget budget(path, limits, sizeof(std::pair<const long, long>) + 3 * sizeof(void *));
   std::string line;
   while (lines.next(line)) {
     const auto fields = split_fields(line);
     if (fields.empty() || fields[0] != "VERTEX_SE2") continue;  // edges, landmarks, FIX, comments
+    budget.charge(lines.number());
     poses.push_back(g2o_vertex(path, lines.number(), fields));
     const auto seen = line_of_id.emplace(poses.back().id, lines.number());
     if (!seen.second)
@@ -258,12 +292,14 @@ std::vector<StampedPose> read_g2o(const std::string &path) {
 
 // The laser poses of the front laser's lines (RLASER / ROBOTLASER2 are the
 // rear laser's, whose poses are of another sensor).
-std::vector<StampedPose> read_carmen(const std::string &path) {
+std::vector<StampedPose> read_carmen(const std::string &path, const PoseReadLimits &limits) {
   carmen::LogReader reader(path);
   carmen::LogMessage msg;
+  PoseBudget budget(path, limits);
   std::vector<StampedPose> poses;
   while (reader.next(msg)) {
     if (!is_scan_message(msg.type)) continue;
+    budget.charge(msg.line);
     StampedPose p;
     p.stamp = msg.laser.timestamp;
     p.line = msg.line;
@@ -507,14 +543,14 @@ const char *pose_file_format_name(PoseFileFormat format) {
   return "auto";
 }
 
-PoseFile read_pose_file(const std::string &path, PoseFileFormat format) {
+PoseFile read_pose_file(const std::string &path, PoseFileFormat format, const PoseReadLimits &limits) {
   PoseFile file;
   file.path = path;
   file.format = format == PoseFileFormat::Auto ? format_of_name(path) : format;
   switch (file.format) {
-    case PoseFileFormat::G2o: file.poses = read_g2o(path); break;
-    case PoseFileFormat::CarmenLog: file.poses = read_carmen(path); break;
-    default: file.poses = read_tum(path); break;
+    case PoseFileFormat::G2o: file.poses = read_g2o(path, limits); break;
+    case PoseFileFormat::CarmenLog: file.poses = read_carmen(path, limits); break;
+    default: file.poses = read_tum(path, limits); break;
   }
   return file;
 }

@@ -52,7 +52,17 @@ struct PoseFile {
 // poses at all; ErrorCode::Io for a file that cannot be read. Stamps may go
 // back (real logs' do now and then): matching by time sorts them, and
 // refuses a stamp given twice with two different poses.
-PoseFile read_pose_file(const std::string &path, PoseFileFormat format = PoseFileFormat::Auto);
+// What a pose file may take in memory, counted while it is read (0: no
+// limit): the pose that passes it is refused (FileError at its line,
+// ErrorCode::OutOfMemory) before the rest is read. budget_option: how the
+// user raises it, as the error names it (log2map: --max-memory).
+struct PoseReadLimits {
+  uint64_t memory_budget = 0;
+  std::string budget_option = "PoseReadLimits::memory_budget";
+};
+
+PoseFile read_pose_file(const std::string &path, PoseFileFormat format = PoseFileFormat::Auto,
+                        const PoseReadLimits &limits = {});
 
 enum class PoseMatching {
   Auto,       // Timestamp when the file has stamps, else Order

@@ -62,10 +62,10 @@ Pose2 laser_pose_of(const Pose2 &robot, const StampedScans &scans, size_t s, con
 // vasco_first_scan and vasco_num_scans count the log's laser messages
 // whatever the pose file lacks.
 std::vector<uint8_t> apply_pose_file(StampedScans &scans, const PoseSource &src, const std::string &source,
-                                     const Pose2 &transform) {
+                                     const Pose2 &transform, const PoseReadLimits &limits) {
   if (src.file.empty()) return {};
   const bool moved = transform.x != 0 || transform.y != 0 || transform.theta != 0;
-  PoseFile file = read_pose_file(src.file, src.format);
+  PoseFile file = read_pose_file(src.file, src.format, limits);
   PoseMatchOptions match = src.match;
   if (!src.id_map_file.empty()) match.id_map = read_pose_id_map(src.id_map_file);
   const PoseMatch m = match_poses(file, scans.batch.num_scans(), scans.stamps, source, scans.batch.line, match);
@@ -128,7 +128,13 @@ void check_downsample(const LogInput &in, const carmen::ParamFile &params, const
 // the effective parameters, the selected run, the grid.
 LogInput finish_input(StampedScans scans, carmen::ParamFile &params, const LogInputOptions &options,
                       LogInput in, const std::string &scan_kind) {
-  const std::vector<uint8_t> matched = apply_pose_file(scans, options.poses, options.log, options.transform);
+  // The pose file gets what the scans left of the budget (at least a byte, so that 0 stays "no limit").
+  PoseReadLimits limits;
+  limits.budget_option = options.budget_option;
+  if (options.memory_budget > 0)
+    limits.memory_budget = std::max<uint64_t>(1, options.memory_budget - std::min(options.memory_budget,
+                                                                                  in.load.log.kept_bytes));
+  const std::vector<uint8_t> matched = apply_pose_file(scans, options.poses, options.log, options.transform, limits);
   in.params = MapperParams::from_params(params, &in.warnings);
   apply_map_resolution(in.params, options, params);  // the log's PARAM lines may have set vasco_downsample
   const long laser_messages = in.load.laser_messages;
