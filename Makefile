@@ -58,7 +58,7 @@ test-sanitize: deps
 # FUZZ_SECONDS (default 300; CI's fuzz-smoke: 20). New inputs go to build-fuzz/corpus.
 FUZZ_SECONDS ?= 300
 FUZZ_TARGETS = fuzz_log_reader fuzz_ini fuzz_map_reader fuzz_map_io fuzz_readlog fuzz_egrid fuzz_pipeline fuzz_session \
-               fuzz_pose_file
+               fuzz_pose_file fuzz_map_server
 fuzz: deps
 	@test -f build-fuzz/CMakeCache.txt || CC=clang CXX=clang++ cmake -S . -B build-fuzz \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVASCO_GPU_CUDA=OFF -DVASCO_GPU_FUZZ=ON \
