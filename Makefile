@@ -23,7 +23,7 @@ configure_in = if [ ! -f $(1)/CMakeCache.txt ] || [ "$$(cat $(1)/.make-configure
 GOLDEN_DIR ?= ../shared/golden
 GOLDEN_DATA ?= ../shared/data
 
-.PHONY: all configure test test-sanitize fuzz fuzz-smoke golden demo bench bench-peers install deps clean
+.PHONY: all configure test test-sanitize fuzz fuzz-python fuzz-smoke golden demo bench bench-peers install deps clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -71,6 +71,16 @@ fuzz: deps
 	    build-fuzz/corpus/$$t fuzz/seeds/$$t > build-fuzz/$$t.log 2>&1 || { tail -60 build-fuzz/$$t.log; exit 1; }; \
 	  grep -E "executed_units|new_units_added" build-fuzz/$$t.log; \
 	done
+	@$(MAKE) --no-print-directory fuzz-python
+
+# The Python fuzzer of the bag reader's and the node's tf tree (fuzz/fuzz_bag_tf.py): NumPy only, run
+# by FUZZ_PYTHON (default python3; CI gives its venv's). Without NumPy there it says so and stops.
+FUZZ_PYTHON ?= python3
+fuzz-python:
+	@$(FUZZ_PYTHON) -c "import numpy" 2>/dev/null || { echo "fuzz-python: $(FUZZ_PYTHON) has no NumPy: give FUZZ_PYTHON=a Python with NumPy"; exit 1; }
+	@mkdir -p build-fuzz
+	@echo "== fuzz_bag_tf ($(FUZZ_SECONDS) s)"
+	$(FUZZ_PYTHON) fuzz/fuzz_bag_tf.py --seconds $(FUZZ_SECONDS) --artifact-dir build-fuzz
 
 fuzz-smoke:
 	$(MAKE) fuzz FUZZ_SECONDS=20

@@ -302,3 +302,26 @@ class Recording:
             for t_ns, _, topic, msgtype, msg in self.events:
                 w.write(topic, msgtype, t_ns, msg)
         return Path(path)
+
+
+def write_foreign_type(path, fmt, topic: str, msgtype: str, definition: str, messages, stamps):
+    """A bag whose topic carries msgtype as `definition` (.msg text) defines it, not as ROS does:
+    a custom message recorded under a standard name, with the bag's own definition (as a
+    recorder stores it). messages: one dict of field values per stamp (float seconds, the time
+    the bag received it); a field of a message type is a dict of its own."""
+    from rosbags.typesys import Stores
+
+    maker = _Messages(ros1=fmt == "rosbag1")
+    maker.store = get_typestore(Stores.EMPTY)  # the writer stores this store's definition
+    maker.store.register(get_types_from_msg(definition, msgtype))
+    with _Writer(Path(path), fmt, maker) as w:
+        for t, fields in zip(stamps, messages):
+            w.write(topic, msgtype, stamp_ns(t), _build(maker.store, msgtype, fields))
+    return Path(path)
+
+
+def _build(store, msgtype: str, fields: dict):
+    """A message of the store's msgtype from field values, nested messages given as dicts."""
+    types = dict(store.fielddefs[msgtype][1])
+    values = {k: _build(store, types[k][1], v) if isinstance(v, dict) else v for k, v in fields.items()}
+    return store.types[msgtype](**values)

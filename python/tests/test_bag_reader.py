@@ -887,3 +887,84 @@ def test_a_pose_that_is_not_a_number_is_an_error_not_a_dropped_scan(tmp_path):
     p = rec.write(bm.bag_path(tmp_path, "mcap", "inf_pose"))
     with pytest.raises(vb.BagError, match=r"pose on '/pose' at stamp .* has position \(inf"):
         vb.read_bag(p, pose_topic="/pose")
+
+
+# ----------------------------------------------------------------------------------------------
+# Bags that bag2carmen and bag2map refused with a traceback, or whose log log2map refused
+
+
+def max_range_fields(b, tmp_path) -> list[float]:
+    out = tmp_path / "out.log"
+    vb.write_carmen_log(b, out)
+    return [parse_robotlaser(line)["max_range"] for line in out.read_text().splitlines()[1:]]
+
+
+def test_an_infinite_range_max_becomes_a_finite_maximum_range(tmp_path):
+    # REP 117's range_max = +inf: every finite reading is a measurement. CARMEN's field must be
+    # finite and above every reading of the topic (a reading at maximum_range is a max-range
+    # reading to CARMEN's programs): the whole metre above the largest, at least 80 m.
+    far = np.array([3.0, 95.5, np.inf, np.nan, 12.25], dtype=np.float32)
+    near = np.array([1.0, 2.0, np.inf], dtype=np.float32)
+    rec = bm.Recording("mcap")
+    for k, t in enumerate(stamps_of(3)):
+        rec.scan("/far", t, "base_link", far if k == 1 else far[[0, 4]], ANGLE_MIN, ANGLE_STEP, 0.0, math.inf)
+        rec.scan("/near", t + 0.01, "base_link", near, ANGLE_MIN, ANGLE_STEP, 0.0, math.inf)
+        rec.scan("/bounded", t + 0.02, "base_link", near, ANGLE_MIN, ANGLE_STEP, 0.0, 30.0)
+        rec.tf(t, "map", "base_link", float(k), 0.0, 0.0)
+    rec.tf(stamps_of(3)[-1] + 1, "map", "base_link", 3.0, 0.0, 0.0)
+    p = rec.write(bm.bag_path(tmp_path, "mcap", "inf_range_max"))
+    b = vb.read_bag(p, scan_topic=["/far", "/near", "/bounded"])
+    fields = max_range_fields(b, tmp_path)
+    by_topic = {b.topics[k]: {f for f, i in zip(fields, b.topic_index) if i == k} for k in range(3)}
+    assert by_topic == {"/far": {96.0}, "/near": {80.0}, "/bounded": {30.0}}
+    b.ranges[:] = np.inf  # no reading at all: CARMEN's 80 m
+    assert set(max_range_fields(b, tmp_path)) == {80.0, 30.0}
+
+
+def test_a_scan_of_more_beams_than_a_carmen_line_takes_names_the_bag_topic_and_stamp(tmp_path):
+    # carmen::kMaxCount (100000) bounds a log line's count and the mapper's Scans: one beam more
+    # was refused later, by the mapper, with an error naming neither the bag nor the scan.
+    t = stamps_of(2)
+    ranges = [np.full(100_000, 5.0, np.float32), np.full(100_001, 5.0, np.float32)]
+    step = 2 * math.pi / 100_001
+    p = bm.write_bag(bm.bag_path(tmp_path, "mcap", "wide"), "mcap", t, ranges, -math.pi, step, 0.0, 30.0,
+                     tf_poses=base_poses(2), static_mount=(0.0, 0.0, 0.0))
+    with pytest.raises(vb.BagError) as e:
+        vb.read_bag(p)
+    assert str(e.value).startswith(f"{p}: scan at stamp ") and "on '/scan' has 100001 beams" in str(e.value)
+    assert e.value.topic == "/scan" and e.value.stamp == pytest.approx(t[1])
+    one = bm.write_bag(bm.bag_path(tmp_path, "mcap", "widest"), "mcap", t[:1], ranges[:1], -math.pi, step, 0.0,
+                       30.0, tf_poses=base_poses(1), static_mount=(0.0, 0.0, 0.0))
+    assert vb.read_bag(one).beam_counts.tolist() == [100_000]
+
+
+SCAN_FIELDS = ("float32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\nfloat32 range_min\n"
+               "float32 range_max\nfloat32[] ranges\n")
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_a_scan_type_without_a_header_names_the_bag_topic_and_type(tmp_path, fmt):
+    # A custom message recorded under LaserScan's name: read_bag ended in an AttributeError.
+    fields = {"angle_min": -1.0, "angle_max": 1.0, "angle_increment": 1.0, "range_min": 0.0, "range_max": 10.0,
+              "ranges": np.array([1.0, 2.0, 3.0], np.float32)}
+    p = bm.write_foreign_type(bm.bag_path(tmp_path, fmt, "custom"), fmt, "/scan", bm.LASER_SCAN, SCAN_FIELDS,
+                              [fields, fields], stamps_of(2))
+    with pytest.raises(vb.BagError) as e:
+        vb.read_bag(p, static_pose=(0.0, 0.0, 0.0))
+    assert str(e.value) == (f"{p}: topic '/scan' (sensor_msgs/LaserScan): the message received at "
+                            f"{bm.stamp_ns(T0) / 1e9:.9f} has no field 'header': the bag defines "
+                            "sensor_msgs/LaserScan otherwise than ROS does (a custom message under a standard "
+                            "name?), so it cannot be read as one")
+    assert e.value.topic == "/scan"
+
+
+def test_a_header_type_without_a_stamp_names_the_inner_type(tmp_path):
+    # LaserScan's header of a custom std_msgs/Header without a stamp: the error names that type.
+    definition = "std_msgs/Header header\n" + SCAN_FIELDS + "=" * 80 + "\nMSG: std_msgs/Header\nstring frame_id\n"
+    p = bm.bag_path(tmp_path, "sqlite3", "custom_header")
+    bm.write_foreign_type(p, "sqlite3", "/scan", bm.LASER_SCAN, definition, [{
+        "header": {"frame_id": "laser"}, "angle_min": -1.0, "angle_max": 1.0, "angle_increment": 1.0, "range_min": 0.0,
+        "range_max": 10.0, "ranges": np.array([1.0], np.float32)}], stamps_of(1))
+    with pytest.raises(vb.BagError, match="has no field 'stamp' in its std_msgs/Header: the bag defines "
+                                          "sensor_msgs/LaserScan otherwise"):
+        vb.read_bag(p, static_pose=(0.0, 0.0, 0.0))

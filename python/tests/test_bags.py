@@ -486,3 +486,71 @@ def test_bad_laser_clock_and_receive_stamps(tmp_path, intel):
     assert vg.read_map(tmp_path / "c.map").sha256() == got.sha256()
     r = run_script("bag2map", path, tmp_path / "d.map")
     assert r.returncode == 1 and "--stamp receive" in r.stderr
+
+
+def built_log2map():
+    """log2map of a build of this checkout (VASCO_BIN, build/bin, PATH), or None."""
+    for d in (os.environ.get("VASCO_BIN"), ROOT / "build" / "bin"):
+        if d and (Path(d) / "log2map").is_file():
+            return Path(d) / "log2map"
+    found = shutil.which("log2map")
+    return Path(found) if found else None
+
+
+def test_bag2carmen_log_of_an_infinite_range_max_is_read_by_log2map(tmp_path, intel):
+    # range_max = +inf (REP 117: no limit) was written as maximum_range "inf", which log2map's
+    # reader (load_log's too) refuses: now the whole metre above the topic's farthest reading.
+    s = intel.scans.select(0, 100)
+    ranges = [s.ranges_of(i).copy() for i in range(len(s))]
+    path = bag_maker.write_bag(bag_maker.bag_path(tmp_path, "mcap"), "mcap", scan_stamps(len(s)), ranges,
+                               float(s.first_angle[0]), float(s.angle_step[0]), 0.0, math.inf,
+                               tf_poses=intel.poses[:len(s)], static_mount=(0.0, 0.0, 0.0))
+    out = tmp_path / "inf.log"
+    r = run_script("bag2carmen", path, out)
+    assert r.returncode == 0, r.stderr
+    log, bag = vg.load_log(out, map_resolution=BAG_CELL), vg.load_bag(path)  # log2map's reader
+    fields = {line.split()[5] for line in out.read_text().splitlines()[1:]}
+    farthest = max(float(x.max()) for x in ranges)
+    assert fields == {repr(max(80.0, math.floor(farthest) + 1.0))}, (fields, farthest)
+    assert np.array_equal(log.ranges, bag.ranges) and np.array_equal(log.poses, bag.poses)
+    assert finished(log).sha256() == finished(bag).sha256()
+    log2map = built_log2map()
+    if log2map is not None:  # the program itself, where built
+        done = subprocess.run([str(log2map), "-q", str(out), str(tmp_path / "inf.map")], capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+
+
+def test_a_message_type_without_a_header_is_an_error_naming_bag_topic_and_type(tmp_path):
+    # A custom message recorded under LaserScan's name: bag2carmen ended in a traceback.
+    definition = ("float32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\nfloat32 range_min\n"
+                  "float32 range_max\nfloat32[] ranges\n")
+    fields = {"angle_min": -1.0, "angle_max": 1.0, "angle_increment": 1.0, "range_min": 0.0, "range_max": 10.0,
+              "ranges": np.array([1.0, 2.0, 3.0], np.float32)}
+    path = bag_maker.write_foreign_type(bag_maker.bag_path(tmp_path, "mcap", "custom"), "mcap", "/scan",
+                                        bag_maker.LASER_SCAN, definition, [fields, fields], [1000.0, 1000.2])
+    for tool, out in (("bag2carmen", "x.log"), ("bag2map", "x.map")):
+        r = run_script(tool, "--static-pose", "0,0,0", path, tmp_path / out)
+        assert r.returncode == 1, (tool, r.stderr)
+        assert "Traceback" not in r.stderr, r.stderr
+        assert f"{tool}: {path}: topic '/scan' (sensor_msgs/LaserScan): " in r.stderr, r.stderr
+        assert "has no field 'header'" in r.stderr
+        assert not (tmp_path / out).exists()
+
+
+def test_a_scan_of_more_than_100000_beams_names_the_bag_topic_and_stamp(tmp_path):
+    # carmen::kMaxCount bounds a log line's beams and the mapper's: bag2carmen and bag2map said
+    # "beam_counts[1] = 100001: must be ...", naming neither the bag, nor the topic, nor the scan.
+    ranges = [np.full(1000, 4.0, np.float32), np.full(100_001, 4.0, np.float32)]
+    path = bag_maker.write_bag(bag_maker.bag_path(tmp_path, "mcap", "wide"), "mcap", [1000.0, 1000.2], ranges,
+                               -math.pi, 2 * math.pi / 100_001, 0.0, 30.0, tf_poses=np.zeros((2, 3)),
+                               static_mount=(0.0, 0.0, 0.0))
+    want = f"{path}: scan at stamp 1000.200000000 on '/scan' has 100001 beams, more than the 100000"
+    for tool, out in (("bag2carmen", "x.log"), ("bag2map", "x.map")):
+        r = run_script(tool, path, tmp_path / out)
+        assert r.returncode == 1, (tool, r.stderr)
+        assert f"{tool}: {want}" in r.stderr, r.stderr
+        assert not (tmp_path / out).exists()
+    with pytest.raises(vg.FileError) as e:
+        vg.load_bag(path)
+    assert e.value.file == str(path) and want in str(e.value)

@@ -185,3 +185,87 @@ def test_a_deep_chain_is_looked_up_in_linear_time():
     # Linear: the lookup itself takes milliseconds; the bound is half the quadratic route's time,
     # so only that route fails it.
     assert took < 15.0, took
+
+
+# Found by fuzz/fuzz_bag_tf.py: inputs the tree took with an exception other than a TfError, or
+# answered with numbers that are not finite.
+
+
+def test_a_stamp_beyond_ros_time_is_refused_and_leaves_no_link():
+    # sec 1e19 overflowed the int64 history (OverflowError) after the link was made, and the
+    # empty link then failed every lookup with an IndexError.
+    tf = bags.TfBuffer()
+    for sec, nanosec in ((10**19, 0), (-(2**63), 4294967295), (2**32 + 5, 0), (0, 2**63), (-(2**31) - 1, 0)):
+        with pytest.raises(bags.TfError, match="the stamp is not a ROS time"):
+            tf.add_transform(transform_at("map", "odom", sec, nanosec, 0.0))
+    assert len(tf) == 0
+    with pytest.raises(bags.TfError, match="neither 'odom' nor 'map' is in tf"):
+        tf.lookup("map", "odom", 0)
+
+
+def transform_at(parent, child, sec, nanosec, x):
+    """A TransformStamped-like link at any (sec, nanosec), moved by x along x."""
+    return NS(header=NS(frame_id=parent, stamp=NS(sec=sec, nanosec=nanosec)), child_frame_id=child,
+              transform=NS(translation=NS(x=x, y=0.0, z=0.0), rotation=NS(x=0.0, y=0.0, z=0.0, w=1.0)))
+
+
+def test_the_extreme_ros_times_and_an_unbounded_keep():
+    # ROS 2's earliest (sec -2^31) and ROS 1's latest (sec 2^32 - 1) stamps: their difference is
+    # below 2^63 ns, so spans, gaps and interpolation stay exact. keep=inf was an OverflowError.
+    tf = bags.TfBuffer(max_gap=10.0)
+    early, late = -(2**31) * 10**9, (2**32 - 1) * 10**9 + 999_999_999
+    for stamp, x in ((early, 0.0), (late, 6.0)):
+        tf.add_transform(transform_at("map", "odom", stamp // 10**9, stamp % 10**9, x))
+    assert tf.span("map", "odom") == (early, late)
+    with pytest.raises(bags.TfError, match="falls in a gap of 6442450944.000 s"):
+        tf.lookup("map", "odom", 0)
+    assert tf.covers("map", "odom", [early, 0, late]).tolist() == [True, False, True]
+    t, q = bags.TfBuffer(keep=math.inf).lookup("a", "a", 0)  # any keep: as long as every stamp
+    assert np.isfinite(t).all()
+
+
+def test_a_translation_too_large_to_compose_is_refused():
+    # 1e308 m passed the finiteness check and gave inf (and nan) in every lookup through it.
+    tf = bags.TfBuffer("run.bag")
+    for x in (1e308, -1e13, 1.5e12):
+        with pytest.raises(bags.TfError, match=r"on /tf has translation .*: not a finite number of metres up to "
+                                               r"1e\+12"):
+            tf.add_message(tf_message(("map", "base_link", 1, (x, 0.0, 0.0), IDENTITY)))
+    tf.add_message(tf_message(("map", "base_link", 1, (1e12, 0.0, 0.0), IDENTITY),
+                              ("map", "base_link", 2, (-1e12, 0.0, 0.0), IDENTITY)))
+    tf.add_message(tf_message(("base_link", "laser", 0, (1e12, 0.0, 0.0), YAW_90)), static=True)
+    t, q = tf.lookup("map", "laser", [ns(1), (ns(1) + ns(2)) // 2, ns(2)])
+    assert np.isfinite(t).all() and np.isfinite(q).all()
+    np.testing.assert_allclose(t[:, 0], [2e12, 1e12, 0.0], rtol=0, atol=1e-3)
+
+
+def test_an_error_the_caller_keeps_does_not_stop_new_samples():
+    # The TfError about two samples at one stamp kept views of the link's history alive in its
+    # traceback: the next sample of the link was a BufferError while the caller held the error.
+    tf = bags.TfBuffer("run.bag", refuse_repeats=True)
+    tf.add_message(tf_message(("map", "base_link", 1, (1.0, 0.0, 0.0), IDENTITY),
+                              ("map", "base_link", 1, (2.0, 0.0, 0.0), IDENTITY)))
+    with pytest.raises(bags.TfError, match="two different samples") as kept:
+        tf.lookup("map", "base_link", [ns(1)])
+    tf.add_message(tf_message(("map", "base_link", 2, (3.0, 0.0, 0.0), IDENTITY)))
+    assert kept.value.topic == "/tf" and len(tf) == 1
+
+
+def test_no_chain_among_thousands_of_frames_is_a_short_error():
+    # A tree of 20,000 frames: the error listed every one (half a megabyte), and its "did you
+    # mean" compared the missing name with each (half a second, in a lookup a node repeats).
+    tf = bags.TfBuffer()
+    name = "robot_{:06d}_laser_link".format
+    tf.add_message(tf_message(*[(name((k - 1) // 2), name(k), 0, (1.0, 0.0, 0.0), IDENTITY)
+                                for k in range(1, 20_000)]), static=True)
+    with pytest.raises(bags.TfError) as e:
+        tf.lookup(name(5), "robot_99999_laser_lnk", [0])
+    text = str(e.value)
+    assert len(text) < 1000, len(text)
+    assert text.endswith(f"(frames in /tf: {', '.join(sorted(name(k) for k in range(20_000))[:20])}, ... "
+                         "(19980 more))")
+    assert "did you mean" not in text
+    small = make_buffer()  # a few frames: all listed, and the closest named
+    with pytest.raises(bags.TfError, match=r"'lazer' is not in tf: did you mean 'laser'\? \(frames in /tf: "
+                                           r"base_link, laser, map\)"):
+        small.lookup("map", "lazer", ns(1))

@@ -156,6 +156,12 @@ class LaserReading:
     ranges: np.ndarray
 
 
+# The most beams a scan may have: a CARMEN log line's limit on a count (carmen::kMaxCount in
+# carmen_compat/log_reader.h, which log2map and the mapper's Scans enforce). Checked as the
+# message is read, so that the error names the bag, topic and stamp, and bag2carmen never
+# writes a line that log2map refuses.
+MAX_BEAMS = 100_000
+
 # How far len(ranges) may be from what angle_min, angle_max and angle_increment imply, in
 # beams: drivers compute angle_max as angle_min + (n - 1) * increment in float32 or from the
 # device's nominal field of view, so the quotient is a whole number give or take rounding, and
@@ -175,8 +181,10 @@ def read_laser(msg, *, no_return: str, counts: dict, fail, multi_echo: bool = Fa
     a0, da = float(msg.angle_min), float(msg.angle_increment)
     if not (math.isfinite(a0) and math.isfinite(da)):
         raise fail(f"has angle_min {a0!r}, angle_increment {da!r}")
+    n = len(msg.ranges)
+    if n > MAX_BEAMS:
+        raise fail(f"has {n} beams, more than the {MAX_BEAMS} a CARMEN log line and the mapper take")
     raw = pick_echoes(msg, echo, fail) if multi_echo else msg.ranges
-    n = len(raw)
     a1 = float(getattr(msg, "angle_max", math.nan))
     if da != 0 and math.isfinite(a1) and n > 0 and abs((a1 - a0) / da + 1 - n) > BEAM_COUNT_SLACK:
         raise fail(f"has {n} ranges, but angle_min {a0:.9g} to angle_max {a1:.9g} by {da:.9g} makes "

@@ -138,5 +138,26 @@ def read_messages(reader, path, handlers: dict, progress) -> None:
             raise BagError(path, f"cannot deserialize a {short_type(connection.msgtype)} message on "
                                  f"{connection.topic!r} received at {stamp_text(t_ns)}: {reason(err)}",
                            topic=connection.topic) from err
-        handlers[connection.topic](msg, t_ns)
+        try:
+            handlers[connection.topic](msg, t_ns)
+        except AttributeError as err:
+            if not _is_message(getattr(err, "obj", None)):
+                raise  # not the message's shape: a fault of ours, left as it is
+            raise BagError(path, _missing_field_text(connection, t_ns, err), topic=connection.topic) from err
         progress.tick()
+
+
+def _is_message(obj) -> bool:
+    """Whether obj is a message rosbags deserialized (its classes carry their type's name)."""
+    return isinstance(getattr(type(obj), "__msgtype__", None), str)
+
+
+def _missing_field_text(connection, t_ns: int, err: AttributeError) -> str:
+    """Why a message lacks a field the reader needs: the bag defines its type otherwise than ROS
+    (a custom message under a standard name, or another version of it)."""
+    kind = short_type(connection.msgtype)
+    inner = short_type(type(err.obj).__msgtype__)
+    where = "" if inner == kind else f" in its {inner}"
+    return (f"topic {connection.topic!r} ({kind}): the message received at {stamp_text(t_ns)} has no field "
+            f"{getattr(err, 'name', None) or str(err)!r}{where}: the bag defines {kind} otherwise than ROS does "
+            "(a custom message under a standard name?), so it cannot be read as one")

@@ -3,18 +3,37 @@ ROS 2 node's subscriptions) and looks up the transform between two frames at giv
 
 from __future__ import annotations
 
-import math
 from array import array
 
 import numpy as np
 
 from .errors import TfError
 from .geometry import compose, inverse, is_identity, slerp, unit_quaternion
-from .header import frame_name, stamp_ns, stamp_seconds, stamp_text
+from .header import NS, frame_name, stamp_ns, stamp_seconds, stamp_text
 from .series import bracket, first_outside, sorted_samples
 from .topics import did_you_mean
 
 __all__ = ["TfBuffer"]
+
+# The stamps a tf message can carry: builtin_interfaces/Time's sec is an int32 (ROS 1's time a
+# uint32), its nanosec a uint32. Any two such stamps are less than 2^63 ns apart, so the int64
+# arithmetic on them (spans, gaps, interpolation, keep) cannot overflow; a stamp beyond them is
+# no ROS time and would wrap around.
+MIN_STAMP_NS = -(2**31) * NS
+MAX_STAMP_NS = (2**32 - 1) * NS + (2**32 - 1)
+
+# The largest translation a link may have, in metres: seven times the sun's distance, beyond any
+# frame a robot uses (ECEF and UTM coordinates are below 1e7 m), and float64 still resolves a
+# quarter millimetre there. A chain of such links cannot overflow float64 when composed or
+# interpolated (1e308 m could), so every lookup gives finite numbers.
+MAX_TRANSLATION = 1e12
+
+# Frames an error lists at most: a tree of thousands of frames keeps the message readable.
+LISTED_FRAMES = 20
+# Frames beyond which a missing frame gets no "did you mean": difflib compares the name with
+# every frame (half a second for 20,000 alike names), in a lookup a live node repeats while it
+# waits for a transform.
+CLOSE_MATCH_FRAMES = 2000
 
 
 class _Edge:
@@ -57,8 +76,10 @@ class _Edge:
         return self._arrays
 
     def _check_repeats(self) -> None:
-        times = np.frombuffer(self.ns, dtype=np.int64)
-        vals = np.frombuffer(self.values, dtype=np.float64).reshape(-1, 7)
+        # copies, not views: a TfError raised here keeps this frame's locals alive with its
+        # traceback, and a view would keep the arrays from growing (BufferError on the next add)
+        times = np.array(self.ns, dtype=np.int64)
+        vals = np.array(self.values, dtype=np.float64).reshape(-1, 7)
         order = np.argsort(times, kind="stable")
         t, v = times[order], vals[order]
         differ = (t[1:] == t[:-1]) & (v[1:] != v[:-1]).any(axis=1)
@@ -104,10 +125,10 @@ class TfBuffer:
                  max_gap: float | None = None, keep: float | None = None, refuse_repeats: bool = False):
         self.file = file
         self.refuse_repeats = refuse_repeats
-        self.keep_ns = None if keep is None else int(round(keep * 1e9))
+        self.keep_ns = _duration_ns(keep, "keep")
         self.stamp_name = stamp_name
         self.outside_hint = outside_hint
-        self.max_gap_ns = None if max_gap is None else int(round(max_gap * 1e9))
+        self.max_gap_ns = _duration_ns(max_gap, "max_gap")
         self._edges: dict[str, _Edge] = {}  # by child: each child has one parent
 
     def __len__(self) -> int:
@@ -126,11 +147,15 @@ class TfBuffer:
             topic = "/tf_static" if static else "/tf"
         parent, child = frame_name(ts.header.frame_id), frame_name(ts.child_frame_id)
         ns = stamp_ns(ts.header.stamp)
-        tr, rot = ts.transform.translation, ts.transform.rotation
         what = f"tf {parent} -> {child} at stamp {stamp_text(ns)} on {topic}"
+        if not MIN_STAMP_NS <= ns <= MAX_STAMP_NS:  # checked first: no edge is made for it
+            raise TfError(self.file, f"{what}: the stamp is not a ROS time (sec {ts.header.stamp.sec}, nanosec "
+                                     f"{ts.header.stamp.nanosec})", topic=topic)
+        tr, rot = ts.transform.translation, ts.transform.rotation
         t = (float(tr.x), float(tr.y), float(tr.z))
-        if not all(math.isfinite(v) for v in t):
-            raise TfError(self.file, f"{what} has translation {t}", topic=topic, stamp=stamp_seconds(ns))
+        if not all(abs(v) <= MAX_TRANSLATION for v in t):  # NaN too
+            raise TfError(self.file, f"{what} has translation {t}: not a finite number of metres up to "
+                                     f"{MAX_TRANSLATION:g}", topic=topic, stamp=stamp_seconds(ns))
         q = unit_quaternion((rot.x, rot.y, rot.z, rot.w), what, self.file, TfError)
         edge = self._edges.get(child)
         if edge is None:
@@ -169,7 +194,7 @@ class TfBuffer:
         chain = self.up(frame)
         if len(chain) == 1:
             return f"{frame!r} is the root of another tree"
-        via = f" via {', '.join(chain[1:-1])}" if len(chain) > 2 else ""
+        via = f" via {_listing(chain[1:-1])}" if len(chain) > 2 else ""
         return f"{frame!r} reaches {chain[-1]!r}{via}"
 
     def _no_chain_text(self, target: str, source: str) -> str:
@@ -183,10 +208,10 @@ class TfBuffer:
             why = f"{self._reach_text(source)}, {target!r} has no connection to it"
         else:
             why = f"{self._reach_text(source)}, {self._reach_text(target)}"
-        frames = ", ".join(sorted(known))
         missing = [f for f in (source, target) if f not in known]
-        hint = did_you_mean(missing[0], known) if missing else ""
-        return f"no transform chain from {target!r} to {source!r}: {why}{hint} (frames in /tf: {frames})"
+        hint = did_you_mean(missing[0], known) if missing and len(known) <= CLOSE_MATCH_FRAMES else ""
+        return (f"no transform chain from {target!r} to {source!r}: {why}{hint} (frames in /tf: "
+                f"{_listing(sorted(known))})")
 
     def _path_between(self, target: str, source: str) -> tuple[list[str], list[str]]:
         """(frames from source up to the common ancestor, frames from target up to it); a
@@ -294,3 +319,22 @@ class TfBuffer:
         if b is None:
             return np.array(a[0], dtype=np.float64), np.array(a[1], dtype=np.float64)
         return compose(inverse(b), a)
+
+
+def _duration_ns(seconds: float | None, what: str) -> int | None:
+    """A duration in whole nanoseconds, at most the span of all ROS times (a longer one means the
+    same, and would overflow the int64 arithmetic on stamps); ValueError for a negative or NaN one."""
+    if seconds is None:
+        return None
+    if not seconds >= 0:
+        raise ValueError(f"{what} must be a number of seconds >= 0, not {seconds!r}")
+    return int(round(min(float(seconds) * 1e9, MAX_STAMP_NS - MIN_STAMP_NS)))
+
+
+def _listing(names: list[str]) -> str:
+    """'a, b, c', or the first LISTED_FRAMES of the names and how many more; 'none' for none."""
+    if not names:
+        return "none"
+    if len(names) <= LISTED_FRAMES:
+        return ", ".join(names)
+    return f"{', '.join(names[:LISTED_FRAMES])}, ... ({len(names) - LISTED_FRAMES} more)"
