@@ -15,6 +15,8 @@
 #include <new>
 #include <stdexcept>
 
+#include "carmen_compat/termination_signals.h"
+
 namespace carmen {
 namespace gzip {
 
@@ -295,7 +297,8 @@ std::string GzipInflater::fault(MemberDecoder::Status status) const {
 // ---------------------------------------------------------------------------
 
 BackgroundInflater::BackgroundInflater(std::FILE *fp, std::size_t block_size, const std::string &prefix)
-    : inflater_(fp, default_codec(), std::size_t(256) << 10, prefix), block_size_(block_size), thread_([this] { produce(); }) {}
+    : inflater_(fp, default_codec(), std::size_t(256) << 10, prefix), block_size_(block_size),
+      thread_(carmen::start_thread([this] { produce(); })) {}
 
 BackgroundInflater::~BackgroundInflater() {
   {

@@ -17,6 +17,8 @@
 #include <thread>
 #include <utility>
 
+#include "carmen_compat/termination_signals.h"
+
 namespace vasco_py {
 
 namespace nb = nanobind;
@@ -33,7 +35,9 @@ auto run_interruptible(Fn &&fn) -> decltype(fn()) {
   std::future<Result> done = task.get_future();
   bool interrupted = false;
   {
-    std::thread worker(std::move(task));
+    // The termination signals blocked on the worker: they reach this thread, whose Python
+    // handlers run between the waits (and the worker may be in an output commit).
+    std::thread worker = carmen::start_thread(std::move(task));
     for (;;) {
       bool ready = false;
       {

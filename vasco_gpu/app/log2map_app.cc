@@ -24,6 +24,7 @@
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_format.h"
+#include "carmen_compat/termination_signals.h"
 #include "cli_support.h"
 #include "vasco_gpu/pipeline/outputs.h"
 #include "log2map_app.h"
@@ -59,9 +60,11 @@ std::future<bool> start_cuda(const Options &opt, const vasco::BackendOptions &bo
 #if defined(VASCO_HAVE_CUDA)
   const vasco::BackendInfo *b = vasco::find_backend(opt.backend);
   if (b != nullptr && b->uses_gpus && !b->chooses) {
-    ready = std::async(std::launch::async, [dev = bopt.cuda_device] {
-      std::string why;
-      return vasco::cuda_usable(dev, &why);
+    ready = carmen::with_termination_signals_blocked([&] {
+      return std::async(std::launch::async, [dev = bopt.cuda_device] {
+        std::string why;
+        return vasco::cuda_usable(dev, &why);
+      });
     });
   }
 #else

@@ -18,6 +18,7 @@
 #include "batch_report.h"
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
+#include "carmen_compat/termination_signals.h"
 #include "cli_support.h"
 #include "log2map_steps.h"
 #include "task_pool.h"
@@ -238,10 +239,11 @@ std::vector<int> batch_devices(const Options &opt) {
 // one-GPU batch. A GPU whose mapper cannot start is said and left out: the
 // others map its share.
 std::thread map_on_other_devices(BatchRun &run, const Options &opt, std::vector<int> devices) {
-  return std::thread([&run, &opt, devices] {
+  return carmen::start_thread([&run, &opt, devices] {
     std::vector<std::thread> workers;
+    workers.reserve(devices.size());  // a push_back that throws would drop a running thread
     for (int d : devices) {
-      workers.emplace_back([&run, &opt, d] {
+      workers.push_back(carmen::start_thread([&run, &opt, d] {
         try {
           vasco::BackendOptions b = backend_options(opt);
           b.cuda_device = d;
@@ -250,7 +252,7 @@ std::thread map_on_other_devices(BatchRun &run, const Options &opt, std::vector<
         } catch (const std::exception &e) {
           std::fprintf(stderr, "%s: GPU %d left out: %s\n", opt.tool.c_str(), d, carmen::printable(e.what()).c_str());
         }
-      });
+      }));
     }
     for (std::thread &w : workers) w.join();
   });

@@ -13,6 +13,7 @@
 
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
+#include "carmen_compat/termination_signals.h"
 #include "cli_support.h"
 #include "vasco_gpu/pipeline/mapped.h"
 #include "vasco_gpu/pipeline/outputs.h"
@@ -41,7 +42,7 @@ void ProgressBar::done() {
 }
 
 PhaseTicker::PhaseTicker(std::string label, bool enabled) : label_(std::move(label)) {
-  if (enabled) thread_ = std::thread([this] { tick(); });
+  if (enabled) thread_ = carmen::start_thread([this] { tick(); });
 }
 
 PhaseTicker::~PhaseTicker() {
@@ -205,6 +206,9 @@ void write_outputs(const Options &opt, const std::string &log, const std::vector
   carmen::OutputTransaction tx;
   for (const std::string &out : outputs) {
     if (out == cli::kStdio) {
+      // Its directory is made, then registered for removal on a signal: no
+      // signal may come in between.
+      const carmen::SignalsWait registered_as_made;
       to_stdout = std::make_unique<cli::StdoutFile>(".map");
       carmen::write_map(tx, to_stdout->path(), map);
     } else {

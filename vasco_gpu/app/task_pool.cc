@@ -2,11 +2,15 @@
 
 #include <algorithm>
 
+#include "carmen_compat/termination_signals.h"
+
 namespace cli {
 
 TaskPool::TaskPool(int threads) {
   threads_.reserve(static_cast<size_t>(std::max(threads, 1)));
-  for (int i = 0; i < std::max(threads, 1); ++i) threads_.emplace_back([this] { work(); });
+  // The termination signals blocked (start_thread): a batch's commits run
+  // here, and a signal must wait for them (carmen_compat/atomic_file.h).
+  for (int i = 0; i < std::max(threads, 1); ++i) threads_.push_back(carmen::start_thread([this] { work(); }));
 }
 
 TaskPool::~TaskPool() {

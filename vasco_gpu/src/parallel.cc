@@ -12,6 +12,8 @@
 #include <thread>
 #include <vector>
 
+#include "carmen_compat/termination_signals.h"
+
 #ifdef __linux__
 #include <sched.h>
 #endif
@@ -46,14 +48,17 @@ int usable_cores() {
 
 // Helper threads that sleep between calls. One call at a time (busy_); the
 // workers take indices from next_, and the caller waits until every index is
-// done and no worker still holds the job, so none can outlive its fn.
+// done and no worker still holds the job, so none can outlive its fn. They
+// block the termination signals (start_thread): a signal must find a thread
+// that lets an output's commit finish first.
 class WorkerPool {
  public:
   // False (nothing run) if another call holds the pool.
   bool try_run(int n, const std::function<void(int)> &fn) {
     std::unique_lock<std::mutex> busy(busy_, std::try_to_lock);
     if (!busy.owns_lock()) return false;
-    while (static_cast<int>(workers_.size()) < n - 1) workers_.emplace_back([this] { work(); });
+    workers_.reserve(static_cast<size_t>(n - 1));  // a push_back that throws would drop a running thread
+    while (static_cast<int>(workers_.size()) < n - 1) workers_.push_back(carmen::start_thread([this] { work(); }));
     {
       std::lock_guard<std::mutex> lock(m_);
       job_ = &fn;
@@ -143,7 +148,7 @@ void run_on_new_threads(int n, const std::function<void(int)> &fn) {
   std::vector<std::thread> threads;
   threads.reserve(static_cast<size_t>(n - 1));
   try {
-    for (int t = 1; t < n; ++t) threads.emplace_back(body, t);
+    for (int t = 1; t < n; ++t) threads.push_back(carmen::start_thread(body, t));
   } catch (...) {
     for (auto &th : threads) th.join();
     throw;

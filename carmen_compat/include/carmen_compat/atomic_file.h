@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "carmen_compat/termination_signals.h"
+
 namespace carmen {
 
 // Usage:
@@ -88,19 +90,31 @@ class AtomicOutput {
 // then (an exception, a signal) no target is touched and the temporaries go.
 //
 // commit():
-//  1. locks each directory involved once (by device and inode, however it is
-//     spelled: "x.map ./x.png", "a//b", a symlinked directory), with flock, in
-//     a fixed order, so two concurrent runs writing the same pair of files (an
-//     image and its YAML) leave both files from the same run. It waits at most
-//     lock_timeout() (kDefaultLockTimeout, 10 s) for another holder, then
-//     fails naming the directory and, where /proc/locks tells, the holder's pid;
+//  1. locks each target, with flock on a lock file of our own beside it
+//     (".NAME.lock", created mode 0600, never through a symlink), in a fixed
+//     order, so two concurrent runs writing the same pair of files (an image
+//     and its YAML) leave both files from the same run. Not the directory: a
+//     flock on it, which anyone who may read it can take, stops no commit. It
+//     waits at most lock_timeout() (kDefaultLockTimeoutMs, 10 s) for another
+//     holder, then fails naming the target, its lock file and, where
+//     /proc/locks tells, the holder's pid. Each lock file goes again when its
+//     commit is done (or on a signal); one a SIGKILL left is taken and
+//     removed by the next commit. Where no lock can be had (a file system
+//     without flock, something else under the name, another user's lock file
+//     that nobody holds) the commit goes on without it;
 //  2. checks every target with check_replaceable() before the first rename;
-//  3. renames, with SIGINT, SIGTERM and SIGHUP held back, keeping each old
-//     file under a hidden name (a hard link ".NAME.old.PID.RANDOM", or the
-//     temporary's name by an atomic exchange where hard links are refused):
-//     should a later rename fail, the earlier targets get their old files
-//     back (a target that did not exist is removed), and the error names the
-//     target that failed. Once all are renamed the old files are removed.
+//  3. renames, keeping each old file under a hidden name (a hard link
+//     ".NAME.old.PID.RANDOM", or the temporary's name by an atomic exchange
+//     where hard links are refused): should a later rename fail, the earlier
+//     targets get their old files back (a target that did not exist is
+//     removed), and the error names the target that failed. Once all are
+//     renamed the old files are removed.
+// From the locks to their release SIGINT, SIGTERM and SIGHUP wait: they are
+// held back on the committing thread, and remove_temporaries_on_signals's
+// handler, on whatever thread a signal lands, lets the commits in progress
+// (of every thread) end before it ends the process (SignalsWait, below).
+// The threads the library starts block them (start_thread,
+// termination_signals.h).
 class OutputTransaction {
  public:
   static constexpr int kDefaultLockTimeoutMs = 10000;
@@ -116,8 +130,13 @@ class OutputTransaction {
   // Tests only: the n-th rename (1-based) of the next commit in this process
   // fails with `err` as if the file system had refused it; 0 disarms.
   static void fail_rename_for_testing(int n, int err);
+  // Tests only: `hook` runs after each rename of every commit in this process
+  // (inside the commit, signals waiting); nullptr removes it.
+  static void after_rename_for_testing(std::function<void()> hook);
 
  private:
+  void rename_all();  // checks, renames (undone on a failure), and removes the old files
+
   std::vector<std::unique_ptr<AtomicOutput>> outputs_;
   int lock_timeout_ms_ = kDefaultLockTimeoutMs;
 };
@@ -154,10 +173,30 @@ TargetKey target_key(const std::string &path);
 void write_file_atomically(const std::string &path, std::string_view contents, bool durable = false);
 
 // Installs handlers for SIGINT, SIGTERM and SIGHUP that remove every live
-// temporary file of this process and then end it as the signal would have
+// temporary file (and lock file held) of this process and then end it as the
+// signal would have; during a commit, once the commits in progress are done
 // (SIGKILL cannot be caught: it can leave a ".NAME.tmp.PID.RANDOM" behind).
-// Idempotent.
+// Idempotent. Throws std::system_error when the handlers cannot be installed.
 void remove_temporaries_on_signals();
+
+// A section of code that no termination signal cuts: while one lives, on
+// any thread, SIGINT, SIGTERM and SIGHUP wait (held back on its own thread,
+// and remove_temporaries_on_signals's handler, on whatever thread a signal
+// lands, ends the process only once every section is left; no section starts
+// once a signal waits). A commit's renames run in one; so should making a
+// path and registering it with TemporaryOnSignal, so that no signal comes
+// between the two. Keep it short: nothing inside may wait for another thread.
+// Throws std::system_error when the signals cannot be blocked.
+class SignalsWait {
+ public:
+  SignalsWait();
+  ~SignalsWait();
+  SignalsWait(const SignalsWait &) = delete;
+  SignalsWait &operator=(const SignalsWait &) = delete;
+
+ private:
+  const TerminationSignalsBlocked blocked_;  // first in, last out
+};
 
 // A path of our own making that a fatal signal must not leave behind (a file,
 // or a directory, removed once empty), registered with the temporaries above

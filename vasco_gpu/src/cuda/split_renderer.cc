@@ -4,6 +4,7 @@
 #include <exception>
 #include <thread>
 
+#include "carmen_compat/termination_signals.h"
 #include "cuda_exact_renderer.h"
 #include "cuda_float_renderer.h"
 
@@ -43,13 +44,13 @@ void on_band_threads(size_t n, Body body) {
   threads.reserve(n);
   try {
     for (size_t i = 0; i < n; ++i)
-      threads.emplace_back([&, i] {
+      threads.push_back(carmen::start_thread([&, i] {
         try {
           body(i);
         } catch (...) {
           failed[i] = std::current_exception();
         }
-      });
+      }));
   } catch (...) {  // no thread for a band: join those started, then report it
     for (auto &t : threads) t.join();
     throw;
