@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "carmen_compat/error.h"
+#include "carmen_compat/map_file.h"
 #include "map_test_support.h"
 
 namespace {
@@ -222,6 +223,37 @@ TEST(MapFormatBad, DamagedCarmenMapsNameTheFile) {
   write_bytes(dir.file("empty.map"), "");
   expect_file_error(dir.file("empty.map"), dir.file("empty.map"), "empty");
   expect_file_error(dir.file("missing.map"), dir.file("missing.map"), "cannot open");
+}
+
+// A CARMEN map cut short inside its cells reads as CARMEN renders it (the
+// rest of the cells unknown), with a warning on stderr naming the file, the
+// chunk and the bytes missing: what mapconvert and mapdiff read. Too little
+// of it is still refused.
+TEST(MapFormatBad, CarmenMapCutShortReadsWithAWarning) {
+  TempDir dir;
+  carmen::MapFile grid_only;  // the gridmap last in the file
+  grid_only.gridmap = sample().grid;
+  carmen::write_map_file(dir.file("whole.map"), grid_only);
+  const std::string whole = read_bytes(dir.file("whole.map"));
+  for (const char *name : {"short.map", "short.map.gz"}) {
+    const std::string path = dir.file(name);
+    if (std::string(name).size() > 9) {
+      maptest::gzip_to_file(path, whole.substr(0, whole.size() - 7));
+    } else {
+      write_bytes(path, whole.substr(0, whole.size() - 7));
+    }
+    testing::internal::CaptureStderr();
+    const carmen::MapRead r = carmen::read_map(path);
+    const std::string err = testing::internal::GetCapturedStderr();
+    ASSERT_EQ(r.grid.cells.size(), 6u);
+    EXPECT_EQ(r.grid.at(0, 0), 0.0f);
+    EXPECT_EQ(r.grid.at(1, 0), 1.0f);
+    const std::vector<float> want = maptest::cells_cut_short(whole.substr(whole.size() - 8), 1);  // the last 2 cells
+    EXPECT_EQ(r.grid.at(2, 0), want[0]);  // one byte of it came, the rest zero as in CARMEN's calloc()ed grid
+    EXPECT_EQ(r.grid.at(2, 1), 0.0f);     // 1 - 51/255 there, cut off
+    EXPECT_EQ(err.rfind(path + ": warning: the GRIDMAP chunk at byte ", 0), 0u) << err;
+    EXPECT_NE(err.find("is 7 bytes short"), std::string::npos) << err;
+  }
 }
 
 TEST(MapFormatBad, DamagedImagesNameTheFile) {

@@ -510,6 +510,113 @@ TEST_P(MapIo, DamageAfterTheChunkDoesNotMatterDamageBeforeIsReported) {
   EXPECT_NE(err.find("at byte 324950"), std::string::npos) << err;
 }
 
+// ---- A GRIDMAP chunk cut short ------------------------------------------------
+// CARMEN's reader renders a gridmap whose file ends inside its cells (the
+// bytes there read, the rest as calloc() left them: zeros); so does ours,
+// with a warning naming the chunk and the bytes missing. The other readers
+// pass it silently.
+TEST_P(MapIo, GridmapCutShortIsReadAsCarmenReadsIt) {
+  const std::string file = path("short");
+  std::string cells;
+  for (float v : {0.0f, 0.25f, 0.5f, 0.75f, 1.0f, 0.125f}) cells += f32(v);
+  const std::string grid = chunk(1, "GRIDMAP", i32(3) + i32(2) + f32(0.5f) + cells);
+  const std::string named = chunk(1, "GRIDMAP", i32(3) + i32(2) + f32(0.5f) + cells, "upstairs", true);
+  for (const std::string &whole : {grid, named}) {
+    const bool is_named = whole[0] != '\x01';
+    // Five bytes short: the last cell gone, the one before it cut.
+    const std::string bytes = kId + whole.substr(0, whole.size() - 5);
+    if (std::string(GetParam()).size() > 4) {
+      maptest::gzip_to_file(file, bytes);
+    } else {
+      maptest::write_bytes(file, bytes);
+    }
+    carmen_map_t map;
+    std::memset(&map, 0x5a, sizeof map);
+    testing::internal::CaptureStderr();
+    const int rc = is_named ? carmen_map_read_named_gridmap_chunk(file.c_str(), "upstairs", &map)
+                            : carmen_map_read_gridmap_chunk(file.c_str(), &map);
+    std::string err = testing::internal::GetCapturedStderr();
+    ASSERT_EQ(rc, 0) << err;
+    const std::string fn = is_named ? "carmen_map_read_named_gridmap_chunk" : "carmen_map_read_gridmap_chunk";
+    EXPECT_EQ(err, fn + ": " + file + ": warning: the GRIDMAP chunk at byte 17 " +
+                       (is_named ? "(named \"upstairs\") " : "") + "is 5 bytes short: it claims " +
+                       std::to_string(maptest::read_i32(whole, 1)) + " bytes but the file ends after " +
+                       std::to_string(maptest::read_i32(whole, 1) - 5) +
+                       " of them; its last 2 of 6 cells (x-major order) are missing and read as CARMEN's "
+                       "reader leaves them: zero bytes (0, free), the first after the bytes that came\n");
+    EXPECT_EQ(map.config.x_size, 3);
+    EXPECT_EQ(map.config.y_size, 2);
+    EXPECT_EQ(map.map[0][0], 0.0f);
+    EXPECT_EQ(map.map[1][1], 0.75f);
+    EXPECT_EQ(map.map[2][0], maptest::cells_cut_short(f32(1.0f), 3)[0]);  // 1.0f's 3 low bytes and a zero
+    EXPECT_EQ(map.map[2][1], 0.0f);
+    std::free(map.map);
+    std::free(map.complete_map);
+    std::free(map.config.map_name);
+    // The config and the chunk's size, as stored; the readers of other
+    // chunks pass it without a word.
+    testing::internal::CaptureStderr();
+    carmen_map_config_t config;
+    EXPECT_EQ(carmen_map_read_gridmap_config(file.c_str(), &config), 0);
+    EXPECT_EQ(config.x_size, 3);
+    std::free(config.map_name);
+    EXPECT_EQ(carmen_map_chunk_exists(file.c_str(), CARMEN_MAP_GRIDMAP_CHUNK), maptest::read_i32(whole, 1));
+    carmen_offlimits_p list = nullptr;
+    int n = 0;
+    EXPECT_EQ(carmen_map_read_offlimits_chunk(file.c_str(), &list, &n), -1);
+    carmen_map_placelist_t places;
+    EXPECT_EQ(carmen_map_read_places_chunk(file.c_str(), &places), -1);
+    EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  }
+}
+
+// ---- OFFLIMITS chunks as CARMEN's writers write them --------------------------
+// CARMEN's line loop leaves out a line (its size still counts it), its named
+// writer's size field says 22: read as the layout CARMEN wrote, with a
+// warning, and the chunks after them found where they are.
+TEST_P(MapIo, OfflimitsInCarmensLayoutsAreRead) {
+  const std::string file = path("carmen_offlimits");
+  const std::vector<maptest::CarmenOffItem> items = {
+      {0, 1, 2, 0, 0}, {1, 0, 0, 5, 5}, {2, 1, 1, 2, 2}, {1, 3, 4, 7, 8}};
+  const std::string grid = chunk(1, "GRIDMAP", i32(1) + i32(1) + f32(1) + f32(0.5f));
+  const std::string scans = chunk(16, "LASERSCANS", i32(1) + f32(1) + f32(2) + f32(3) + i32(1) + f32(4));
+  const std::string bytes = kId + grid + maptest::carmen_offlimits_chunk(items) +
+                            maptest::carmen_offlimits_chunk(items, "zone", true) + scans;
+  if (std::string(GetParam()).size() > 4) {
+    maptest::gzip_to_file(file, bytes);
+  } else {
+    maptest::write_bytes(file, bytes);
+  }
+  for (const char *name : {static_cast<const char *>(nullptr), "zone"}) {
+    carmen_offlimits_p list = nullptr;
+    int n = 0;
+    testing::internal::CaptureStderr();
+    const int rc = name ? carmen_map_read_named_offlimits_chunk(file.c_str(), name, &list, &n)
+                        : carmen_map_read_offlimits_chunk(file.c_str(), &list, &n);
+    const std::string err = testing::internal::GetCapturedStderr();
+    ASSERT_EQ(rc, 0) << err;
+    const std::string at = name ? "at byte 115 (named \"zone\")" : "at byte 48";
+    const std::string fn = name ? "carmen_map_read_named_offlimits_chunk" : "carmen_map_read_offlimits_chunk";
+    EXPECT_EQ(err.rfind(fn + ": " + file + ": warning: the OFFLIMITS chunk " + at, 0), 0u) << err;
+    EXPECT_NE(err.find("1 of its 2 lines were counted but never written"), std::string::npos) << err;
+    ASSERT_EQ(n, 3);  // the point, the line written, the rectangle
+    EXPECT_EQ(list[0].type, CARMEN_OFFLIMITS_POINT_ID);
+    EXPECT_EQ(list[0].y1, 2);
+    EXPECT_EQ(list[1].type, CARMEN_OFFLIMITS_LINE_ID);
+    EXPECT_EQ(list[1].x2, 5);
+    EXPECT_EQ(list[2].type, CARMEN_OFFLIMITS_RECT_ID);
+    EXPECT_EQ(list[2].y2, 2);
+    std::free(list);
+  }
+  carmen_laser_scan_p scan_list = nullptr;
+  int num = 0;
+  ASSERT_EQ(carmen_map_read_laserscans_chunk(file.c_str(), &scan_list, &num), 0);
+  ASSERT_EQ(num, 1);
+  EXPECT_EQ(scan_list[0].range[0], 4.0f);
+  std::free(scan_list[0].range);
+  std::free(scan_list);
+}
+
 // ---- CARMEN's map-server calls, without IPC ---------------------------------
 TEST(MapIoServer, StandInsLinkAndSayThereIsNoIpc) {
   carmen_map_publish_update();  // nothing to publish to: a no-op
@@ -588,9 +695,11 @@ TEST(MapIoDamaged, IntactChunksAreReadAndDamageIsReported) {
   const Case cases[] = {
       // Garbage cells in an intact chunk: returned as stored, with a warning.
       {"longwood", 0, 0, 536, 379, 0, "GRIDMAP chunk at byte 584 holds 39919 invalid cell values"},
-      // The gridmap chunk lacks its last byte: its cells are refused, its
-      // header (all the config reader reads) is there.
-      {"nsh_level_3", -1, 0, 677, 469, 0, "GRIDMAP chunk at byte 540 is cut short"},
+      // The gridmap chunk lacks a byte: read as CARMEN reads it, its last
+      // byte a zero, with a warning; the cells after the lost byte are
+      // shifted (garbage): returned as stored, with the other warning.
+      {"nsh_level_3", 0, 0, 677, 469, 0,
+       "GRIDMAP chunk at byte 540 is 1 byte short: it claims 1270074 bytes but the file ends after 1270073"},
       // A damaged chunk after an intact gridmap (with some damaged cells).
       {"thickwean", 0, 0, 477, 170, 0, "GRIDMAP chunk at byte 563 holds 7656 invalid cell values"},
       // gzip inside gzip: no map at all.

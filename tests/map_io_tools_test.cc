@@ -390,6 +390,79 @@ TEST_P(MapIoTools, OfflimitsLineFollowsCarmensSteepReversedWalk) {
   free_map(map);
 }
 
+// Off-limits written by CARMEN's own writers (map_test_support.h): its line
+// loop leaves out the second line, its named writer's size says 22. What
+// maptool toppm, strip and rotate do with them: mark the cells, and copy
+// them (as the chunks CARMEN meant, so CARMEN reads the copy right too) or
+// strip them, with the chunks after them intact.
+TEST_P(MapIoTools, OfflimitsInCarmensLayoutsSurviveToppmStripAndRotate) {
+  const std::string file = path("carmen_offl");
+  const std::vector<maptest::CarmenOffItem> items = {
+      {0, 0, 0, 0, 0}, {1, 1, 1, 4, 3}, {2, 3, 0, 4, 1}, {1, 0, 4, 1, 4}};
+  const std::string grid = chunk(1, "GRIDMAP", grid_payload(6, 5, 1.0f, std::vector<float>(30, 0.25f)));
+  const std::string scans = chunk(16, "LASERSCANS", i32(1) + f32(1) + f32(2) + f32(3) + i32(1) + f32(4));
+  write_map(file, kId + grid + maptest::carmen_offlimits_chunk(items) + scans +
+                      maptest::carmen_offlimits_chunk(items, "zone", true));
+  // toppm: the point, the line CARMEN wrote and the rectangle are marked.
+  carmen_map_t map;
+  std::memset(&map, 0, sizeof map);
+  ASSERT_EQ(carmen_map_read_gridmap_chunk(file.c_str(), &map), 0);
+  testing::internal::CaptureStderr();
+  const int rc = carmen_map_read_offlimits_chunk_into_map(file.c_str(), &map);
+  const std::string err = testing::internal::GetCapturedStderr();
+  ASSERT_EQ(rc, 0) << err;
+  EXPECT_NE(err.find("warning: the OFFLIMITS chunk at byte 164"), std::string::npos) << err;
+  const std::vector<std::pair<int, int>> marked = {{0, 0}, {1, 1}, {2, 2}, {3, 2}, {4, 3},
+                                                   {3, 0}, {3, 1}, {4, 0}, {4, 1}};
+  for (int x = 0; x < 6; ++x) {
+    for (int y = 0; y < 5; ++y) {
+      const bool hit = std::find(marked.begin(), marked.end(), std::make_pair(x, y)) != marked.end();
+      EXPECT_EQ(map.map[x][y], hit ? 2.25f : 0.25f) << x << "," << y;
+    }
+  }
+  free_map(map);
+  // strip (of a type the file lacks): every chunk copied, the off-limits as
+  // CARMEN meant them.
+  const std::string meant = i32(1) + i32(0) + i32(0) + i32(1) + i32(1) + i32(1) + i32(4) + i32(3) + i32(1) +
+                            i32(3) + i32(0) + i32(4) + i32(1);
+  const std::string fixed = chunk(2, "OFFLIMITS", meant);
+  const std::string fixed_named = chunk(2, "OFFLIMITS", meant, "zone", true);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(run_on(file, path("out"),
+                   [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_strip(i, o, CARMEN_MAP_PLACES_CHUNK); }),
+            0);
+  EXPECT_EQ(content(path("out")), kId + grid + fixed + scans + fixed_named);
+  // rotate strips the gridmap, the off-limits and the places before writing
+  // its own: the scans stay, and the named chunk (never stripped).
+  EXPECT_EQ(run_on(file, path("rot"),
+                   [](carmen_FILE *i, carmen_FILE *o) {
+                     return carmen_map_vstrip(i, o, 3, CARMEN_MAP_GRIDMAP_CHUNK, CARMEN_MAP_OFFLIMITS_CHUNK,
+                                              CARMEN_MAP_PLACES_CHUNK);
+                   }),
+            0);
+  EXPECT_EQ(content(path("rot")), kId + scans + fixed_named);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+}
+
+// A gridmap cut short is read (map_file.h), so rotate, which strips it
+// before writing its own, must get past it: stripped, it goes as far as the
+// file does, as CARMEN's fseek takes it. Copied, it is still an error, as in
+// CARMEN, whose copy fails there too.
+TEST_P(MapIoTools, StripDropsAGridmapCutShort) {
+  const Pieces p;
+  const std::string file = path("short");
+  write_map(file, kId + p.places + p.grid.substr(0, p.grid.size() - 3));
+  EXPECT_EQ(run_on(file, path("out"),
+                   [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_strip(i, o, CARMEN_MAP_GRIDMAP_CHUNK); }),
+            0);
+  EXPECT_EQ(content(path("out")), kId + p.places);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(run_on(file, path("out"),
+                   [](carmen_FILE *i, carmen_FILE *o) { return carmen_map_strip(i, o, CARMEN_MAP_PLACES_CHUNK); }),
+            -1);
+  EXPECT_NE(testing::internal::GetCapturedStderr().find("ends inside a chunk"), std::string::npos);
+}
+
 TEST_P(MapIoTools, OfflimitsIntoMapFailsAsCarmenDoes) {
   const std::string file = path("empty_offl");
   carmen_map_t map = read_with_offlimits(file, 1, 1, {0.5f}, i32(0) + i32(0) + i32(0));

@@ -112,6 +112,20 @@ inline uint32_t read_le32(const std::string &s, size_t at) {
   return uint32_t(uint8_t(s[at])) | uint32_t(uint8_t(s[at + 1])) << 8 | uint32_t(uint8_t(s[at + 2])) << 16 |
          uint32_t(uint8_t(s[at + 3])) << 24;
 }
+// The cells CARMEN's reader leaves of `cell_bytes` (little-endian floats)
+// when only the first `present` bytes are in the file: it fread()s into a
+// calloc()ed grid, so every missing byte is a zero.
+inline std::vector<float> cells_cut_short(std::string cell_bytes, size_t present) {
+  for (size_t i = present; i < cell_bytes.size(); ++i) cell_bytes[i] = '\0';
+  std::vector<float> cells(cell_bytes.size() / 4);
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const uint32_t b = uint32_t(uint8_t(cell_bytes[4 * i])) | uint32_t(uint8_t(cell_bytes[4 * i + 1])) << 8 |
+                       uint32_t(uint8_t(cell_bytes[4 * i + 2])) << 16 | uint32_t(uint8_t(cell_bytes[4 * i + 3])) << 24;
+    std::memcpy(&cells[i], &b, 4);
+  }
+  return cells;
+}
+
 inline int32_t read_i32(const std::string &s, size_t at) { return static_cast<int32_t>(read_le32(s, at)); }
 inline float read_f32(const std::string &s, size_t at) {
   const uint32_t u = read_le32(s, at);
@@ -134,6 +148,40 @@ inline std::string chunk(int type, const std::string &desc, const std::string &p
          payload;
 }
 inline const std::string kId = "CARMENMAPFILEv020";
+
+// ---- CARMEN 0.7.4's off-limits writers, as the format notes describe them --
+// An item of CARMEN's off-limits list: type 0 point (x1 y1), 1 line, 2
+// rectangle (x1 y1 x2 y2).
+struct CarmenOffItem {
+  int type, x1, y1, x2, y2;
+};
+// The OFFLIMITS chunk carmen_map_write_offlimits_chunk writes: the point,
+// line and rectangle counts, each followed by its items, but the line loop
+// runs over the first `lines` items of the list rather than all of them, so
+// a line further down is counted and not written; the size field counts
+// every item. named: carmen_map_write_named_offlimits_chunk, which writes the
+// same payload after the name but sizes the chunk with the unnamed size
+// function given the name as the list: its size field says 10 + 12 = 22
+// (when the count it then reads from a pointer is negative; otherwise it
+// reads past the name and crashes).
+inline std::string carmen_offlimits_chunk(const std::vector<CarmenOffItem> &items, const std::string &name = "",
+                                          bool named = false) {
+  int counts[3] = {0, 0, 0};
+  for (const auto &it : items) ++counts[it.type];
+  auto quad = [](const CarmenOffItem &it) { return i32(it.x1) + i32(it.y1) + i32(it.x2) + i32(it.y2); };
+  std::string payload = i32(counts[0]);
+  for (const auto &it : items)
+    if (it.type == 0) payload += i32(it.x1) + i32(it.y1);
+  payload += i32(counts[1]);
+  for (size_t i = 0; i < items.size() && i < size_t(counts[1]); ++i)
+    if (items[i].type == 1) payload += quad(items[i]);
+  payload += i32(counts[2]);
+  for (const auto &it : items)
+    if (it.type == 2) payload += quad(it);
+  const int32_t size = named ? 22 : 10 + 12 + 8 * counts[0] + 16 * (counts[1] + counts[2]);
+  return std::string(1, static_cast<char>(named ? 0x82 : 0x02)) + i32(size) + "OFFLIMITS " +
+         (named ? name + std::string(1, '\0') : std::string()) + payload;
+}
 
 }  // namespace maptest
 

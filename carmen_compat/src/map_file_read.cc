@@ -2,6 +2,7 @@
 // claims is checked against what it holds before memory is allocated for it.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <sstream>
@@ -140,32 +141,6 @@ PlaceList parse_places(const std::vector<unsigned char> &b) {
   return places;
 }
 
-// A count, then that many x1 y1 x2 y2 quadruples (off-limits lines or rectangles).
-void read_segments(Cursor &cur, const char *items, const char *item, std::vector<OffLimits::Segment> *out) {
-  out->resize(cur.count(16, items));
-  for (auto &sg : *out) {
-    sg.x1 = cur.i32(item);
-    sg.y1 = cur.i32(item);
-    sg.x2 = cur.i32(item);
-    sg.y2 = cur.i32(item);
-  }
-}
-
-OffLimits parse_offlimits(const std::vector<unsigned char> &b) {
-  Cursor cur(b.data(), b.size());
-  OffLimits o;
-  const size_t np = cur.count(8, "points");
-  o.points.resize(np);
-  for (auto &pt : o.points) {
-    pt.x = cur.i32("a point");
-    pt.y = cur.i32("a point");
-  }
-  read_segments(cur, "lines", "a line", &o.lines);
-  read_segments(cur, "rectangles", "a rectangle", &o.rects);
-  cur.expect_end();
-  return o;
-}
-
 LaserScanList parse_laserscans(const std::vector<unsigned char> &b) {
   Cursor cur(b.data(), b.size());
   const size_t n = cur.count(16, "scans");
@@ -185,6 +160,57 @@ LaserScanList parse_laserscans(const std::vector<unsigned char> &b) {
   cur.expect_end();
   return scans;
 }
+
+// ---------------------------------------------------------------------------
+// Source: the Input, with bytes given back. An OFFLIMITS chunk in CARMEN's
+// layout ends before its size field says; what was read past its end is the
+// next chunk's and is read again from here.
+// ---------------------------------------------------------------------------
+class Source {
+ public:
+  explicit Source(const std::string &path) : in_(path) {}
+  const std::string &path() const { return in_.path(); }
+  bool compressed() const { return in_.compressed(); }
+  std::string stream_error() const { return in_.stream_error(); }
+  int64_t pos() const { return in_.pos() - int64_t(held()); }
+  int64_t remaining() const {
+    const int64_t r = in_.remaining();
+    return r < 0 ? r : r + int64_t(held());
+  }
+  int peek() { return held() > 0 ? back_[at_] : in_.peek(); }
+  int get() { return held() > 0 ? back_[at_++] : in_.get(); }
+  size_t read(void *dst, size_t n) {
+    const size_t k = std::min(n, held());
+    if (k > 0) std::memcpy(dst, back_.data() + at_, k);
+    at_ += k;
+    return k + (n > k ? in_.read(static_cast<unsigned char *>(dst) + k, n - k) : 0);
+  }
+  uint64_t skip(uint64_t n) {
+    const size_t k = static_cast<size_t>(std::min<uint64_t>(n, held()));
+    at_ += k;
+    return k + (n > k ? in_.skip(n - k) : 0);
+  }
+  // The bytes [p, p + n) are read again before anything else.
+  void give_back(const unsigned char *p, size_t n) {
+    std::vector<unsigned char> b(p, p + n);
+    b.insert(b.end(), back_.begin() + static_cast<std::ptrdiff_t>(at_), back_.end());
+    back_ = std::move(b);
+    at_ = 0;
+  }
+
+ private:
+  size_t held() const { return back_.size() - at_; }
+  Input in_;
+  std::vector<unsigned char> back_;
+  size_t at_ = 0;
+};
+
+// A GRIDMAP chunk whose data ends inside its cells is read when at least
+// half of its cell bytes are there, or all but this many: what is allocated
+// for it stays within twice what the file holds (plus 1 MiB).
+constexpr uint64_t kShortGridSlack = uint64_t{1} << 20;
+
+std::string byte_count(uint64_t n) { return std::to_string(n) + (n == 1 ? " byte" : " bytes"); }
 
 // ---------------------------------------------------------------------------
 // The reader
@@ -235,7 +261,7 @@ class Reader {
         !info.named() || !is_named_kind(info.base_type()))
       fail("at byte " + std::to_string(listed.offset) + " is not the named chunk the listing gave");
     chunk_ = &info;
-    NamedChunk nc{info.name, parse_or_fail([&] { return named_payload(info.base_type(), left); })};
+    NamedChunk nc{info.name, parse_or_fail([&] { return named_payload(info, left); })};
     if (const auto *g = std::get_if<GridMap>(&nc.payload); g != nullptr && opts_.check_cells) check_cells(*g);
     chunk_ = nullptr;
     return nc;
@@ -250,7 +276,7 @@ class Reader {
     read_id();
     while (read_chunk_header(info, left)) {
       if (info->base_type() == type && (name == nullptr || (info->named() && info->name == *name))) return true;
-      skip(*left);
+      pass(*info, *left);
       *info = ChunkInfo{};
       chunk_ = nullptr;
     }
@@ -273,7 +299,7 @@ class Reader {
     if (!seek_first(type, name, &info, &left)) return std::nullopt;
     chunk_ = &info;
     ChunkPayload p = parse_or_fail(
-        [&] { return type == kOldCreatorChunk ? ChunkPayload(parse_creator(payload(left))) : named_payload(type, left); });
+        [&] { return type == kOldCreatorChunk ? ChunkPayload(parse_creator(payload(left))) : named_payload(info, left); });
     if (const auto *g = std::get_if<GridMap>(&p); g != nullptr && opts_.check_cells) check_cells(*g);
     chunk_ = nullptr;
     return FoundChunk{std::move(info), std::move(p)};
@@ -314,15 +340,15 @@ class Reader {
   void read_chunk(ChunkInfo &info, uint64_t left) {
     chunk_ = &info;
     if (headers_only_) {
-      skip(left);
+      pass(info, left);
     } else if (info.named() && opts_.named_chunks == NamedChunkReading::Index) {
       info.deferred = is_named_kind(info.base_type());
-      skip(left);
+      pass(info, left);
       map_.unknown_chunks += !info.deferred;
     } else {
       info.used = parse_or_fail([&] { return info.named() ? read_named(info, left) : read_unnamed(info, left); });
       if (!info.used) {
-        skip(left);
+        pass(info, left);
         ++map_.unknown_chunks;
       }
     }
@@ -338,7 +364,7 @@ class Reader {
         return !old_creator_ && (left == 174 || left == 178) && (old_creator_ = parse_creator(payload(left)), true);
       case kGlobalOffsetChunk: return !map_.offset && (map_.offset = parse_offset(payload(left)), true);
       case kPlacesChunk: return !map_.places && (map_.places = parse_places(payload(left)), true);
-      case kOfflimitsChunk: return !map_.offlimits && (map_.offlimits = parse_offlimits(payload(left)), true);
+      case kOfflimitsChunk: return !map_.offlimits && (map_.offlimits = read_offlimits(info, left, true), true);
       case kLaserscansChunk: return !map_.laserscans && (map_.laserscans = parse_laserscans(payload(left)), true);
       default: return false;
     }
@@ -346,18 +372,29 @@ class Reader {
 
   bool read_named(const ChunkInfo &info, uint64_t left) {
     if (!is_named_kind(info.base_type())) return false;
-    map_.named.push_back(NamedChunk{info.name, named_payload(info.base_type(), left)});
+    map_.named.push_back(NamedChunk{info.name, named_payload(info, left)});
     return true;
   }
 
-  ChunkPayload named_payload(int base, uint64_t left) {
-    switch (base) {
+  ChunkPayload named_payload(const ChunkInfo &info, uint64_t left) {
+    switch (info.base_type()) {
       case kGridmapChunk: return read_gridmap(left);
       case kCreatorChunk: return parse_creator(payload(left));
       case kGlobalOffsetChunk: return parse_offset(payload(left));
       case kPlacesChunk: return parse_places(payload(left));
-      case kOfflimitsChunk: return parse_offlimits(payload(left));
+      case kOfflimitsChunk: return read_offlimits(info, left, true);
       default: return parse_laserscans(payload(left));
+    }
+  }
+
+  // Past a chunk that is not read: by its size, but an OFFLIMITS chunk to
+  // where it really ends, and a GRIDMAP cut short as read_gridmap would
+  // accept it. Nothing is reported but damage.
+  void pass(const ChunkInfo &info, uint64_t left) {
+    switch (info.base_type()) {
+      case kOfflimitsChunk: read_offlimits(info, left, false); break;
+      case kGridmapChunk: pass_gridmap(left); break;
+      default: skip(left);
     }
   }
 
@@ -378,14 +415,25 @@ class Reader {
     chunk_ = nullptr;
   }
 
+  // "the GRIDMAP chunk at byte 540 " (with its name), or "the file ".
+  std::string where() const {
+    if (chunk_ == nullptr) return "the file ";
+    return "the " + chunk_type_name(chunk_->type) + " chunk at byte " + std::to_string(chunk_->offset) +
+           (chunk_->named() && !chunk_->name.empty() ? " (named \"" + printable(chunk_->name) + "\")" : "") + " ";
+  }
+
   [[noreturn]] void fail(const std::string &msg, ErrorCode code = ErrorCode::BadInput) const {
-    std::string where = "the file ";
-    if (chunk_ != nullptr) {
-      where = "the " + chunk_type_name(chunk_->type) + " chunk at byte " + std::to_string(chunk_->offset) +
-              (chunk_->named() && !chunk_->name.empty() ? " (named \"" + printable(chunk_->name) + "\")" : "") +
-              " ";
+    throw FileError(in_.path(), where() + msg, code);
+  }
+
+  // A warning about the chunk being read: to MapReadOptions::on_warning, or stderr.
+  void warn(const std::string &msg) const {
+    const std::string text = FileError::format(in_.path(), 0, "warning: " + where() + msg);
+    if (opts_.on_warning) {
+      opts_.on_warning(text);
+    } else {
+      std::fprintf(stderr, "%s\n", text.c_str());
     }
-    throw FileError(in_.path(), where + msg, code);
   }
 
   // Called when fewer bytes came than were needed.
@@ -398,6 +446,21 @@ class Reader {
            std::to_string(present) + " of them (inside " + what + ")");
     }
     fail("is cut short: the file ends inside " + what);
+  }
+
+  // A plain file that ends before the chunk does: what is in it, from the
+  // chunk's size field on.
+  [[noreturn]] void fail_remain(const std::string &why = "") const {
+    const int64_t rem = in_.pos() + in_.remaining() - (chunk_->offset + 5);
+    fail("claims " + std::to_string(chunk_->size) + " bytes but only " + std::to_string(rem) +
+         " remain in the file: it is truncated or damaged" + why);
+  }
+
+  // Data that ends inside the chunk being read: the message of a plain
+  // file's size check, or (a stream) where the data ended.
+  [[noreturn]] void fail_cut(const std::string &what, const std::string &why = "") const {
+    if (!in_.stream_error().empty() || in_.remaining() < 0) fail_short(what + why);
+    fail_remain(why);
   }
 
   void read_comments() {
@@ -466,11 +529,12 @@ class Reader {
       fail("has size " + std::to_string(info->size) +
            ", less than its 10-byte description: the file is damaged");
     }
+    // A GRIDMAP may be cut short and an OFFLIMITS chunk may end before its
+    // size says (CARMEN's layouts): their readers judge what is there, and
+    // allocate no more than it.
     const int64_t rem = in_.remaining();
-    if (rem >= 0 && info->size > rem) {
-      fail("claims " + std::to_string(info->size) + " bytes but only " + std::to_string(rem) +
-           " remain in the file: it is truncated or damaged");
-    }
+    const bool may_end_early = info->base_type() == kGridmapChunk || info->base_type() == kOfflimitsChunk;
+    if (rem >= 0 && info->size > rem && !may_end_early) fail_remain();
     char desc[10];
     const size_t dgot = in_.read(desc, 10);
     if (dgot < 10) fail_short("its description");
@@ -478,11 +542,14 @@ class Reader {
     *left = static_cast<uint64_t>(info->size) - 10;
     if (info->named()) {
       std::string name;
+      // CARMEN's named off-limits writer leaves the name out of the size:
+      // there the name may run past it (decode_offlimits_payload).
+      const bool sized_name = info->base_type() != kOfflimitsChunk;
       while (true) {
-        if (*left == 0) fail("has a name that runs past the end of the chunk (no NUL)");
+        if (*left == 0 && sized_name) fail("has a name that runs past the end of the chunk (no NUL)");
         const int c = in_.get();
         if (c < 0) fail_short("its name");
-        --*left;
+        if (*left > 0) --*left;
         if (c == 0) break;
         if (name.size() + 1 >= kMaxChunkName) {
           fail("has a name longer than " + std::to_string(kMaxChunkName - 1) + " bytes: the file is damaged");
@@ -535,6 +602,10 @@ class Reader {
     unsigned char hdr[12];
     const size_t hgot = in_.read(hdr, 12);
     if (hgot < 12) fail_short("the map size");
+    return gridmap_header(hdr, left);
+  }
+
+  GridMap gridmap_header(const unsigned char *hdr, uint64_t left) {
     GridMap g;
     g.size_x = get_i32(hdr);
     g.size_y = get_i32(hdr + 4);
@@ -563,9 +634,12 @@ class Reader {
     GridMap g = read_gridmap_header(left);
     const uint64_t ncells = uint64_t(g.size_x) * uint64_t(g.size_y);
     // ncells * 4 + 22 <= INT32_MAX here, so ncells < 2^29.
-    const bool known = in_.remaining() >= 0;
+    const int64_t rem = in_.remaining();
+    const bool known = rem >= 0;
+    if (known && uint64_t(rem) < ncells * 4) check_short(uint64_t(rem), ncells * 4);  // before allocating
     if (known) g.cells.reserve(static_cast<size_t>(ncells));
     const size_t piece = kReadPiece / 4;
+    uint64_t present = ncells * 4;  // cell bytes in the file
     while (g.cells.size() < ncells) {
       const size_t old = g.cells.size();
       const size_t want = known ? static_cast<size_t>(ncells) - old
@@ -573,14 +647,106 @@ class Reader {
       g.cells.resize(old + want);
       const size_t got = in_.read(g.cells.data() + old, want * 4);
       if (got < want * 4) {
-        fail_short("the cells");
+        if (!in_.stream_error().empty()) fail_short("the cells");
+        present = uint64_t(old) * 4 + got;
+        check_short(present, ncells * 4);
+        // The bytes that came stay where they are and the rest are zero (resize's
+        // 0.0f), as in CARMEN's calloc()ed grid after its one fread().
+        break;
       }
     }
     if (!host_is_little_endian()) {
       for (float &v : g.cells) v = get_f32(reinterpret_cast<const unsigned char *>(&v));
     }
+    if (present < ncells * 4) read_short(g, present);
     if (opts_.check_cells) grid_chunks_.push_back(*chunk_);  // checked once the layout is known good
     return g;
+  }
+
+  // Refuses a gridmap cut short of which too little is there to read the
+  // rest as unknown (kShortGridSlack): a few bytes claiming gigabytes.
+  void check_short(uint64_t present, uint64_t wanted) const {
+    if (wanted - present <= std::max(present, kShortGridSlack)) return;
+    fail_cut("the cells", "; fewer than half of its cells are there, too few to read the rest as unknown");
+  }
+
+  // The cells the file lacks, as CARMEN renders a gridmap cut short: its
+  // reader fread()s into a calloc()ed grid, so a missing byte is a zero: the
+  // missing cells are 0 (free), and a cell only partly there keeps the bytes
+  // that came (the readers' check of cell values judges it like any other).
+  void read_short(GridMap &g, uint64_t present) const {
+    const uint64_t ncells = uint64_t(g.size_x) * uint64_t(g.size_y);
+    const uint64_t missing = ncells * 4 - present;
+    const uint64_t unread = ncells - present / 4;
+    g.cells.resize(static_cast<size_t>(ncells), 0.0f);
+    warn("is " + byte_count(missing) + " short: it claims " + std::to_string(chunk_->size) +
+         " bytes but the file ends after " + std::to_string(uint64_t(chunk_->size) - missing) +
+         " of them; its last " + std::to_string(unread) + " of " + std::to_string(ncells) +
+         " cells (x-major order) are missing and read as CARMEN's reader leaves them: zero bytes (0, free)" +
+         (present % 4 != 0 ? ", the first after the bytes that came" : ""));
+  }
+
+  // Past a GRIDMAP chunk that is not read: a chunk cut short passes as
+  // read_gridmap would read it (its header sound, enough of its cells there).
+  void pass_gridmap(uint64_t left) {
+    unsigned char hdr[12];
+    const size_t head = static_cast<size_t>(std::min<uint64_t>(left, 12));
+    if (in_.read(hdr, head) < head) fail_short("its payload");
+    const uint64_t got = in_.skip(left - head);
+    if (got == left - head) return;
+    if (!in_.stream_error().empty() || head < 12) fail_short("its payload");
+    gridmap_header(hdr, left);
+    check_short(got, left - 12);
+  }
+
+  // An OFFLIMITS chunk, in the layout its size field gives or in CARMEN's
+  // (decode_offlimits_payload); the input is left where it really ends.
+  // `read`: the chunk is asked for, so damage is an error and CARMEN's
+  // layout a warning. Otherwise it is passed, and passed by its size when it
+  // is in neither layout, as any chunk; one larger than 16 MiB is passed by
+  // its size (CARMEN's layouts are looked for within 16 MiB).
+  OffLimits read_offlimits(const ChunkInfo &info, uint64_t left, bool read) {
+    if (read) {
+      keep(left);
+    } else if (left > kReadPiece) {
+      skip(left);
+      return {};
+    }
+    const int64_t start = in_.pos();
+    // Damage past the size field's end (a look at the next chunk) is left
+    // for the reader of that chunk to report.
+    const PayloadFetch fetch = [&](std::vector<unsigned char> &b, uint64_t want) {
+      while (b.size() < want) {
+        const size_t k = static_cast<size_t>(std::min<uint64_t>(want - b.size(), kReadPiece));
+        const size_t old = b.size();
+        b.resize(old + k);
+        const size_t got = in_.read(b.data() + old, k);
+        b.resize(old + got);
+        if (got < k) {
+          if (b.size() < left && !in_.stream_error().empty()) fail_short("its payload");
+          return;
+        }
+      }
+    };
+    std::vector<unsigned char> bytes;
+    const OffLimitsPayload d = decode_offlimits_payload(bytes, left, info.named(), fetch);
+    const uint64_t end = d.ok ? d.length : left;
+    if (!d.ok && (bytes.size() < left || !in_.stream_error().empty())) fail_cut("its payload");
+    if (!d.ok && read) fail(d.error);
+    if (bytes.size() > end) in_.give_back(bytes.data() + end, static_cast<size_t>(bytes.size() - end));
+    if (read && d.carmen_layout) warn_carmen_layout(d, start);
+    return d.offlimits;
+  }
+
+  void warn_carmen_layout(const OffLimitsPayload &d, int64_t start) const {
+    std::string msg = "is laid out as CARMEN 0.7.4's writer lays it out, not as its size field (" +
+                      std::to_string(chunk_->size) + ") says";
+    if (d.lines_left_out > 0) {
+      msg += ": " + std::to_string(d.lines_left_out) + " of its " +
+             std::to_string(d.lines_left_out + d.offlimits.lines.size()) +
+             " lines were counted but never written (the writer's line loop skips them)";
+    }
+    warn(msg + "; it ends at byte " + std::to_string(start + int64_t(d.length)));
   }
 
   void check_cells(const GridMap &g) {
@@ -599,7 +765,7 @@ class Reader {
        << ") = " << g.cells[first] << ". The map is damaged";
     fail(os.str());
   }
-  Input in_;
+  Source in_;
   MapReadOptions opts_;
   uint64_t kept_ = 0;  // chunk bytes kept so far
   bool headers_only_;

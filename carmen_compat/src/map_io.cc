@@ -483,11 +483,21 @@ static void clear_map(carmen_map_p map) {
   map->map = nullptr;
 }
 
+// The reader's warnings (map_file.h: a gridmap cut short, CARMEN's
+// off-limits layouts) on stderr, as "fn: FILE: warning: ...", like the
+// warning about invalid cells.
+static carmen::MapReadOptions warning_options(const char *fn) {
+  carmen::MapReadOptions opts;
+  opts.on_warning = [fn](const std::string &text) { std::fprintf(stderr, "%s: %s\n", fn, text.c_str()); };
+  return opts;
+}
+
 // The first chunk of `type` (chunk_name NULL: named or not), or nullopt.
-static std::optional<carmen::FoundChunk> first_chunk(const char *filename, int type, const char *chunk_name) {
+static std::optional<carmen::FoundChunk> first_chunk(const char *fn, const char *filename, int type,
+                                                     const char *chunk_name) {
   carmen::map_io_detail::need_name(filename);
   const std::string name = chunk_name ? chunk_name : "";
-  return carmen::read_first_chunk(filename, type, chunk_name ? &name : nullptr);
+  return carmen::read_first_chunk(filename, type, chunk_name ? &name : nullptr, warning_options(fn));
 }
 
 static void need_chunk_name(const char *chunk_name) {
@@ -523,7 +533,7 @@ static int read_gridmap(const char *fn, const char *filename, const char *chunk_
     if (map == nullptr) throw std::invalid_argument("no map given (NULL)");
     if (named) need_chunk_name(chunk_name);
     carmen::map_io_detail::need_name(filename);
-    carmen::MapReadOptions opts;
+    carmen::MapReadOptions opts = warning_options(fn);
     opts.check_cells = false;  // checked below, as a warning
     // A C caller cannot raise max_kept_bytes, and CARMEN reads any map. A
     // plain file's chunk sizes are checked against its size (and a pipe is
@@ -605,21 +615,22 @@ static void copy_creator(const carmen::CreatorInfo &c, time_t *creation_time, ch
 // reported only when there is no old-style creator to fall back to.
 int carmen_map_read_creator_chunk(const char *filename, time_t *creation_time, char *username, char *origin,
                                   char *description) {
+  const char *const fn = __func__;
   clear_creator(creation_time, username, origin, description);
-  return guarded(__func__, filename, [&] {
+  return guarded(fn, filename, [&] {
     std::optional<carmen::FoundChunk> c;
     try {
-      c = first_chunk(filename, CARMEN_MAP_CREATOR_CHUNK, nullptr);
+      c = first_chunk(fn, filename, CARMEN_MAP_CREATOR_CHUNK, nullptr);
     } catch (const carmen::FileError &) {
       std::optional<carmen::FoundChunk> old;
       try {
-        old = first_chunk(filename, CARMEN_MAP_CREATOR_OLD_CHUNK, nullptr);
+        old = first_chunk(fn, filename, CARMEN_MAP_CREATOR_OLD_CHUNK, nullptr);
       } catch (const carmen::FileError &) {
       }
       if (!old) throw;
       c = std::move(old);
     }
-    if (!c) c = first_chunk(filename, CARMEN_MAP_CREATOR_OLD_CHUNK, nullptr);
+    if (!c) c = first_chunk(fn, filename, CARMEN_MAP_CREATOR_OLD_CHUNK, nullptr);
     if (!c) missing(filename, "CREATOR");
     if (c->info.base_type() == CARMEN_MAP_CREATOR_OLD_CHUNK)
       std::fprintf(stderr, "%s: old-style map (creator chunk code 0)\n", filename);
@@ -632,10 +643,11 @@ int carmen_map_read_creator_chunk(const char *filename, time_t *creation_time, c
 // answers here.
 int carmen_map_read_named_creator_chunk(const char *filename, const char *chunk_name, time_t *creation_time,
                                         char *username, char *origin, char *description) {
+  const char *const fn = __func__;
   clear_creator(creation_time, username, origin, description);
-  return guarded(__func__, filename, [&] {
+  return guarded(fn, filename, [&] {
     need_chunk_name(chunk_name);
-    const auto c = first_chunk(filename, CARMEN_MAP_CREATOR_CHUNK, chunk_name);
+    const auto c = first_chunk(fn, filename, CARMEN_MAP_CREATOR_CHUNK, chunk_name);
     if (!c) missing_named(filename, "CREATOR", chunk_name);
     copy_creator(payload_of<carmen::CreatorInfo>(*c), creation_time, username, origin, description);
     return 0;
@@ -651,7 +663,7 @@ static int read_places(const char *fn, const char *filename, const char *chunk_n
   return guarded(fn, filename, [&] {
     if (places == nullptr) throw std::invalid_argument("no place list given (NULL)");
     if (named) need_chunk_name(chunk_name);
-    const auto c = first_chunk(filename, CARMEN_MAP_PLACES_CHUNK, chunk_name);
+    const auto c = first_chunk(fn, filename, CARMEN_MAP_PLACES_CHUNK, chunk_name);
     if (!c && !named) return -1;  // silent, as CARMEN's
     if (!c) missing_named(filename, "PLACES", chunk_name);
     fill_places(payload_of<carmen::PlaceList>(*c), places);
@@ -674,7 +686,7 @@ static int read_offlimits(const char *fn, const char *filename, const char *chun
     if (offlimits_list == nullptr || list_length == nullptr)
       throw std::invalid_argument("NULL output argument");
     if (named) need_chunk_name(chunk_name);
-    const auto c = first_chunk(filename, CARMEN_MAP_OFFLIMITS_CHUNK, chunk_name);
+    const auto c = first_chunk(fn, filename, CARMEN_MAP_OFFLIMITS_CHUNK, chunk_name);
     if (!c && !named) return -1;  // silent, as CARMEN's
     if (!c) missing_named(filename, "OFFLIMITS", chunk_name);
     fill_offlimits(payload_of<carmen::OffLimits>(*c), offlimits_list, list_length);
@@ -697,7 +709,7 @@ static int read_laserscans(const char *fn, const char *filename, const char *chu
   return guarded(fn, filename, [&] {
     if (scan_list == nullptr || num_scans == nullptr) throw std::invalid_argument("NULL output argument");
     if (named) need_chunk_name(chunk_name);
-    const auto c = first_chunk(filename, CARMEN_MAP_LASERSCANS_CHUNK, chunk_name);
+    const auto c = first_chunk(fn, filename, CARMEN_MAP_LASERSCANS_CHUNK, chunk_name);
     if (!c) missing_chunk(filename, "LASERSCANS", chunk_name);
     fill_scans(payload_of<carmen::LaserScanList>(*c), scan_list, num_scans);
     return 0;
@@ -717,7 +729,7 @@ static int read_global_offset(const char *fn, const char *filename, const char *
   return guarded(fn, filename, [&] {
     if (global_offset == nullptr) throw std::invalid_argument("no offset given (NULL)");
     if (named) need_chunk_name(chunk_name);
-    const auto c = first_chunk(filename, CARMEN_MAP_GLOBAL_OFFSET_CHUNK, chunk_name);
+    const auto c = first_chunk(fn, filename, CARMEN_MAP_GLOBAL_OFFSET_CHUNK, chunk_name);
     if (!c && !named) return -1;  // silent, as CARMEN's
     if (!c) missing_named(filename, "OFFSET", chunk_name);
     const carmen::GlobalOffset &o = payload_of<carmen::GlobalOffset>(*c);

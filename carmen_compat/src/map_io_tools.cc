@@ -15,6 +15,7 @@
 #include "carmen/map_io.h"
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_file.h"
+#include "carmen_stdio_results.h"
 #include "map_io_support.h"
 
 using carmen::map_io_detail::guarded;
@@ -23,6 +24,8 @@ using carmen::map_io_detail::put_bytes;
 namespace {
 
 constexpr size_t kCopyPiece = size_t{1} << 16;
+constexpr uint64_t kOfflimitsWindow = uint64_t{16} << 20;  // decode_offlimits_payload's
+constexpr size_t kMaxChunkName = 4096;
 
 std::string map_id() { return std::string(CARMEN_MAP_LABEL) + CARMEN_MAP_VERSION; }
 
@@ -64,6 +67,65 @@ int32_t read_le_i32(const unsigned char *b) {
   return v;
 }
 
+// Discards up to n bytes of in: a chunk stripped that the input ends
+// inside goes as far as the input does, as CARMEN's fseek takes it.
+void drop_bytes(carmen_FILE *in, int64_t n) {
+  std::vector<char> buf(kCopyPiece);
+  while (n > 0) {
+    const size_t k = static_cast<size_t>(std::min<int64_t>(n, int64_t(buf.size())));
+    if (carmen_fread(buf.data(), 1, k, in) != k) return;
+    n -= int64_t(k);
+  }
+}
+
+void seek_to(carmen_FILE *in, off_t at) {
+  if (at < 0 || !carmen::checked_seek(in, at, SEEK_SET)) throw std::runtime_error("cannot seek in the input");
+}
+
+// One chunk whose type and size were read (`head`: those 5 bytes), copied
+// (keep) or not. A chunk is copied by its size, but an OFFLIMITS chunk to
+// where it really ends: CARMEN's writers size it wrongly (map_file.h,
+// decode_offlimits_payload). One in CARMEN's layout is written as the chunk
+// CARMEN meant (its lines, rectangles and size right), which CARMEN's own
+// reader reads too; one in neither layout is copied by its size.
+void copy_offlimits(carmen_FILE *in, carmen_FILE *out, const std::string &head, int32_t size, bool keep) {
+  const off_t after_size = carmen_ftell(in);
+  const bool named = CARMEN_MAP_CHUNK_IS_NAMED(static_cast<unsigned char>(head[0]));
+  std::string desc(10, '\0'), name;
+  if (carmen_fread(&desc[0], 1, 10, in) != 10) throw std::runtime_error("input ends inside a chunk");
+  int c = 0;
+  while (named && (c = carmen_fgetc(in)) != EOF && c != 0 && name.size() < kMaxChunkName)
+    name.push_back(static_cast<char>(c));
+  const int64_t declared = int64_t(size) - 10 - (named ? int64_t(name.size()) + 1 : 0);
+  const off_t payload_at = carmen_ftell(in);
+  std::vector<unsigned char> bytes;
+  carmen::OffLimitsPayload d;
+  if ((!named || c == 0) && uint64_t(std::max<int64_t>(declared, 0)) <= kOfflimitsWindow) {
+    d = carmen::decode_offlimits_payload(bytes, uint64_t(std::max<int64_t>(declared, 0)), named,
+                                         [&](std::vector<unsigned char> &b, uint64_t want) {
+                                           const size_t old = b.size();
+                                           if (want <= old) return;
+                                           b.resize(static_cast<size_t>(want));
+                                           const size_t got = carmen_fread(b.data() + old, 1, b.size() - old, in);
+                                           b.resize(old + (got <= b.size() - old ? got : 0));  // -1: none
+                                         });
+  }
+  if (!d.ok) {  // as any chunk
+    seek_to(in, after_size);
+    if (keep) put_bytes(out, head);
+    pass_bytes(in, keep ? out : nullptr, size);
+    return;
+  }
+  seek_to(in, payload_at + off_t(d.length));
+  if (!keep) return;
+  if (d.carmen_layout && !(named && name.empty())) {
+    put_bytes(out, carmen::encode_offlimits_chunk(d.offlimits, name));
+  } else {
+    put_bytes(out, head + desc + (named ? name + std::string(1, '\0') : std::string()) +
+                       std::string(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(d.length)));
+  }
+}
+
 // The chunks after the id: each one copied unless its type is in strip. As
 // in CARMEN, whose table is indexed by the raw type byte, a named chunk
 // (type | 0x80) is never stripped: a map's named gridmaps, places or hmap
@@ -76,10 +138,16 @@ void copy_chunks(carmen_FILE *in, carmen_FILE *out, const bool strip[128]) {
     const int32_t size = read_le_i32(size_bytes);
     if (size < 10) throw std::runtime_error("damaged chunk: size " + std::to_string(size) + " (at least 10)");
     const bool keep = CARMEN_MAP_CHUNK_IS_NAMED(type) || !strip[type];
-    if (keep)
-      put_bytes(out, std::string(1, static_cast<char>(type)) +
-                         std::string(reinterpret_cast<char *>(size_bytes), 4));
-    pass_bytes(in, keep ? out : nullptr, size);
+    const std::string head =
+        std::string(1, static_cast<char>(type)) + std::string(reinterpret_cast<char *>(size_bytes), 4);
+    if ((type & ~CARMEN_MAP_NAMED_CHUNK_FLAG) == CARMEN_MAP_OFFLIMITS_CHUNK) {
+      copy_offlimits(in, out, head, size, keep);
+    } else if (!keep && type == CARMEN_MAP_GRIDMAP_CHUNK) {
+      drop_bytes(in, size);  // a gridmap cut short is read (map_file.h), so it is stripped too
+    } else {
+      if (keep) put_bytes(out, head);
+      pass_bytes(in, keep ? out : nullptr, size);
+    }
   }
 }
 

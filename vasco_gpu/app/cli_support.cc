@@ -99,6 +99,9 @@ uint64_t parse_mebibytes(const std::string &text, const std::string &option) {
 std::string input_path(const std::string &arg) { return arg == kStdio ? "/dev/stdin" : arg; }
 
 StdoutFile::StdoutFile(const std::string &extension) {
+  // The directory is made, then registered for removal on a signal: no
+  // signal may come in between.
+  const carmen::SignalsWait registered_as_made;
   const char *tmp = std::getenv("TMPDIR");
   std::string pattern = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/vasco_stdout.XXXXXX";
   if (::mkdtemp(pattern.data()) == nullptr)

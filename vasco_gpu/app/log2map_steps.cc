@@ -206,9 +206,6 @@ void write_outputs(const Options &opt, const std::string &log, const std::vector
   carmen::OutputTransaction tx;
   for (const std::string &out : outputs) {
     if (out == cli::kStdio) {
-      // Its directory is made, then registered for removal on a signal: no
-      // signal may come in between.
-      const carmen::SignalsWait registered_as_made;
       to_stdout = std::make_unique<cli::StdoutFile>(".map");
       carmen::write_map(tx, to_stdout->path(), map);
     } else {

@@ -19,6 +19,7 @@
 #define CARMEN_COMPAT_MAP_FILE_H
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <variant>
@@ -183,6 +184,18 @@ enum class NamedChunkReading {
   Index,  // headers only; MapFile::named stays empty; read one with read_named_chunk()
 };
 
+// What the reader reads as CARMEN reads it, with a warning, although the file
+// is not as its sizes say:
+//  - a GRIDMAP chunk whose data ends inside its cells (the map is cut short,
+//    or a byte was lost, as in CARMEN's own nsh_level_3.map): the cells there
+//    are read and the missing ones are unknown (-1). Only a chunk whose header
+//    is sound (sizes, resolution, a size field that matches them) and of whose
+//    cells at least half (or all but 1 MiB) are in the file: so what is
+//    allocated stays within twice what the file holds, and a few bytes cannot
+//    claim gigabytes. A gzip stream that is itself cut short or corrupt is
+//    still an error (zlib reports it).
+//  - OFFLIMITS chunks in the layouts CARMEN 0.7.4's writers give them
+//    (decode_offlimits_payload below).
 struct MapReadOptions {
   // Reject gridmaps holding values outside valid_cell_value(). On: a damaged
   // map (NaN, huge or negative garbage) is reported, not passed on.
@@ -193,6 +206,10 @@ struct MapReadOptions {
   // 16000 x 16000 grid.
   uint64_t max_kept_bytes = uint64_t(1) << 30;
   NamedChunkReading named_chunks = NamedChunkReading::Parse;
+  // Where warnings go (one line each, "FILE: warning: the GRIDMAP chunk at
+  // byte N ..."): only for a chunk that is read, not for one passed on the
+  // way to it. Unset: printed on stderr.
+  std::function<void(const std::string &)> on_warning;
 };
 
 // Reads a whole map file; ".gz" names are gunzipped (as carmen_fopen does:
@@ -298,6 +315,42 @@ std::string encode_chunk(const ChunkPayload &payload, const std::string &name = 
 // A whole chunk of `type` around a payload already encoded by the caller
 // (for kinds MapFile does not hold, such as HMAP).
 std::string encode_raw_chunk(int type, const std::string &payload, const std::string &name = {});
+
+// ---------------------------------------------------------------------------
+// OFFLIMITS payloads as CARMEN 0.7.4's writers lay them out. The layout is
+// int32 points, (x y) each; int32 lines, (x1 y1 x2 y2) each; int32
+// rectangles, (x1 y1 x2 y2) each. CARMEN's writer counts every line but
+// writes only those among the first `lines` items of its list (its loop runs
+// to the line count, not the item count), while its size field counts them
+// all: such a chunk ends 16 bytes early for each line left out, and the next
+// chunk begins there. Its named writer also sizes the chunk without the name
+// and the items (the size field says 22, where the writer does not crash),
+// so a named chunk's end is found from its counts. decode_offlimits_payload
+// reads the layout the size field gives when it parses and the data after it
+// ends or is a chunk header of a kind CARMEN writes; else the layout CARMEN
+// wrote, when one fits (the lines that are there, the rectangles after them,
+// followed likewise by the end or a chunk header); else the sized layout,
+// when it parses.
+// ---------------------------------------------------------------------------
+struct OffLimitsPayload {
+  bool ok = false;
+  std::string error;            // when !ok: what is wrong (the size field's layout)
+  OffLimits offlimits;
+  uint64_t length = 0;          // payload bytes the chunk holds: the next chunk begins there
+  uint64_t lines_left_out = 0;  // lines counted but not written by CARMEN's writer
+  bool carmen_layout = false;   // the size field does not give the chunk's end
+};
+// Makes `bytes` hold the payload's first `want` bytes, or all there are when
+// the data ends first, by appending to it. May throw (the caller's errors).
+using PayloadFetch = std::function<void(std::vector<unsigned char> &bytes, uint64_t want)>;
+// `bytes` starts empty and is filled through `fetch` only; on return it
+// holds all that was fetched, which may run past the chunk's end (the caller
+// reads that again as the next chunk). `declared`: the payload bytes the
+// size field gives (after the name); `named`: the chunk has the 0x80 flag
+// (its size field is not trusted). CARMEN's layouts are looked for within
+// the first 16 MiB only.
+OffLimitsPayload decode_offlimits_payload(std::vector<unsigned char> &bytes, uint64_t declared, bool named,
+                                          const PayloadFetch &fetch);
 
 // The bytes after the size field of a chunk found by list_map_chunks():
 // description, name and NUL (named chunks), payload. Throws FileError.
