@@ -34,6 +34,10 @@ struct OutputFile {
 }  // namespace
 
 void bind_output_file(nb::module_ &m) {
+  m.def("_remove_temporaries_on_signals", &carmen::remove_temporaries_on_signals,
+        "Installs the engine's SIGINT, SIGTERM and SIGHUP handlers (atomic_file.h): they remove every live\n"
+        "temporary of this process, then end it as the signal would. For console scripts that write through\n"
+        "_OutputFile (bag2carmen); a library user's signal handlers are theirs.");
   nb::class_<OutputFile>(m, "_OutputFile",
                          "A file written whole or not at all: a hidden temporary beside the target (mode 0666 less\n"
                          "the umask), renamed over it by commit(); abandon() (or the object's end) removes it.\n"

@@ -24,9 +24,11 @@ from __future__ import annotations
 import math
 import os
 import shutil
+import signal
 import stat
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -235,6 +237,32 @@ def test_bag2carmen_writes_through_the_engines_output_file(tmp_path, intel):
     assert r.returncode == 0, r.stderr
     assert stat.S_IMODE(os.stat(tmp_path / "plain.log").st_mode) == 0o644
     assert sorted(os.listdir(tmp_path)) == sorted(["pipe.log", "plain.log", Path(path).name])  # no temporary
+
+
+def test_bag2carmen_leaves_no_temporary_on_a_signal(tmp_path, intel):
+    # SIGTERM, SIGINT or SIGHUP while the log's temporary is written: the process dies of it and
+    # the temporary goes (the engine's handlers); the target, had it existed, would be unchanged.
+    path = tf_bag(tmp_path, "mcap", intel)
+    out = tmp_path / "out" / "x.log"
+    out.parent.mkdir()
+    code = "import sys; from vasco_gpu.bags.cli import bag2carmen_main; sys.exit(bag2carmen_main())"
+    caught = 0
+    for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP) * 3:
+        proc = subprocess.Popen([sys.executable, "-c", code, "-q", str(path), str(out)], stderr=subprocess.DEVNULL)
+        end = time.monotonic() + 60
+        while proc.poll() is None and time.monotonic() < end and not any(
+                p.name.startswith(".x.log.tmp.") for p in out.parent.iterdir()):
+            time.sleep(0.0005)
+        if proc.poll() is None:
+            proc.send_signal(sig)
+        rc = proc.wait(60)
+        if rc == -sig:
+            caught += 1
+        assert rc in (0, -sig), rc
+        assert [p.name for p in out.parent.iterdir()] in ([], ["x.log"]), list(out.parent.iterdir())
+        if out.exists():
+            out.unlink()
+    assert caught > 0, "no run was caught while writing: the test saw nothing"
 
 
 def test_bag2map_batch_mode_gives_each_bags_map(tmp_path, intel):

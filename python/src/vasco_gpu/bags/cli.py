@@ -166,6 +166,7 @@ def _bag2carmen_parser() -> argparse.ArgumentParser:
 
 def bag2carmen_main(argv: list[str] | None = None) -> int:
     """The console script bag2carmen. Exit 0 done, 1 bad input, 2 usage error."""
+    _core._remove_temporaries_on_signals()  # SIGINT, SIGTERM, SIGHUP: no temporary left behind
     parser = _bag2carmen_parser()
     try:
         a = parser.parse_args(sys.argv[1:] if argv is None else argv)
