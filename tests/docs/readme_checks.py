@@ -338,6 +338,9 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "text: Mapping session (vasco defaults; re-render = new poses in ho",
             "text: batch_bench: 120 copies of fr079-complete.gfs.log.gz, output",
         )
+    } | {
+        "text: Target: cpu_float at least 1.25x MRPT's speed, one core each": Check(
+            "quoted", quote_of="bench/results/peers-2026-12-05-2core.txt"),
     },
     "docs/python.md": {
         "sh: pip install .": Check(
