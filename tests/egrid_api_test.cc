@@ -173,6 +173,9 @@ TEST_F(EgridApi, FinishDownsamplesAndCrops) {
 // more blocks, and dies "Out of memory" before its caller writes a map. Ours
 // stops there too, saying why, so that no half-written map file follows.
 TEST_F(EgridApi, FinishingAGridThatMappedNothingStopsAsCarmenDoes) {
+  EXPECT_EQ(vasco_egrid_finish_would_stop(&g, 1, 2), 1);
+  EXPECT_EQ(vasco_egrid_finish_would_stop(&g, 1, 5), 0);  // 20 blocks <= 4 x 5 + 1: CARMEN finishes it
+  EXPECT_EQ(vasco_egrid_finish_would_stop(nullptr, 1, 2), 0);
   EXPECT_EXIT(carmen_mapper_finish_evidence_grid(&g, 1, 2), ::testing::ExitedWithCode(EXIT_FAILURE),
               "no cell of the 20 x 20 grid was updated");
 }
@@ -181,6 +184,7 @@ TEST_F(EgridApi, ASmallGridThatMappedNothingFinishesAsCarmensDoes) {
   // 20 blocks <= 4 x 5 + 1: CARMEN's bounds (14, 5) move out by the border
   // to (9, 10): a 1 x 1 map (4 x 5 + 1 - 20), its cell unknown.
   carmen_mapper_finish_evidence_grid(&g, 1, 5);
+  EXPECT_EQ(vasco_egrid_finish_would_stop(&g, 1, 5), 0);
   EXPECT_EQ(g.size_x, 1);
   EXPECT_EQ(g.size_y, 1);
   EXPECT_EQ(g.prob[0][0], -1.0f);

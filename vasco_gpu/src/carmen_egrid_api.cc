@@ -408,6 +408,10 @@ int vasco_egrid_set_backend(const char *backend) {
   return 0;
 }
 
+int vasco_egrid_finish_would_stop(const evidence_grid *grid, int downsample, int border) {
+  return grid != nullptr && grid->prob != nullptr && carmen_dies_finishing(grid, downsample, border) ? 1 : 0;
+}
+
 const char *vasco_egrid_grid_backend(const evidence_grid *grid) {
   const Session *s = session_of(grid);
   const char *name = s != nullptr ? registry_name(s->mapper->backend_name()) : nullptr;

@@ -53,7 +53,12 @@ void carmen_mapper_update_evidence_grid_general(evidence_grid *grid, double lase
 void carmen_mapper_clear_evidence_grid(evidence_grid *grid);
 
 /* Downsamples by `downsample` and crops to the known cells plus `border`
- * (DESIGN §2 step 7); size and resolution are updated in place. */
+ * (DESIGN §2 step 7); size and resolution are updated in place. A grid that
+ * mapped nothing (no cell known) and is more than 4 * border + 1 blocks wide
+ * or high is where CARMEN's finish dies "Out of memory" (its map size comes
+ * out negative): this one stops the process there too (exit status 1, a
+ * message saying why), so that no half-written map file follows;
+ * vasco_egrid_finish_would_stop says so beforehand. */
 void carmen_mapper_finish_evidence_grid(evidence_grid *grid, int downsample, int border);
 
 void carmen_mapper_free_evidence_grid(evidence_grid *grid);
@@ -81,6 +86,11 @@ int vasco_egrid_set_backend(const char *backend);
 /* vasco_gpu extension: the backend `grid` runs on now ("cpu_double" for the
  * oracle, "cpu_threads", "cpu_float", "cuda_float", "cuda_exact"). */
 const char *vasco_egrid_grid_backend(const evidence_grid *grid);
+
+/* vasco_gpu extension: 1 where carmen_mapper_finish_evidence_grid(grid,
+ * downsample, border) would stop the process (a grid that mapped nothing, as
+ * above), else 0: a program may test it and say so its own way. */
+int vasco_egrid_finish_would_stop(const evidence_grid *grid, int downsample, int border);
 
 #ifdef __cplusplus
 }
