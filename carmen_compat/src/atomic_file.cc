@@ -1,23 +1,12 @@
-// AtomicOutput: an exclusively created temp file in the target's directory +
-// rename; OutputTransaction: several of them renamed together under a lock
-// file of our own beside each target, undone should a later rename fail; the
-// checks that a target can be replaced; the registry of live temporaries that
-// the signal handlers remove, and the commit sections those handlers wait for.
+// The output files and their transaction: AtomicOutput, OutputTransaction and the checks of a target.
 #include "carmen_compat/atomic_file.h"
 
 #include <fcntl.h>
-#include <pthread.h>
-#include <signal.h>
-#include <sys/file.h>
 #include <sys/stat.h>
-#include <sys/sysmacros.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <chrono>
-#include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -26,18 +15,15 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
-#include <system_error>
-#include <thread>
-#include <tuple>
 
+#include "atomic_file_support.h"
 #include "carmen_compat/error.h"
 #include "carmen_compat/input_file.h"
-#include "carmen_compat/termination_signals.h"
+#include "signal_cleanup.h"
+#include "target_locks.h"
 
 namespace carmen {
-namespace {
-
-std::string errno_text(int err) { return std::strerror(err); }
+namespace internal {
 
 // Splits "a/b/c.map" into "a/" and "c.map" (directory keeps its slash).
 void split_path(const std::string &path, std::string *dir, std::string *base) {
@@ -58,6 +44,21 @@ std::string directory_of(const std::string &path) {
   return dir.empty() ? std::string(".") : dir;
 }
 
+FileError io_error(const std::string &path, const std::string &why) { return FileError(path, why, ErrorCode::Io); }
+
+}  // namespace internal
+
+namespace {
+
+using internal::directory_of;
+using internal::io_error;
+using internal::register_temp;
+using internal::split_path;
+using internal::TargetLocks;
+using internal::unregister_temp;
+
+std::string errno_text(int err) { return std::strerror(err); }
+
 std::string file_name_of(const std::string &path) {
   std::string dir, base;
   split_path(path, &dir, &base);
@@ -71,8 +72,6 @@ bool fsync_path(const std::string &path, bool directory) {
   ::close(fd);
   return ok;
 }
-
-FileError io_error(const std::string &path, const std::string &why) { return FileError(path, why, ErrorCode::Io); }
 
 // --- Names -----------------------------------------------------------------
 std::mutex name_mutex;
@@ -97,120 +96,6 @@ std::string hidden_name(const std::string &path, const char *role) {
   std::string dir, base;
   split_path(path, &dir, &base);
   return dir + "." + base + "." + role + "." + std::to_string(static_cast<long>(::getpid())) + "." + random_part();
-}
-
-// --- The registry of live temporaries ----------------------------------------
-// Fixed slots a signal handler can read without locks or allocation: the
-// temporaries, the lock files held, log2map's directory for the output '-'.
-constexpr int kSlots = 128;
-char slot_path[kSlots][PATH_MAX];
-volatile sig_atomic_t slot_used[kSlots];
-std::mutex slot_mutex;
-
-int register_temp(const std::string &path) {
-  if (path.size() >= PATH_MAX) return -1;
-  std::lock_guard<std::mutex> lock(slot_mutex);
-  for (int i = 0; i < kSlots; ++i) {
-    if (slot_used[i]) continue;
-    std::memcpy(slot_path[i], path.c_str(), path.size() + 1);
-    slot_used[i] = 1;
-    return i;
-  }
-  return -1;  // more than kSlots at once: not cleaned on a signal, still on unwinding
-}
-
-void unregister_temp(int slot) {
-  if (slot < 0) return;
-  std::lock_guard<std::mutex> lock(slot_mutex);
-  slot_used[slot] = 0;
-}
-
-// Async-signal-safe. A path already gone (unlink's ENOENT) or a directory
-// not yet empty (rmdir's ENOTEMPTY) needs nothing more: the results are not
-// looked at.
-void remove_registered() noexcept {
-  for (int i = 0; i < kSlots; ++i)
-    if (slot_used[i]) ::unlink(slot_path[i]);
-  for (int i = 0; i < kSlots; ++i)
-    if (slot_used[i]) ::rmdir(slot_path[i]);  // the directories, now that their files are gone
-}
-
-// Removes what is registered and ends the process as `sig` would, from the
-// handler or from the last commit a signal waited for (async-signal-safe).
-[[noreturn]] void die_of(int sig) noexcept {
-  remove_registered();
-  ::signal(sig, SIG_DFL);
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, sig);
-  ::pthread_sigmask(SIG_UNBLOCK, &set, nullptr);  // a commit's thread holds it back
-  ::raise(sig);
-  ::_exit(128 + sig);  // not reached: the default action of these signals ends the process
-}
-
-// --- Sections the signals wait for (SignalsWait) -----------------------------------
-// A commit must not be cut between its renames and their undoing, nor a file
-// of ours (a temporary, a lock file) be left between being made and being
-// registered, whatever thread the signal lands on: a process-directed signal
-// goes to any thread that does not block it, and in batch mode the commits
-// run on the pool's threads while the main thread maps. So the handler looks
-// at commit_state first: inside a section (count > 0) it only marks the
-// signal as waiting; the last thread to leave a section then ends the
-// process. Lock-free atomics, shared with the handler.
-constexpr int kSignalWaits = 1 << 30;  // a signal came during a section
-constexpr int kEnding = 1 << 29;       // the process is ending: no section starts
-constexpr int kCountMask = kEnding - 1;
-std::atomic<int> commit_state{0};
-std::atomic<int> waiting_signal{0};
-static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads commit_state");
-thread_local int section_depth = 0;  // a section inside another on one thread counts once
-
-extern "C" void remove_temporaries_and_die(int sig) {
-  int expected = 0;
-  waiting_signal.compare_exchange_strong(expected, sig);  // the first signal is the one the process dies of
-  int state = commit_state.load();
-  int next = 0;
-  do {
-    if (state & (kEnding | kSignalWaits)) return;  // the process is ending, or will once the sections are left
-    next = (state & kCountMask) == 0 ? kEnding : (state | kSignalWaits);
-  } while (!commit_state.compare_exchange_weak(state, next));
-  if (next == kEnding) die_of(sig);
-}
-
-// A forked child has none of its parent's other threads, so none of their
-// sections: it starts with none.
-void reset_sections_in_child() {
-  commit_state.store(0);
-  waiting_signal.store(0);
-}
-
-// Until the process ends (another thread is ending it, or a signal waits for
-// the sections in progress, whose last one ends it).
-[[noreturn]] void wait_for_the_end() {
-  for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
-}
-
-// SignalsWait's entry: counts this thread in (once, however nested), unless
-// a signal already waits or the process is ending.
-void enter_section() {
-  if (section_depth++ > 0) return;
-  int state = commit_state.load();
-  do {
-    if (state & (kEnding | kSignalWaits)) wait_for_the_end();  // no new section once a signal came
-  } while (!commit_state.compare_exchange_weak(state, state + 1));
-}
-
-// SignalsWait's exit: the last thread out of its sections ends the process
-// when a signal waited for them.
-void leave_section() noexcept {
-  if (--section_depth > 0) return;
-  int state = commit_state.load();
-  int next = 0;
-  do {
-    next = state - 1;
-    if ((next & kCountMask) == 0 && (next & kSignalWaits)) next = kEnding;
-  } while (!commit_state.compare_exchange_weak(state, next));
-  if (next == kEnding) die_of(waiting_signal.load());  // the signal that waited for us
 }
 
 // Tests only: called after each rename of a commit (inside its section).
@@ -312,227 +197,7 @@ void check_existing_target(const std::string &path, const std::string &dir, cons
     throw io_error(path, "is a mount point: it cannot be replaced");
 }
 
-// --- Target locks ----------------------------------------------------------------
-// Two of our writers committing the same target take turns, so that a pair
-// (an image and its YAML) is left from one of them: each holds an exclusive
-// flock on ".NAME.lock" beside every target while it renames. A lock file of
-// our own, not the directory: anyone who may read a directory may flock it
-// and so stop every writer there. The lock file is created mode 0600 (another
-// user can neither open nor lock it) and never through a symlink; its holder
-// removes it before letting go, so none is left behind, and a writer that
-// gets the lock of a file already removed (or replaced) tries again.
-struct FileKey {
-  dev_t dev;
-  ino_t ino;
-};
-
-bool same_file(const struct stat &a, const struct stat &b) { return a.st_dev == b.st_dev && a.st_ino == b.st_ino; }
-
-// "pid 1234, log2map" of the process /proc/locks says holds a flock on the
-// file (dev, ino); empty when it does not say.
-std::string lock_holder(const FileKey &key) {
-  char id[64];
-  std::snprintf(id, sizeof id, "%02x:%02x:%lu", major(key.dev), minor(key.dev), static_cast<unsigned long>(key.ino));
-  std::ifstream locks("/proc/locks");
-  std::string line;
-  while (std::getline(locks, line)) {
-    std::istringstream fields(line);
-    std::string number, type, advisory, mode, pid, file;
-    if (!(fields >> number >> type >> advisory >> mode >> pid >> file) || type != "FLOCK" || file != id) continue;
-    std::ifstream comm_file("/proc/" + pid + "/comm");
-    std::string comm;
-    std::getline(comm_file, comm);
-    return "pid " + pid + (comm.empty() ? std::string() : ", " + comm);
-  }
-  return std::string();
-}
-
-// The lock of one target: its directory (open) and the lock file's name.
-struct LockPlace {
-  FileKey dir;
-  int dir_fd;
-  std::string name;    // ".NAME.lock"
-  std::string path;    // as the target is spelled, for the registry and messages
-  std::string target;
-  bool operator<(const LockPlace &o) const {
-    return std::tie(dir.dev, dir.ino, name) < std::tie(o.dir.dev, o.dir.ino, o.name);
-  }
-  bool operator==(const LockPlace &o) const { return dir.dev == o.dir.dev && dir.ino == o.dir.ino && name == o.name; }
-};
-
-// What one try at a lock file came to.
-enum class LockTry {
-  Held,      // locked, and the file is still the one named
-  Busy,      // another writer holds it (ours, or another user's that we may not open)
-  Again,     // the holder removed it as we opened it: try again at once
-  Unusable,  // no lock here (no flock on this file system, something else under the name, another
-             // user's lock file nobody holds): go on without
-};
-
-// A held lock file, registered for removal on a signal while it is held.
-class TargetLock {
- public:
-  // Takes the lock of `place` (closing its dir_fd in any case), waiting until
-  // `deadline`; nullptr when the place has no usable lock. Throws
-  // carmen::FileError naming the target when another writer holds it longer.
-  static std::unique_ptr<TargetLock> take(const LockPlace &place, std::chrono::steady_clock::time_point deadline,
-                                          int timeout_ms) {
-    auto lock = std::unique_ptr<TargetLock>(new TargetLock(place));
-    for (;;) {
-      LockTry result;
-      {
-        const SignalsWait section;  // a lock file held is a lock file registered
-        result = lock->try_once();
-      }
-      if (result == LockTry::Held) return lock;
-      if (result == LockTry::Unusable) return nullptr;
-      if (std::chrono::steady_clock::now() >= deadline) lock->time_out(timeout_ms);
-      if (result == LockTry::Busy) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-
-  ~TargetLock() { release(); }
-  TargetLock(const TargetLock &) = delete;
-  TargetLock &operator=(const TargetLock &) = delete;
-
-  // Removes the lock file (ours: empty and regular) while still holding it,
-  // then lets go. Inside a commit section, so that no signal finds the name
-  // unregistered yet removed, or registered and already another writer's.
-  void release() noexcept {
-    if (fd_ >= 0) {
-      // An unlink that fails (the name already gone, a read-only directory)
-      // leaves an empty lock file at worst, which the next writer reuses.
-      if (removable_ && still_named()) ::unlinkat(place_.dir_fd, place_.name.c_str(), 0);
-      unregister_temp(slot_);
-      slot_ = -1;
-      ::close(fd_);  // closing releases the flock; nothing to do should it fail
-      fd_ = -1;
-    }
-    if (place_.dir_fd >= 0) {
-      ::close(place_.dir_fd);
-      place_.dir_fd = -1;
-    }
-  }
-
- private:
-  explicit TargetLock(const LockPlace &place) : place_(place) {}
-
-  LockTry try_once() {
-    const int fd = ::openat(place_.dir_fd, place_.name.c_str(),
-                            O_RDONLY | O_CREAT | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0600);
-    if (fd < 0) return errno == EACCES && held_by_someone() ? LockTry::Busy : LockTry::Unusable;
-    struct stat st;
-    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-      ::close(fd);
-      return LockTry::Unusable;
-    }
-    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-      const int err = errno;
-      ::close(fd);
-      return err == EWOULDBLOCK || err == EINTR ? LockTry::Busy : LockTry::Unusable;
-    }
-    fd_ = fd;
-    if (!still_named()) {  // the previous holder removed it before we locked it
-      ::close(fd_);
-      fd_ = -1;
-      return LockTry::Again;
-    }
-    removable_ = st.st_size == 0 && st.st_uid == ::geteuid();  // a file of someone else's under our name stays
-    if (removable_) slot_ = register_temp(place_.path);
-    return LockTry::Held;
-  }
-
-  // Whether /proc/locks says someone holds a flock on the lock file we may
-  // not open (another user's): a file nobody holds (its writer was killed)
-  // must not stop us for good; we go on without it.
-  bool held_by_someone() const {
-    struct stat st;
-    return ::fstatat(place_.dir_fd, place_.name.c_str(), &st, AT_SYMLINK_NOFOLLOW) == 0 &&
-           !lock_holder(FileKey{st.st_dev, st.st_ino}).empty();
-  }
-
-  // Whether the name still leads to the file we hold.
-  bool still_named() const {
-    struct stat held, named;
-    return ::fstat(fd_, &held) == 0 &&
-           ::fstatat(place_.dir_fd, place_.name.c_str(), &named, AT_SYMLINK_NOFOLLOW) == 0 && same_file(held, named);
-  }
-
-  [[noreturn]] void time_out(int timeout_ms) const {
-    struct stat st;
-    std::string holder;
-    if (::fstatat(place_.dir_fd, place_.name.c_str(), &st, AT_SYMLINK_NOFOLLOW) == 0)
-      holder = lock_holder(FileKey{st.st_dev, st.st_ino});
-    char waited[32];
-    std::snprintf(waited, sizeof waited, "%g s", timeout_ms / 1000.0);
-    throw io_error(place_.target, "another writer holds its lock " + place_.path + " (" +
-                                      (holder.empty() ? std::string("holder unknown") : holder) +
-                                      ") for more than " + waited + ": nothing was written");
-  }
-
-  LockPlace place_;
-  int fd_ = -1;
-  int slot_ = -1;
-  bool removable_ = false;
-};
-
-// The lock places of `paths`, each once, in a fixed order (by directory and
-// name), so that two writers never wait for each other in a circle.
-std::vector<LockPlace> lock_places(const std::vector<std::string> &paths) {
-  std::vector<LockPlace> places;
-  for (const std::string &p : paths) {
-    std::string dir, base;
-    split_path(p, &dir, &base);
-    const int fd = ::open(directory_of(p).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd < 0) continue;  // the rename will say what is wrong
-    struct stat st;
-    if (::fstat(fd, &st) != 0) {
-      ::close(fd);
-      continue;
-    }
-    LockPlace place{FileKey{st.st_dev, st.st_ino}, fd, "." + base + ".lock", dir + "." + base + ".lock", p};
-    if (std::find(places.begin(), places.end(), place) != places.end()) ::close(fd);
-    else places.push_back(std::move(place));
-  }
-  std::sort(places.begin(), places.end());
-  return places;
-}
-
-// Every target's lock of one commit, held until release().
-class TargetLocks {
- public:
-  TargetLocks(const std::vector<std::string> &paths, int timeout_ms) {
-    std::vector<LockPlace> places = lock_places(paths);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
-    for (size_t i = 0; i < places.size(); ++i) {
-      try {
-        auto lock = TargetLock::take(places[i], deadline, timeout_ms);
-        if (lock) locks_.push_back(std::move(lock));
-      } catch (...) {
-        for (size_t j = i + 1; j < places.size(); ++j) ::close(places[j].dir_fd);  // i's went with its lock
-        release();
-        throw;
-      }
-    }
-  }
-  ~TargetLocks() { release(); }
-  TargetLocks(const TargetLocks &) = delete;
-  TargetLocks &operator=(const TargetLocks &) = delete;
-
-  void release() noexcept {
-    const SignalsWait section;
-    for (size_t i = locks_.size(); i-- > 0;) locks_[i]->release();
-    locks_.clear();
-  }
-
- private:
-  std::vector<std::unique_ptr<TargetLock>> locks_;
-};
-
 }  // namespace
-
-SignalsWait::SignalsWait() { enter_section(); }  // blocked_, a member, first: no handler here inside
-SignalsWait::~SignalsWait() { leave_section(); }
 
 void check_replaceable(const std::string &path) {
   const std::string base = file_name_of(path);
@@ -571,9 +236,6 @@ void AtomicOutput::set_name_source_for_testing(std::function<std::string()> sour
   std::lock_guard<std::mutex> lock(name_mutex);
   name_source() = std::move(source);
 }
-
-TemporaryOnSignal::TemporaryOnSignal(const std::string &path) : slot_(register_temp(path)) {}
-TemporaryOnSignal::~TemporaryOnSignal() { unregister_temp(slot_); }
 
 AtomicOutput::AtomicOutput(std::string final_path) : final_path_(std::move(final_path)) {
   check_replaceable(final_path_);  // before a temporary appears beside a device or in a directory we cannot use
@@ -783,21 +445,4 @@ void write_file_atomically(const std::string &path, std::string_view contents, b
   }
   out.commit(durable);
 }
-
-void remove_temporaries_on_signals() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    struct sigaction sa;
-    std::memset(&sa, 0, sizeof sa);
-    sa.sa_handler = remove_temporaries_and_die;
-    sa.sa_mask = termination_signals();  // one handler at a time on a thread
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
-      if (::sigaction(sig, &sa, nullptr) != 0)
-        throw std::system_error(errno, std::generic_category(), "cannot handle the termination signals");
-    }
-    const int err = ::pthread_atfork(nullptr, nullptr, reset_sections_in_child);
-    if (err != 0) throw std::system_error(err, std::generic_category(), "cannot handle the termination signals");
-  });
-}
-
 }  // namespace carmen
