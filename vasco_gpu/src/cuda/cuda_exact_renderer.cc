@@ -1,7 +1,8 @@
-// CUDA exact mode, in three parts per launch: place the beams on the host
-// into pinned staging; upload and list (tile, beam) pairs; apply them tile by
-// tile. No wait between the parts: the pair arrays are sized by a host bound
-// (exact_pair_bound).
+// CUDA exact mode, in three parts per launch: place the beams (on the
+// device, device_placement.h, or on the host into pinned staging and
+// uploaded); list (tile, beam) pairs; apply them tile by tile. The pair
+// arrays are sized by a bound on the pairs that the placement sums
+// (exact_tile_bound.h), so no part waits for the real count.
 #include "cuda_exact_renderer.h"
 
 #include <algorithm>
@@ -77,22 +78,48 @@ void CudaExactRenderer::ensure_tables() {
 // after the first leaves the grid lost).
 void CudaExactRenderer::apply_scans(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
   ensure_tables();
+  const bool on_device = !cuda_host::host_placement_forced();
+  if (on_device) placement_.ranges().upload(scans, last, stream());
   const uint64_t max_beams = cuda_host::exact_beams_per_launch(params().table_size());
   for (size_t a = first; a < last;) {
     size_t b = a + 1;
     while (b < last && scans.beam_offset[b + 1] - scans.beam_offset[a] <= max_beams) ++b;
-    apply_launch(scans, a, b, st);
+    apply_launch(scans, a, b, on_device, st);
     a = b;
   }
+  if (on_device) placement_.ranges().commit();
   end_update();
 }
 
-void CudaExactRenderer::apply_launch(const ScanBatch &scans, size_t first, size_t last, MapStats *st) {
+void CudaExactRenderer::apply_launch(const ScanBatch &scans, size_t first, size_t last, bool on_device,
+                                     MapStats *st) {
   const auto t_prep = std::chrono::steady_clock::now();
-  const uint64_t pair_bound = place_beams(scans, first, last, st);
+  uint64_t pair_bound = 0;
+  const bool placed = on_device && place_on_device(scans, first, last, st, &pair_bound);
+  if (!placed) pair_bound = place_beams(scans, first, last, st);
   st->prep_s += seconds_since(t_prep);
   if (beams_ == 0) return;
-  launch_apply(pair_bound, st);
+  launch_apply(pair_bound, !placed, st);
+}
+
+// The beams of scans [first, last) placed on the device into beams_dev_ and
+// starts_; false when the device left too many for the host (nothing
+// counted then: the caller places them on the host).
+bool CudaExactRenderer::place_on_device(const ScanBatch &scans, size_t first, size_t last, MapStats *st,
+                                        uint64_t *pair_bound) {
+  const cuda_host::DevicePlacement::Placed p =
+      placement_.place(scans, first, last, geo(), params(), beams_dev_, starts_, stream());
+  if (std::getenv("VASCO_CUDA_PROFILE"))
+    std::fprintf(stderr, "  [cuda] placed on the device: %llu beams, %llu unsure%s\n",
+                 static_cast<unsigned long long>(p.beams), static_cast<unsigned long long>(p.unsure),
+                 p.done ? "" : " (too many: placed on the host)");
+  if (!p.done) return false;
+  beams_ = p.beams;
+  scans_ = last - first;
+  st->beams_used += p.beams;
+  st->beams_skipped += p.skipped;
+  *pair_bound = p.pair_bound;
+  return true;
 }
 
 // Places the beams of scans [first, last) with the oracle's code, on every
@@ -166,7 +193,7 @@ void CudaExactRenderer::launch_tile_lists(const cuda::KernelModel<double> &m, ui
 
 // Allocates every scratch buffer first; the grid changes only in the tiles
 // kernel.
-void CudaExactRenderer::launch_apply(uint64_t pair_bound, MapStats *st) {
+void CudaExactRenderer::launch_apply(uint64_t pair_bound, bool upload_beams, MapStats *st) {
   const cuda::KernelModel<double> m = kernel_model_of<double>(params(), grid_geo(), band_x0());
   const size_t tiles = num_tiles();
   reserve_scratch(pair_bound, tiles);
@@ -178,10 +205,12 @@ void CudaExactRenderer::launch_apply(uint64_t pair_bound, MapStats *st) {
   PhaseEvents &ev = events();
   cudaStream_t s = stream();
   ev.start.record(s);
-  VG_CUDA_CHECK(cudaMemcpyAsync(beams_dev_.get(), staging_beams_.get(), beams_ * sizeof(PlacedBeam),
-                                cudaMemcpyHostToDevice, s));
-  VG_CUDA_CHECK(cudaMemcpyAsync(starts_.get(), staging_starts_.get(), scans_ * sizeof(cuda::StartCell),
-                                cudaMemcpyHostToDevice, s));
+  if (upload_beams) {
+    VG_CUDA_CHECK(cudaMemcpyAsync(beams_dev_.get(), staging_beams_.get(), beams_ * sizeof(PlacedBeam),
+                                  cudaMemcpyHostToDevice, s));
+    VG_CUDA_CHECK(cudaMemcpyAsync(starts_.get(), staging_starts_.get(), scans_ * sizeof(cuda::StartCell),
+                                  cudaMemcpyHostToDevice, s));
+  }
   ev.uploaded.record(s);
   cuda_host::StageTimer timer(s);
   timer.mark("start");

@@ -85,6 +85,60 @@ size_t exact_sort_temp_bytes(size_t num_pairs);
 constexpr int kMaxExactTable = 2048;
 void launch_exact_tables(const KernelModel<double> &m, double2 *factors, int *reach, cudaStream_t stream);
 
+// The beams' placement on the device (exact_placement.cu): what the host
+// does with the oracle's code (beam_placement.cc), from a record per scan
+// and the device's copy of the ranges. A scan's beam angles are the
+// oracle's repeated additions (oracle::SteppedAngles), a thread per scan. A
+// beam's end cell is (int)(l + (range + wall) * cos(angle) / resolution) per
+// axis, computed with CUDA's cos and sin, which are within 2 ulp of the true
+// value as glibc's are within 1: where the value lies farther than
+// kUnsureTolerance (relative) from every integer, its truncation is the
+// oracle's; elsewhere (a few beams in 10^7, and non-finite values or those
+// past 2^30) the beam is listed as unsure and the host places it with the
+// oracle's own code (launch_exact_fix).
+struct ExactScan {
+  double lx, ly;        // laser position in cells (oracle::scan_start)
+  double angle0, step;  // beam 0's angle (theta + first) and the step added after each beam
+  uint32_t beam_begin;  // first beam, counted from the launch's first
+  int beam_count;
+  int x1, y1;           // start cell
+};
+struct UnsureBeam {
+  uint32_t slot;  // its PlacedBeam's index
+  uint32_t scan;  // counted from the launch's first
+  double angle;
+  float range;
+};
+struct BeamFix {
+  uint32_t slot;
+  int x2, y2;
+};
+// The error of both sides is below 1e-14 relative (a few ulp of the
+// coordinate and of (range + wall) / resolution); 1e-11 is a 1000x margin.
+constexpr double kUnsureTolerance = 1e-11;
+struct PlacementModel {
+  double resolution, wall;  // the frame's cell and the parameters' wall_size
+  int table_size;
+};
+
+// Per scan: its beams' angles and scan indices (num_beams in all).
+void launch_exact_angles(const ExactScan *scans, int num_scans, double *angles, uint32_t *scan_of,
+                         cudaStream_t stream);
+// Per beam: 1 where it is used (egrid::is_beam_used), 0 else, and a 0 after
+// the last (num_beams + 1 entries, for exact_scan).
+void launch_exact_used(const float *ranges, size_t num_beams, uint32_t *used, cudaStream_t stream);
+// Per used beam i: its PlacedBeam at beams[slots[i]] (slots: exact_scan of
+// `used`). counters[0] += the beams' tile bounds (exact_tile_bound.h; the
+// box bound for an unsure beam), counters[1] += the unsure beams, the first
+// `unsure_capacity` of which are listed in `unsure` (their end cells left
+// for launch_exact_fix).
+void launch_exact_place(const PlacementModel &m, const ExactScan *scans, const float *ranges, const double *angles,
+                        const uint32_t *scan_of, const uint32_t *slots, size_t num_beams, PlacedBeam *beams,
+                        UnsureBeam *unsure, uint32_t unsure_capacity, unsigned long long *counters,
+                        cudaStream_t stream);
+// The host's end cells of the unsure beams.
+void launch_exact_fix(const BeamFix *fixes, size_t n, PlacedBeam *beams, cudaStream_t stream);
+
 // Per beam: builds its LineRec and counts the tiles its walk passes through.
 void launch_exact_lines(const KernelModel<double> &m, const PlacedBeam *beams, const StartCell *starts,
                         size_t num_beams, LineRec *lines, uint32_t *tile_counts,
