@@ -10,6 +10,9 @@ for each backend. Printed as a table, ratios in the same run:
   scan p50/p99  the node's own: callback entry -> scan in the grid (ms)
   Path->/map  publish() of the serialized Path -> the new /map in this process's subscriber
               (ms, median and best of --paths), the whole loop a SLAM back end sees
+  node        of that, the node's own: its Path callback's entry -> /map published (p50 ms:
+              reading the Path, the render, the finish, the OccupancyGrid); the rest is DDS
+              carrying the Path and the map, and the callbacks' wake-ups
   vs cpu_double  cpu_double's Path->/map over this one: against rebuilding the map from
               every scan on the CPU, as a CPU mapper does after a loop closure
 
@@ -97,6 +100,7 @@ def bench_one(player, log, name, args, stamps, raw_path):
         mapped = line.split("vasco_mapper: ", 1)[1].split(" scans mapped")[0] if line else "?"
         return {"scans": f"{mapped}/{len(log)}", "cpu_live": cpu_live, "cpu_fast": cpu_fast,
                 "scan": summary_value(line, "scan -> grid"), "path_p50": float(np.median(lat)),
+                "node": summary_value(line, "Path -> /map published").split("/")[0],
                 "path_min": float(min(lat)), "rc": rc}
     finally:
         proc.kill()
@@ -121,7 +125,7 @@ def main() -> int:
         print(f"# map cell {args.resolution:g} m (evidence grid {args.resolution / args.downsample:g} m); {args.live_scans} scans at {args.rate:g} Hz, "
               f"the rest at {args.fast_rate:g} Hz; Path -> /map over {args.paths} Paths")
         print(f"{'log':<24} {'backend':<12} {'scans':>11} {'CPU 40 Hz':>9} {'CPU fast':>8} "
-              f"{'scan p50/p99 ms':>16} {'Path->/map ms':>13} {'best':>7} {'vs cpu_double':>13}")
+              f"{'scan p50/p99 ms':>16} {'Path->/map ms':>13} {'best':>7} {'node':>7} {'vs cpu_double':>13}")
         for path in args.logs:
             log = vg.load_log(ROOT / path)
             stamps = 10**12 + np.arange(len(log), dtype=np.int64) * int(1e9 / args.rate)
@@ -131,7 +135,7 @@ def main() -> int:
             for name, r in rows.items():
                 ratio = f"{ref / r['path_p50']:.1f}x" if ref else "-"
                 print(f"{Path(path).name:<24} {name:<12} {r['scans']:>11} {100 * r['cpu_live']:>8.1f}% "
-                      f"{100 * r['cpu_fast']:>7.1f}% {r['scan']:>16} {r['path_p50']:>13.1f} {r['path_min']:>7.1f} "
+                      f"{100 * r['cpu_fast']:>7.1f}% {r['scan']:>16} {r['path_p50']:>13.1f} {r['path_min']:>7.1f} {r['node']:>7} "
                       f"{ratio:>13}", flush=True)
     finally:
         player.close()
