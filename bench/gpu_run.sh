@@ -28,6 +28,8 @@ for tool in memcheck racecheck; do
   echo "compute-sanitizer $tool golden_cuda_test rc=$? : $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer_golden_$tool.log" | tail -1)" >> "$out/summary.txt"
   timeout 200 compute-sanitizer --tool $tool --error-exitcode 99 build/bin/mapper_cuda_test --gtest_filter='MapperCuda.Finish*' > "$out/sanitizer_mapper_$tool.log" 2>&1
   echo "compute-sanitizer $tool mapper_cuda_test rc=$? : $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer_mapper_$tool.log" | tail -1)" >> "$out/summary.txt"
+  timeout 120 compute-sanitizer --tool $tool --error-exitcode 99 build/bin/exact_placement_cuda_test > "$out/sanitizer_placement_$tool.log" 2>&1
+  echo "compute-sanitizer $tool exact_placement_cuda_test rc=$? : $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer_placement_$tool.log" | tail -1)" >> "$out/summary.txt"
 done
 if [ -n "${SKIP_BENCH:-}" ]; then cat "$out/summary.txt"; exit 0; fi
 for mode in float exact; do

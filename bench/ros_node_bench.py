@@ -12,7 +12,8 @@ for each backend. Printed as a table, ratios in the same run:
               (ms, median and best of --paths), the whole loop a SLAM back end sees
   node        of that, the node's own: its Path callback's entry -> /map published (p50 ms:
               reading the Path, the render, the finish, the OccupancyGrid); the rest is DDS
-              carrying the Path and the map, and the callbacks' wake-ups
+              carrying the Path and the map, and the callbacks' wake-ups; its steps (read the
+              Path, repose: move the scans and render, finish, message, publish) follow the table
   vs cpu_double  cpu_double's Path->/map over this one: against rebuilding the map from
               every scan on the CPU, as a CPU mapper does after a loop closure
 
@@ -101,6 +102,7 @@ def bench_one(player, log, name, args, stamps, raw_path):
         return {"scans": f"{mapped}/{len(log)}", "cpu_live": cpu_live, "cpu_fast": cpu_fast,
                 "scan": summary_value(line, "scan -> grid"), "path_p50": float(np.median(lat)),
                 "node": summary_value(line, "Path -> /map published").split("/")[0],
+                "steps": line.split("Path steps p50 ms: ", 1)[1].split(";")[0] if "Path steps" in line else "-",
                 "path_min": float(min(lat)), "rc": rc}
     finally:
         proc.kill()
@@ -137,6 +139,8 @@ def main() -> int:
                 print(f"{Path(path).name:<24} {name:<12} {r['scans']:>11} {100 * r['cpu_live']:>8.1f}% "
                       f"{100 * r['cpu_fast']:>7.1f}% {r['scan']:>16} {r['path_p50']:>13.1f} {r['path_min']:>7.1f} {r['node']:>7} "
                       f"{ratio:>13}", flush=True)
+            for name, r in rows.items():
+                print(f"#   {Path(path).name} {name}: the node's Path steps, p50 ms: {r['steps']}", flush=True)
     finally:
         player.close()
         rclpy.try_shutdown()

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -272,6 +273,9 @@ def test_the_node_under_test_exits_cleanly_too(node):
     rc, took = node.interrupt()
     assert rc == 0 and took < 1.0, (rc, took, node.output[-2000:])
     assert "vasco_mapper: 60 scans mapped; not mapped:" in node.output
+    # where the rendered Paths' time went (the bench's node column and steps come from this line)
+    assert re.search(r"Path -> /map published: p50 [\d.]+ ms, p99 [\d.]+ ms \(\d+\); Path steps p50 ms: read [\d.]+, "
+                     r"repose [\d.]+, finish [\d.]+, message [\d.]+, publish [\d.]+", node.output), node.output[-2000:]
 
 
 def test_a_bad_parameter_stops_the_node_at_start_up():

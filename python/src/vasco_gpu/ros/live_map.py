@@ -103,8 +103,9 @@ class LiveMap:
         n = len(self)
         if n == 0 or len(stamps_ns) == 0:
             return counts
-        times, vals = sorted_samples(array("q", (int(t) for t in stamps_ns)),
-                                     array("d", np.asarray(base_poses, dtype=np.float64).ravel()), 3)
+        # NumPy arrays, not array.array built element by element (~2 ms a Path of 4,791 poses)
+        times, vals = sorted_samples(np.ascontiguousarray(stamps_ns, dtype=np.int64),
+                                     np.ascontiguousarray(base_poses, dtype=np.float64).ravel(), 3)
         ns = np.frombuffer(self.stamps, dtype=np.int64)
         mounts = np.frombuffer(self.mounts, dtype=np.float64).reshape(-1, 3)
         has_mount = np.isfinite(mounts).all(axis=1)
@@ -129,7 +130,8 @@ class LiveMap:
             self.mapper.render(poses)
         except (RuntimeError, MemoryError) as e:
             raise LiveMapError(str(e)) from None
-        self.poses = array("d", np.asarray(poses, dtype=np.float64).ravel())
+        self.poses = array("d")
+        self.poses.frombytes(np.ascontiguousarray(poses, dtype=np.float64).tobytes())
         self._renders_settled = self.mapper.renders
         self.version += 1
 
