@@ -4,6 +4,8 @@ then faster than real time, then a nav_msgs/Path of every pose published again a
 for each backend. Printed as a table, ratios in the same run:
 
   scans       mapped / sent (a replay over reliable QoS loses none while the node keeps up)
+  CPU idle    the node process's CPU time over wall time for 3 s before the replay (% of
+              one core: timers, DDS threads)
   CPU 40 Hz   the node process's CPU time over wall time while scans arrive at 40 Hz (%
               of one core: callbacks, tf, conversion, DDS threads, the insert)
   CPU fast    the same at --fast-rate
@@ -90,6 +92,10 @@ def bench_one(player, log, name, args, stamps, raw_path):
     proc = NodeProcess(params)
     try:
         proc.wait_for("ready", timeout=120)
+        time.sleep(1.0)  # past start-up and discovery
+        c0, t0 = cpu_seconds(proc.proc.pid), time.monotonic()
+        time.sleep(3.0)
+        cpu_idle = (cpu_seconds(proc.proc.pid) - c0) / (time.monotonic() - t0)
         live = min(args.live_scans, len(log))
         cpu_live = replay_measured(player, proc, log.scans.select(0, live), stamps[:live], args.rate)
         rest = log.scans.select(live, len(log) - live)
@@ -99,7 +105,7 @@ def bench_one(player, log, name, args, stamps, raw_path):
         rc, _ = proc.interrupt(timeout=60)
         line = next((ln for ln in proc.lines if "scans mapped" in ln), "")
         mapped = line.split("vasco_mapper: ", 1)[1].split(" scans mapped")[0] if line else "?"
-        return {"scans": f"{mapped}/{len(log)}", "cpu_live": cpu_live, "cpu_fast": cpu_fast,
+        return {"scans": f"{mapped}/{len(log)}", "cpu_idle": cpu_idle, "cpu_live": cpu_live, "cpu_fast": cpu_fast,
                 "scan": summary_value(line, "scan -> grid"), "path_p50": float(np.median(lat)),
                 "node": summary_value(line, "Path -> /map published").split("/")[0],
                 "steps": line.split("Path steps p50 ms: ", 1)[1].split(";")[0] if "Path steps" in line else "-",
@@ -126,7 +132,7 @@ def main() -> int:
     try:
         print(f"# map cell {args.resolution:g} m (evidence grid {args.resolution / args.downsample:g} m); {args.live_scans} scans at {args.rate:g} Hz, "
               f"the rest at {args.fast_rate:g} Hz; Path -> /map over {args.paths} Paths")
-        print(f"{'log':<24} {'backend':<12} {'scans':>11} {'CPU 40 Hz':>9} {'CPU fast':>8} "
+        print(f"{'log':<24} {'backend':<12} {'scans':>11} {'CPU idle':>8} {'CPU 40 Hz':>9} {'CPU fast':>8} "
               f"{'scan p50/p99 ms':>16} {'Path->/map ms':>13} {'best':>7} {'node':>7} {'vs cpu_double':>13}")
         for path in args.logs:
             log = vg.load_log(ROOT / path)
@@ -136,7 +142,8 @@ def main() -> int:
             ref = rows.get("cpu_double", {}).get("path_p50")
             for name, r in rows.items():
                 ratio = f"{ref / r['path_p50']:.1f}x" if ref else "-"
-                print(f"{Path(path).name:<24} {name:<12} {r['scans']:>11} {100 * r['cpu_live']:>8.1f}% "
+                print(f"{Path(path).name:<24} {name:<12} {r['scans']:>11} {100 * r['cpu_idle']:>7.1f}% "
+                      f"{100 * r['cpu_live']:>8.1f}% "
                       f"{100 * r['cpu_fast']:>7.1f}% {r['scan']:>16} {r['path_p50']:>13.1f} {r['path_min']:>7.1f} {r['node']:>7} "
                       f"{ratio:>13}", flush=True)
             for name, r in rows.items():
