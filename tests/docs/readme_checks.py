@@ -371,8 +371,12 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "sh: ros2 launch examples/ros/vasco_with_slam_toolbox.launch.py b": Check(
             "skip", reason="needs ros2 launch and slam_toolbox (a system ROS 2); python/tests/test_live_map.py "
                            "compiles the launch file and checks the node parameters it sets"),
-        "text: log backend scans CPU 40 Hz CPU fast scan p50/p99 ms Path->/": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-04-2core.txt"),
+        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --paths 3": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h200-b.txt"),
+        "text: ## python3 bench/ros_node_bench.py --fast-rate 800": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h200.txt"),
+        "text: ## python3 bench/ros_node_bench.py --fast-rate 400": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core.txt"),
     },
     "docs/walkthrough-bag.md": {
         # carmen2bag and mapdiff are not among test_readme.py's tools: the test runs the block
