@@ -80,11 +80,11 @@ namespace {
 //   cos(d) = cos(b·step) - sin(b·step)·r,  sin(d) = sin(b·step) + cos(b·step)·r
 //   cos(angle) = cos(a0)cos(d) - sin(a0)sin(d),  sin likewise.
 // Every term is within an ulp or two of the true value and the dropped r²/2
-// is below 1e-18, so the result is within 1e-14 of glibc's (taken as 1e-12
-// below: a 100x margin). A truncation changes only at an integer, so where
-// the approximate coordinate v lies farther than its error bound from every
-// integer, (int)v is the oracle's; elsewhere (a few beams in 10^7), and for
-// non-finite or huge values, the oracle's own beam_end decides.
+// is below 1e-18, so the result is within 1e-14 of glibc's. A truncation
+// changes only at an integer, so where the approximate coordinate v lies
+// farther than egrid::placement_tolerance from every integer, (int)v is the
+// oracle's; elsewhere (a few beams in 10^7), and for non-finite or huge
+// values, the oracle's own beam_end decides.
 class BeamEnds {
  public:
   // Prepares the table for scans of n beams `step` apart.
@@ -109,8 +109,8 @@ class BeamEnds {
       const double k = (static_cast<double>(range) + wall) / resolution;
       const double vx = s.lx + k * (ca0 * cd - sa0 * sd);
       const double vy = s.ly + k * (sa0 * cd + ca0 * sd);
-      const double tol = 1e-11 * (1 + std::fabs(s.lx) + std::fabs(s.ly) + std::fabs(k));
-      if (far_from_integers(vx, tol) && far_from_integers(vy, tol)) {
+      const double tol = egrid::placement_tolerance(s.lx, s.ly, k);
+      if (egrid::far_from_integers(vx, tol) && egrid::far_from_integers(vy, tol)) {
         *x2 = static_cast<int>(vx);
         *y2 = static_cast<int>(vy);
         return;
@@ -120,14 +120,6 @@ class BeamEnds {
   }
 
  private:
-  // Whether v lies farther than tol from every integer; false for NaN and
-  // past +-2^30 (left to the oracle's checks).
-  static bool far_from_integers(double v, double tol) {
-    if (!(std::fabs(v) < 1073741824.0)) return false;
-    const double f = std::fabs(v - static_cast<double>(static_cast<int>(v)));  // in [0, 1)
-    return f > tol && f < 1 - tol;
-  }
-
   double step_ = std::nan("");
   std::vector<double> cos_, sin_;
 };

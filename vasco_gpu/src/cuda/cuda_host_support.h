@@ -55,20 +55,25 @@ inline std::string grid_description(const GridGeometry &geo, double bytes_per_ce
   return s.str();
 }
 
-// VASCO_CUDA_NO_TABLES=1 computes every update in full, as grids too large
-// for the tables are: the tests compare both ways bit for bit.
-inline bool tables_disabled() {
-  const char *v = std::getenv("VASCO_CUDA_NO_TABLES");
+// Whether the switch `name` is set: present, not empty and not "0".
+inline bool env_flag(const char *name) {
+  const char *v = std::getenv(name);
   return v != nullptr && *v != '\0' && std::string(v) != "0";
 }
+
+// VASCO_CUDA_NO_TABLES=1 computes every update in full, as grids too large
+// for the tables are: the tests compare both ways bit for bit.
+inline bool tables_disabled() { return env_flag("VASCO_CUDA_NO_TABLES"); }
 
 // VASCO_CUDA_NO_ACROSS=1 maps float mode without its y-major accumulator
 // (cuda_float_renderer.cc), as a grid too large for it is: for the tests
 // and benchmarks that compare both ways.
-inline bool across_disabled() {
-  const char *v = std::getenv("VASCO_CUDA_NO_ACROSS");
-  return v != nullptr && *v != '\0' && std::string(v) != "0";
-}
+inline bool across_disabled() { return env_flag("VASCO_CUDA_NO_ACROSS"); }
+
+// VASCO_CUDA_HOST_PLACEMENT=1 places exact mode's beams on the host, as
+// before the device placement (device_placement.h): for the benchmarks that
+// compare the two.
+inline bool host_placement_forced() { return env_flag("VASCO_CUDA_HOST_PLACEMENT"); }
 
 // With VASCO_CUDA_PROFILE set, prints the time of each GPU stage to stderr
 // (events between stages; for tuning, not for the benchmark table).

@@ -1,8 +1,6 @@
 #include "device_placement.h"
 
 #include <algorithm>
-#include <cstdlib>
-#include <string>
 
 #include "vasco_gpu/internal/beam_placement.h"
 
@@ -16,11 +14,6 @@ namespace {
 constexpr uint32_t kUnsureCapacity = 1 << 14;
 
 }  // namespace
-
-bool host_placement_forced() {
-  const char *v = std::getenv("VASCO_CUDA_HOST_PLACEMENT");
-  return v != nullptr && *v != '\0' && std::string(v) != "0";
-}
 
 // The scans' records: their starts placed by the oracle's code on the host
 // (sequential: the first scan fixes the frame), beam 0's angle as

@@ -60,10 +60,6 @@ class DevicePlacement {
   cuda::DeviceBuffer<unsigned long long> counters_;
 };
 
-// VASCO_CUDA_HOST_PLACEMENT=1 places exact mode's beams on the host, as
-// before the device placement: for the tests and benchmarks that compare.
-bool host_placement_forced();
-
 }  // namespace cuda_host
 }  // namespace vasco
 

@@ -91,11 +91,10 @@ void launch_exact_tables(const KernelModel<double> &m, double2 *factors, int *re
 // oracle's repeated additions (oracle::SteppedAngles), a thread per scan. A
 // beam's end cell is (int)(l + (range + wall) * cos(angle) / resolution) per
 // axis, computed with CUDA's cos and sin, which are within 2 ulp of the true
-// value as glibc's are within 1: where the value lies farther than
-// kUnsureTolerance (relative) from every integer, its truncation is the
-// oracle's; elsewhere (a few beams in 10^7, and non-finite values or those
-// past 2^30) the beam is listed as unsure and the host places it with the
-// oracle's own code (launch_exact_fix).
+// value as glibc's are within 1: where egrid::far_from_integers says the
+// truncation is the oracle's, it is kept; elsewhere (a few beams in 10^7,
+// and non-finite values or those past 2^30) the beam is listed as unsure and
+// the host places it with the oracle's own code (launch_exact_fix).
 struct ExactScan {
   double lx, ly;        // laser position in cells (oracle::scan_start)
   double angle0, step;  // beam 0's angle (theta + first) and the step added after each beam
@@ -113,9 +112,6 @@ struct BeamFix {
   uint32_t slot;
   int x2, y2;
 };
-// The error of both sides is below 1e-14 relative (a few ulp of the
-// coordinate and of (range + wall) / resolution); 1e-11 is a 1000x margin.
-constexpr double kUnsureTolerance = 1e-11;
 struct PlacementModel {
   double resolution, wall;  // the frame's cell and the parameters' wall_size
   int table_size;

@@ -17,6 +17,7 @@
 
 #include "cuda_check.h"
 #include "egrid_kernels.h"
+#include "launch_shape.cuh"
 #include "line_rec.cuh"
 #include "warp_sum.cuh"
 #include "vasco_gpu/internal/egrid_math.h"
@@ -636,10 +637,6 @@ __global__ void tile_keys_kernel(const uint32_t *begin, const uint32_t *end, siz
   if (t >= n) return;
   keys[t] = end[t] - begin[t];
   ids[t] = static_cast<uint32_t>(t);
-}
-
-unsigned blocks_for(size_t n, unsigned threads) {
-  return static_cast<unsigned>((n + threads - 1) / threads);
 }
 
 }  // namespace

@@ -9,13 +9,12 @@
 #include "cuda_check.h"
 #include "egrid_kernels.h"
 #include "exact_tile_bound.h"
+#include "launch_shape.cuh"
 #include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
 namespace cuda {
 namespace {
-
-unsigned blocks_for(size_t n, unsigned threads) { return static_cast<unsigned>((n + threads - 1) / threads); }
 
 // One thread per scan: the oracle's angles are a running sum (beam 0's, then
 // `step` added after every beam, skipped beams too), so each depends on the
@@ -38,14 +37,6 @@ __global__ void used_kernel(const float *ranges, size_t n, uint32_t *used) {
   if (i == n) used[n] = 0;
 }
 
-// Whether v lies farther than tol from every integer; false for NaN and past
-// +-2^30 (left to the host's oracle, as beam_placement.cc does).
-__device__ __forceinline__ bool far_from_integers(double v, double tol) {
-  if (!(fabs(v) < 1073741824.0)) return false;
-  const double f = fabs(v - static_cast<double>(static_cast<int>(v)));
-  return f > tol && f < 1 - tol;
-}
-
 // The oracle's beam_end (oracle.h) with the device's cos and sin: true with
 // the end cell where the truncation is sure to be the oracle's.
 __device__ __forceinline__ bool sure_end_cell(const PlacementModel &m, const ExactScan &sc, double angle, float range,
@@ -55,8 +46,8 @@ __device__ __forceinline__ bool sure_end_cell(const PlacementModel &m, const Exa
   const double r = range;
   const double vx = sc.lx + (r + m.wall) * cs / m.resolution;
   const double vy = sc.ly + (r + m.wall) * sn / m.resolution;
-  const double tol = kUnsureTolerance * (1 + fabs(sc.lx) + fabs(sc.ly) + fabs((r + m.wall) / m.resolution));
-  if (!far_from_integers(vx, tol) || !far_from_integers(vy, tol)) return false;
+  const double tol = egrid::placement_tolerance(sc.lx, sc.ly, (r + m.wall) / m.resolution);
+  if (!egrid::far_from_integers(vx, tol) || !egrid::far_from_integers(vy, tol)) return false;
   *x2 = static_cast<int>(vx);
   *y2 = static_cast<int>(vy);
   return true;

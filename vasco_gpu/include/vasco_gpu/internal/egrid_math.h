@@ -56,6 +56,25 @@ VG_HD int trunc_to_int(double v) {
   return static_cast<int>(v);
 }
 
+// A beam's end cell, (int)(l + k·cos(angle)) per axis with k = (range + wall)
+// / resolution, computed with a cosine other than the host libm's (the host
+// placement's per-step table, beam_placement.cc; the device's sincos,
+// exact_placement.cu) is the oracle's where the coordinate v lies farther
+// than placement_tolerance from every integer: both sides' errors are below
+// 1e-14 relative, 1e-11 is a 1000x margin. Elsewhere the oracle's own
+// beam_end decides.
+constexpr double kPlacementTolerance = 1e-11;
+VG_HD double placement_tolerance(double lx, double ly, double k) {
+  return kPlacementTolerance * (1 + fabs(lx) + fabs(ly) + fabs(k));
+}
+// Whether v lies farther than tol from every integer; false for NaN and past
+// +-2^30 (left to the oracle's checks).
+VG_HD bool far_from_integers(double v, double tol) {
+  if (!(fabs(v) < 1073741824.0)) return false;
+  const double f = fabs(v - static_cast<double>(static_cast<int>(v)));  // in [0, 1)
+  return f > tol && f < 1 - tol;
+}
+
 VG_HD int wrap_add(int a, int b) {
   return static_cast<int>(static_cast<uint32_t>(a) + static_cast<uint32_t>(b));
 }
