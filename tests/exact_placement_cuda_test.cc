@@ -26,12 +26,6 @@
 namespace vasco {
 namespace {
 
-#define REQUIRE_GPU()                                                              \
-  do {                                                                             \
-    std::string why_;                                                              \
-    if (!golden::cuda_available(&why_)) GTEST_SKIP() << "no usable GPU: " << why_; \
-  } while (0)
-
 #if defined(VASCO_HAVE_CUDA)
 struct DevicePlaced {
   cuda_host::DevicePlacement::Placed result;

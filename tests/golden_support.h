@@ -183,6 +183,13 @@ inline bool cuda_available(std::string *why) {
 #endif
 }
 
+// In a GoogleTest test: skips it, saying why, where the CUDA backend cannot run.
+#define REQUIRE_GPU()                                                                        \
+  do {                                                                                       \
+    std::string why_;                                                                        \
+    if (!::vasco::golden::cuda_available(&why_)) GTEST_SKIP() << "no usable GPU: " << why_;  \
+  } while (0)
+
 // A mapping session fed the case's scans in pieces of 97 (vasco::Mapper):
 // incremental inserts, frame growth and the renderer's finish.
 // A session fed the scans in pieces of 97: its grid grows with a margin, so

@@ -24,12 +24,6 @@ namespace {
 
 using testing_support::bundled_log;
 
-#define REQUIRE_GPU()                                                                \
-  do {                                                                               \
-    std::string why_;                                                                \
-    if (!golden::cuda_available(&why_)) GTEST_SKIP() << "no usable GPU: " << why_;   \
-  } while (0)
-
 // `parts` bands over the GPUs there are: device i % count, so one GPU holds
 // them all.
 std::vector<int> split_over_gpus(int parts) {
