@@ -55,11 +55,16 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def cpu_share(proc, action) -> float:
+    """The node's CPU time over wall time while action() runs."""
+    c0, t0 = cpu_seconds(proc.proc.pid), time.monotonic()
+    action()
+    return (cpu_seconds(proc.proc.pid) - c0) / (time.monotonic() - t0)
+
+
 def replay_measured(player, proc, scans, stamps, rate):
     """Replays at rate; the node's CPU share over the replay."""
-    c0, t0 = cpu_seconds(proc.proc.pid), time.monotonic()
-    player.replay(scans, stamps, rate_hz=rate)
-    return (cpu_seconds(proc.proc.pid) - c0) / (time.monotonic() - t0)
+    return cpu_share(proc, lambda: player.replay(scans, stamps, rate_hz=rate))
 
 
 def path_latencies(player, raw: bytes, repeats: int) -> list[float]:
@@ -93,9 +98,7 @@ def bench_one(player, log, name, args, stamps, raw_path):
     try:
         proc.wait_for("ready", timeout=120)
         time.sleep(1.0)  # past start-up and discovery
-        c0, t0 = cpu_seconds(proc.proc.pid), time.monotonic()
-        time.sleep(3.0)
-        cpu_idle = (cpu_seconds(proc.proc.pid) - c0) / (time.monotonic() - t0)
+        cpu_idle = cpu_share(proc, lambda: time.sleep(3.0))
         live = min(args.live_scans, len(log))
         cpu_live = replay_measured(player, proc, log.scans.select(0, live), stamps[:live], args.rate)
         rest = log.scans.select(live, len(log) - live)

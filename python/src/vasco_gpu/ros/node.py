@@ -91,7 +91,6 @@ class MappingNode(Node):
         self.path_ms: list[float] = []  # callback -> /map published, per Path
         # ... and its steps, per Path (ms): where a Path's time goes, in the summary
         self.path_steps: dict[str, list[float]] = {k: [] for k in ("read", "repose", "finish", "message", "publish")}
-        self._publish_steps: dict[str, float] = {}
         self._subscribe()
         self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
         self.meta_pub = self.create_publisher(MapMetaData, "map_metadata", LATCHED)
@@ -311,11 +310,9 @@ class MappingNode(Node):
             self._refuse(self.settings.path_topic, "paths not rendered", f"Path not rendered: {e}")
             return
         rendered = time.perf_counter()
-        self._publish_steps = {}
-        self._publish_if_changed(settle=False)
-        end = time.perf_counter()
-        self.path_ms.append((end - start) * 1e3)
-        steps = {"read": read - start, "repose": rendered - read, **self._publish_steps}
+        published = self._publish_if_changed(settle=False)
+        self.path_ms.append((time.perf_counter() - start) * 1e3)
+        steps = {"read": read - start, "repose": rendered - read, **published}
         for k, v in steps.items():
             self.path_steps[k].append(v * 1e3)
         self.get_logger().debug(f"Path of {len(stamps)} poses: {counts}, published in {self.path_ms[-1]:.1f} ms")
@@ -351,9 +348,11 @@ class MappingNode(Node):
         return path.stamps, np.column_stack([path.positions[:, :2], yaw(q)])
 
     # -- outputs ----------------------------------------------------------------------------
-    def _publish_if_changed(self, settle: bool = True) -> None:
+    def _publish_if_changed(self, settle: bool = True) -> dict:
         """Publishes /map and /map_metadata when the grid changed since the last publication. A
-        grown grid is rendered once more when the stream has paused for an interval (LiveMap)."""
+        grown grid is rendered once more when the stream has paused for an interval (LiveMap).
+        Returns the seconds of its steps (finish, message, publish); empty when nothing was
+        published."""
         quiet = time.monotonic() - self._last_scan > self.settings.map_update_interval
         if settle and quiet:
             try:
@@ -361,12 +360,12 @@ class MappingNode(Node):
             except LiveMapError as e:
                 self.get_logger().warning(f"grid not rendered again after growing: {e}")
         if self.live.version == self._published:
-            return
+            return {}
         t0 = time.perf_counter()
         m = self.live.finish()
         self._published = self.live.version
         if m is None:
-            return
+            return {}
         s = self.settings
         t1 = time.perf_counter()
         msg = OccupancyGrid()
@@ -375,7 +374,7 @@ class MappingNode(Node):
         t2 = time.perf_counter()
         self.map_pub.publish(msg)
         self.meta_pub.publish(msg.info)
-        self._publish_steps = {"finish": t1 - t0, "message": t2 - t1, "publish": time.perf_counter() - t2}
+        return {"finish": t1 - t0, "message": t2 - t1, "publish": time.perf_counter() - t2}
 
     def _save_map(self, request, response):
         paths = self.settings.save_map_path
