@@ -16,6 +16,7 @@
 #include "carmen_compat/error.h"
 
 namespace carmen {
+
 namespace {
 
 void check_map(const GridMap &map) {
@@ -41,10 +42,6 @@ std::vector<uint8_t> render(const GridMap &map, PixelFn pixel) {
   }
   return img;
 }
-
-bool is_unknown(float v) { return std::isnan(v) || v < 0.0f; }
-bool is_offlimits(float v) { return v >= 2.0f; }
-double clamp01(double p) { return p < 0.0 ? 0.0 : (p > 1.0 ? 1.0 : p); }
 
 // How map_server reads a grey level (negate 0): occupancy (255 - v) / 255.
 double level_occupancy(int v) { return (255 - v) / 255.0; }

@@ -18,6 +18,7 @@
 #include "carmen_compat/atomic_file.h"
 #include "map_files.h"
 #include "carmen_compat/map_digest.h"
+#include "carmen_compat/occupancy_grid.h"
 
 namespace vasco_py {
 
@@ -168,6 +169,28 @@ void bind_map_files(nb::module_ &m) {
       "paths"_a, "map"_a, "mode"_a = "trinary", "description"_a = "",
       "write_map to every one of ``paths`` as one transaction: all are written to temporaries, then\n"
       "renamed; a failure touches no output and leaves no temporary.");
+  m.def(
+      "_occupancy_grid_data",
+      [](const Map &mp, const std::string &mode, double free_thresh, double occupied_thresh) {
+        carmen::MapServerOptions o;
+        if (!carmen::parse_pgm_mode(mode, &o.mode))
+          throw carmen::Error(carmen::ErrorCode::Usage, "occupancy grid data: mode '" + mode + "': expected trinary or raw");
+        o.free_thresh = free_thresh;
+        o.occupied_thresh = occupied_thresh;
+        // filled in place: a bytes object nobody else holds yet, written without the GIL
+        nb::bytes out = nb::steal<nb::bytes>(PyBytes_FromStringAndSize(nullptr, Py_ssize_t(mp.grid.cells.size())));
+        if (!out.is_valid()) throw nb::python_error();
+        int8_t *data = reinterpret_cast<int8_t *>(PyBytes_AS_STRING(out.ptr()));
+        {
+          nb::gil_scoped_release release;
+          carmen::occupancy_grid_data(mp.grid, o, data);
+        }
+        return out;
+      },
+      "map"_a, "mode"_a, "free_thresh"_a, "occupied_thresh"_a,
+      "The map as nav_msgs/OccupancyGrid data (bytes, int8): rows from the lower-left cell; mode\n"
+      "trinary (100 / 0 / -1 by the thresholds, as map_server reads a trinary picture) or raw\n"
+      "(round(100 p), -1 unknown). carmen_compat/occupancy_grid.h.");
   m.def("_fail_rename_for_testing", &carmen::OutputTransaction::fail_rename_for_testing, "n"_a, "err"_a,
         "Tests only: the n-th rename (1-based) of the next transaction's commit in this process fails\n"
         "with errno ``err``; 0 disarms.");

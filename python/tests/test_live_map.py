@@ -8,6 +8,7 @@ import math
 import re
 import subprocess
 import sys
+from array import array
 from pathlib import Path
 
 import numpy as np
@@ -121,10 +122,14 @@ def test_new_parameters_map_every_stored_scan_again():
 def test_grid_values_by_hand():
     # cells[x, y], x-major: 3 wide, 2 high; values exact in float32
     cells = np.array([[-1.0, 0.125], [0.5, 0.6875], [0.1875, 0.0625]], dtype=np.float32)
+    m = vg.Map(cells, 0.05)
+    values = lambda *a: list(array("b", grid_values(m, *a)))  # noqa: E731
     # rows from y = 0: (x0, x1, x2) = (-1, 0.5, 0.1875), then (0.125, 0.6875, 0.0625)
-    assert grid_values(cells, "scale").tolist() == [-1, 50, 19, 13, 69, 6]  # 12.5 rounds up
-    assert grid_values(cells, "trinary").tolist() == [-1, -1, 0, 0, 100, 0]
-    assert grid_values(cells, "trinary", 0.1, 0.7).tolist() == [-1, -1, -1, -1, -1, 0]
+    assert values("scale") == [-1, 50, 19, 13, 69, 6]  # 12.5 rounds up
+    assert values("trinary") == [-1, -1, 0, 0, 100, 0]
+    assert values("trinary", 0.1, 0.7) == [-1, -1, -1, -1, -1, 0]
+    with pytest.raises(ValueError, match="map_mode 'raw'"):
+        grid_values(m, "raw")
 
 
 def test_settings_refuse_naming_the_parameter(tmp_path):

@@ -118,6 +118,31 @@ def test_incremental_samples_extend_the_span():
     assert_transform(tf.lookup("map", "laser", ns(4)), (4.0, 2.5, 0.2), (0.0, 0.0, 1.0, 0.0))
 
 
+def test_samples_given_in_order_look_up_as_those_given_out_of_order():
+    # make_buffer gives base_link's samples 3 s, then 1 s (sorted on lookup); in order, the
+    # buffer keeps them as they came: the same transforms at a sample and between two.
+    tf = bags.TfBuffer()
+    tf.add_message(tf_message(("/base_link", "/laser", 0, (0.5, 0.0, 0.2), YAW_90)), static=True)
+    tf.add_message(tf_message(("map", "base_link", 1, (1.0, 2.0, 0.0), IDENTITY)))
+    tf.add_message(tf_message(("map", "base_link", 3, (3.0, 2.0, 0.0), YAW_90)))
+    stamps = np.array([ns(1), ns(2), ns(3)])
+    for got, want in zip(tf.lookup("map", "laser", stamps), make_buffer().lookup("map", "laser", stamps)):
+        np.testing.assert_array_equal(got, want)
+    # a sample older than the newest afterwards: sorted again, the 2 s lookup now between 2 s and 3 s
+    tf.add_message(tf_message(("map", "base_link", 2, (2.0, 3.0, 0.0), YAW_90)))
+    assert_transform(tf.lookup("map", "laser", ns(2)), (2.0, 3.5, 0.2), (0.0, 0.0, 1.0, 0.0))
+
+
+def test_waiting_for_a_link_without_a_sample_yet():
+    tf = make_buffer()  # base_link's newest sample at 3 s
+    assert not tf.waiting_for("map", "laser", ns(3))
+    assert tf.waiting_for("map", "laser", ns(4))  # lookup would say: outside the time span
+    assert not tf.waiting_for("base_link", "laser", ns(9))  # a static chain waits for nothing
+    assert not tf.waiting_for("map", "nowhere", ns(1))  # no chain: lookup says why
+    tf.add_message(tf_message(("map", "base_link", 5, (5.0, 2.0, 0.0), YAW_90)))
+    assert not tf.waiting_for("map", "laser", ns(4))
+
+
 def test_missing_chain():
     tf = make_buffer()
     with pytest.raises(bags.TfError) as e:

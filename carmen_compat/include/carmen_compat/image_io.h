@@ -61,6 +61,13 @@ constexpr PictureRgb kPictureUnknown{0x70, 0x89, 0x86};
 // of p = 0.5 too): read_png still reads such a grey PNG that way.
 constexpr uint8_t kPngUnknown = 128;
 
+// How the images read a cell: unknown (NaN or negative: CARMEN's -1),
+// off-limits (2 and above), else an occupancy, clamped to [0, 1].
+// Inline: the per-cell loops (occupancy_grid.cc) vectorise them.
+inline bool is_unknown(float v) { return !(v >= 0.0f); }
+inline bool is_offlimits(float v) { return v >= 2.0f; }
+inline double clamp01(double p) { return p < 0.0 ? 0.0 : (p > 1.0 ? 1.0 : p); }
+
 // "trinary", "scale", "raw" (as in the YAML's mode key).
 const char *pgm_mode_name(PgmMode mode);
 // Parses a mode name; false if it is none of the three.

@@ -110,11 +110,12 @@ class PoseSeries:
         return planar_at(times, vals, ns)
 
 
-def planar_at(times: np.ndarray, vals: np.ndarray, ns: np.ndarray) -> np.ndarray:
+def planar_at(times: np.ndarray, vals: np.ndarray, ns: np.ndarray, located=None) -> np.ndarray:
     """(n, 3) planar poses at stamps ns (within the span of the sorted samples times, vals):
     the sample on an exact hit, else linear x, y and shortest-arc yaw between the bracketing
-    samples (the --poses rule; a pose topic's and the live node's Path)."""
-    hit, i, lo, hi, f = bracket(times, ns)
+    samples (the --poses rule; a pose topic's and the live node's Path). located: what
+    bracket(times, ns) gave, when the caller has it."""
+    hit, i, lo, hi, f = bracket(times, ns) if located is None else located
     a, b = vals[lo], vals[hi]
     out = np.empty((len(ns), 3))
     out[:, :2] = a[:, :2] + (b[:, :2] - a[:, :2]) * f[:, None]

@@ -46,10 +46,17 @@ class _Edge:
         self.ns = array("q")
         self.values = array("d")  # tx ty tz qx qy qz qw per sample
         self._arrays = None
+        # the samples' stamps strictly increase (a live /tf's usual order): arrays() then needs
+        # no sort, and the newest stamp is the last
+        self._in_order = True
+        self.newest = None  # the newest stamp (ns), None before the first sample
 
     def add(self, ns: int, t, q) -> None:
         if self.static:  # the latest static transform wins, as in tf2
             del self.ns[:], self.values[:]
+            self._in_order, self.newest = True, None
+        self._in_order = self._in_order and (self.newest is None or ns > self.newest)
+        self.newest = ns if self.newest is None else max(self.newest, ns)
         self.ns.append(ns)
         self.values.extend((*t, *q))
         self._arrays = None
@@ -63,15 +70,20 @@ class _Edge:
         keep = times >= times[-1] - self.keep_ns
         keep[-2:] = True
         self.ns, self.values = array("q", times[keep].tobytes()), array("d", vals[keep].tobytes())
+        self._in_order = True  # sorted, one sample a stamp
 
     def arrays(self):
         """(stamps (k,), translations (k, 3), quaternions (k, 4)) sorted by stamp; two samples
         at one stamp that differ are a TfError when the buffer refuses repeats (a bag's: two
         publishers of one link), else the later one is taken (a live buffer, as tf2 goes on)."""
         if self._arrays is None:
-            if self.refuse_repeats:
-                self._check_repeats()
-            times, vals = sorted_samples(self.ns, self.values, 7)
+            if self._in_order:  # copies (a view would keep the arrays from growing), no sort
+                times = np.array(self.ns, dtype=np.int64)
+                vals = np.array(self.values, dtype=np.float64).reshape(-1, 7)
+            else:
+                if self.refuse_repeats:
+                    self._check_repeats()
+                times, vals = sorted_samples(self.ns, self.values, 7)
             self._arrays = (times, vals[:, :3].copy(), vals[:, 3:].copy())
         return self._arrays
 
@@ -303,6 +315,16 @@ class TfBuffer:
                 within[within] = ~self._in_gap(times, ns[within], hit, lo, hi)
             inside &= within
         return inside
+
+    def waiting_for(self, target: str, source: str, ns: int) -> bool:
+        """True while a /tf link between the two frames has no sample at or after stamp ns yet:
+        a live lookup then waits for it (tf is not extrapolated), as tf2's message filter does,
+        without building lookup's error. False otherwise (lookup answers, or says why not)."""
+        try:
+            moving = self._moving(target, source)
+        except TfError:
+            return False
+        return any(e.newest is not None and e.newest < ns for e in moving)
 
     def lookup(self, target: str, source: str, stamps, static_only: bool = False):
         """T_target_source at stamps (whole nanoseconds, a number or an array of n): translations

@@ -10,26 +10,21 @@ from __future__ import annotations
 import math
 from array import array
 
-import numpy as np
+from .. import _core
 
 __all__ = ["grid_values", "fill_grid"]
 
+# The node's map_mode -> the picture mode whose levels, read as int8, are the values
+# (carmen_compat/occupancy_grid.h: "scale" is the raw picture's round(100 p)).
+_DATA_MODES = {"trinary": "trinary", "scale": "raw"}
 
-def grid_values(cells: np.ndarray, mode: str, free_thresh: float = 0.196,
-                occupied_thresh: float = 0.65) -> np.ndarray:
-    """(size_y * size_x,) int8 OccupancyGrid data of x-major cells (-1: unknown, else p)."""
-    # (size_y, size_x), row y; float64, so that the thresholds compare as map_server's doubles do
-    p = np.ascontiguousarray(np.asarray(cells, dtype=np.float32).T).astype(np.float64)
-    known = (p >= 0) & (p <= 1)
-    out = np.full(p.shape, -1, dtype=np.int8)
-    if mode == "scale":
-        out[known] = np.floor(p[known] * 100.0 + 0.5).astype(np.int8)
-    elif mode == "trinary":
-        out[known & (p > occupied_thresh)] = 100
-        out[known & (p < free_thresh)] = 0
-    else:
+
+def grid_values(m, mode: str, free_thresh: float = 0.196, occupied_thresh: float = 0.65) -> bytes:
+    """(size_y * size_x) int8 OccupancyGrid data of map m, as bytes (-1: unknown). In C++: the
+    transpose and the thresholds cost ~1 ms a million cells there, ~7 ms in NumPy."""
+    if mode not in _DATA_MODES:
         raise ValueError(f"map_mode {mode!r} is not trinary or scale")
-    return out.ravel()
+    return _core._occupancy_grid_data(m, _DATA_MODES[mode], free_thresh, occupied_thresh)
 
 
 def fill_grid(msg, m, *, mode: str, frame: str, stamp, free_thresh: float, occupied_thresh: float) -> None:
@@ -44,9 +39,8 @@ def fill_grid(msg, m, *, mode: str, frame: str, stamp, free_thresh: float, occup
     info.origin.position.x, info.origin.position.y, info.origin.position.z = float(x), float(y), 0.0
     info.origin.orientation.z = math.sin(theta / 2.0)
     info.origin.orientation.w = math.cos(theta / 2.0)
-    values = grid_values(m.cells, mode, free_thresh, occupied_thresh)
     # array('b') filled from bytes: assigning a NumPy array to an rclpy message's data field
     # converts element by element (~60x slower for a 2000 x 2000 map).
     data = array("b")
-    data.frombytes(values.tobytes())
+    data.frombytes(grid_values(m, mode, free_thresh, occupied_thresh))
     msg.data = data

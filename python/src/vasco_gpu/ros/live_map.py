@@ -114,12 +114,14 @@ class LiveMap:
         counts["no_mount"] = int((inside & ~has_mount).sum())
         take = np.flatnonzero(inside & has_mount)
         if len(take):
-            hit, _, lo, hi, _ = bracket(times, ns[take])
+            located = bracket(times, ns[take])
+            hit, _, lo, hi, _ = located
             near = hit | (times[hi] - times[lo] <= max_gap_ns)
             counts["in_gap"] = int((~near).sum())
             take = take[near]
             poses = self._pose_array().copy()
-            poses[take] = planar_compose(planar_at(times, vals, ns[take]), mounts[take])
+            at = planar_at(times, vals, ns[take], tuple(a[near] for a in located))
+            poses[take] = planar_compose(at, mounts[take])
             counts["moved"] = len(take)
             self.render(poses)
         return counts

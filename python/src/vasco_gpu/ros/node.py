@@ -193,11 +193,12 @@ class MappingNode(Node):
         if self._paused_on(topic):
             return
         ns = stamp_ns(msg.header.stamp)
-        where = f"{self.resolve_topic_name(topic)}: scan at stamp {stamp_text(ns)}"
         try:
+            # the scan's name made only for a refusal: per scan it cost more than the reading
             reading = read_laser(msg, no_return=self.settings.no_return, counts=self.range_counts,
                                  multi_echo=multi_echo, echo=self.settings.echo,
-                                 fail=lambda what: Refused(f"{where} {what}"))
+                                 fail=lambda what: Refused(f"{self.resolve_topic_name(topic)}: scan at stamp "
+                                                           f"{stamp_text(ns)} {what}"))
         except Refused as e:
             self._refuse(topic, "bad scans", f"{e}; not mapped")  # the first of each topic
             return
@@ -266,6 +267,9 @@ class MappingNode(Node):
                 except Refused as e:
                     self._refuse(p.topic, e.cause, str(e))
                     continue
+            if now < p.deadline and self.tf.waiting_for(self.settings.map_frame, p.reading.frame, p.ns):
+                keep.append(p)  # its /tf is not there yet: no lookup (and no error text) until it is
+                continue
             try:
                 t, q = self.tf.lookup(self.settings.map_frame, p.reading.frame, [p.ns])
                 pose = planar(None, t, q, f"the laser frame {p.reading.frame!r} in {self.settings.map_frame!r}")[0]
