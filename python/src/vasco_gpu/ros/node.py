@@ -153,15 +153,18 @@ class MappingNode(Node):
     def _subscribe(self) -> None:
         s = self.settings
         qos = qos_profile_sensor_data if s.scan_qos == "sensor_data" else REPLAY
+        # /tf first: rclpy's executor runs the ready callbacks of one wake-up in the order the
+        # subscriptions were made, so a scan and the /tf of its stamp that came together are
+        # taken tf first and the scan is mapped at once, without waiting (and a retry timer)
+        tf_type = tf_message_type()
+        self.create_subscription(tf_type, "/tf", lambda m: self._on_tf(m, False), TF)
+        self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
         for topic in s.scan_topics:
             self.create_subscription(LaserScan, topic, lambda m, t=topic: self._on_scan(m, t, False), qos)
         for topic in s.multi_echo_topics:
             self.create_subscription(MultiEchoLaserScan, topic, lambda m, t=topic: self._on_scan(m, t, True), qos)
         for topic in s.cloud_topics:
             self.create_subscription(PointCloud2, topic, lambda m, t=topic: self._on_cloud(m, t), qos)
-        tf_type = tf_message_type()
-        self.create_subscription(tf_type, "/tf", lambda m: self._on_tf(m, False), TF)
-        self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
         if s.path_topic:  # as bytes: path_cdr.py reads them far faster than rclpy's objects
             self.create_subscription(Path, s.path_topic, self._on_path, PATH, raw=True)
 
