@@ -116,11 +116,14 @@ def planar_at(times: np.ndarray, vals: np.ndarray, ns: np.ndarray, located=None)
     samples (the --poses rule; a pose topic's and the live node's Path). located: what
     bracket(times, ns) gave, when the caller has it."""
     hit, i, lo, hi, f = bracket(times, ns) if located is None else located
-    a, b = vals[lo], vals[hi]
-    out = np.empty((len(ns), 3))
-    out[:, :2] = a[:, :2] + (b[:, :2] - a[:, :2]) * f[:, None]
-    out[:, 2] = a[:, 2] + wrap_angle(b[:, 2] - a[:, 2]) * f
-    out[hit] = vals[i[hit]]  # exact hits: the sample unchanged
+    out = vals[i]  # exact hits: the sample unchanged (a SLAM Path's poses are often at the scans' stamps)
+    miss = ~hit
+    if miss.any():
+        a, b, f = vals[lo[miss]], vals[hi[miss]], f[miss]
+        between = np.empty((len(f), 3))
+        between[:, :2] = a[:, :2] + (b[:, :2] - a[:, :2]) * f[:, None]
+        between[:, 2] = a[:, 2] + wrap_angle(b[:, 2] - a[:, 2]) * f
+        out[miss] = between
     return out
 
 
