@@ -43,11 +43,8 @@ from rclpy.serialization import serialize_message  # noqa: E402
 
 import vasco_gpu as vg  # noqa: E402
 from ros_player import Player  # noqa: E402
+from live_map_steps import BACKENDS, LOGS, backend_name  # noqa: E402  (beside this script)
 
-BACKENDS = {"cuda float": {"backend": "cuda", "cuda_mode": "float"},
-            "cuda exact": {"backend": "cuda", "cuda_mode": "exact"},
-            "cpu_threads": {"backend": "cpu_threads"}, "cpu_double": {"backend": "cpu_double"}}
-LOGS = ["logs/fr079-complete.gfs.log.gz", "logs/fr101.carmen.log.gz"]
 
 
 def cpu_seconds(pid: int) -> float:
@@ -129,7 +126,8 @@ def main() -> int:
     ap.add_argument("--downsample", type=int, default=1,
                     help="vasco_downsample (1: the evidence grid at --resolution too)")
     args = ap.parse_args()
-    names = args.backends or [b for b in BACKENDS if vg.cuda_available() or not b.startswith("cuda")]
+    names = [backend_name(b) for b in args.backends] if args.backends else \
+        [b for b in BACKENDS if vg.cuda_available() or not b.startswith("cuda")]
     rclpy.init()
     player = Player()
     try:

@@ -7,13 +7,15 @@
 #   bench/run_all.sh BUILD_DIR [STEP...]   (BUILD_DIR absolute or from the repository root;
 #                                          steps: parse oracle mapping large scaling session batch;
 #                                          ros, the ROS 2 node, only when named: it needs the [ros] extra;
+#                                          livemap, the node's Path steps without ROS (PYTHON's vasco_gpu),
+#                                          only when named;
 #                                          peers, MRPT's and OctoMap's grids beside ours (peer_bench, built by
 #                                          make bench-peers), only when named)
 # COST_MODEL_OUT=FILE: batch_bench also writes auto's measured constants there
 # (vasco_gpu/app/backend_cost_model.txt is such a file); BATCH_ARGS: more of
 # batch_bench's options; BENCH_COMMIT: the commit to name where the tree is
 # a copy without its git history; PYTHON: the interpreter of the ros step (one with vasco_gpu,
-# rclpy and tf2_msgs), ROS_BENCH_ARGS: more of ros_node_bench.py's options; PEER_ARGS: peer_bench's.
+# rclpy and tf2_msgs), ROS_BENCH_ARGS: more of ros_node_bench.py's options; LIVEMAP_ARGS: live_map_steps.py's; PEER_ARGS: peer_bench's.
 set -euo pipefail
 build=${1:?usage: bench/run_all.sh BUILD_DIR [STEP...]}
 shift
@@ -53,6 +55,8 @@ for step in $steps; do
              ${COST_MODEL_OUT:+--cost-model-out "$COST_MODEL_OUT"} ;;
     ros) run_as "python3 bench/ros_node_bench.py ${ROS_BENCH_ARGS:-}" \
            "${PYTHON:-python3}" bench/ros_node_bench.py ${ROS_BENCH_ARGS:-} ;;
+    livemap) run_as "python3 bench/live_map_steps.py ${LIVEMAP_ARGS:-}" \
+               "${PYTHON:-python3}" bench/live_map_steps.py ${LIVEMAP_ARGS:-} ;;
     peers) run "$build/bin/peer_bench" ${PEER_ARGS:-} ;;
     *) echo "bench/run_all.sh: unknown step '$step'" >&2; exit 2 ;;
   esac
