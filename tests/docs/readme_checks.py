@@ -376,7 +376,11 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "text: ## python3 bench/ros_node_bench.py --fast-rate 800": Check(
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-h200.txt"),
         "text: ## python3 bench/ros_node_bench.py --fast-rate 400": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core.txt"),
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-b.txt"),
+        "text: ## python3 bench/live_map_steps.py": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-b.txt"),
+        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --paths 5": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100.txt"),
     },
     "docs/walkthrough-bag.md": {
         # carmen2bag and mapdiff are not among test_readme.py's tools: the test runs the block

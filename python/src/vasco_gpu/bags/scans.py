@@ -87,20 +87,21 @@ class BagScans:
 def apply_rep117(v: np.ndarray, rmin: float, rmax: float, no_return: str, counts: dict) -> np.ndarray:
     """A float32 copy of one scan's ranges after the policy in the module docstring; counts updated."""
     out = np.asarray(v).astype(np.float32, copy=True)
-    finite = np.isfinite(out)
-    if finite.all() and (out >= rmin).all() and (out <= rmax).all():
+    # the beams outside [range_min, range_max] (NaN and the infinities among them) first, then
+    # what each of those few is: a live node reads 40 scans a second
+    bad = np.flatnonzero(~((out >= rmin) & (out <= rmax)))
+    if len(bad) == 0:
         return out
-    nan = np.isnan(out)
-    pos = out == np.inf
-    neg = out == -np.inf
-    below = finite & (out < rmin)
-    above = finite & (out > rmax)
+    b = out[bad]
+    finite = np.isfinite(b)
+    nan, pos, neg = np.isnan(b), b == np.inf, b == -np.inf
+    below, above = finite & (b < rmin), finite & (b > rmax)
     masks = {"nan": nan, "pos_inf": pos, "neg_inf": neg, "below_min": below, "above_max": above}
     for key, mask in masks.items():
         counts[key] += int(mask.sum())
-    out[nan | neg | below | above] = np.nan
+    out[bad[~pos]] = np.nan  # +inf (no return) stays, or becomes a free beam's range
     if no_return == "free":
-        out[pos] = NO_RETURN_FREE
+        out[bad[pos]] = NO_RETURN_FREE
     return out
 
 
