@@ -968,3 +968,21 @@ def test_a_header_type_without_a_stamp_names_the_inner_type(tmp_path):
     with pytest.raises(vb.BagError, match="has no field 'stamp' in its std_msgs/Header: the bag defines "
                                           "sensor_msgs/LaserScan otherwise"):
         vb.read_bag(p, static_pose=(0.0, 0.0, 0.0))
+
+
+def test_rep117_table_by_hand_also_with_infinite_limits():
+    # The module docstring's table, one beam a row; an infinite range_min / range_max (a driver
+    # that leaves them open) takes no infinity in: -inf is still "too close", +inf "no return".
+    from vasco_gpu.bags.scans import COUNT_KEYS, NO_RETURN_FREE, apply_rep117
+
+    v = np.array([1.0, np.nan, np.inf, -np.inf, 0.01, 50.0], dtype=np.float32)
+    nan = float("nan")
+    for (rmin, rmax), kept, outside in (((0.1, 30.0), [nan, nan], (1, 1)),
+                                        ((-math.inf, math.inf), [0.01, 50.0], (0, 0))):
+        for no_return, inf_becomes in (("skip", math.inf), ("free", float(NO_RETURN_FREE))):
+            counts = dict.fromkeys(COUNT_KEYS, 0)
+            out = apply_rep117(v, rmin, rmax, no_return, counts)
+            want = np.array([1.0, nan, inf_becomes, nan, *kept], dtype=np.float32)
+            np.testing.assert_array_equal(out, want)
+            assert (counts["nan"], counts["pos_inf"], counts["neg_inf"]) == (1, 1, 1)
+            assert (counts["below_min"], counts["above_max"]) == outside

@@ -87,9 +87,9 @@ class BagScans:
 def apply_rep117(v: np.ndarray, rmin: float, rmax: float, no_return: str, counts: dict) -> np.ndarray:
     """A float32 copy of one scan's ranges after the policy in the module docstring; counts updated."""
     out = np.asarray(v).astype(np.float32, copy=True)
-    # the beams outside [range_min, range_max] (NaN and the infinities among them) first, then
-    # what each of those few is: a live node reads 40 scans a second
-    bad = np.flatnonzero(~((out >= rmin) & (out <= rmax)))
+    # the beams not finite or outside [range_min, range_max] first (an infinite range_max does
+    # not take +inf in), then what each of those few is: a live node reads 40 scans a second
+    bad = np.flatnonzero(~(np.isfinite(out) & (out >= rmin) & (out <= rmax)))
     if len(bad) == 0:
         return out
     b = out[bad]
