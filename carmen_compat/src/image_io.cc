@@ -17,11 +17,9 @@
 
 namespace carmen {
 
-namespace {
-
-void check_map(const GridMap &map) {
+void check_map_size(const GridMap &map, const char *what) {
   if (map.size_x <= 0 || map.size_y <= 0) {
-    throw std::invalid_argument("cannot make an image of a " + std::to_string(map.size_x) + " x " +
+    throw std::invalid_argument(std::string("cannot make ") + what + " of a " + std::to_string(map.size_x) + " x " +
                                 std::to_string(map.size_y) + " map");
   }
   if (map.cells.size() != size_t(map.size_x) * size_t(map.size_y)) {
@@ -30,9 +28,11 @@ void check_map(const GridMap &map) {
   }
 }
 
+namespace {
+
 template <typename PixelFn>
 std::vector<uint8_t> render(const GridMap &map, PixelFn pixel) {
-  check_map(map);
+  check_map_size(map, "an image");
   const size_t w = size_t(map.size_x), h = size_t(map.size_y);
   std::vector<uint8_t> img(w * h);
   for (size_t r = 0; r < h; ++r) {

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
-#include <string>
 
 namespace carmen {
 namespace {
@@ -32,15 +31,6 @@ void transposed(const GridMap &map, ValueFn value, int8_t *out) {
   }
 }
 
-void check_grid(const GridMap &map) {
-  if (map.size_x <= 0 || map.size_y <= 0)
-    throw std::invalid_argument("occupancy grid of a " + std::to_string(map.size_x) + " x " +
-                                std::to_string(map.size_y) + " map");
-  if (map.cells.size() != size_t(map.size_x) * size_t(map.size_y))
-    throw std::invalid_argument("map has " + std::to_string(map.cells.size()) + " cells, its size says " +
-                                std::to_string(size_t(map.size_x) * size_t(map.size_y)));
-}
-
 // The float f with f > v exactly when double(f) > t: the largest float not above t.
 float largest_float_not_above(double t) {
   float f = static_cast<float>(t);
@@ -58,7 +48,7 @@ float smallest_float_not_below(double t) {
 }  // namespace
 
 void occupancy_grid_data(const GridMap &map, const MapServerOptions &o, int8_t *out) {
-  check_grid(map);
+  check_map_size(map, "occupancy grid data");
   if (o.negate) throw std::invalid_argument("occupancy grid data: negate has no meaning here");
   switch (o.mode) {
     case PgmMode::Trinary: {
@@ -91,8 +81,7 @@ void occupancy_grid_data(const GridMap &map, const MapServerOptions &o, int8_t *
 }
 
 std::vector<int8_t> occupancy_grid_data(const GridMap &map, const MapServerOptions &o) {
-  check_grid(map);
-  std::vector<int8_t> out(map.cells.size());
+  std::vector<int8_t> out(map.cells.size());  // the size is checked before anything is written
   occupancy_grid_data(map, o, out.data());
   return out;
 }

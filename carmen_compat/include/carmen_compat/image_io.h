@@ -68,6 +68,10 @@ inline bool is_unknown(float v) { return !(v >= 0.0f); }
 inline bool is_offlimits(float v) { return v >= 2.0f; }
 inline double clamp01(double p) { return p < 0.0 ? 0.0 : (p > 1.0 ? 1.0 : p); }
 
+// std::invalid_argument for a map that is empty or whose cells disagree with
+// its size; `what` names what could not be made of it ("an image").
+void check_map_size(const GridMap &map, const char *what);
+
 // "trinary", "scale", "raw" (as in the YAML's mode key).
 const char *pgm_mode_name(PgmMode mode);
 // Parses a mode name; false if it is none of the three.

@@ -46,16 +46,12 @@ class _Edge:
         self.ns = array("q")
         self.values = array("d")  # tx ty tz qx qy qz qw per sample
         self._arrays = None
-        # the samples' stamps strictly increase (a live /tf's usual order): arrays() then needs
-        # no sort, and the newest stamp is the last
-        self._in_order = True
-        self.newest = None  # the newest stamp (ns), None before the first sample
+        self.newest = None  # the newest stamp (ns), None before the first sample: waiting_for's
 
     def add(self, ns: int, t, q) -> None:
         if self.static:  # the latest static transform wins, as in tf2
             del self.ns[:], self.values[:]
-            self._in_order, self.newest = True, None
-        self._in_order = self._in_order and (self.newest is None or ns > self.newest)
+            self.newest = None
         self.newest = ns if self.newest is None else max(self.newest, ns)
         self.ns.append(ns)
         self.values.extend((*t, *q))
@@ -70,20 +66,17 @@ class _Edge:
         keep = times >= times[-1] - self.keep_ns
         keep[-2:] = True
         self.ns, self.values = array("q", times[keep].tobytes()), array("d", vals[keep].tobytes())
-        self._in_order = True  # sorted, one sample a stamp
 
     def arrays(self):
         """(stamps (k,), translations (k, 3), quaternions (k, 4)) sorted by stamp; two samples
         at one stamp that differ are a TfError when the buffer refuses repeats (a bag's: two
         publishers of one link), else the later one is taken (a live buffer, as tf2 goes on)."""
         if self._arrays is None:
-            if self._in_order:  # copies (a view would keep the arrays from growing), no sort
-                times = np.array(self.ns, dtype=np.int64)
-                vals = np.array(self.values, dtype=np.float64).reshape(-1, 7)
-            else:
-                if self.refuse_repeats:
-                    self._check_repeats()
-                times, vals = sorted_samples(self.ns, self.values, 7)
+            # samples received in stamp order (a live /tf's) are not sorted again: sorted_samples
+            # sees it; a stamp seen twice leaves fewer stamps than samples
+            times, vals = sorted_samples(self.ns, self.values, 7)
+            if self.refuse_repeats and len(times) < len(self.ns):
+                self._check_repeats()
             self._arrays = (times, vals[:, :3].copy(), vals[:, 3:].copy())
         return self._arrays
 
