@@ -3,20 +3,23 @@
 then faster than real time, then a nav_msgs/Path of every pose published again and again,
 for each backend. Printed as a table, ratios in the same run:
 
+  batch       the node's scan_batch_interval (s): scans posed and mapped together that often
+              (0: each on arrival, every message a callback); --batch runs each backend with each
   scans       mapped / sent (a replay over reliable QoS loses none while the node keeps up)
   CPU idle    the node process's CPU time over wall time for 3 s before the replay (% of
               one core: timers, DDS threads)
   CPU 40 Hz   the node process's CPU time over wall time while scans arrive at 40 Hz (%
               of one core: callbacks, tf, conversion, DDS threads, the insert)
   CPU fast    the same at --fast-rate
-  scan p50/p99  the node's own: callback entry -> scan in the grid (ms)
+  scan p50/p99  the node's own: the scan received (DDS's stamp when batched, else the callback's
+              entry) -> the scan in the grid (ms): a batch waits up to its interval
   Path->/map  publish() of the serialized Path -> the new /map in this process's subscriber
               (ms, median and best of --paths), the whole loop a SLAM back end sees
   node        of that, the node's own: its Path callback's entry -> /map published (p50 ms:
               reading the Path, the render, the finish, the OccupancyGrid); the rest is DDS
               carrying the Path and the map, and the callbacks' wake-ups; its steps (read the
               Path, repose: move the scans and render, finish, message, publish) follow the table
-  vs cpu_double  cpu_double's Path->/map over this one: against rebuilding the map from
+  vs cpu_double  cpu_double's Path->/map (at the first --batch) over this one: against rebuilding the map from
               every scan on the CPU, as a CPU mapper does after a loop closure
 
 Every ROS process runs on Fast DDS's shared-memory transport in a domain of its own
@@ -44,6 +47,9 @@ from rclpy.serialization import serialize_message  # noqa: E402
 import vasco_gpu as vg  # noqa: E402
 from ros_player import Player  # noqa: E402
 from live_map_steps import BACKENDS, LOGS, backend_name  # noqa: E402  (beside this script)
+from vasco_gpu.ros.settings import NODE_PARAMETERS  # noqa: E402
+
+BATCH_DEFAULT = next(p.default for p in NODE_PARAMETERS if p.name == "scan_batch_interval")
 
 
 
@@ -88,9 +94,9 @@ def summary_value(line: str, what: str) -> str:
     return f"{p50}/{p99}"
 
 
-def bench_one(player, log, name, args, stamps, raw_path):
+def bench_one(player, log, name, batch, args, stamps, raw_path):
     params = {**BACKENDS[name], "scan_qos": "reliable", "map_update_interval": 0.5, "transform_timeout": 2.0,
-              "resolution": args.resolution, "vasco_downsample": args.downsample}
+              "resolution": args.resolution, "vasco_downsample": args.downsample, "scan_batch_interval": batch}
     proc = NodeProcess(params)
     try:
         proc.wait_for("ready", timeout=120)
@@ -123,6 +129,8 @@ def main() -> int:
     ap.add_argument("--fast-rate", type=float, default=400.0, help="the rest's rate (Hz)")
     ap.add_argument("--paths", type=int, default=5, help="Paths published, one after the other")
     ap.add_argument("--resolution", type=float, default=0.05, help="the map's cell (m): the node's resolution")
+    ap.add_argument("--batch", type=float, nargs="+", default=[BATCH_DEFAULT],
+                    help=f"the node's scan_batch_interval (s), each in turn (default {BATCH_DEFAULT:g}, the node's)")
     ap.add_argument("--downsample", type=int, default=1,
                     help="vasco_downsample (1: the evidence grid at --resolution too)")
     args = ap.parse_args()
@@ -133,22 +141,22 @@ def main() -> int:
     try:
         print(f"# map cell {args.resolution:g} m (evidence grid {args.resolution / args.downsample:g} m); {args.live_scans} scans at {args.rate:g} Hz, "
               f"the rest at {args.fast_rate:g} Hz; Path -> /map over {args.paths} Paths")
-        print(f"{'log':<24} {'backend':<12} {'scans':>11} {'CPU idle':>8} {'CPU 40 Hz':>9} {'CPU fast':>8} "
+        print(f"{'log':<24} {'backend':<12} {'batch':>5} {'scans':>11} {'CPU idle':>8} {'CPU 40 Hz':>9} {'CPU fast':>8} "
               f"{'scan p50/p99 ms':>16} {'Path->/map ms':>13} {'best':>7} {'node':>7} {'vs cpu_double':>13}")
         for path in args.logs:
             log = vg.load_log(ROOT / path)
             stamps = 10**12 + np.arange(len(log), dtype=np.int64) * int(1e9 / args.rate)
             raw = serialize_message(player.path_message(stamps, log.poses))
-            rows = {name: bench_one(player, log, name, args, stamps, raw) for name in names}
-            ref = rows.get("cpu_double", {}).get("path_p50")
-            for name, r in rows.items():
+            rows = {(name, b): bench_one(player, log, name, b, args, stamps, raw) for name in names for b in args.batch}
+            ref = rows.get(("cpu_double", args.batch[0]), {}).get("path_p50")
+            for (name, b), r in rows.items():
                 ratio = f"{ref / r['path_p50']:.1f}x" if ref else "-"
-                print(f"{Path(path).name:<24} {name:<12} {r['scans']:>11} {100 * r['cpu_idle']:>7.1f}% "
+                print(f"{Path(path).name:<24} {name:<12} {b:>5g} {r['scans']:>11} {100 * r['cpu_idle']:>7.1f}% "
                       f"{100 * r['cpu_live']:>8.1f}% "
                       f"{100 * r['cpu_fast']:>7.1f}% {r['scan']:>16} {r['path_p50']:>13.1f} {r['path_min']:>7.1f} {r['node']:>7} "
                       f"{ratio:>13}", flush=True)
-            for name, r in rows.items():
-                print(f"#   {Path(path).name} {name}: the node's Path steps, p50 ms: {r['steps']}", flush=True)
+            for (name, b), r in rows.items():
+                print(f"#   {Path(path).name} {name}, batch {b:g} s: the node's Path steps, p50 ms: {r['steps']}", flush=True)
     finally:
         player.close()
         rclpy.try_shutdown()

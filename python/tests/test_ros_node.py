@@ -211,12 +211,29 @@ def test_pause_and_reset(ros, node, intel):
     assert ros.call(SetBool, "/vasco_mapper/pause", SetBool.Request(data=False)).success
     r = ros.call(Trigger, "/vasco_mapper/reset", Trigger.Request())
     assert r.success and f"dropped {len(intel)} scans" in r.message, r.message
-    first = intel.scans.select(0, 30)
-    ros.replay(first, 4 * 10**12 + np.arange(30) * 10**8)
-    small = vg.Mapper(intel.params, backend="cpu_double")
-    small.insert(first)
-    got = ros.wait_map(n, grid_equals(small.finish()), timeout=30)
+    replay_and_expect(ros, node, intel, n, 0, 30, 4 * 10**12)
+
+
+def replay_and_expect(ros, node, intel, n, first: int, count: int, t0: int):
+    """Replays count scans from first (0.1 s apart from stamp t0) to a node that has no other
+    scan; a /map after the n-th equals their map."""
+    some = intel.scans.select(first, count)
+    ros.replay(some, t0 + np.arange(count) * 10**8)
+    want = vg.Mapper(intel.params, backend="cpu_double")
+    want.insert(some)
+    got = ros.wait_map(n, grid_equals(want.finish()), timeout=30)
     assert got is not None, node.output[-2000:]
+
+
+def test_scans_map_in_batches_or_on_arrival(ros, node, intel):
+    assert "scans mapped in batches every 0.1 s" in node.output  # the default, in the ready line
+    assert not set_parameter(ros, "scan_batch_interval", -0.1).successful
+    assert set_parameter(ros, "scan_batch_interval", 0.0).successful
+    try:
+        assert ros.call(Trigger, "/vasco_mapper/reset", Trigger.Request()).success
+        replay_and_expect(ros, node, intel, ros.map_count(), 30, 25, 5 * 10**12)
+    finally:
+        assert set_parameter(ros, "scan_batch_interval", 0.1).successful
 
 
 def test_point_clouds_map_as_their_scans(ros, node, intel):

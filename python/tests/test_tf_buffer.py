@@ -141,6 +141,38 @@ def test_waiting_for_a_link_without_a_sample_yet():
     assert not tf.waiting_for("map", "nowhere", ns(1))  # no chain: lookup says why
     tf.add_message(tf_message(("map", "base_link", 5, (5.0, 2.0, 0.0), YAW_90)))
     assert not tf.waiting_for("map", "laser", ns(4))
+    # stamps in an array (a live node's batch): each answered as alone
+    stamps = np.array([ns(1), ns(5), ns(6), ns(9)])
+    assert tf.waiting_for("map", "laser", stamps).tolist() == [False, False, True, True]
+    assert tf.waiting_for("map", "nowhere", stamps).tolist() == [False] * 4
+
+
+def test_many_samples_in_and_out_of_order_and_forgotten():
+    # 1,000 samples of one link, x = the stamp's second: given in order, in reverse, and in order
+    # to a buffer that keeps 100 s; each answers every stamp it holds with its sample, and the
+    # interpolation half way between two with the mean (the samples grow the link's storage
+    # many times over; the reversed ones are sorted, the kept ones are the newest).
+    def sample(k):
+        return ("map", "base_link", k, (float(k), 0.0, 0.0), IDENTITY)
+
+    forward, backward, kept = bags.TfBuffer(), bags.TfBuffer(), bags.TfBuffer(keep=100.0)
+    for k in range(1000):
+        forward.add_message(tf_message(sample(k)))
+        backward.add_message(tf_message(sample(999 - k)))
+        kept.add_message(tf_message(sample(k)))
+        if k == 499:  # a lookup before more samples come: it must not see later ones
+            t, _ = forward.lookup("map", "base_link", np.array([ns(499)]))
+            assert t[0, 0] == 499.0
+    stamps = np.array([ns(k) for k in range(1000)])
+    for tf in (forward, backward):
+        t, q = tf.lookup("map", "base_link", stamps)
+        np.testing.assert_array_equal(t[:, 0], np.arange(1000.0))
+        np.testing.assert_array_equal(q, np.tile(IDENTITY, (1000, 1)))
+    assert kept.span("map", "base_link")[0] >= ns(999 - 100 - 256)  # forgotten in steps of 256 samples
+    t, _ = kept.lookup("map", "base_link", np.array([ns(899), ns(999)]))
+    assert t[:, 0].tolist() == [899.0, 999.0]
+    half = (ns(10) + ns(11)) // 2
+    assert forward.lookup("map", "base_link", half)[0][0, 0] == 10.5
 
 
 def test_missing_chain():

@@ -85,13 +85,15 @@ def is_identity(t: np.ndarray, q: np.ndarray) -> bool:
     return not t.any() and not q[:3].any() and abs(q[3]) == 1.0
 
 
-def unit_quaternion(q, what: str, path, error: type[BagError] = BagError) -> np.ndarray:
+def unit_quaternion(q, what, path, error: type[BagError] = BagError) -> np.ndarray:
     """q as a float64 unit quaternion: untouched when within 1e-9 of unit length (exactness),
-    renormalised otherwise; a zero or non-finite quaternion is an `error` (a BagError)."""
+    renormalised otherwise; a zero or non-finite quaternion is an `error` (a BagError) naming
+    `what` (a string, or a function giving it: made only for the error)."""
     q = np.asarray(q, dtype=np.float64)
     n = math.sqrt(float(np.dot(q, q)))
     if not math.isfinite(n) or n < 1e-6:
-        raise error(path, f"{what} has an invalid rotation quaternion {tuple(q.tolist())}")
+        raise error(path, f"{what() if callable(what) else what} has an invalid rotation quaternion "
+                          f"{tuple(q.tolist())}")
     return q if abs(n - 1.0) <= QUAT_TOL else q / n
 
 

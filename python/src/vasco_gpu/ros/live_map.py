@@ -69,24 +69,33 @@ class LiveMap:
             mount=None) -> None:
         """Stores one scan at laser pose (x, y, theta) and applies it to the grid; LiveMapError
         (nothing stored) when max_memory would be exceeded or the mapper refuses it."""
-        ranges = np.ascontiguousarray(ranges, dtype=np.float32)
-        more = ranges.nbytes + _SCAN_BYTES
+        self.add_many([stamp_ns], [pose], [ranges], [first_angle], [angle_step], [mount])
+
+    def add_many(self, stamps_ns, poses, ranges, first_angles, angle_steps, mounts) -> None:
+        """Stores k scans (a list or array of k of each; a mount None: unknown) and applies them
+        to the grid in one insert, in their order; LiveMapError (none stored) when max_memory
+        would be exceeded or the mapper refuses them."""
+        ranges = [np.ascontiguousarray(r, dtype=np.float32) for r in ranges]
+        more = sum(r.nbytes for r in ranges) + _SCAN_BYTES * len(ranges)
         if self.max_memory and self.bytes + more > self.max_memory:
             raise LiveMapError(f"max_memory {self.max_memory} bytes reached: {len(self)} scans stored "
                                f"({self.bytes} bytes of ranges and poses here, the grid besides)")
-        scan = _core.Scans(np.asarray(pose, dtype=np.float64).reshape(1, 3), ranges, [len(ranges)],
-                           first_angle, angle_step)
+        poses = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
+        counts = [len(r) for r in ranges]
+        scans = _core.Scans(poses, ranges[0] if len(ranges) == 1 else np.concatenate(ranges), counts,
+                            np.asarray(first_angles, dtype=np.float64), np.asarray(angle_steps, dtype=np.float64))
         try:
-            self.mapper.insert(scan)
+            self.mapper.insert(scans)
         except (RuntimeError, MemoryError) as e:
             raise LiveMapError(str(e)) from None
-        self.stamps.append(int(stamp_ns))
-        self.poses.extend(float(v) for v in np.asarray(pose).ravel()[:3])
-        self.mounts.extend((np.nan,) * 3 if mount is None else (float(v) for v in mount))
-        self.first_angle.append(first_angle)
-        self.angle_step.append(angle_step)
-        self.beam_counts.append(len(ranges))
-        self.ranges.append(ranges)
+        self.stamps.extend(int(ns) for ns in stamps_ns)
+        self.poses.frombytes(poses.tobytes())
+        for m in mounts:
+            self.mounts.extend((np.nan,) * 3 if m is None else (float(v) for v in m))
+        self.first_angle.extend(float(a) for a in first_angles)
+        self.angle_step.extend(float(a) for a in angle_steps)
+        self.beam_counts.extend(counts)
+        self.ranges.extend(ranges)
         self.bytes += more
         self.version += 1
 

@@ -13,8 +13,10 @@ import numpy as np
 import rclpy
 from nav_msgs.msg import MapMetaData, OccupancyGrid, Path
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy import exceptions as rclpy_exceptions
+from rclpy.callback_groups import CallbackGroup
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import LaserScan, MultiEchoLaserScan, PointCloud2
 from std_srvs.srv import SetBool, Trigger
 
@@ -44,6 +46,12 @@ TF = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=Hist
 TF_STATIC = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL, history=HistoryPolicy.KEEP_LAST)
 PATH = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
+# sensor_data's QoS (best effort, volatile) with a queue that holds a batch's scans: 100 is a
+# laser at 1 kHz for scan_batch_interval 0.1 s, or at 40 Hz for 2.5 s
+SENSOR = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE,
+                    history=HistoryPolicy.KEEP_LAST)
+DRAIN_MAX = 100_000  # messages a batch takes from one topic at most: a flood cannot hold the node
+_InvalidHandle = getattr(rclpy_exceptions, "InvalidHandle", RuntimeError)
 TF_KEEP_S = 60.0  # seconds of stamps each /tf link keeps
 
 
@@ -64,6 +72,31 @@ class _Pending:
         self.topic, self.ns, self.reading, self.deadline = topic, ns, reading, deadline
         self.received = received  # perf_counter() when the callback took it
         self.cloud = cloud  # a PointCloud2 waiting for its mount (reading is None until read)
+
+
+class _BatchGroup(CallbackGroup):
+    """The callback group of /tf and the scan topics. While batching, its subscriptions are in
+    no wait set: a message does not wake the node (each wake-up costs rclpy's executor more
+    Python than the message's own work), the batch timer takes what queued, as rclpy's
+    wait_for_message takes a message. Otherwise a reentrant group: each callback as it comes."""
+
+    def __init__(self):
+        super().__init__()
+        self.batching = False
+
+    def can_execute(self, entity) -> bool:
+        return not self.batching
+
+    def beginning_execution(self, entity) -> bool:
+        return not self.batching
+
+    def ending_execution(self, entity) -> None:
+        pass
+
+
+def _can_take(sub) -> bool:
+    """Whether this rclpy lets the node take a subscription's messages itself."""
+    return hasattr(sub, "handle") and hasattr(sub.handle, "take_message")
 
 
 class MappingNode(Node):
@@ -91,18 +124,24 @@ class MappingNode(Node):
         self.path_ms: list[float] = []  # callback -> /map published, per Path
         # ... and its steps, per Path (ms): where a Path's time goes, in the summary
         self.path_steps: dict[str, list[float]] = {k: [] for k in ("read", "repose", "finish", "message", "publish")}
+        self._batched = _BatchGroup()
         self._subscribe()
+        self._batched.batching = s.scan_batch_interval > 0 and all(_can_take(sub) for sub, _ in self._drained)
         self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
         self.meta_pub = self.create_publisher(MapMetaData, "map_metadata", LATCHED)
         self.create_service(Trigger, "~/save_map", self._save_map)
         self.create_service(Trigger, "~/reset", self._reset)
         self.create_service(SetBool, "~/pause", self._pause)
         self._timer = self.create_timer(s.map_update_interval, self._publish_if_changed)
-        # Waiting scans are retried on every /tf and /tf_static message; this timer only drops
-        # those past their deadline (at most 0.1 s late), and runs only while some wait: at 50 Hz
-        # and always on, it cost an idle node 4 % of a core on the 2-core machine.
-        self._retry = self.create_timer(0.1, self._pose_pending)
+        # Batches: every scan_batch_interval this timer takes what queued on /tf and the scan
+        # topics (_BatchGroup: they do not wake the node) and poses and maps those scans together
+        # (one tf lookup, one insert: per scan, rclpy's wake-up, the callbacks' Python and the
+        # GPU's launch cost more than the work). With scan_batch_interval 0 each message is a
+        # callback, a scan is mapped on arrival or on a later /tf message, and this timer only
+        # drops the scans past transform_timeout, running only while some wait.
+        self._retry = self.create_timer(self._retry_period(s), self._on_batch_timer)
         self._retry.cancel()
+        self._arm()
         self.add_on_set_parameters_callback(self._on_parameters)
 
     def announce_ready(self) -> None:
@@ -112,7 +151,16 @@ class MappingNode(Node):
         self.get_logger().info(
             f"ready: backend {self.live.backend}, scans on {', '.join(topics)}, poses from tf {s.map_frame} -> "
             f"the scans' frames and from the Path on "
-            f"{self.resolve_topic_name(s.path_topic) if s.path_topic else '(none)'}")
+            f"{self.resolve_topic_name(s.path_topic) if s.path_topic else '(none)'}; {self._batch_text()}")
+
+    def _batch_text(self) -> str:
+        s = self.settings
+        if self._batched.batching:
+            return f"scans mapped in batches every {s.scan_batch_interval:g} s"
+        if s.scan_batch_interval > 0:
+            return (f"scans gathered every {s.scan_batch_interval:g} s, each message a callback (this rclpy does not "
+                    f"let the node take them itself)")
+        return "each scan mapped on arrival"
 
     # -- parameters -------------------------------------------------------------------------
     def _declare(self) -> None:
@@ -142,6 +190,11 @@ class MappingNode(Node):
             return SetParametersResult(successful=False, reason=str(e))
         if new.map_update_interval != self.settings.map_update_interval:
             self._timer.timer_period_ns = int(new.map_update_interval * 1e9)
+        if new.scan_batch_interval != self.settings.scan_batch_interval:
+            self._flush()  # the scans gathered so far, before the period changes
+            self._retry.timer_period_ns = int(self._retry_period(new) * 1e9)
+            self._batched.batching = new.scan_batch_interval > 0 and all(_can_take(sub) for sub, _ in self._drained)
+            self._arm()
         mode_changed = (new.map_mode, new.free_thresh, new.occupied_thresh) != (
             self.settings.map_mode, self.settings.free_thresh, self.settings.occupied_thresh)
         self.settings = new
@@ -150,19 +203,65 @@ class MappingNode(Node):
         return SetParametersResult(successful=True)
 
     # -- inputs -----------------------------------------------------------------------------
+    @staticmethod
+    def _retry_period(s: Settings) -> float:
+        return s.scan_batch_interval if s.scan_batch_interval > 0 else 0.1
+
+    def _pose_soon(self) -> None:
+        """A scan (or a transform) came: pose the waiting scans now, or with the next batch."""
+        if self.settings.scan_batch_interval > 0:
+            self._arm()
+        else:
+            self._pose_pending()
+
+    def _arm(self) -> None:
+        """The batch timer runs while batches are taken, or some scan waits; else it sleeps."""
+        need = self._batched.batching or bool(self.pending)
+        if need and self._retry.is_canceled():
+            self._retry.reset()
+        elif not need and not self._retry.is_canceled():
+            self._retry.cancel()
+
+    def _on_batch_timer(self) -> None:
+        self._take_batch()
+        self._pose_pending()
+
+    def _take_batch(self) -> None:
+        """The messages queued on /tf and the scan topics, /tf first, while batching (they do
+        not wake the node: _BatchGroup)."""
+        if not self._batched.batching:
+            return
+        now, now_ns = time.perf_counter(), time.time_ns()
+        for sub, handler in self._drained:
+            for _ in range(DRAIN_MAX):
+                try:
+                    with sub.handle:
+                        taken = sub.handle.take_message(sub.msg_type, sub.raw)
+                except _InvalidHandle:  # destroyed: the node is shutting down
+                    return
+                if taken is None:
+                    break
+                msg, info = taken
+                age = max(0, now_ns - info.get("received_timestamp", now_ns)) * 1e-9 if isinstance(info, dict) else 0.0
+                handler(msg, now - age)  # when DDS received it, on perf_counter's clock
+
     def _subscribe(self) -> None:
         s = self.settings
-        qos = qos_profile_sensor_data if s.scan_qos == "sensor_data" else REPLAY
+        qos = SENSOR if s.scan_qos == "sensor_data" else REPLAY
         # /tf first: rclpy's executor runs the ready callbacks of one wake-up in the order the
         # subscriptions were made, so a scan and the /tf of its stamp that came together are
         # taken tf first and the scan is mapped at once, without waiting (and a retry timer)
-        tf_type = tf_message_type()
-        self.create_subscription(tf_type, "/tf", lambda m: self._on_tf(m, False), TF)
+        # (with scan_batch_interval 0; batches take /tf first too)
+        tf_type, batched = tf_message_type(), self._batched
+        self._drained = [(self.create_subscription(tf_type, "/tf", lambda m: self._on_tf(m, False), TF,
+                                                   callback_group=batched),
+                          lambda m, received: self._on_tf(m, False))]
         self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
-        for topic in s.scan_topics:
-            self.create_subscription(LaserScan, topic, lambda m, t=topic: self._on_scan(m, t, False), qos)
-        for topic in s.multi_echo_topics:
-            self.create_subscription(MultiEchoLaserScan, topic, lambda m, t=topic: self._on_scan(m, t, True), qos)
+        for topic, kind, echoes in [(t, LaserScan, False) for t in s.scan_topics] + \
+                [(t, MultiEchoLaserScan, True) for t in s.multi_echo_topics]:
+            sub = self.create_subscription(kind, topic, lambda m, t=topic, e=echoes: self._on_scan(m, t, e), qos,
+                                           callback_group=batched)
+            self._drained.append((sub, lambda m, received, t=topic, e=echoes: self._on_scan(m, t, e, received)))
         for topic in s.cloud_topics:
             self.create_subscription(PointCloud2, topic, lambda m, t=topic: self._on_cloud(m, t), qos)
         if s.path_topic:  # as bytes: path_cdr.py reads them far faster than rclpy's objects
@@ -184,7 +283,8 @@ class MappingNode(Node):
             return
         if static:
             self._mounts.clear()
-        self._pose_pending()
+        if self.pending:
+            self._pose_soon()
 
     def _paused_on(self, topic: str) -> bool:
         """While paused, a message on topic is counted and not mapped."""
@@ -192,7 +292,7 @@ class MappingNode(Node):
             self.refused[(topic, "paused")] = self.refused.get((topic, "paused"), 0) + 1
         return self.paused
 
-    def _on_scan(self, msg, topic: str, multi_echo: bool) -> None:
+    def _on_scan(self, msg, topic: str, multi_echo: bool, received: float | None = None) -> None:
         if self._paused_on(topic):
             return
         ns = stamp_ns(msg.header.stamp)
@@ -205,9 +305,11 @@ class MappingNode(Node):
         except Refused as e:
             self._refuse(topic, "bad scans", f"{e}; not mapped")  # the first of each topic
             return
-        self.pending.append(_Pending(topic, ns, reading, time.monotonic() + self.settings.transform_timeout,
-                                     time.perf_counter()))
-        self._pose_pending()
+        now = time.perf_counter()
+        received = now if received is None else min(received, now)  # a batch's: when DDS received it
+        self.pending.append(_Pending(topic, ns, reading,
+                                     time.monotonic() - (now - received) + self.settings.transform_timeout, received))
+        self._pose_soon()
 
     def _on_cloud(self, msg, topic: str) -> None:
         """A PointCloud2: read once its frame's mount is known (the height band is in base_frame)."""
@@ -215,7 +317,7 @@ class MappingNode(Node):
             return
         self.pending.append(_Pending(topic, stamp_ns(msg.header.stamp), None,
                                      time.monotonic() + self.settings.transform_timeout, time.perf_counter(), msg))
-        self._pose_pending()
+        self._pose_soon()
 
     def _read_cloud(self, p: _Pending) -> bool:
         """Turns a waiting cloud into its reading; False while its mount is not known yet.
@@ -254,13 +356,10 @@ class MappingNode(Node):
         """Maps every waiting scan whose transform is there; drops those past their deadline."""
         if self.pending:
             self._pose_waiting()
-        if self.pending and self._retry.is_canceled():
-            self._retry.reset()
-        elif not self.pending and not self._retry.is_canceled():
-            self._retry.cancel()
+        self._arm()
 
     def _pose_waiting(self) -> None:
-        now, keep = time.monotonic(), []
+        now, keep, ready = time.monotonic(), [], []
         for p in self.pending:
             if p.cloud is not None:
                 try:
@@ -270,40 +369,95 @@ class MappingNode(Node):
                 except Refused as e:
                     self._refuse(p.topic, e.cause, str(e))
                     continue
-            if now < p.deadline and self.tf.waiting_for(self.settings.map_frame, p.reading.frame, p.ns):
-                keep.append(p)  # its /tf is not there yet: no lookup (and no error text) until it is
-                continue
-            try:
-                t, q = self.tf.lookup(self.settings.map_frame, p.reading.frame, [p.ns])
-                pose = planar(None, t, q, f"the laser frame {p.reading.frame!r} in {self.settings.map_frame!r}")[0]
-            except BagError as e:
-                if now < p.deadline:
-                    keep.append(p)
-                else:
-                    where = f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)}"
-                    self._refuse(p.topic, "scans without a transform",
-                                 f"{where} not mapped: no transform within transform_timeout "
-                                 f"{self.settings.transform_timeout:g} s: {e.message}")
-                continue
-            self._insert(p, pose)
+            ready.append(p)
+        by_frame: dict[str, list[_Pending]] = {}
+        for p in ready:
+            by_frame.setdefault(p.reading.frame, []).append(p)
+        posed = {}  # id(pending) -> laser pose
+        for frame, waiting in by_frame.items():
+            self._pose_frame(frame, waiting, now, keep, posed)
         self.pending = keep
+        self._insert([(p, posed[id(p)]) for p in ready if id(p) in posed])  # in the order they came
 
-    def _insert(self, p: _Pending, pose) -> None:
-        r = p.reading
+    def _pose_frame(self, frame: str, waiting: list, now: float, keep: list, posed: dict) -> None:
+        """The laser poses of the waiting scans in one frame, by one tf lookup where every stamp
+        has its transform; the others one by one (each kept, or refused past its deadline)."""
+        target = self.settings.map_frame
+        ns = np.fromiter((p.ns for p in waiting), dtype=np.int64, count=len(waiting))
+        wait = self.tf.waiting_for(target, frame, ns)  # its /tf not there yet: no lookup until it is
         try:
-            self.live.add(p.ns, pose, r.ranges, r.first_angle, r.angle_step, self._mount(r.frame))
+            ok = ~wait & self.tf.covers(target, frame, ns)
+        except BagError:  # no chain to the frame (yet): each scan's own lookup says why
+            ok = np.zeros(len(ns), dtype=bool)
+        if ok.any():
+            try:
+                t, q = self.tf.lookup(target, frame, ns[ok])
+                poses = planar(None, t, q, f"the laser frame {frame!r} in {target!r}")
+                for p, pose in zip((p for p, k in zip(waiting, ok) if k), poses):
+                    posed[id(p)] = pose
+            except BagError:  # one of them refused (upside down): each its own below
+                ok[:] = False
+        for p, k, w in zip(waiting, ok, wait):
+            if k:
+                continue
+            if w and now < p.deadline:
+                keep.append(p)
+                continue
+            pose = self._pose_one(p, now)
+            if pose is not None:
+                posed[id(p)] = pose
+            elif now < p.deadline:
+                keep.append(p)
+
+    def _pose_one(self, p: _Pending, now: float):
+        """One scan's laser pose; None while it has none (refused once past its deadline)."""
+        try:
+            t, q = self.tf.lookup(self.settings.map_frame, p.reading.frame, [p.ns])
+            return planar(None, t, q, f"the laser frame {p.reading.frame!r} in {self.settings.map_frame!r}")[0]
+        except BagError as e:
+            if now >= p.deadline:
+                where = f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)}"
+                self._refuse(p.topic, "scans without a transform",
+                             f"{where} not mapped: no transform within transform_timeout "
+                             f"{self.settings.transform_timeout:g} s: {e.message}")
+            return None
+
+    def _insert(self, posed: list) -> None:
+        """Maps the posed scans [(pending, laser pose)], in one insert; when that is refused
+        (max_memory), one by one, so that each refusal names its scan."""
+        if not posed:
+            return
+        mounts = [self._mount(p.reading.frame) for p, _ in posed]
+        try:
+            self.live.add_many([p.ns for p, _ in posed], [pose for _, pose in posed],
+                               [p.reading.ranges for p, _ in posed], [p.reading.first_angle for p, _ in posed],
+                               [p.reading.angle_step for p, _ in posed], mounts)
         except LiveMapError as e:
+            if len(posed) > 1:
+                for one in posed:
+                    self._insert([one])
+                return
+            p = posed[0][0]
             self._refuse(p.topic, "scans over max_memory",
                          f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)} not mapped: {e}")
             return
         self._last_scan = time.monotonic()
-        self.scan_ms.append((time.perf_counter() - p.received) * 1e3)
-        if self._mount(r.frame) is None:
-            self._refuse(p.topic, "scans without a mount",
-                         f"{self.resolve_topic_name(p.topic)}: no /tf_static chain {self.settings.base_frame} -> "
-                         f"{r.frame}: its scans are mapped at their tf pose, a Path cannot move them")
+        done = time.perf_counter()
+        for (p, _), mount in zip(posed, mounts):
+            self.scan_ms.append((done - p.received) * 1e3)
+            if mount is None:
+                self._refuse(p.topic, "scans without a mount",
+                             f"{self.resolve_topic_name(p.topic)}: no /tf_static chain {self.settings.base_frame} -> "
+                             f"{p.reading.frame}: its scans are mapped at their tf pose, a Path cannot move them")
+
+    def _flush(self) -> None:
+        """The scans gathered for the next batch mapped now (before a Path, a map, a save)."""
+        self._take_batch()
+        if self.pending:
+            self._pose_pending()
 
     def _on_path(self, raw: bytes) -> None:
+        self._flush()  # the scans received before the Path are moved by it
         start = time.perf_counter()
         try:
             stamps, poses = self._path_poses(raw)
@@ -360,6 +514,7 @@ class MappingNode(Node):
         grown grid is rendered once more when the stream has paused for an interval (LiveMap).
         Returns the seconds of its steps (finish, message, publish); empty when nothing was
         published."""
+        self._flush()
         quiet = time.monotonic() - self._last_scan > self.settings.map_update_interval
         if settle and quiet:
             try:
@@ -385,6 +540,7 @@ class MappingNode(Node):
 
     def _save_map(self, request, response):
         paths = self.settings.save_map_path
+        self._flush()
         m = self.live.finish()
         if not paths or m is None:
             response.success = False
@@ -408,6 +564,7 @@ class MappingNode(Node):
         return response
 
     def _pause(self, request, response):
+        self._flush()  # the scans received before the pause are mapped
         self.paused = bool(request.data)
         response.success = True
         response.message = "paused: new scans are not mapped" if self.paused else "mapping new scans"
