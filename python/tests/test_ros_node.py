@@ -234,6 +234,10 @@ def test_scans_map_in_batches_or_on_arrival(ros, node, intel):
         replay_and_expect(ros, node, intel, ros.map_count(), 30, 25, 5 * 10**12)
     finally:
         assert set_parameter(ros, "scan_batch_interval", 0.1).successful
+    # batches again; after a quiet second they stop, and the next message starts them
+    assert ros.call(Trigger, "/vasco_mapper/reset", Trigger.Request()).success
+    time.sleep(1.5)
+    replay_and_expect(ros, node, intel, ros.map_count(), 60, 25, 6 * 10**12)
 
 
 def test_point_clouds_map_as_their_scans(ros, node, intel):

@@ -16,7 +16,7 @@ from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy import exceptions as rclpy_exceptions
 from rclpy.callback_groups import CallbackGroup
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan, MultiEchoLaserScan, PointCloud2
 from std_srvs.srv import SetBool, Trigger
 
@@ -50,6 +50,7 @@ PATH = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=Histo
 # laser at 1 kHz for scan_batch_interval 0.1 s, or at 40 Hz for 2.5 s
 SENSOR = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE,
                     history=HistoryPolicy.KEEP_LAST)
+QUIET_S = 1.0  # seconds without a /tf or scan message after which batches stop until the next
 DRAIN_MAX = 100_000  # messages a batch takes from one topic at most: a flood cannot hold the node
 _InvalidHandle = getattr(rclpy_exceptions, "InvalidHandle", RuntimeError)
 TF_KEEP_S = 60.0  # seconds of stamps each /tf link keeps
@@ -126,7 +127,9 @@ class MappingNode(Node):
         self.path_steps: dict[str, list[float]] = {k: [] for k in ("read", "repose", "finish", "message", "publish")}
         self._batched = _BatchGroup()
         self._subscribe()
-        self._batched.batching = s.scan_batch_interval > 0 and all(_can_take(sub) for sub, _ in self._drained)
+        self._can_batch = all(_can_take(sub) for sub, _ in self._drained)
+        self._batched.batching = s.scan_batch_interval > 0 and self._can_batch
+        self._quiet_batches = 0  # batches in a row that took no message
         self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
         self.meta_pub = self.create_publisher(MapMetaData, "map_metadata", LATCHED)
         self.create_service(Trigger, "~/save_map", self._save_map)
@@ -193,7 +196,7 @@ class MappingNode(Node):
         if new.scan_batch_interval != self.settings.scan_batch_interval:
             self._flush()  # the scans gathered so far, before the period changes
             self._retry.timer_period_ns = int(self._retry_period(new) * 1e9)
-            self._batched.batching = new.scan_batch_interval > 0 and all(_can_take(sub) for sub, _ in self._drained)
+            self._batched.batching = new.scan_batch_interval > 0 and self._can_batch
             self._arm()
         mode_changed = (new.map_mode, new.free_thresh, new.occupied_thresh) != (
             self.settings.map_mode, self.settings.free_thresh, self.settings.occupied_thresh)
@@ -226,12 +229,20 @@ class MappingNode(Node):
         self._take_batch()
         self._pose_pending()
 
+    def _on_input(self, handler, msg) -> None:
+        """A message on /tf or a scan topic as a callback: with scan_batch_interval 0, or the first
+        after a quiet spell, which starts the batches again."""
+        handler(msg, None)
+        if not self._batched.batching and self._can_batch and self.settings.scan_batch_interval > 0:
+            self._batched.batching, self._quiet_batches = True, 0
+            self._arm()
+
     def _take_batch(self) -> None:
         """The messages queued on /tf and the scan topics, /tf first, while batching (they do
         not wake the node: _BatchGroup)."""
         if not self._batched.batching:
             return
-        now, now_ns = time.perf_counter(), time.time_ns()
+        now, now_ns, taken_any = time.perf_counter(), time.time_ns(), False
         for sub, handler in self._drained:
             for _ in range(DRAIN_MAX):
                 try:
@@ -241,29 +252,39 @@ class MappingNode(Node):
                     return
                 if taken is None:
                     break
+                taken_any = True
                 msg, info = taken
                 age = max(0, now_ns - info.get("received_timestamp", now_ns)) * 1e-9 if isinstance(info, dict) else 0.0
                 handler(msg, now - age)  # when DDS received it, on perf_counter's clock
+        # A second without a message: the subscriptions wait in the executor again, so that an
+        # idle node's timer sleeps (_on_input starts the batches with the next message).
+        self._quiet_batches = 0 if taken_any else self._quiet_batches + 1
+        if self._quiet_batches * self.settings.scan_batch_interval >= QUIET_S:
+            self._batched.batching = False
 
     def _subscribe(self) -> None:
         s = self.settings
         qos = SENSOR if s.scan_qos == "sensor_data" else REPLAY
-        # /tf first: rclpy's executor runs the ready callbacks of one wake-up in the order the
+        # tf first: rclpy's executor runs the ready callbacks of one wake-up in the order the
         # subscriptions were made, so a scan and the /tf of its stamp that came together are
-        # taken tf first and the scan is mapped at once, without waiting (and a retry timer)
-        # (with scan_batch_interval 0; batches take /tf first too)
-        tf_type, batched = tf_message_type(), self._batched
-        self._drained = [(self.create_subscription(tf_type, "/tf", lambda m: self._on_tf(m, False), TF,
-                                                   callback_group=batched),
-                          lambda m, received: self._on_tf(m, False))]
+        # taken tf first and the scan is mapped at once (batches take /tf first too)
+        tf_type = tf_message_type()
         self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
-        for topic, kind, echoes in [(t, LaserScan, False) for t in s.scan_topics] + \
-                [(t, MultiEchoLaserScan, True) for t in s.multi_echo_topics]:
-            sub = self.create_subscription(kind, topic, lambda m, t=topic, e=echoes: self._on_scan(m, t, e), qos,
-                                           callback_group=batched)
-            self._drained.append((sub, lambda m, received, t=topic, e=echoes: self._on_scan(m, t, e, received)))
+        self._drained = []  # (subscription, handler(msg, received)) of what batches take, /tf first
+        inputs = [(tf_type, "/tf", TF, lambda m, received: self._on_tf(m, False))]
+        inputs += [(LaserScan, t, qos, lambda m, received, t=t: self._on_scan(m, t, False, received))
+                   for t in s.scan_topics]
+        inputs += [(MultiEchoLaserScan, t, qos, lambda m, received, t=t: self._on_scan(m, t, True, received))
+                   for t in s.multi_echo_topics]
+        for kind, topic, topic_qos, handler in inputs:
+            sub = self.create_subscription(kind, topic, lambda m, h=handler: self._on_input(h, m), topic_qos,
+                                           callback_group=self._batched)
+            self._drained.append((sub, handler))
+        # clouds (megabytes each) a callback each, as they come: their reading costs far more than
+        # a wake-up, and a batch's queue of them would hold hundreds of megabytes
+        cloud_qos = qos_profile_sensor_data if s.scan_qos == "sensor_data" else REPLAY
         for topic in s.cloud_topics:
-            self.create_subscription(PointCloud2, topic, lambda m, t=topic: self._on_cloud(m, t), qos)
+            self.create_subscription(PointCloud2, topic, lambda m, t=topic: self._on_cloud(m, t), cloud_qos)
         if s.path_topic:  # as bytes: path_cdr.py reads them far faster than rclpy's objects
             self.create_subscription(Path, s.path_topic, self._on_path, PATH, raw=True)
 
