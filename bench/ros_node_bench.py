@@ -17,8 +17,9 @@ for each backend. Printed as a table, ratios in the same run:
               (ms, median and best of --paths), the whole loop a SLAM back end sees
   node        of that, the node's own: its Path callback's entry -> /map published (p50 ms:
               reading the Path, the render, the finish, the OccupancyGrid); the rest is DDS
-              carrying the Path and the map, and the callbacks' wake-ups; its steps (read the
-              Path, repose: move the scans and render, finish, message, publish) follow the table
+              carrying the Path and the map, and the callbacks' wake-ups; its steps (batch: map
+              the scans still waiting for their batch, read the Path, repose: move the scans
+              and render, finish, message, publish) follow the table
   vs cpu_double  cpu_double's Path->/map (at the first --batch) over this one: against rebuilding the map from
               every scan on the CPU, as a CPU mapper does after a loop closure
 

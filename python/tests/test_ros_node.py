@@ -295,7 +295,7 @@ def test_the_node_under_test_exits_cleanly_too(node):
     assert rc == 0 and took < 1.0, (rc, took, node.output[-2000:])
     assert "vasco_mapper: 60 scans mapped; not mapped:" in node.output
     # where the rendered Paths' time went (the bench's node column and steps come from this line)
-    assert re.search(r"Path -> /map published: p50 [\d.]+ ms, p99 [\d.]+ ms \(\d+\); Path steps p50 ms: read [\d.]+, "
+    assert re.search(r"Path -> /map published: p50 [\d.]+ ms, p99 [\d.]+ ms \(\d+\); Path steps p50 ms: batch [\d.]+, read [\d.]+, "
                      r"repose [\d.]+, finish [\d.]+, message [\d.]+, publish [\d.]+", node.output), node.output[-2000:]
 
 

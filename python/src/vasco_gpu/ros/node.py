@@ -71,7 +71,7 @@ class _Pending:
 
     def __init__(self, topic, ns, reading, deadline, received, cloud=None):
         self.topic, self.ns, self.reading, self.deadline = topic, ns, reading, deadline
-        self.received = received  # perf_counter() when the callback took it
+        self.received = received  # when received, on perf_counter's clock (DDS's time in a batch)
         self.cloud = cloud  # a PointCloud2 waiting for its mount (reading is None until read)
 
 
@@ -124,12 +124,13 @@ class MappingNode(Node):
         self.scan_ms = array("d")  # callback -> scan in the grid, per scan
         self.path_ms: list[float] = []  # callback -> /map published, per Path
         # ... and its steps, per Path (ms): where a Path's time goes, in the summary
-        self.path_steps: dict[str, list[float]] = {k: [] for k in ("read", "repose", "finish", "message", "publish")}
+        self.path_steps: dict[str, list[float]] = {
+            k: [] for k in ("batch", "read", "repose", "finish", "message", "publish")}
         self._batched = _BatchGroup()
         self._subscribe()
         self._can_batch = all(_can_take(sub) for sub, _ in self._drained)
         self._batched.batching = s.scan_batch_interval > 0 and self._can_batch
-        self._quiet_batches = 0  # batches in a row that took no message
+        self._last_taken = time.monotonic()  # when a batch last took a message
         self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
         self.meta_pub = self.create_publisher(MapMetaData, "map_metadata", LATCHED)
         self.create_service(Trigger, "~/save_map", self._save_map)
@@ -234,16 +235,16 @@ class MappingNode(Node):
         after a quiet spell, which starts the batches again."""
         handler(msg, None)
         if not self._batched.batching and self._can_batch and self.settings.scan_batch_interval > 0:
-            self._batched.batching, self._quiet_batches = True, 0
+            self._batched.batching, self._last_taken = True, time.monotonic()
             self._arm()
 
     def _take_batch(self) -> None:
-        """The messages queued on /tf and the scan topics, /tf first, while batching (they do
-        not wake the node: _BatchGroup)."""
+        """The messages queued on the scan topics, then on /tf (a /tf that came while the scans
+        were taken is there for them), while batching (they do not wake the node: _BatchGroup)."""
         if not self._batched.batching:
             return
-        now, now_ns, taken_any = time.perf_counter(), time.time_ns(), False
-        for sub, handler in self._drained:
+        now, now_ns = time.perf_counter(), time.time_ns()
+        for sub, handler in self._drained[1:] + self._drained[:1]:
             for _ in range(DRAIN_MAX):
                 try:
                     with sub.handle:
@@ -252,25 +253,30 @@ class MappingNode(Node):
                     return
                 if taken is None:
                     break
-                taken_any = True
-                msg, info = taken
-                age = max(0, now_ns - info.get("received_timestamp", now_ns)) * 1e-9 if isinstance(info, dict) else 0.0
-                handler(msg, now - age)  # when DDS received it, on perf_counter's clock
+                self._last_taken = time.monotonic()
+                handler(taken[0], now - self._age(taken[1], now_ns))
         # A second without a message: the subscriptions wait in the executor again, so that an
         # idle node's timer sleeps (_on_input starts the batches with the next message).
-        self._quiet_batches = 0 if taken_any else self._quiet_batches + 1
-        if self._quiet_batches * self.settings.scan_batch_interval >= QUIET_S:
+        if time.monotonic() - self._last_taken >= QUIET_S:
             self._batched.batching = False
+
+    def _age(self, info, now_ns: int) -> float:
+        """Seconds since DDS received a message taken now: its received_timestamp, where the
+        middleware gives one (Cyclone DDS gives 0) and it is no older than a batch can be
+        (a step of the system clock); 0 otherwise (taken when received)."""
+        received = info.get("received_timestamp", 0) if isinstance(info, dict) else 0
+        age = (now_ns - received) * 1e-9 if 0 < received <= now_ns else 0.0
+        return age if age <= self.settings.scan_batch_interval + QUIET_S else 0.0
 
     def _subscribe(self) -> None:
         s = self.settings
         qos = SENSOR if s.scan_qos == "sensor_data" else REPLAY
         # tf first: rclpy's executor runs the ready callbacks of one wake-up in the order the
         # subscriptions were made, so a scan and the /tf of its stamp that came together are
-        # taken tf first and the scan is mapped at once (batches take /tf first too)
+        # taken tf first and the scan is mapped at once (a batch takes /tf after the scans)
         tf_type = tf_message_type()
         self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
-        self._drained = []  # (subscription, handler(msg, received)) of what batches take, /tf first
+        self._drained = []  # (subscription, handler(msg, received)) of what batches take: /tf, the scans
         inputs = [(tf_type, "/tf", TF, lambda m, received: self._on_tf(m, False))]
         inputs += [(LaserScan, t, qos, lambda m, received, t=t: self._on_scan(m, t, False, received))
                    for t in s.scan_topics]
@@ -336,8 +342,9 @@ class MappingNode(Node):
         """A PointCloud2: read once its frame's mount is known (the height band is in base_frame)."""
         if self._paused_on(topic):
             return
+        now = time.perf_counter()
         self.pending.append(_Pending(topic, stamp_ns(msg.header.stamp), None,
-                                     time.monotonic() + self.settings.transform_timeout, time.perf_counter(), msg))
+                                     time.monotonic() + self.settings.transform_timeout, now, msg))
         self._pose_soon()
 
     def _read_cloud(self, p: _Pending) -> bool:
@@ -398,7 +405,9 @@ class MappingNode(Node):
         for frame, waiting in by_frame.items():
             self._pose_frame(frame, waiting, now, keep, posed)
         self.pending = keep
-        self._insert([(p, posed[id(p)]) for p in ready if id(p) in posed])  # in the order they came
+        # in the order they were taken: each topic's in the order they came, a batch's topic by
+        # topic (sorted by DDS's reception times, the first scans of a replay came out of order)
+        self._insert([(p, posed[id(p)]) for p in ready if id(p) in posed])
 
     def _pose_frame(self, frame: str, waiting: list, now: float, keep: list, posed: dict) -> None:
         """The laser poses of the waiting scans in one frame, by one tf lookup where every stamp
@@ -478,8 +487,9 @@ class MappingNode(Node):
             self._pose_pending()
 
     def _on_path(self, raw: bytes) -> None:
-        self._flush()  # the scans received before the Path are moved by it
         start = time.perf_counter()
+        self._flush()  # the scans received before the Path are moved by it
+        flushed = time.perf_counter()
         try:
             stamps, poses = self._path_poses(raw)
         except Refused as e:
@@ -494,7 +504,7 @@ class MappingNode(Node):
         rendered = time.perf_counter()
         published = self._publish_if_changed(settle=False)
         self.path_ms.append((time.perf_counter() - start) * 1e3)
-        steps = {"read": read - start, "repose": rendered - read, **published}
+        steps = {"batch": flushed - start, "read": read - flushed, "repose": rendered - read, **published}
         for k, v in steps.items():
             self.path_steps[k].append(v * 1e3)
         self.get_logger().debug(f"Path of {len(stamps)} poses: {counts}, published in {self.path_ms[-1]:.1f} ms")
@@ -582,6 +592,7 @@ class MappingNode(Node):
         return response
 
     def _reset(self, request, response):
+        self._flush()  # the scans received before the reset are dropped with the others
         n = self.live.reset()
         self.pending.clear()
         response.success, response.message = True, f"dropped {n} scans and the grid"

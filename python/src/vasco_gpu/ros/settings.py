@@ -106,7 +106,7 @@ NODE_PARAMETERS = (
     NodeParameter("z_band", [0.2, 1.8], "clouds: the heights kept, min and max, in metres in base_frame"),
     NodeParameter("cloud_angle_step", 0.25, "clouds: the beams' angle step in degrees (nearest point per step)"),
     NodeParameter("cloud_range_max", 50.0, "clouds: points farther than this (m) are no return"),
-    NodeParameter("scan_qos", "sensor_data", "the scans' QoS: sensor_data (best effort, depth 100) or "
+    NodeParameter("scan_qos", "sensor_data", "the scans' QoS: sensor_data (best effort, depth 100; clouds 5) or "
                                              "reliable (reliable, depth 1000: a replay loses no scan)"),
     NodeParameter("resolution", _core.ROS_MAP_RESOLUTION, "the map's cell size (m), /map's info.resolution, as log2map --resolution "
                                       "sets it (vasco_resolution = resolution / vasco_downsample; the downsample "
