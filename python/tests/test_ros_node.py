@@ -225,19 +225,43 @@ def replay_and_expect(ros, node, intel, n, first: int, count: int, t0: int):
     assert got is not None, node.output[-2000:]
 
 
+# Each test's stamps come after the ones before (1, 2, 3, 4, 4.1, 4.2, 4.3, 5 x 10^12 ns): the
+# node keeps 60 s of /tf behind the newest sample, so an older replay could lose its transforms.
 def test_scans_map_in_batches_or_on_arrival(ros, node, intel):
     assert "scans mapped in batches every 0.1 s" in node.output  # the default, in the ready line
     assert not set_parameter(ros, "scan_batch_interval", -0.1).successful
     assert set_parameter(ros, "scan_batch_interval", 0.0).successful
     try:
         assert ros.call(Trigger, "/vasco_mapper/reset", Trigger.Request()).success
-        replay_and_expect(ros, node, intel, ros.map_count(), 30, 25, 5 * 10**12)
+        replay_and_expect(ros, node, intel, ros.map_count(), 30, 25, 41 * 10**11)
     finally:
         assert set_parameter(ros, "scan_batch_interval", 0.1).successful
     # batches again; after a quiet second they stop, and the next message starts them
     assert ros.call(Trigger, "/vasco_mapper/reset", Trigger.Request()).success
     time.sleep(1.5)
-    replay_and_expect(ros, node, intel, ros.map_count(), 60, 25, 6 * 10**12)
+    replay_and_expect(ros, node, intel, ros.map_count(), 60, 25, 42 * 10**11)
+
+
+def test_an_incompatible_scan_publisher_is_named_while_batching(ros, node):
+    # The node's scans are reliable here (scan_qos reliable): a best-effort publisher sends it
+    # nothing, and rclpy's warning about it comes while /tf keeps the batches going (the
+    # subscription waits in no wait set then; its QoS events do).
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import LaserScan
+    from tf2_msgs.msg import TFMessage
+
+    quiet = ros.node.create_publisher(LaserScan, "scan", QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT))
+    try:
+        end, k = time.monotonic() + 20, 0
+        while time.monotonic() < end and "offering incompatible QoS" not in node.output:
+            ros.tf.publish(TFMessage(transforms=[ros.transform("map", "base_link", 43 * 10**11 + k * 10**8, (0, 0, 0))]))
+            k += 1
+            time.sleep(0.05)
+        line = next((ln for ln in node.lines if "offering incompatible QoS" in ln), None)
+        assert line is not None and "'scan'" in line, node.output[-2000:]
+        print(f"warned after {k} /tf messages")
+    finally:
+        ros.node.destroy_publisher(quiet)
 
 
 def test_point_clouds_map_as_their_scans(ros, node, intel):

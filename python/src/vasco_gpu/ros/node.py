@@ -17,6 +17,7 @@ from rclpy import exceptions as rclpy_exceptions
 from rclpy.callback_groups import CallbackGroup
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.subscription import Subscription
 from sensor_msgs.msg import LaserScan, MultiEchoLaserScan, PointCloud2
 from std_srvs.srv import SetBool, Trigger
 
@@ -79,17 +80,19 @@ class _BatchGroup(CallbackGroup):
     """The callback group of /tf and the scan topics. While batching, its subscriptions are in
     no wait set: a message does not wake the node (each wake-up costs rclpy's executor more
     Python than the message's own work), the batch timer takes what queued, as rclpy's
-    wait_for_message takes a message. Otherwise a reentrant group: each callback as it comes."""
+    wait_for_message takes a message. Otherwise a reentrant group: each callback as it comes.
+    The subscriptions' QoS event handlers (in this group too) always wait: rclpy's warning
+    about a publisher with an incompatible QoS comes as it would without batches."""
 
     def __init__(self):
         super().__init__()
         self.batching = False
 
     def can_execute(self, entity) -> bool:
-        return not self.batching
+        return not (self.batching and isinstance(entity, Subscription))
 
     def beginning_execution(self, entity) -> bool:
-        return not self.batching
+        return self.can_execute(entity)
 
     def ending_execution(self, entity) -> None:
         pass
