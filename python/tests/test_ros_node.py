@@ -31,7 +31,7 @@ rclpy = ros_support.import_or_skip("rclpy")
 ros_support.import_or_skip("tf2_msgs")
 
 import vasco_gpu as vg  # noqa: E402
-from ros_player import LATCHED, Player  # noqa: E402
+from ros_player import LATCHED, RELIABLE, Player  # noqa: E402
 from nav_msgs.msg import OccupancyGrid  # noqa: E402
 from std_srvs.srv import SetBool, Trigger  # noqa: E402
 
@@ -225,7 +225,7 @@ def replay_and_expect(ros, node, intel, n, first: int, count: int, t0: int):
     assert got is not None, node.output[-2000:]
 
 
-# Each test's stamps come after the ones before (1, 2, 3, 4, 4.1, 4.2, 4.3, 5 x 10^12 ns): the
+# Each test's stamps come after the ones before (1, 2, 3, 4, 4.1, 4.2, 4.3, 4.4, 5 x 10^12 ns): the
 # node keeps 60 s of /tf behind the newest sample, so an older replay could lose its transforms.
 def test_scans_map_in_batches_or_on_arrival(ros, node, intel):
     assert "scans mapped in batches every 0.1 s" in node.output  # the default, in the ready line
@@ -262,6 +262,33 @@ def test_an_incompatible_scan_publisher_is_named_while_batching(ros, node):
         print(f"warned after {k} /tf messages")
     finally:
         ros.node.destroy_publisher(quiet)
+
+
+def test_batches_come_on_the_steady_clock_under_sim_time(ros, node, intel):
+    # use_sim_time with no /clock: ROS time stands still, and a batch timer on it would never
+    # take a scan; on the steady clock the batches come and the summary counts the scans mapped.
+    from sensor_msgs.msg import LaserScan
+    from tf2_msgs.msg import TFMessage
+
+    sim = NodeProcess({"backend": "cpu_double", "use_sim_time": True, "scan_topics": ["sim_scan"], "path_topic": ""})
+    pub = ros.node.create_publisher(LaserScan, "sim_scan", RELIABLE)
+    try:
+        sim.wait_for("ready")
+        end = time.monotonic() + 20
+        while pub.get_subscription_count() == 0 and time.monotonic() < end:
+            time.sleep(0.02)
+        for k in range(20):
+            ns = 44 * 10**11 + k * 10**8
+            ros.tf.publish(TFMessage(transforms=[ros.transform("map", "base_link", ns, intel.poses[k])]))
+            pub.publish(ros.laser_scan(ns, intel.scans.ranges_of(k), float(intel.scans.first_angle[k]),
+                                       float(intel.scans.angle_step[k])))
+            time.sleep(0.01)
+        time.sleep(1.0)
+        rc, _ = sim.interrupt()
+        assert rc == 0 and "vasco_mapper: 20 scans mapped" in sim.output, sim.output[-2000:]
+    finally:
+        ros.node.destroy_publisher(pub)
+        sim.kill()
 
 
 def test_point_clouds_map_as_their_scans(ros, node, intel):

@@ -14,13 +14,30 @@ def main(argv=None) -> int:
     ROS 2 is not there."""
     import sys
 
+    # A SIGINT while rclpy loads can land inside importlib's lock callbacks, where Python prints
+    # it as an ignored exception: not printed (the node exits 0, as for any SIGINT while starting)
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda u: None if isinstance(u.exc_value, KeyboardInterrupt) else hook(u)
     try:
         from .run import main as run
     except KeyboardInterrupt:  # SIGINT while rclpy loads: nothing started yet
         return 0
     except ImportError as e:  # rclpy or a message package
+        if _interrupted(e):  # SIGINT inside an extension's initialisation: pybind11 raises ImportError from it
+            return 0
         print(f"vasco_map_node: {e.name or e} does not import: install the ROS 2 extra (pip install "
               "'.[ros]' ./ros/tf2_msgs from the repository, Python 3.10 or newer) or source a ROS 2 "
               "installation (docs/ros.md)", file=sys.stderr)
         return 1
     return run(argv)
+
+
+def _interrupted(e: BaseException) -> bool:
+    """Whether a KeyboardInterrupt is among the causes of e."""
+    seen = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return False

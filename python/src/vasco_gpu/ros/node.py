@@ -15,6 +15,7 @@ from nav_msgs.msg import MapMetaData, OccupancyGrid, Path
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy import exceptions as rclpy_exceptions
 from rclpy.callback_groups import CallbackGroup
+from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.subscription import Subscription
@@ -145,8 +146,11 @@ class MappingNode(Node):
         # (one tf lookup, one insert: per scan, rclpy's wake-up, the callbacks' Python and the
         # GPU's launch cost more than the work). With scan_batch_interval 0 each message is a
         # callback, a scan is mapped on arrival or on a later /tf message, and this timer only
-        # drops the scans past transform_timeout, running only while some wait.
-        self._retry = self.create_timer(self._retry_period(s), self._on_batch_timer)
+        # drops the scans past transform_timeout, running only while some wait. On the steady
+        # clock: with use_sim_time and a paused (or absent) /clock, batches still come, and /tf
+        # does not overflow its queue while it waits.
+        self._retry = self.create_timer(self._retry_period(s), self._on_batch_timer,
+                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._retry.cancel()
         self._arm()
         self.add_on_set_parameters_callback(self._on_parameters)

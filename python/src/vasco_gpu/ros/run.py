@@ -33,6 +33,10 @@ def main(argv=None) -> int:
         except (SettingsError, MissingMessages, ImportError) as e:
             print(f"vasco_mapper: {e}", file=sys.stderr)
             return 2
+        except Exception:  # rclpy's RCLError: a signal shut ROS 2 down while the node was made
+            if rclpy.ok():
+                raise
+            return 0
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         node.announce_ready()  # only now: a signal from here on ends the spin cleanly
