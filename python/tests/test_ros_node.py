@@ -270,13 +270,17 @@ def test_batches_come_on_the_steady_clock_under_sim_time(ros, node, intel):
     from sensor_msgs.msg import LaserScan
     from tf2_msgs.msg import TFMessage
 
-    sim = NodeProcess({"backend": "cpu_double", "use_sim_time": True, "scan_topics": ["sim_scan"], "path_topic": ""})
+    others = ros.tf.get_subscription_count()  # the module's node, when it runs
+    sim = NodeProcess({"backend": "cpu_double", "use_sim_time": True, "scan_topics": ["sim_scan"], "path_topic": "",
+                       "scan_qos": "reliable"})
     pub = ros.node.create_publisher(LaserScan, "sim_scan", RELIABLE)
     try:
         sim.wait_for("ready")
         end = time.monotonic() + 20
-        while pub.get_subscription_count() == 0 and time.monotonic() < end:
+        while (pub.get_subscription_count() == 0 or ros.tf.get_subscription_count() <= others) and \
+                time.monotonic() < end:
             time.sleep(0.02)
+        ros.tf_static.publish(TFMessage(transforms=[ros.transform("base_link", "laser", 0, (0, 0, 0))]))
         for k in range(20):
             ns = 44 * 10**11 + k * 10**8
             ros.tf.publish(TFMessage(transforms=[ros.transform("map", "base_link", ns, intel.poses[k])]))

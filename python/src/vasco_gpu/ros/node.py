@@ -13,12 +13,9 @@ import numpy as np
 import rclpy
 from nav_msgs.msg import MapMetaData, OccupancyGrid, Path
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
-from rclpy import exceptions as rclpy_exceptions
-from rclpy.callback_groups import CallbackGroup
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
-from rclpy.subscription import Subscription
 from sensor_msgs.msg import LaserScan, MultiEchoLaserScan, PointCloud2
 from std_srvs.srv import SetBool, Trigger
 
@@ -30,6 +27,7 @@ from ..bags.poses import static_mount
 from ..bags.cloud import cloud_mount, read_cloud
 from ..bags.scans import COUNT_KEYS, read_laser
 from ..bags.tf import TfBuffer
+from .batches import Batches
 from .grid import fill_grid
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
@@ -52,9 +50,6 @@ PATH = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=Histo
 # laser at 1 kHz for scan_batch_interval 0.1 s, or at 40 Hz for 2.5 s
 SENSOR = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE,
                     history=HistoryPolicy.KEEP_LAST)
-QUIET_S = 1.0  # seconds without a /tf or scan message after which batches stop until the next
-DRAIN_MAX = 100_000  # messages a batch takes from one topic at most: a flood cannot hold the node
-_InvalidHandle = getattr(rclpy_exceptions, "InvalidHandle", RuntimeError)
 TF_KEEP_S = 60.0  # seconds of stamps each /tf link keeps
 
 
@@ -75,33 +70,6 @@ class _Pending:
         self.topic, self.ns, self.reading, self.deadline = topic, ns, reading, deadline
         self.received = received  # when received, on perf_counter's clock (DDS's time in a batch)
         self.cloud = cloud  # a PointCloud2 waiting for its mount (reading is None until read)
-
-
-class _BatchGroup(CallbackGroup):
-    """The callback group of /tf and the scan topics. While batching, its subscriptions are in
-    no wait set: a message does not wake the node (each wake-up costs rclpy's executor more
-    Python than the message's own work), the batch timer takes what queued, as rclpy's
-    wait_for_message takes a message. Otherwise a reentrant group: each callback as it comes.
-    The subscriptions' QoS event handlers (in this group too) always wait: rclpy's warning
-    about a publisher with an incompatible QoS comes as it would without batches."""
-
-    def __init__(self):
-        super().__init__()
-        self.batching = False
-
-    def can_execute(self, entity) -> bool:
-        return not (self.batching and isinstance(entity, Subscription))
-
-    def beginning_execution(self, entity) -> bool:
-        return self.can_execute(entity)
-
-    def ending_execution(self, entity) -> None:
-        pass
-
-
-def _can_take(sub) -> bool:
-    """Whether this rclpy lets the node take a subscription's messages itself."""
-    return hasattr(sub, "handle") and hasattr(sub.handle, "take_message")
 
 
 class MappingNode(Node):
@@ -130,11 +98,9 @@ class MappingNode(Node):
         # ... and its steps, per Path (ms): where a Path's time goes, in the summary
         self.path_steps: dict[str, list[float]] = {
             k: [] for k in ("batch", "read", "repose", "finish", "message", "publish")}
-        self._batched = _BatchGroup()
+        self._batches = Batches()
         self._subscribe()
-        self._can_batch = all(_can_take(sub) for sub, _ in self._drained)
-        self._batched.batching = s.scan_batch_interval > 0 and self._can_batch
-        self._last_taken = time.monotonic()  # when a batch last took a message
+        self._batches.start(s.scan_batch_interval)
         self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
         self.meta_pub = self.create_publisher(MapMetaData, "map_metadata", LATCHED)
         self.create_service(Trigger, "~/save_map", self._save_map)
@@ -142,7 +108,7 @@ class MappingNode(Node):
         self.create_service(SetBool, "~/pause", self._pause)
         self._timer = self.create_timer(s.map_update_interval, self._publish_if_changed)
         # Batches: every scan_batch_interval this timer takes what queued on /tf and the scan
-        # topics (_BatchGroup: they do not wake the node) and poses and maps those scans together
+        # topics (batches.py: they do not wake the node) and poses and maps those scans together
         # (one tf lookup, one insert: per scan, rclpy's wake-up, the callbacks' Python and the
         # GPU's launch cost more than the work). With scan_batch_interval 0 each message is a
         # callback, a scan is mapped on arrival or on a later /tf message, and this timer only
@@ -166,7 +132,7 @@ class MappingNode(Node):
 
     def _batch_text(self) -> str:
         s = self.settings
-        if self._batched.batching:
+        if self._batches.running:
             return f"scans mapped in batches every {s.scan_batch_interval:g} s"
         if s.scan_batch_interval > 0:
             return (f"scans gathered every {s.scan_batch_interval:g} s, each message a callback (this rclpy does not "
@@ -204,7 +170,7 @@ class MappingNode(Node):
         if new.scan_batch_interval != self.settings.scan_batch_interval:
             self._flush()  # the scans gathered so far, before the period changes
             self._retry.timer_period_ns = int(self._retry_period(new) * 1e9)
-            self._batched.batching = new.scan_batch_interval > 0 and self._can_batch
+            self._batches.start(new.scan_batch_interval)
             self._arm()
         mode_changed = (new.map_mode, new.free_thresh, new.occupied_thresh) != (
             self.settings.map_mode, self.settings.free_thresh, self.settings.occupied_thresh)
@@ -227,53 +193,23 @@ class MappingNode(Node):
 
     def _arm(self) -> None:
         """The batch timer runs while batches are taken, or some scan waits; else it sleeps."""
-        need = self._batched.batching or bool(self.pending)
+        need = self._batches.running or bool(self.pending)
         if need and self._retry.is_canceled():
             self._retry.reset()
         elif not need and not self._retry.is_canceled():
             self._retry.cancel()
 
     def _on_batch_timer(self) -> None:
-        self._take_batch()
+        self._batches.take(self.settings.scan_batch_interval)
         self._pose_pending()
 
     def _on_input(self, handler, msg) -> None:
         """A message on /tf or a scan topic as a callback: with scan_batch_interval 0, or the first
         after a quiet spell, which starts the batches again."""
         handler(msg, None)
-        if not self._batched.batching and self._can_batch and self.settings.scan_batch_interval > 0:
-            self._batched.batching, self._last_taken = True, time.monotonic()
+        if not self._batches.running and self.settings.scan_batch_interval > 0:
+            self._batches.start(self.settings.scan_batch_interval)
             self._arm()
-
-    def _take_batch(self) -> None:
-        """The messages queued on the scan topics, then on /tf (a /tf that came while the scans
-        were taken is there for them), while batching (they do not wake the node: _BatchGroup)."""
-        if not self._batched.batching:
-            return
-        now, now_ns = time.perf_counter(), time.time_ns()
-        for sub, handler in self._drained[1:] + self._drained[:1]:
-            for _ in range(DRAIN_MAX):
-                try:
-                    with sub.handle:
-                        taken = sub.handle.take_message(sub.msg_type, sub.raw)
-                except _InvalidHandle:  # destroyed: the node is shutting down
-                    return
-                if taken is None:
-                    break
-                self._last_taken = time.monotonic()
-                handler(taken[0], now - self._age(taken[1], now_ns))
-        # A second without a message: the subscriptions wait in the executor again, so that an
-        # idle node's timer sleeps (_on_input starts the batches with the next message).
-        if time.monotonic() - self._last_taken >= QUIET_S:
-            self._batched.batching = False
-
-    def _age(self, info, now_ns: int) -> float:
-        """Seconds since DDS received a message taken now: its received_timestamp, where the
-        middleware gives one (Cyclone DDS gives 0) and it is no older than a batch can be
-        (a step of the system clock); 0 otherwise (taken when received)."""
-        received = info.get("received_timestamp", 0) if isinstance(info, dict) else 0
-        age = (now_ns - received) * 1e-9 if 0 < received <= now_ns else 0.0
-        return age if age <= self.settings.scan_batch_interval + QUIET_S else 0.0
 
     def _subscribe(self) -> None:
         s = self.settings
@@ -283,16 +219,14 @@ class MappingNode(Node):
         # taken tf first and the scan is mapped at once (a batch takes /tf after the scans)
         tf_type = tf_message_type()
         self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
-        self._drained = []  # (subscription, handler(msg, received)) of what batches take: /tf, the scans
         inputs = [(tf_type, "/tf", TF, lambda m, received: self._on_tf(m, False))]
         inputs += [(LaserScan, t, qos, lambda m, received, t=t: self._on_scan(m, t, False, received))
                    for t in s.scan_topics]
         inputs += [(MultiEchoLaserScan, t, qos, lambda m, received, t=t: self._on_scan(m, t, True, received))
                    for t in s.multi_echo_topics]
         for kind, topic, topic_qos, handler in inputs:
-            sub = self.create_subscription(kind, topic, lambda m, h=handler: self._on_input(h, m), topic_qos,
-                                           callback_group=self._batched)
-            self._drained.append((sub, handler))
+            self._batches.add(self.create_subscription(kind, topic, lambda m, h=handler: self._on_input(h, m),
+                                                       topic_qos, callback_group=self._batches.group), handler)
         # clouds (megabytes each) a callback each, as they come: their reading costs far more than
         # a wake-up, and a batch's queue of them would hold hundreds of megabytes
         cloud_qos = qos_profile_sensor_data if s.scan_qos == "sensor_data" else REPLAY
@@ -489,7 +423,7 @@ class MappingNode(Node):
 
     def _flush(self) -> None:
         """The scans gathered for the next batch mapped now (before a Path, a map, a save)."""
-        self._take_batch()
+        self._batches.take(self.settings.scan_batch_interval)
         if self.pending:
             self._pose_pending()
 
