@@ -483,7 +483,7 @@ class Runner:
         within = len(stamps) - bisect_left(stamps, stamps[-1] - keep_ns)
         most[child] = max(most.get(child, 0), within)
         edge = tf._edges.get(child)  # the one look inside: the link's stored samples
-        held = 0 if edge is None else len(edge.ns)
+        held = 0 if edge is None else len(edge)
         if held > most[child] + SAMPLE_SLACK:
             raise Violation("memory", f"link -> {child!r} holds {held} samples, at most {most[child]} within "
                                       f"keep + {SAMPLE_SLACK} expected", index)
