@@ -12,7 +12,7 @@ def sorted_samples(ns: array, values: array, width: int):
     one sample per stamp (the last one recorded for a repeated stamp)."""
     times = np.frombuffer(ns, dtype=np.int64)
     vals = np.frombuffer(values, dtype=np.float64).reshape(-1, width)
-    if (times[1:] > times[:-1]).all():  # already sorted, one a stamp (a Path's, a live /tf link's)
+    if (times[1:] > times[:-1]).all():  # already sorted, one a stamp (a Path's usual order)
         return times.copy(), vals.copy()  # copies: a view would keep an array.array from growing
     order = np.argsort(times, kind="stable")
     times, vals = times[order], vals[order]

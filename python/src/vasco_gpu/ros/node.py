@@ -115,7 +115,7 @@ class MappingNode(Node):
         # drops the scans past transform_timeout, running only while some wait. On the steady
         # clock: with use_sim_time and a paused (or absent) /clock, batches still come, and /tf
         # does not overflow its queue while it waits.
-        self._retry = self.create_timer(self._retry_period(s), self._on_batch_timer,
+        self._retry = self.create_timer(self._retry_period(s), self._flush,
                                         clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._retry.cancel()
         self._arm()
@@ -199,10 +199,6 @@ class MappingNode(Node):
         elif not need and not self._retry.is_canceled():
             self._retry.cancel()
 
-    def _on_batch_timer(self) -> None:
-        self._batches.take(self.settings.scan_batch_interval)
-        self._pose_pending()
-
     def _on_input(self, handler, msg) -> None:
         """A message on /tf or a scan topic as a callback: with scan_batch_interval 0, or the first
         after a quiet spell, which starts the batches again."""
@@ -283,9 +279,8 @@ class MappingNode(Node):
         """A PointCloud2: read once its frame's mount is known (the height band is in base_frame)."""
         if self._paused_on(topic):
             return
-        now = time.perf_counter()
         self.pending.append(_Pending(topic, stamp_ns(msg.header.stamp), None,
-                                     time.monotonic() + self.settings.transform_timeout, now, msg))
+                                     time.monotonic() + self.settings.transform_timeout, time.perf_counter(), msg))
         self._pose_soon()
 
     def _read_cloud(self, p: _Pending) -> bool:
@@ -422,10 +417,10 @@ class MappingNode(Node):
                              f"{p.reading.frame}: its scans are mapped at their tf pose, a Path cannot move them")
 
     def _flush(self) -> None:
-        """The scans gathered for the next batch mapped now (before a Path, a map, a save)."""
+        """The batch: the scans gathered for it mapped (by the timer, and now before a Path, a
+        map, a save)."""
         self._batches.take(self.settings.scan_batch_interval)
-        if self.pending:
-            self._pose_pending()
+        self._pose_pending()
 
     def _on_path(self, raw: bytes) -> None:
         start = time.perf_counter()
