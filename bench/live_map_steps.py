@@ -5,6 +5,8 @@ one at a time, as the node is, then timed on a Path of every pose at the scans' 
 
   repose    LiveMap.repose: the Path's poses to every scan's laser pose, and the render
   render    of that, Mapper.render alone (the backend's re-render from the stored scans)
+  idle      LiveMap.repose again, each run after IDLE_S of sleep (median of 3), as the node
+            applies a Path after a quiet spell: what the wake-up of the device and caches costs
   finish    LiveMap.finish: CARMEN's finish of the grid, the map in host memory
   data      the OccupancyGrid's int8 data of that map (grid.grid_values), trinary
 
@@ -32,6 +34,7 @@ BACKENDS = {"cuda float": {"backend": "cuda", "cuda_mode": "float"},
             "cpu_threads": {"backend": "cpu_threads"}, "cpu_double": {"backend": "cpu_double"}}
 LOGS = ["logs/fr079-complete.gfs.log.gz", "logs/fr101.carmen.log.gz"]
 SCAN_PERIOD_NS = 25_000_000  # 40 Hz
+IDLE_S = 1.0  # the ROS bench's quiet spell before each Path
 
 
 def backend_name(name: str) -> str:
@@ -49,6 +52,20 @@ def median_ms(step, runs: int) -> float:
         step()
         times.append(time.perf_counter() - t)
     return float(np.median(times)) * 1e3
+
+
+def idle_ms(step) -> float:
+    times = []
+    for _ in range(3):
+        time.sleep(IDLE_S)
+        t = time.perf_counter()
+        step()
+        times.append(time.perf_counter() - t)
+    return float(np.median(times)) * 1e3
+
+
+def phases(stats: dict) -> str:
+    return ", ".join(f"{k[:-2]} {stats[k] * 1e3:.2f}" for k in ("prep_s", "upload_s", "map_s", "download_s"))
 
 
 def fed_session(log, name: str) -> LiveMap:
@@ -71,7 +88,7 @@ def main() -> int:
         [b for b in BACKENDS if vg.cuda_available() or not b.startswith("cuda")]
     print(f"# map cell 0.05 m (evidence grid 0.05 m); a Path of every pose at the scans' stamps; median of "
           f"{args.runs} warm runs (CPU backends' repose and render: 3)")
-    print(f"{'log':<26} {'backend':<12} {'map':>11} {'repose ms':>9} {'render ms':>9} {'finish ms':>9} {'data ms':>8}")
+    print(f"{'log':<26} {'backend':<12} {'map':>11} {'repose ms':>9} {'idle ms':>8} {'render ms':>9} {'finish ms':>9} {'data ms':>8}")
     for path in args.logs:
         log = vg.load_log(ROOT / path)
         stamps = 10**12 + np.arange(len(log), dtype=np.int64) * SCAN_PERIOD_NS
@@ -81,12 +98,15 @@ def main() -> int:
             slow = 3 if name.startswith("cpu") else args.runs
             poses = live._pose_array().copy()
             repose = median_ms(lambda: live.repose(stamps, base, 10**9), slow)
+            idle = idle_ms(lambda: live.repose(stamps, base, 10**9))
             render = median_ms(lambda: live.mapper.render(poses), slow)
+            stats = phases(live.mapper.last_stats)
             m = live.finish()
             finish = median_ms(live.finish, args.runs)
             data = median_ms(lambda: grid_values(m, "trinary"), args.runs)
-            print(f"{Path(path).name:<26} {name:<12} {f'{m.size_x}x{m.size_y}':>11} {repose:>9.2f} {render:>9.2f} "
+            print(f"{Path(path).name:<26} {name:<12} {f'{m.size_x}x{m.size_y}':>11} {repose:>9.2f} {idle:>8.2f} {render:>9.2f} "
                   f"{finish:>9.2f} {data:>8.2f}", flush=True)
+            print(f"#   {Path(path).name} {name}: the last render's phases, ms: {stats}", flush=True)
     return 0
 
 
