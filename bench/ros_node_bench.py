@@ -31,7 +31,6 @@ Every ROS process runs on Fast DDS's shared-memory transport in a domain of its 
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -54,21 +53,9 @@ BATCH_DEFAULT = next(p.default for p in NODE_PARAMETERS if p.name == "scan_batch
 
 
 
-def cpu_seconds(pid: int) -> float:
-    fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-
-
-def cpu_share(proc, action) -> float:
-    """The node's CPU time over wall time while action() runs."""
-    c0, t0 = cpu_seconds(proc.proc.pid), time.monotonic()
-    action()
-    return (cpu_seconds(proc.proc.pid) - c0) / (time.monotonic() - t0)
-
-
 def replay_measured(player, proc, scans, stamps, rate):
     """Replays at rate; the node's CPU share over the replay."""
-    return cpu_share(proc, lambda: player.replay(scans, stamps, rate_hz=rate))
+    return proc.cpu_share(lambda: player.replay(scans, stamps, rate_hz=rate))
 
 
 def path_latencies(player, raw: bytes, repeats: int) -> list[float]:
@@ -102,7 +89,7 @@ def bench_one(player, log, name, batch, args, stamps, raw_path):
     try:
         proc.wait_for("ready", timeout=120)
         time.sleep(1.0)  # past start-up and discovery
-        cpu_idle = cpu_share(proc, lambda: time.sleep(3.0))
+        cpu_idle = proc.cpu_share(lambda: time.sleep(3.0))
         live = min(args.live_scans, len(log))
         cpu_live = replay_measured(player, proc, log.scans.select(0, live), stamps[:live], args.rate)
         rest = log.scans.select(live, len(log) - live)

@@ -91,6 +91,17 @@ class NodeProcess:
             self.proc.kill()
             self.proc.wait(10)
 
+    def cpu_seconds(self) -> float:
+        """The process's CPU time so far (user + system, /proc)."""
+        fields = open(f"/proc/{self.proc.pid}/stat").read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+    def cpu_share(self, action) -> float:
+        """The process's CPU time over wall time while action() runs (1.0: one core)."""
+        c0, t0 = self.cpu_seconds(), time.monotonic()
+        action()
+        return (self.cpu_seconds() - c0) / (time.monotonic() - t0)
+
 
 def _ros_value(v) -> str:
     if isinstance(v, bool):

@@ -3,15 +3,23 @@ executor's wait set while batches run, so that their messages do not wake the no
 (each wake-up costs rclpy's Python executor more than the message's own work); a timer of the
 node's takes what queued, as rclpy's wait_for_message takes a message, and the node poses and
 maps those scans together. After a quiet second the subscriptions wait in the executor again,
-so that an idle node sleeps, and the next message starts the batches."""
+so that an idle node sleeps, and the next message starts the batches.
+
+Their QoS event handlers (rclpy's warning about a publisher with an incompatible QoS) wait in no
+wait set while batching either: in rmw_fastrtps a subscription's events share its reader's
+status condition, so an event handler in the executor's wait set wakes it whenever a message
+has queued, and the executor spins until the batch takes it (80 % of a core at 40 Hz instead of
+5 %). Each batch polls them instead, as the executor would, with a wait set of its own that
+does not wait."""
 
 from __future__ import annotations
 
 import time
+from contextlib import ExitStack
 
 from rclpy import exceptions as rclpy_exceptions
 from rclpy.callback_groups import CallbackGroup
-from rclpy.subscription import Subscription
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
 __all__ = ["Batches", "QUIET_S"]
 
@@ -21,17 +29,16 @@ _InvalidHandle = getattr(rclpy_exceptions, "InvalidHandle", RuntimeError)
 
 
 class BatchGroup(CallbackGroup):
-    """The callback group of /tf and the scan topics. While batching, its subscriptions are in
-    no wait set; otherwise a reentrant group: each callback as it comes. The subscriptions' QoS
-    event handlers (in this group too) always wait: rclpy's warning about a publisher with an
-    incompatible QoS comes as it would without batches."""
+    """The callback group of /tf and the scan topics. While batching, nothing of it (the
+    subscriptions, their QoS event handlers) is in a wait set; otherwise a reentrant group:
+    each callback as it comes."""
 
     def __init__(self):
         super().__init__()
         self.batching = False
 
     def can_execute(self, entity) -> bool:
-        return not (self.batching and isinstance(entity, Subscription))
+        return not self.batching
 
     def beginning_execution(self, entity) -> bool:
         return self.can_execute(entity)
@@ -50,8 +57,9 @@ class Batches:
     batches run. ``take`` calls each message's handler(msg, received: when DDS received it, on
     perf_counter's clock)."""
 
-    def __init__(self):
+    def __init__(self, context):
         self.group = BatchGroup()
+        self._context = context
         self._inputs = []  # (subscription, handler)
         self._last_taken = time.monotonic()
 
@@ -85,8 +93,34 @@ class Batches:
                     break
                 self._last_taken = time.monotonic()
                 handler(taken[0], now - _age(taken[1], now_ns, interval + QUIET_S))
+        self._poll_events()
         if time.monotonic() - self._last_taken >= QUIET_S:
             self.group.batching = False
+
+    def _poll_events(self) -> None:
+        """Runs the callbacks of the subscriptions' QoS events that have come, as the executor
+        runs a ready event handler (take_data, then its callback), from a wait set that does not
+        wait (rclpy's wait_for_message builds its wait set so too)."""
+        handlers = [h for sub, _ in self._inputs for h in getattr(sub, "event_handlers", ())]
+        if not handlers or self._context.handle is None:
+            return
+        try:
+            with ExitStack() as held:
+                for h in handlers:
+                    held.enter_context(h)
+                held.enter_context(self._context.handle)
+                wait_set = _rclpy.WaitSet(0, 0, 0, 0, 0, len(handlers), self._context.handle)
+                wait_set.clear_entities()
+                for h in handlers:
+                    h.add_to_wait_set(wait_set)
+                wait_set.wait(0)
+                ready = [h for h in handlers if h.is_ready(wait_set)]
+                taken = [(h, h.take_data()) for h in ready]
+        except _InvalidHandle:  # destroyed: the node is shutting down
+            return
+        for h, data in taken:
+            if data:
+                h.callback(data)
 
 
 def _age(info, now_ns: int, limit: float) -> float:

@@ -98,7 +98,7 @@ class MappingNode(Node):
         # ... and its steps, per Path (ms): where a Path's time goes, in the summary
         self.path_steps: dict[str, list[float]] = {
             k: [] for k in ("batch", "read", "repose", "finish", "message", "publish")}
-        self._batches = Batches()
+        self._batches = Batches(self.context)
         self._subscribe()
         self._batches.start(s.scan_batch_interval)
         self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
