@@ -3,29 +3,32 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
 #include <stdexcept>
 
 namespace carmen {
 namespace {
 
-// out[y * size_x + x] = value(cells[x * size_y + y]), in two passes: the values in the cells'
-// order (a loop of selects the compiler vectorises), then a byte transpose a tile at a time
-// (whole cache lines read and written).
+// out[y * size_x + x] = value(cells[x * size_y + y]), a tile at a time: the tile's values in
+// the cells' order (a loop of selects the compiler vectorises) into a buffer on the stack,
+// then transposed into the rows (whole cache lines read and written). No heap memory: a map's
+// worth of scratch, allocated for each map the node publishes, cost page faults every time.
 template <typename ValueFn>
 void transposed(const GridMap &map, ValueFn value, int8_t *out) {
   constexpr size_t kTile = 64;
-  const size_t w = size_t(map.size_x), h = size_t(map.size_y), n = w * h;
-  const std::unique_ptr<int8_t[]> x_major(new int8_t[n]);
+  const size_t w = size_t(map.size_x), h = size_t(map.size_y);
   const float *cells = map.cells.data();
-  for (size_t i = 0; i < n; ++i) x_major[i] = value(cells[i]);
+  int8_t tile[kTile][kTile];  // [x - x0][y - y0]
   for (size_t x0 = 0; x0 < w; x0 += kTile) {
     const size_t x1 = std::min(w, x0 + kTile);
     for (size_t y0 = 0; y0 < h; y0 += kTile) {
       const size_t y1 = std::min(h, y0 + kTile);
+      for (size_t x = x0; x < x1; ++x) {
+        const float *column = cells + x * h;
+        for (size_t y = y0; y < y1; ++y) tile[x - x0][y - y0] = value(column[y]);
+      }
       for (size_t y = y0; y < y1; ++y) {
         int8_t *row = out + y * w;
-        for (size_t x = x0; x < x1; ++x) row[x] = x_major[x * h + y];
+        for (size_t x = x0; x < x1; ++x) row[x] = tile[x - x0][y - y0];
       }
     }
   }

@@ -9,6 +9,7 @@
 
 #include <climits>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <tuple>
 
@@ -171,26 +172,42 @@ void bind_map_files(nb::module_ &m) {
       "renamed; a failure touches no output and leaves no temporary.");
   m.def(
       "_occupancy_grid_data",
-      [](const Map &mp, const std::string &mode, double free_thresh, double occupied_thresh) {
+      [](const Map &mp, const std::string &mode, double free_thresh, double occupied_thresh,
+         nb::handle out) -> nb::object {
         carmen::MapServerOptions o;
         if (!carmen::parse_pgm_mode(mode, &o.mode))
           throw carmen::Error(carmen::ErrorCode::Usage, "occupancy grid data: mode '" + mode + "': expected trinary or raw");
         o.free_thresh = free_thresh;
         o.occupied_thresh = occupied_thresh;
-        // filled in place: a bytes object nobody else holds yet, written without the GIL
-        nb::bytes out = nb::steal<nb::bytes>(PyBytes_FromStringAndSize(nullptr, Py_ssize_t(mp.grid.cells.size())));
-        if (!out.is_valid()) throw nb::python_error();
-        int8_t *data = reinterpret_cast<int8_t *>(PyBytes_AS_STRING(out.ptr()));
-        {
+        const size_t cells = mp.grid.cells.size();
+        if (out.is_none()) {
+          // filled in place: a bytes object nobody else holds yet, written without the GIL
+          nb::bytes made = nb::steal<nb::bytes>(PyBytes_FromStringAndSize(nullptr, Py_ssize_t(cells)));
+          if (!made.is_valid()) throw nb::python_error();
+          int8_t *data = reinterpret_cast<int8_t *>(PyBytes_AS_STRING(made.ptr()));
           nb::gil_scoped_release release;
           carmen::occupancy_grid_data(mp.grid, o, data);
+          return std::move(made);
         }
-        return out;
+        // a writable buffer of the caller's (the node's message data, used again for each map
+        // of one size): exported while it is written, so that it cannot be resized meanwhile
+        Py_buffer view;
+        if (PyObject_GetBuffer(out.ptr(), &view, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) != 0) throw nb::python_error();
+        const std::unique_ptr<Py_buffer, void (*)(Py_buffer *)> held(&view, PyBuffer_Release);
+        if (size_t(view.len) != cells)
+          throw carmen::Error(carmen::ErrorCode::Usage, "occupancy grid data: out holds " + std::to_string(view.len) +
+                                                            " bytes, the map has " + std::to_string(cells) + " cells");
+        {
+          nb::gil_scoped_release release;
+          carmen::occupancy_grid_data(mp.grid, o, static_cast<int8_t *>(view.buf));
+        }
+        return nb::borrow(out);
       },
-      "map"_a, "mode"_a, "free_thresh"_a, "occupied_thresh"_a,
-      "The map as nav_msgs/OccupancyGrid data (bytes, int8): rows from the lower-left cell; mode\n"
+      "map"_a, "mode"_a, "free_thresh"_a, "occupied_thresh"_a, "out"_a = nb::none(),
+      "The map as nav_msgs/OccupancyGrid data (int8): rows from the lower-left cell; mode\n"
       "trinary (100 / 0 / -1 by the thresholds, as map_server reads a trinary picture) or raw\n"
-      "(round(100 p), -1 unknown). carmen_compat/occupancy_grid.h.");
+      "(round(100 p), -1 unknown). carmen_compat/occupancy_grid.h. Into ``out`` (a writable buffer\n"
+      "of size_x * size_y bytes, returned) when given, else a new bytes object.");
   m.def("_fail_rename_for_testing", &carmen::OutputTransaction::fail_rename_for_testing, "n"_a, "err"_a,
         "Tests only: the n-th rename (1-based) of the next transaction's commit in this process fails\n"
         "with errno ``err``; 0 disarms.");

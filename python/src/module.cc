@@ -108,4 +108,5 @@ NB_MODULE(_core, m) {
   vasco_py::bind_map(m);
   vasco_py::bind_compare(m);
   vasco_py::bind_mapper(m);
+  vasco_py::bind_pose_series(m);
 }

@@ -51,6 +51,7 @@ def test_read_path_equals_rclpys_deserialisation(frames, frame):
     got = path_cdr.read_path(raw, Path)
     f, ns, stamps, ids, pos, quat = expected(msg)
     assert (got.frame_id, got.stamp_ns, got.frame_ids) == (f, ns, ids)
+    assert got.distinct_frames == set(ids)
     assert got.stamps.tolist() == stamps
     assert got.positions.reshape(-1, 3).tolist() == [list(p) for p in pos]  # bit for bit
     assert got.orientations.reshape(-1, 4).tolist() == [list(q) for q in quat]

@@ -20,6 +20,7 @@
 #include "carmen_compat/file_names.h"
 #include "carmen_compat/input_file.h"
 #include "carmen_compat/log_reader.h"
+#include "vasco_gpu/pose_series.h"
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco {
@@ -28,8 +29,6 @@ namespace {
 
 using carmen::ErrorCode;
 using carmen::FileError;
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Longer lines are refused before they are stored: a pose line is well under
 // 1 KiB, so a longer one is a binary or foreign file, not a reason to
@@ -417,18 +416,8 @@ void match_by_id(const PoseFile &file, const Scans &scans, const PoseMatchOption
   finish_unmatched(file, scans, options, "vertex", m);
 }
 
-// The difference b - a taken into [-pi, pi): the shorter way round.
-// remainder() is exact, so a difference already in range is unchanged.
-double angle_difference(double a, double b) {
-  double d = std::remainder(b - a, 2 * kPi);
-  if (d >= kPi) d -= 2 * kPi;
-  return d;
-}
-
 Pose2 interpolate(const StampedPose &p0, const StampedPose &p1, double t) {
-  const double u = (t - p0.stamp) / (p1.stamp - p0.stamp);
-  const Pose2 &a = p0.pose, &b = p1.pose;
-  return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * angle_difference(a.theta, b.theta)};
+  return pose_between(p0.pose, p1.pose, (t - p0.stamp) / (p1.stamp - p0.stamp));
 }
 
 // A distance in seconds for messages: few digits, but enough that it

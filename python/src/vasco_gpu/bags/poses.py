@@ -110,12 +110,12 @@ class PoseSeries:
         return planar_at(times, vals, ns)
 
 
-def planar_at(times: np.ndarray, vals: np.ndarray, ns: np.ndarray, located=None) -> np.ndarray:
+def planar_at(times: np.ndarray, vals: np.ndarray, ns: np.ndarray) -> np.ndarray:
     """(n, 3) planar poses at stamps ns (within the span of the sorted samples times, vals):
     the sample on an exact hit, else linear x, y and shortest-arc yaw between the bracketing
-    samples (the --poses rule; a pose topic's and the live node's Path). located: what
-    bracket(times, ns) gave, when the caller has it."""
-    hit, i, lo, hi, f = bracket(times, ns) if located is None else located
+    samples: the --poses rule, which log2map and the live node's Path take from
+    vasco_gpu/pose_series.h (this package does not load the compiled extension)."""
+    hit, i, lo, hi, f = bracket(times, ns)
     out = vals[i]  # exact hits: the sample unchanged (a SLAM Path's poses are often at the scans' stamps)
     miss = ~hit
     if miss.any():

@@ -92,6 +92,7 @@ class MappingNode(Node):
         self.refused: dict[tuple[str, str], int] = {}
         self._mounts: dict[str, np.ndarray | None] = {}
         self._published = -1
+        self._grid_data = None  # the last /map's data array, written again for a map of its size
         self._last_scan = 0.0
         self.scan_ms = array("d")  # callback -> scan in the grid, per scan
         self.path_ms: list[float] = []  # callback -> /map published, per Path
@@ -460,12 +461,13 @@ class MappingNode(Node):
                           f"map_frame {want!r}", "paths in another frame")
         # the distinct frame_ids first (a Path's are nearly always one): a loop over every pose's
         # cost ~1 ms for fr079's 4,791
-        if any(f and frame_name(f) != want for f in set(path.frame_ids)):
+        if any(f and frame_name(f) != want for f in path.distinct_frames):
             k = next(k for k, f in enumerate(path.frame_ids) if f and frame_name(f) != want)
             raise Refused(f"{topic}: pose {k} (stamp {stamp_text(int(path.stamps[k]))}) is in frame "
                           f"{frame_name(path.frame_ids[k])!r}, not {want!r}", "paths in another frame")
         pos, q = path.positions, path.orientations
-        norm = np.sqrt((q ** 2).sum(axis=1))
+        x, y, z, w = q.T  # a sum over rows of 4 is NumPy's slow reduction (0.07 ms here, 0.01 by columns)
+        norm = np.sqrt(x * x + y * y + z * z + w * w)
         # whole-array checks first, the rows only for a refusal: every NumPy call costs a Path
         # in a live node several times what it costs in a loop
         if not (np.isfinite(pos).all() and np.isfinite(norm).all() and norm.min(initial=1.0) >= 1e-6):
@@ -502,8 +504,9 @@ class MappingNode(Node):
         s = self.settings
         t1 = time.perf_counter()
         msg = OccupancyGrid()
-        fill_grid(msg, m, mode=s.map_mode, frame=s.map_frame, stamp=self.get_clock().now().to_msg(),
-                  free_thresh=s.free_thresh, occupied_thresh=s.occupied_thresh)
+        # the last map's data array, written again: published (serialised) by now
+        self._grid_data = fill_grid(msg, m, mode=s.map_mode, frame=s.map_frame, stamp=self.get_clock().now().to_msg(),
+                                    free_thresh=s.free_thresh, occupied_thresh=s.occupied_thresh, data=self._grid_data)
         t2 = time.perf_counter()
         self.map_pub.publish(msg)
         self.meta_pub.publish(msg.info)
