@@ -33,6 +33,7 @@ from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
 from .settings import NODE_PARAMETERS, Settings, SettingsError, mapper_parameter_names
 from .tf_messages import tf_message_type
+from .transport import map_sized_shm_in_use
 
 __all__ = ["MappingNode"]
 
@@ -129,7 +130,8 @@ class MappingNode(Node):
         self.get_logger().info(
             f"ready: backend {self.live.backend}, scans on {', '.join(topics)}, poses from tf {s.map_frame} -> "
             f"the scans' frames and from the Path on "
-            f"{self.resolve_topic_name(s.path_topic) if s.path_topic else '(none)'}; {self._batch_text()}")
+            f"{self.resolve_topic_name(s.path_topic) if s.path_topic else '(none)'}; {self._batch_text()}"
+            f"{'; maps in one piece over shared memory (up to 4 MiB)' if map_sized_shm_in_use() else ''}")
 
     def _batch_text(self) -> str:
         s = self.settings
