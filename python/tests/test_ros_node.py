@@ -323,6 +323,8 @@ def test_point_clouds_map_as_their_scans(ros, node, intel):
 
 
 def test_no_udp_socket_off_loopback(node):
+    # on shared memory alone, with the node's map-sized profile (test_ros_transport.py)
+    assert "maps in one piece over shared memory" in node.output
     sockets = udp_sockets(node.proc.pid)
     assert not [s for s in sockets if not is_loopback(s)], sockets
 
