@@ -8,7 +8,8 @@
 #                                          steps: parse oracle mapping large scaling session batch;
 #                                          ros, the ROS 2 node, only when named: it needs the [ros] extra;
 #                                          livemap, the node's Path steps without ROS (PYTHON's vasco_gpu),
-#                                          only when named;
+#                                          only when named; transport, a map over Fast DDS's shared memory
+#                                          with its defaults and the node's profile, only when named;
 #                                          peers, MRPT's and OctoMap's grids beside ours (peer_bench, built by
 #                                          make bench-peers), only when named)
 # COST_MODEL_OUT=FILE: batch_bench also writes auto's measured constants there
@@ -57,6 +58,7 @@ for step in $steps; do
            "${PYTHON:-python3}" bench/ros_node_bench.py ${ROS_BENCH_ARGS:-} ;;
     livemap) run_as "python3 bench/live_map_steps.py ${LIVEMAP_ARGS:-}" \
                "${PYTHON:-python3}" bench/live_map_steps.py ${LIVEMAP_ARGS:-} ;;
+    transport) run_as "python3 bench/ros_map_transport.py" "${PYTHON:-python3}" bench/ros_map_transport.py ;;
     peers) run "$build/bin/peer_bench" ${PEER_ARGS:-} ;;
     *) echo "bench/run_all.sh: unknown step '$step'" >&2; exit 2 ;;
   esac

@@ -1,0 +1,123 @@
+#!/usr/bin/env python3
+"""A map from one process to another over Fast DDS's shared memory, as the node publishes it:
+publish() -> the subscriber's callback, per map size, with Fast DDS's defaults (a message cut
+into fragments of 65,500 bytes) and with the node's own profile (vasco_gpu/ros/
+fastdds_shm_maps.xml: whole messages up to 4 MiB), ratios in the same run. The publisher is
+a child process (the profile is read when its participant starts); the subscriber, this one,
+keeps Fast DDS's defaults, as any subscriber of the node's map does.
+
+  map        cells (an OccupancyGrid of one byte a cell: fr079, fr101 at 0.05 m, 2000 x 2000)
+  default    median ms over --maps maps, Fast DDS's defaults on the publisher
+  profile    the same with the node's profile
+  ratio      default / profile
+  bench/ros_map_transport.py [--maps 20]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+from array import array
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "python" / "tests"))
+if "--publish" not in sys.argv:  # the child takes its parent's environment, domain included
+    import ros_support  # noqa: E402,F401  (shared memory alone, a domain of its own)
+
+import numpy as np  # noqa: E402
+
+SIZES = [(941, 375), (1302, 1267), (2000, 2000)]
+TOPIC = "map_transport_bench"
+
+
+def qos():
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+    return QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+def publish(width: int, height: int, count: int) -> int:
+    """The child: count maps, 0.2 s apart, each stamped with CLOCK_MONOTONIC when published."""
+    import rclpy
+    from nav_msgs.msg import OccupancyGrid
+
+    rclpy.init()
+    node = rclpy.create_node("map_transport_publisher")
+    pub = node.create_publisher(OccupancyGrid, TOPIC, qos())
+    end = time.monotonic() + 20
+    while pub.get_subscription_count() == 0 and time.monotonic() < end:
+        time.sleep(0.01)
+    time.sleep(0.5)
+    msg = OccupancyGrid()
+    msg.info.width, msg.info.height = width, height
+    msg.data = array("b", bytes(width * height))
+    for _ in range(count):
+        ns = time.monotonic_ns()
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(ns, 10**9)
+        pub.publish(msg)
+        time.sleep(0.2)
+    time.sleep(0.5)
+    node.destroy_node()
+    rclpy.try_shutdown()
+    return 0
+
+
+def latencies(node, executor, width: int, height: int, count: int, profile: bool) -> list[float]:
+    from nav_msgs.msg import OccupancyGrid
+
+    from vasco_gpu.ros.transport import MAP_SIZED_SHM_PROFILE
+
+    got = []
+    sub = node.create_subscription(OccupancyGrid, TOPIC, lambda m: got.append(
+        (time.monotonic_ns() - (m.header.stamp.sec * 10**9 + m.header.stamp.nanosec)) * 1e-6), qos())
+    env = {k: v for k, v in os.environ.items() if not k.endswith("_DEFAULT_PROFILES_FILE")}
+    if profile:
+        env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(MAP_SIZED_SHM_PROFILE)
+    child = subprocess.Popen([sys.executable, __file__, "--publish", str(width), str(height), str(count)], env=env)
+    try:
+        end = time.monotonic() + 60
+        while child.poll() is None and time.monotonic() < end:
+            executor.spin_once(timeout_sec=0.05)
+        if child.wait(10) != 0 or len(got) < count // 2:
+            raise RuntimeError(f"{width} x {height}: {len(got)} of {count} maps came")
+    finally:
+        if child.poll() is None:
+            child.kill()
+        node.destroy_subscription(sub)
+    return got[1:]  # the first may be the transient-local sample, sent on matching
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--maps", type=int, default=20)
+    ap.add_argument("--publish", nargs=3, type=int, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.publish:
+        return publish(*args.publish)
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+
+    rclpy.init()
+    node = rclpy.create_node("map_transport_bench")
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    print(f"# publish() -> subscriber over Fast DDS shared memory, median of {args.maps} maps")
+    print(f"{'map':>11} {'MB':>6} {'default ms':>10} {'profile ms':>10} {'ratio':>6}")
+    try:
+        for w, h in SIZES:
+            default = float(np.median(latencies(node, executor, w, h, args.maps, False)))
+            profile = float(np.median(latencies(node, executor, w, h, args.maps, True)))
+            print(f"{f'{w}x{h}':>11} {w * h / 1e6:>6.2f} {default:>10.2f} {profile:>10.2f} {default / profile:>5.1f}x",
+                  flush=True)
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
