@@ -381,6 +381,8 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-c.txt"),
         "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --paths 5": Check(
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100.txt"),
+        "text: ## python3 bench/ros_map_transport.py": Check(
+            "quoted", quote_of="bench/results/bench-ros-transport-2026-12-05-2core.txt"),
     },
     "docs/walkthrough-bag.md": {
         # carmen2bag and mapdiff are not among test_readme.py's tools: the test runs the block
