@@ -29,6 +29,8 @@ def use_map_sized_shm(environ=os.environ) -> bool:
         return False
     if any(environ.get(v) for v in _PROFILE_VARIABLES) or environ.get("RMW_IMPLEMENTATION", "") not in _FAST_DDS:
         return False
+    if not MAP_SIZED_SHM_PROFILE.is_file():  # an install without it: Fast DDS's defaults, as before
+        return False
     environ["FASTDDS_DEFAULT_PROFILES_FILE"] = str(MAP_SIZED_SHM_PROFILE)
     return True
 
