@@ -376,9 +376,9 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "text: ## python3 bench/ros_node_bench.py --fast-rate 800": Check(
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-h200.txt"),
         "text: ## python3 bench/ros_node_bench.py --fast-rate 400 --batch 0": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-c.txt"),
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-d.txt"),
         "text: ## python3 bench/live_map_steps.py": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-c.txt"),
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-d.txt"),
         "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --paths 5": Check(
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100.txt"),
         "text: ## python3 bench/ros_map_transport.py": Check(
