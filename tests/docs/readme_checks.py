@@ -379,8 +379,10 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-d.txt"),
         "text: ## python3 bench/live_map_steps.py": Check(
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-d.txt"),
-        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --paths 5": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100.txt"),
+        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --logs lo": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-b.txt"),
+        "text: ## python3 bench/live_map_steps.py --logs logs/fr079-complet": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-b.txt"),
         "text: ## python3 bench/ros_map_transport.py": Check(
             "quoted", quote_of="bench/results/bench-ros-transport-2026-12-05-2core.txt"),
     },
