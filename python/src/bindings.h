@@ -25,6 +25,7 @@ void bind_map(nb::module_ &m);      // Map, _read_map, write_map
 void bind_compare(nb::module_ &m);  // Comparison, compare
 void bind_mapper(nb::module_ &m);   // Mapper
 void bind_pose_series(nb::module_ &m);  // _repose (pose_series.h)
+void bind_path_cdr(nb::module_ &m);     // _path_from_cdr (the node's Path bytes)
 
 // The batch's poses as a new (n, 3) float64 array of (x, y, theta).
 nb::ndarray<nb::numpy, double> poses_of(const vasco::ScanBatch &b);

@@ -67,6 +67,9 @@ def test_the_fast_route_takes_one_frame_id_length():
 
 def test_bytes_that_are_not_a_path_are_a_value_error():
     raw = serialize_message(make_path(["map"] * 20))
-    for bad in (raw[:40], raw[:-8], b"\x00\x01\x00\x00" + b"\xff" * 12):
+    # a pose count of 2^31 - 1 (after the encapsulation 4, stamp 8, "map" 4 + 4): refused before
+    # anything is allocated for it
+    huge = raw[:20] + (2**31 - 1).to_bytes(4, "little") + raw[24:]
+    for bad in (raw[:40], raw[:-8], b"\x00\x01\x00\x00" + b"\xff" * 12, huge):
         with pytest.raises(ValueError):
             path_cdr.read_path(bad, Path)

@@ -93,7 +93,8 @@ class MappingNode(Node):
         self.refused: dict[tuple[str, str], int] = {}
         self._mounts: dict[str, np.ndarray | None] = {}
         self._published = -1
-        self._grid_data = None  # the last /map's data array, written again for a map of its size
+        self._grid_msg = OccupancyGrid()  # /map's message, filled again for each map
+        self._grid_data = None  # its data array, written again for a map of its size
         self._last_scan = 0.0
         self.scan_ms = array("d")  # callback -> scan in the grid, per scan
         self.path_ms: list[float] = []  # callback -> /map published, per Path
@@ -505,8 +506,9 @@ class MappingNode(Node):
             return {}
         s = self.settings
         t1 = time.perf_counter()
-        msg = OccupancyGrid()
-        # the last map's data array, written again: published (serialised) by now
+        # one message, filled again for each map (published, that is serialised, by then), with
+        # its data array written again where the size is the same
+        msg = self._grid_msg
         self._grid_data = fill_grid(msg, m, mode=s.map_mode, frame=s.map_frame, stamp=self.get_clock().now().to_msg(),
                                     free_thresh=s.free_thresh, occupied_thresh=s.occupied_thresh, data=self._grid_data)
         t2 = time.perf_counter()
