@@ -35,9 +35,10 @@ TOPIC = "map_transport_bench"
 
 
 def qos():
-    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    """/map's QoS, the node's own (reliable, transient local, depth 1)."""
+    from vasco_gpu.ros.node import LATCHED
 
-    return QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    return LATCHED
 
 
 def publish(width: int, height: int, count: int) -> int:

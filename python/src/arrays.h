@@ -63,6 +63,17 @@ nb::ndarray<const T, nb::c_contig, nb::device::cpu> as_array(nb::handle obj, con
   return arr;
 }
 
+// `obj` as a C-contiguous (n, 3) float64 array of (x, y, theta) rows, one a
+// `row` (a scan, a pose); another shape is bad input naming `what`.
+inline nb::ndarray<const double, nb::c_contig, nb::device::cpu> xy_theta_rows(nb::handle obj, const char *what,
+                                                                             const char *row) {
+  auto a = as_array<double>(obj, "float64", what, 2);
+  if (a.shape(1) != 3)
+    throw carmen::Error(carmen::ErrorCode::BadInput,
+                        std::string(what) + ": expected shape (n, 3) (x, y, theta per " + row + ")");
+  return a;
+}
+
 }  // namespace vasco_py
 
 #endif  // VASCO_PY_ARRAYS_H

@@ -120,8 +120,7 @@ nb::dict stats_dict(const vasco::MapStats &s) {
 }
 
 std::vector<vasco::Pose> poses_from(nb::handle obj) {
-  auto a = as_array<double>(obj, "float64", "poses", 2);
-  if (a.shape(1) != 3) throw Error(ErrorCode::BadInput, "poses: expected shape (n, 3) (x, y, theta per scan)");
+  auto a = xy_theta_rows(obj, "poses", "scan");
   std::vector<vasco::Pose> p(a.shape(0));
   const double *d = a.data();
   for (size_t s = 0; s < p.size(); ++s) p[s] = {d[3 * s], d[3 * s + 1], d[3 * s + 2]};

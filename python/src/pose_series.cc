@@ -29,11 +29,9 @@ using Rows = nb::ndarray<double, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 
 [[noreturn]] void bad(const std::string &what) { throw carmen::Error(carmen::ErrorCode::BadInput, what); }
 
-// Rows of (x, y, theta) as Pose2s, n of them.
-const Pose2 *pose_rows(const nb::ndarray<const double, nb::c_contig, nb::device::cpu> &a, size_t n, const char *what) {
-  if (a.shape(0) != n || a.shape(1) != 3)
-    bad(std::string(what) + ": expected (" + std::to_string(n) + ", 3), got (" + std::to_string(a.shape(0)) + ", " +
-        std::to_string(a.shape(1)) + ")");
+// The rows of an (n, 3) array (xy_theta_rows) as Pose2s; a row count other than n is bad input.
+const Pose2 *as_poses(const nb::ndarray<const double, nb::c_contig, nb::device::cpu> &a, size_t n, const char *what) {
+  if (a.shape(0) != n) bad(std::string(what) + ": " + std::to_string(a.shape(0)) + " rows for " + std::to_string(n) + " stamps");
   return reinterpret_cast<const Pose2 *>(a.data());
 }
 
@@ -46,12 +44,12 @@ Pose2 on_mount(const Pose2 &base, const Pose2 &mount) {
 nb::tuple repose(nb::handle path_ns_obj, nb::handle path_poses_obj, nb::handle scan_ns_obj, nb::handle mounts_obj,
                  Rows laser, int64_t max_gap_ns) {
   const auto path_ns = as_array<int64_t>(path_ns_obj, "int64", "path stamps", 1);
-  const auto path_poses = as_array<double>(path_poses_obj, "float64", "path poses", 2);
+  const auto path_poses = xy_theta_rows(path_poses_obj, "path poses", "pose");
   const auto scan_ns = as_array<int64_t>(scan_ns_obj, "int64", "scan stamps", 1);
-  const auto mounts = as_array<double>(mounts_obj, "float64", "mounts", 2);
+  const auto mounts = xy_theta_rows(mounts_obj, "mounts", "scan");
   const size_t k = path_ns.shape(0), n = scan_ns.shape(0);
-  const Pose2 *given = pose_rows(path_poses, k, "path poses");
-  const Pose2 *mount = pose_rows(mounts, n, "mounts");
+  const Pose2 *given = as_poses(path_poses, k, "path poses");
+  const Pose2 *mount = as_poses(mounts, n, "mounts");
   if (laser.shape(0) != n || laser.shape(1) != 3) bad("laser poses: expected (" + std::to_string(n) + ", 3)");
   Pose2 *out = reinterpret_cast<Pose2 *>(laser.data());
   size_t moved = 0, outside = 0, in_gap = 0, no_mount = 0;
@@ -61,26 +59,21 @@ nb::tuple repose(nb::handle path_ns_obj, nb::handle path_poses_obj, nb::handle s
     std::vector<Pose2> poses(given, given + k);
     vasco::sort_series(stamps, poses);
     const vasco::PoseSeriesView series{stamps.data(), poses.data(), stamps.size()};
-    for (size_t i = 0; i < n && !stamps.empty(); ++i) {
-      const int64_t t = scan_ns.data()[i];
-      if (t < stamps.front() || t > stamps.back()) {
-        ++outside;
-        continue;
-      }
-      const Pose2 &m = mount[i];
-      if (!(std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.theta))) {
-        ++no_mount;
-        continue;
-      }
+    for (size_t i = 0; i < n; ++i) {
       Pose2 base;
-      if (vasco::pose_at_stamp(series, t, max_gap_ns, base) == SeriesPlace::InGap) {
+      const SeriesPlace place = vasco::pose_at_stamp(series, scan_ns.data()[i], max_gap_ns, base);
+      const Pose2 &m = mount[i];
+      if (place == SeriesPlace::Outside) {
+        ++outside;
+      } else if (!(std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.theta))) {
+        ++no_mount;  // within the span: counted whatever the gap
+      } else if (place == SeriesPlace::InGap) {
         ++in_gap;
-        continue;
+      } else {
+        out[i] = on_mount(base, m);
+        ++moved;
       }
-      out[i] = on_mount(base, m);
-      ++moved;
     }
-    if (stamps.empty()) outside = n;
   }
   return nb::make_tuple(moved, outside, in_gap, no_mount);
 }

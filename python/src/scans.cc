@@ -62,8 +62,7 @@ std::vector<double> per_scan(nb::handle obj, const char *what, size_t n) {
 
 ScanBatch make_scans(nb::handle poses_obj, nb::handle ranges_obj, nb::handle counts_obj, nb::handle first_obj,
                      nb::handle step_obj) {
-  auto poses = as_array<double>(poses_obj, "float64", "poses", 2);
-  if (poses.shape(1) != 3) throw Error(ErrorCode::BadInput, "poses: expected shape (n, 3) (x, y, theta per scan)");
+  auto poses = xy_theta_rows(poses_obj, "poses", "scan");
   const size_t n = poses.shape(0);
   auto ranges = as_array<float>(ranges_obj, "float32", "ranges", 1);
   const std::vector<int> counts = beam_counts_from(counts_obj, n);

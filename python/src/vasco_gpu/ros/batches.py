@@ -61,6 +61,7 @@ class Batches:
         self.group = BatchGroup()
         self._context = context
         self._inputs = []  # (subscription, handler)
+        self._events = []  # their QoS event handlers, polled by each batch
         self._last_taken = time.monotonic()
 
     @property
@@ -69,6 +70,7 @@ class Batches:
 
     def add(self, sub, handler) -> None:
         self._inputs.append((sub, handler))
+        self._events.extend(getattr(sub, "event_handlers", ()))
 
     def start(self, interval: float) -> None:
         """Batches every interval seconds (> 0; where this rclpy lets the node take messages),
@@ -101,7 +103,7 @@ class Batches:
         """Runs the callbacks of the subscriptions' QoS events that have come, as the executor
         runs a ready event handler (take_data, then its callback), from a wait set that does not
         wait (rclpy's wait_for_message builds its wait set so too)."""
-        handlers = [h for sub, _ in self._inputs for h in getattr(sub, "event_handlers", ())]
+        handlers = self._events
         if not handlers or self._context.handle is None:
             return
         try:
