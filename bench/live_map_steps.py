@@ -9,6 +9,9 @@ one at a time, as the node is, then timed on a Path of every pose at the scans' 
             applies a Path after a quiet spell: what the wake-up of the device and caches costs
   finish    LiveMap.finish: CARMEN's finish of the grid, the map in host memory
   data      the OccupancyGrid's int8 data of that map (grid.grid_values), trinary
+  grid      LiveMap.finish_grid: the finish as that data at once, written into the last map's
+            array (what the node does; on the GPU for cuda, where only the bytes come back):
+            the work of finish + data
 
 What the node adds to these (reading the Path, building and publishing the message, DDS) is
 ros_node_bench.py's; run cold in the node, each step takes longer than here.
@@ -88,7 +91,7 @@ def main() -> int:
         [b for b in BACKENDS if vg.cuda_available() or not b.startswith("cuda")]
     print(f"# map cell 0.05 m (evidence grid 0.05 m); a Path of every pose at the scans' stamps; median of "
           f"{args.runs} warm runs (CPU backends' repose and render: 3)")
-    print(f"{'log':<26} {'backend':<12} {'map':>11} {'repose ms':>9} {'idle ms':>8} {'render ms':>9} {'finish ms':>9} {'data ms':>8}")
+    print(f"{'log':<26} {'backend':<12} {'map':>11} {'repose ms':>9} {'idle ms':>8} {'render ms':>9} {'finish ms':>9} {'data ms':>8} {'grid ms':>8}")
     for path in args.logs:
         log = vg.load_log(ROOT / path)
         stamps = 10**12 + np.arange(len(log), dtype=np.int64) * SCAN_PERIOD_NS
@@ -104,8 +107,10 @@ def main() -> int:
             m = live.finish()
             finish = median_ms(live.finish, args.runs)
             data = median_ms(lambda: grid_values(m, "trinary"), args.runs)
+            out = bytearray(m.size_x * m.size_y)
+            grid = median_ms(lambda: live.finish_grid("trinary", 0.196, 0.65, out=out), args.runs)
             print(f"{Path(path).name:<26} {name:<12} {f'{m.size_x}x{m.size_y}':>11} {repose:>9.2f} {idle:>8.2f} {render:>9.2f} "
-                  f"{finish:>9.2f} {data:>8.2f}", flush=True)
+                  f"{finish:>9.2f} {data:>8.2f} {grid:>8.2f}", flush=True)
             print(f"#   {Path(path).name} {name}: the last render's phases, ms: {stats}", flush=True)
     return 0
 

@@ -19,7 +19,8 @@ for each backend. Printed as a table, ratios in the same run:
               reading the Path, the render, the finish, the OccupancyGrid); the rest is DDS
               carrying the Path and the map, and the callbacks' wake-ups; its steps (batch: map
               the scans still waiting for their batch, read the Path, repose: move the scans
-              and render, finish, message, publish) follow the table
+              and render, finish: CARMEN's finish as the OccupancyGrid's data (on the GPU for
+              cuda), message: the rest of the message, publish) follow the table
   vs cpu_double  cpu_double's Path->/map (at the first --batch) over this one: against rebuilding the map from
               every scan on the CPU, as a CPU mapper does after a loop closure
 

@@ -178,6 +178,23 @@ TEST_F(MapperCuda, FinishOnTheDeviceEqualsCarmensFinishOfTheGrid) {
   }
 }
 
+// finish as OccupancyGrid data, converted on the device: the host's
+// conversion of the finish, in either mode; in a grown grid (finished on the
+// host in strips) too.
+TEST_F(MapperCuda, FinishOccupancyOnTheDeviceIsTheHostsConversion) {
+  for (CudaMode md : {CudaMode::Float, CudaMode::Exact}) {
+    Mapper m(params_, "cuda", mode(md));
+    m.insert(scans_);
+    for (int ds : {1, 3}) testing_support::expect_occupancy_of_finish(m, ds, 20, m.backend_name());
+    testing_support::expect_occupancy_of_finish(m, 1, 0, m.backend_name() + " border 0");
+    Mapper grown(params_, "cuda", mode(md));
+    for (size_t a = 0; a < scans_.num_scans(); a += 70)
+      grown.insert(scans_.select(static_cast<long>(a), 70));
+    ASSERT_NE(grown.grid_frame().size_x, grown.frame().size_x) << "the grid did not grow: the case is not tested";
+    testing_support::expect_occupancy_of_finish(grown, 1, 20, grown.backend_name() + " grown");
+  }
+}
+
 // Float mode sums fixed-point log-odds with integer atomics, so neither the
 // order of the adds (which the GPU picks anew on every run) nor the split of
 // the scans into inserts changes a bit. (With float atomics, three runs of

@@ -238,6 +238,23 @@ TEST(MapperSession, ReadsAWindowOfTheGrid) {
   EXPECT_THROW(m.read(GridWindow{INT_MAX, 0, INT_MAX, 1}), vasco::Error);
 }
 
+// finish as OccupancyGrid data on the CPU (the renderers' default: finish,
+// then the host's conversion), in the session's frame and in a grown grid
+// (finished in strips from the grid's window).
+TEST(MapperSession, FinishOccupancyIsTheConversionOfTheFinish) {
+  const Fixture f = fr079(300);
+  for (const char *backend : {"cpu_double", "cpu_float"}) {
+    Mapper m(f.params, backend);
+    m.insert(f.scans);
+    testing_support::expect_occupancy_of_finish(m, 1, 20, backend);
+    testing_support::expect_occupancy_of_finish(m, 3, 0, backend);
+  }
+  Mapper grown(f.params, "cpu_float");
+  for (size_t a = 0; a < 300; a += 30) grown.insert(part(f.scans, a, a + 30));
+  ASSERT_NE(grown.grid_frame().size_x, grown.frame().size_x) << "the grid did not grow: the case is not tested";
+  testing_support::expect_occupancy_of_finish(grown, 1, 20, "cpu_float grown");
+}
+
 TEST(MapperSession, ErrorsLeaveTheSessionAsItWas) {
   const Fixture f = fr079(30);
   Mapper m(f.params);

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -11,7 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "carmen_compat/occupancy_grid.h"
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/renderer.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
@@ -79,6 +82,53 @@ inline void expect_bit_identical(const std::vector<float> &ref, const std::vecto
     msg << "first difference at cell (" << i / geo.size_y << ", " << i % geo.size_y << "): oracle "
         << ref[i] << ", " << what << " " << got[i];
     ADD_FAILURE() << msg.str();
+  }
+}
+
+// Fails the test unless the session's finish as OccupancyGrid data
+// (Mapper::finish_occupancy, converted where the grid is) is the host's
+// conversion (carmen_compat/occupancy_grid.h, tested against map_server's
+// reading of our pictures) of its finish(), with the same frame, for both
+// modes and two pairs of thresholds; `out` is asked once, for the map's
+// cells.
+inline void expect_occupancy_of_finish(const Mapper &m, int ds, int border, const std::string &what) {
+  const FinishedMap ref = m.finish(ds, border);
+  carmen::GridMap grid = carmen::GridMap::filled(ref.size_x, ref.size_y, ref.resolution);
+  grid.cells = ref.cells;
+  carmen::MapServerOptions opts[3];
+  opts[1].free_thresh = 0.25;
+  opts[1].occupied_thresh = 0.5;
+  opts[2].mode = carmen::PgmMode::Raw;
+  for (const carmen::MapServerOptions &o : opts) {
+    const std::vector<int8_t> want = carmen::occupancy_grid_data(grid, o);
+    if (&o == &opts[0]) {  // a map with cells of every kind, or the comparison would prove little
+      EXPECT_TRUE(std::count(want.begin(), want.end(), 100) > 0 && std::count(want.begin(), want.end(), 0) > 0 &&
+                  std::count(want.begin(), want.end(), -1) > 0)
+          << what << ": a map without occupied, free and unknown cells";
+    }
+    std::vector<int8_t> got;
+    int asked = 0;
+    const FinishedMap f = m.finish_occupancy(carmen::occupancy_values(o), [&](size_t n) {
+      ++asked;
+      got.assign(n, int8_t(42));
+      return got.data();
+    }, ds, border);
+    const std::string label = what + " downsample " + std::to_string(ds) + " mode " +
+                              (o.mode == carmen::PgmMode::Raw ? "raw" : "trinary") + " free " +
+                              std::to_string(o.free_thresh);
+    EXPECT_EQ(asked, 1) << label;
+    EXPECT_TRUE(f.cells.empty()) << label;
+    EXPECT_EQ(f.size_x, ref.size_x) << label;
+    EXPECT_EQ(f.size_y, ref.size_y) << label;
+    EXPECT_EQ(f.min_x, ref.min_x) << label;
+    EXPECT_EQ(f.min_y, ref.min_y) << label;
+    EXPECT_EQ(f.resolution, ref.resolution) << label;
+    EXPECT_EQ(f.downsample, ref.downsample) << label;
+    ASSERT_EQ(got.size(), want.size()) << label;
+    size_t differ = 0, first = got.size();
+    for (size_t i = 0; i < got.size(); ++i)
+      if (got[i] != want[i] && differ++ == 0) first = i;
+    EXPECT_EQ(differ, 0u) << label << ": first at data index " << first;
   }
 }
 

@@ -13,10 +13,8 @@ namespace {
 // then transposed into the rows (whole cache lines read and written). No heap memory: a map's
 // worth of scratch, allocated for each map the node publishes, cost page faults every time.
 template <typename ValueFn>
-void transposed(const GridMap &map, ValueFn value, int8_t *out) {
+void transposed(const float *cells, size_t w, size_t h, ValueFn value, int8_t *out) {
   constexpr size_t kTile = 64;
-  const size_t w = size_t(map.size_x), h = size_t(map.size_y);
-  const float *cells = map.cells.data();
   int8_t tile[kTile][kTile];  // [x - x0][y - y0]
   for (size_t x0 = 0; x0 < w; x0 += kTile) {
     const size_t x1 = std::min(w, x0 + kTile);
@@ -50,37 +48,33 @@ float smallest_float_not_below(double t) {
 
 }  // namespace
 
-void occupancy_grid_data(const GridMap &map, const MapServerOptions &o, int8_t *out) {
-  check_map_size(map, "occupancy grid data");
+OccupancyValues occupancy_values(const MapServerOptions &o) {
   if (o.negate) throw std::invalid_argument("occupancy grid data: negate has no meaning here");
   switch (o.mode) {
-    case PgmMode::Trinary: {
-      // map_server's double comparisons (p > occupied_thresh, p < free_thresh) made on the
-      // float cells by the float bounds that decide them alike. An off-limits cell (2 and
-      // above) is above any occupied_thresh (at most 1), a cell between 1 and 2 too: both 100,
-      // as is_offlimits and clamp01 have it in the pictures.
-      const float occupied = largest_float_not_above(o.occupied_thresh);
-      const float free = smallest_float_not_below(o.free_thresh);
-      transposed(map, [occupied, free](float v) -> int8_t {
-        const int8_t known = v > occupied ? int8_t(100) : v < free ? int8_t(0) : int8_t(-1);
-        return is_unknown(v) ? int8_t(-1) : known;
-      }, out);
-      return;
-    }
+    case PgmMode::Trinary:
+      return OccupancyValues{false, largest_float_not_above(o.occupied_thresh), smallest_float_not_below(o.free_thresh)};
     case PgmMode::Raw:
-      transposed(map, [](float v) -> int8_t {
-        // round(100 p), halves up, as floor(100 p + 0.5): exact for every float p in [0, 1]
-        // (100 p is then a multiple of 2^-22 below 2^7, so adding 0.5 rounds nothing); 1 and
-        // above (off-limits too) 100
-        const double p = is_unknown(v) ? 0.0 : std::min(double(v), 1.0);  // no NaN converted
-        const int8_t level = static_cast<int8_t>(100.0 * p + 0.5);
-        return is_unknown(v) ? int8_t(-1) : level;
-      }, out);
-      return;
+      return OccupancyValues{true, 0.0f, 0.0f};
     case PgmMode::Scale:
       break;
   }
   throw std::invalid_argument("occupancy grid data: mode scale (a grey level's occupancy) has no meaning here");
+}
+
+// One loop per rule (occupancy_value.h's two), so that each vectorises without a test per cell.
+void occupancy_grid_data(const float *cells, int size_x, int size_y, const OccupancyValues &values, int8_t *out) {
+  const size_t w = static_cast<size_t>(size_x), h = static_cast<size_t>(size_y);
+  if (values.raw) {
+    transposed(cells, w, h, [](float v) { return raw_occupancy_value(v); }, out);
+  } else {
+    const float occupied = values.occupied, free = values.free;
+    transposed(cells, w, h, [occupied, free](float v) { return trinary_occupancy_value(occupied, free, v); }, out);
+  }
+}
+
+void occupancy_grid_data(const GridMap &map, const MapServerOptions &o, int8_t *out) {
+  check_map_size(map, "occupancy grid data");
+  occupancy_grid_data(map.cells.data(), map.size_x, map.size_y, occupancy_values(o), out);
 }
 
 std::vector<int8_t> occupancy_grid_data(const GridMap &map, const MapServerOptions &o) {

@@ -174,11 +174,8 @@ void bind_map_files(nb::module_ &m) {
       "_occupancy_grid_data",
       [](const Map &mp, const std::string &mode, double free_thresh, double occupied_thresh,
          nb::handle out) -> nb::object {
-        carmen::MapServerOptions o;
-        if (!carmen::parse_pgm_mode(mode, &o.mode))
-          throw carmen::Error(carmen::ErrorCode::Usage, "occupancy grid data: mode '" + mode + "': expected trinary or raw");
-        o.free_thresh = free_thresh;
-        o.occupied_thresh = occupied_thresh;
+        const carmen::OccupancyValues values = occupancy_values(mode, free_thresh, occupied_thresh);
+        carmen::check_map_size(mp.grid, "occupancy grid data");
         const size_t cells = mp.grid.cells.size();
         if (out.is_none()) {
           // filled in place: a bytes object nobody else holds yet, written without the GIL
@@ -186,7 +183,7 @@ void bind_map_files(nb::module_ &m) {
           if (!made.is_valid()) throw nb::python_error();
           int8_t *data = reinterpret_cast<int8_t *>(PyBytes_AS_STRING(made.ptr()));
           nb::gil_scoped_release release;
-          carmen::occupancy_grid_data(mp.grid, o, data);
+          carmen::occupancy_grid_data(mp.grid.cells.data(), mp.grid.size_x, mp.grid.size_y, values, data);
           return std::move(made);
         }
         // a writable buffer of the caller's (the node's message data, used again for each map
@@ -199,7 +196,8 @@ void bind_map_files(nb::module_ &m) {
                                                             " bytes, the map has " + std::to_string(cells) + " cells");
         {
           nb::gil_scoped_release release;
-          carmen::occupancy_grid_data(mp.grid, o, static_cast<int8_t *>(view.buf));
+          carmen::occupancy_grid_data(mp.grid.cells.data(), mp.grid.size_x, mp.grid.size_y, values,
+                                      static_cast<int8_t *>(view.buf));
         }
         return nb::borrow(out);
       },

@@ -6,6 +6,7 @@
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_format.h"
+#include "carmen_compat/occupancy_grid.h"
 #include "vasco_gpu/map_output.h"
 #include "vasco_gpu/pipeline/outputs.h"
 #include "vasco_gpu/version.h"
@@ -24,6 +25,15 @@ Map map_from_finished(vasco::FinishedMap &&f, const vasco::GridGeometry &geo) {
   m.min_y = f.min_y;
   m.has_origin = true;
   return m;
+}
+
+carmen::OccupancyValues occupancy_values(const std::string &mode, double free_thresh, double occupied_thresh) {
+  carmen::MapServerOptions o;
+  if (!carmen::parse_pgm_mode(mode, &o.mode) || o.mode == carmen::PgmMode::Scale)
+    throw carmen::Error(carmen::ErrorCode::Usage, "occupancy grid data: mode '" + mode + "': expected trinary or raw");
+  o.free_thresh = free_thresh;
+  o.occupied_thresh = occupied_thresh;
+  return carmen::occupancy_values(o);
 }
 
 Map read_map(const std::string &path) {

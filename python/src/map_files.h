@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "carmen_compat/map_file.h"
+#include "carmen_compat/occupancy_value.h"
 #include "vasco_gpu/grid.h"
 
 namespace vasco_py {
@@ -36,6 +37,11 @@ void write_map(const std::string &path, const Map &m, const std::string &pgm_mod
 // write_map_outputs): all written, or none touched.
 void write_maps(const std::vector<std::string> &paths, const Map &m, const std::string &pgm_mode,
                 const std::string &description);
+
+// The per-cell rule of OccupancyGrid data (carmen_compat/occupancy_value.h)
+// for a mode ("trinary" or "raw") and map_server's thresholds; Error(Usage)
+// for another mode.
+carmen::OccupancyValues occupancy_values(const std::string &mode, double free_thresh, double occupied_thresh);
 
 // Error(BadInput) naming `what` when a cell of `m` is not a CARMEN cell value.
 void check_cells(const Map &m, const std::string &what);

@@ -20,6 +20,7 @@
 #include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "arrays.h"
@@ -28,6 +29,7 @@
 #include "interruptible.h"
 #include "map_files.h"
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/map_output.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/pipeline/mapped.h"
 
@@ -166,6 +168,43 @@ Map finish(Session &s, std::optional<int> downsample, std::optional<int> border)
   });
 }
 
+// finish as OccupancyGrid data (Mapper::finish_occupancy): ((size_x, size_y, resolution,
+// origin), data). The data goes into `out` (a writable buffer, exported while it is written, so
+// that it cannot be resized meanwhile) when the map has its size, else into new bytes.
+nb::tuple finish_occupancy_grid(Session &s, const std::string &mode, double free_thresh, double occupied_thresh,
+                                nb::handle out, std::optional<int> downsample, std::optional<int> border) {
+  const carmen::OccupancyValues values = occupancy_values(mode, free_thresh, occupied_thresh);
+  Py_buffer view{};
+  std::unique_ptr<Py_buffer, void (*)(Py_buffer *)> held(nullptr, PyBuffer_Release);
+  if (!out.is_none()) {
+    if (PyObject_GetBuffer(out.ptr(), &view, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) != 0) throw nb::python_error();
+    held.reset(&view);
+  }
+  std::vector<int8_t> scratch;  // when out is not given or has another size
+  bool into_out = false;
+  const vasco::OccupancyOut where = [&](size_t n) {
+    into_out = held && static_cast<size_t>(view.len) == n;
+    if (into_out) return static_cast<int8_t *>(view.buf);
+    scratch.resize(n);
+    return scratch.data();
+  };
+  const auto [f, origin] = run_interruptible([&] {
+    return s.locked([&](vasco::Mapper &m) {
+      const int ds = downsample ? *downsample : static_cast<int>(m.params().downsample);
+      const int b = border ? *border : static_cast<int>(m.params().border);
+      vasco::FinishedMap map = m.finish_occupancy(values, where, ds, b);
+      const carmen::GlobalOffset at = vasco::world_origin(map, m.frame());
+      return std::make_pair(std::move(map), at);
+    });
+  });
+  nb::object data = into_out ? nb::borrow(out)
+                             : nb::steal(PyBytes_FromStringAndSize(reinterpret_cast<const char *>(scratch.data()),
+                                                                   Py_ssize_t(scratch.size())));
+  if (!data.is_valid()) throw nb::python_error();
+  return nb::make_tuple(nb::make_tuple(f.size_x, f.size_y, f.resolution, nb::make_tuple(origin.x, origin.y, origin.theta)),
+                        data);
+}
+
 void start_over(Session &s, const vasco::MapperParams &params) {
   const vasco::MapperParams p = params;  // copied while the GIL guards the Params object
   nb::gil_scoped_release release;
@@ -247,6 +286,12 @@ void bind_mapper_mapping(nb::class_<Session> &cls) {
            "CARMEN's finish of the current grid (block means, crop to the known area plus ``border``),\n"
            "on the GPU for cuda; ``downsample``/``border`` default to the params'. Returns a Map whose\n"
            "cells are moved, not copied, out of the session.")
+      .def("_finish_occupancy_grid", &finish_occupancy_grid, "mode"_a, "free_thresh"_a, "occupied_thresh"_a,
+           "out"_a = nb::none(), "downsample"_a = nb::none(), "border"_a = nb::none(),
+           "finish as nav_msgs/OccupancyGrid data (the ROS node's /map): ((size_x, size_y, resolution,\n"
+           "origin), data), data by ``mode`` and the thresholds as Map's _occupancy_grid_data makes it\n"
+           "(converted on the GPU for cuda: a byte a cell comes back), written into ``out`` (a writable\n"
+           "buffer, returned) when it has the map's size, else new bytes.")
       .def("start_over", &start_over, "params"_a,
            "A new session on the same backend: the stored scans, the frame and the grid dropped,\n"
            "``params`` in force (validated first: a refusal raises ValueError and changes nothing; a\n"

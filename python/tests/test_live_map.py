@@ -132,6 +132,26 @@ def test_grid_values_by_hand():
         grid_values(m, "raw")
 
 
+def test_finish_grid_is_the_values_of_the_finish_written_into_the_last_array():
+    log = vg.load_log(CASES["intel.gfs__vasco_default_ds4"][0])
+    live = LiveMap(log.params, backend="cpu_double")
+    assert live.finish_grid("trinary", 0.196, 0.65) is None  # no scan yet
+    feed(live, log.scans.select(0, 200), np.arange(200) * 10**8)
+    m = live.finish()
+    for mode, free, occupied in [("trinary", 0.196, 0.65), ("trinary", 0.25, 0.5), ("scale", 0.196, 0.65)]:
+        want = grid_values(m, mode, free, occupied)
+        (sx, sy, res, origin), data = live.finish_grid(mode, free, occupied)
+        assert (sx, sy, res, origin) == (m.size_x, m.size_y, m.resolution, tuple(m.origin))
+        assert isinstance(data, bytes) and data == want
+        out = array("b", bytes(sx * sy))
+        assert live.finish_grid(mode, free, occupied, out=out)[1] is out and out.tobytes() == want
+    assert {-1, 0, 100} <= set(array("b", grid_values(m, "trinary")))  # every kind of cell compared
+    other = array("b", bytes(7))  # another size: left alone, new bytes returned
+    assert isinstance(live.finish_grid("scale", 0.196, 0.65, out=other)[1], bytes) and other.tobytes() == bytes(7)
+    with pytest.raises(ValueError, match="map_mode 'raw'"):
+        live.finish_grid("raw", 0.196, 0.65)
+
+
 def test_settings_refuse_naming_the_parameter(tmp_path):
     assert "vasco_resolution" in mapper_parameter_names() and "vasco_p_occ" in mapper_parameter_names()
     s = Settings.from_values({}, {})

@@ -179,11 +179,4 @@ std::unique_ptr<Renderer> make_renderer(const std::string &backend, const Backen
   return find_backend(name)->make(o);
 }
 
-std::vector<float> render_grid(Renderer &renderer, const ScanBatch &scans, const MapperParams &params,
-                               const GridGeometry &geo, MapStats *stats) {
-  renderer.reset(geo, params);
-  renderer.apply(scans, 0, scans.num_scans(), stats);
-  return renderer.read(GridWindow{0, 0, geo.size_x, geo.size_y});
-}
-
 }  // namespace vasco

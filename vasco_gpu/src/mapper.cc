@@ -353,6 +353,16 @@ FinishedMap Mapper::finish(int downsample, int border) const {
                                 kFinishStripCells);
 }
 
+FinishedMap Mapper::finish_occupancy(const carmen::OccupancyValues &values, const OccupancyOut &out,
+                                     int downsample, int border) const {
+  check_grid_usable("Mapper::finish_occupancy");
+  if (downsample < 1) throw Error(ErrorCode::Usage, "Mapper::finish_occupancy: downsample must be at least 1");
+  if (border < 0) throw Error(ErrorCode::Usage, "Mapper::finish_occupancy: border must not be negative");
+  if (grid_.size_x == geo_.size_x && grid_.size_y == geo_.size_y)
+    return renderer_->finish_occupancy(downsample, border, values, out);
+  return occupancy_of(finish(downsample, border), values, out);  // a grown grid: finished in strips on the host
+}
+
 std::vector<float> Mapper::read(const GridWindow &window) const {
   check_grid_usable("Mapper::read");
   check_window(window, geo_);

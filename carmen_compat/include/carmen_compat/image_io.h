@@ -16,6 +16,7 @@
 
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/map_file.h"
+#include "carmen_compat/occupancy_value.h"
 
 namespace carmen {
 
@@ -64,7 +65,7 @@ constexpr uint8_t kPngUnknown = 128;
 // How the images read a cell: unknown (NaN or negative: CARMEN's -1),
 // off-limits (2 and above), else an occupancy, clamped to [0, 1].
 // Inline: the per-cell loops (occupancy_grid.cc) vectorise them.
-inline bool is_unknown(float v) { return !(v >= 0.0f); }
+inline bool is_unknown(float v) { return unknown_cell(v); }  // occupancy_value.h
 inline bool is_offlimits(float v) { return v >= 2.0f; }
 inline double clamp01(double p) { return p < 0.0 ? 0.0 : (p > 1.0 ? 1.0 : p); }
 

@@ -7,6 +7,7 @@
 
 #include "carmen_compat/image_io.h"
 #include "carmen_compat/map_file.h"
+#include "carmen_compat/occupancy_value.h"
 
 namespace carmen {
 
@@ -25,5 +26,12 @@ namespace carmen {
 std::vector<int8_t> occupancy_grid_data(const GridMap &map, const MapServerOptions &o);
 // The same into out[size_x * size_y].
 void occupancy_grid_data(const GridMap &map, const MapServerOptions &o, int8_t *out);
+
+// `o` as the per-cell rule of occupancy_value.h (std::invalid_argument for
+// scale or negate, as above): what a GPU converting a map needs.
+OccupancyValues occupancy_values(const MapServerOptions &o);
+// The same conversion of size_x * size_y cells, x-major
+// (cells[x * size_y + y]), by that rule, into out[size_x * size_y].
+void occupancy_grid_data(const float *cells, int size_x, int size_y, const OccupancyValues &values, int8_t *out);
 
 }  // namespace carmen

@@ -106,6 +106,13 @@ class Mapper {
   // downsample < 1 or a negative border (any larger border crops to the grid).
   FinishedMap finish() const { return finish(static_cast<int>(params_.downsample), static_cast<int>(params_.border)); }
   FinishedMap finish(int downsample, int border) const;
+  // The same finish as nav_msgs/OccupancyGrid data by `values`
+  // (carmen_compat/occupancy_grid.h), written into out(n) once the map's n
+  // cells are known; returns the finished map with its cells left empty. On
+  // a GPU the conversion runs there and one byte a cell crosses the bus (the
+  // ROS node's /map); the bytes are occupancy_grid_data's of finish().
+  FinishedMap finish_occupancy(const carmen::OccupancyValues &values, const OccupancyOut &out, int downsample,
+                               int border) const;
   // Error(Usage) for a window not inside frame(), Error(State) before any insert.
   std::vector<float> read(const GridWindow &window) const;
   std::vector<float> read() const;  // the whole full-resolution grid

@@ -8,10 +8,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "carmen_compat/occupancy_value.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
@@ -28,6 +30,11 @@ struct Pose {
 struct GridWindow {
   int x0 = 0, y0 = 0, width = 0, height = 0;
 };
+
+// Where finish_occupancy writes a finished map of `cells` cells as
+// OccupancyGrid data: a buffer of that many bytes, valid until the call
+// returns.
+using OccupancyOut = std::function<int8_t *(size_t cells)>;
 
 // What a renderer is, for its users: whether its grid is CARMEN's bytes
 // (cpu_double's), whether the grid lives in device memory (so the host
@@ -54,6 +61,14 @@ class Renderer {
   virtual void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) = 0;
   // CARMEN's finish of the current grid (DESIGN §2 step 7).
   virtual FinishedMap finish(int downsample, int border) = 0;
+  // The same finish as nav_msgs/OccupancyGrid data by `values`
+  // (carmen_compat/occupancy_grid.h: row-major from the lower-left cell),
+  // written into out(n) once the finished map's n cells are known; returns
+  // the finished map with its cells left empty. By default finish, then the
+  // host's conversion (occupancy_of); the CUDA renderers convert on the
+  // device and send one byte a cell instead of a float.
+  virtual FinishedMap finish_occupancy(int downsample, int border, const carmen::OccupancyValues &values,
+                                       const OccupancyOut &out);
   // A window of the full-resolution grid, x-major (cells[x * height + y]);
   // the window must lie inside the grid.
   virtual std::vector<float> read(const GridWindow &window) = 0;
@@ -76,6 +91,10 @@ class Renderer {
 // when this build has no CUDA backend or no GPU is usable (the message says
 // why); auto falls back to cpu_threads.
 std::unique_ptr<Renderer> make_renderer(const std::string &backend, const BackendOptions &options = {});
+
+// A finished map's cells as OccupancyGrid data by `values`, into out(n):
+// the map returned with its cells dropped (finish_occupancy's host half).
+FinishedMap occupancy_of(FinishedMap map, const carmen::OccupancyValues &values, const OccupancyOut &out);
 
 // Every scan of `scans` on a fresh grid of `geo`: reset, apply, and the whole
 // full-resolution grid read back (x-major). What a one-shot map is.

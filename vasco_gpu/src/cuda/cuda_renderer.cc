@@ -6,6 +6,7 @@
 #include "cuda_renderer.h"
 
 #include <algorithm>
+#include <cstring>
 
 namespace vasco {
 
@@ -88,13 +89,36 @@ cuda::PinnedBuffer<float> &CudaRenderer::download(const float *device, size_t n)
 // finish_math.h's finish: the block means and the known box on the device,
 // the crop's bounds on the host, the crop on the device.
 FinishedMap CudaRenderer::finish(int downsample, int border) {
+  finish::Crop crop;
+  FinishedMap m = finish_frame(downsample, border, &crop);
+  m.cells = read_blocks(crop);
+  return m;
+}
+
+// The block means on the device and the finished map's frame (its cells not
+// filled), `crop` its window of the blocks.
+FinishedMap CudaRenderer::finish_frame(int downsample, int border, finish::Crop *crop) {
   finish::check_arguments(downsample, border);
   require_grid("finish");
   const finish::KnownBox known = finish_blocks(downsample);
   const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, downsample);
-  const finish::Crop crop = finish::crop_of(known, blocks, border);
-  FinishedMap m = finish::finished_frame(crop, grid_geo_.resolution, downsample);
-  m.cells = read_blocks(crop);
+  *crop = finish::crop_of(known, blocks, border);
+  return finish::finished_frame(*crop, grid_geo_.resolution, downsample);
+}
+
+FinishedMap CudaRenderer::finish_occupancy(int downsample, int border, const carmen::OccupancyValues &values,
+                                           const OccupancyOut &out) {
+  finish::Crop crop;
+  FinishedMap m = finish_frame(downsample, border, &crop);
+  const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, downsample);
+  const size_t n = static_cast<size_t>(crop.count());
+  cuda_host::reserve_checked(occupancy_, std::max<size_t>(n, 1), "the finished map's OccupancyGrid data");
+  reserve(staging_occupancy_, std::max<size_t>(n, 1));
+  cuda::launch_occupancy_crop(blocks_.get(), blocks, crop, values, occupancy_.get(), stream_);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_occupancy_.get(), occupancy_.get(), n, cudaMemcpyDeviceToHost, stream_));
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
+  int8_t *data = out(n);
+  if (n > 0) std::memcpy(data, staging_occupancy_.get(), n);
   return m;
 }
 

@@ -65,6 +65,10 @@ class CudaRenderer : public Renderer {
   std::vector<float> read_blocks(const finish::Crop &crop);
   void apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) final;
   FinishedMap finish(int downsample, int border) final;
+  // finish's crop converted on the device (launch_occupancy_crop): a byte a
+  // cell comes back instead of a float.
+  FinishedMap finish_occupancy(int downsample, int border, const carmen::OccupancyValues &values,
+                               const OccupancyOut &out) final;
   std::vector<float> read(const GridWindow &window) final;
 
  protected:
@@ -128,6 +132,7 @@ class CudaRenderer : public Renderer {
   enum class GridState { None, Valid, Lost };
   void require_grid(const char *call) const;
   cuda::PinnedBuffer<float> &download(const float *device, size_t n);
+  FinishedMap finish_frame(int downsample, int border, finish::Crop *crop);
 
   BackendOptions options_;
   bool exact_;
@@ -144,6 +149,8 @@ class CudaRenderer : public Renderer {
   cuda::DeviceBuffer<finish::KnownBox> known_;
   cuda::PinnedBuffer<finish::KnownBox> staging_known_;
   cuda::PinnedBuffer<float> staging_out_;
+  cuda::DeviceBuffer<int8_t> occupancy_;
+  cuda::PinnedBuffer<int8_t> staging_occupancy_;
 };
 
 }  // namespace vasco

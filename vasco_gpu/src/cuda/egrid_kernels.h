@@ -12,6 +12,7 @@
 #include <string>
 
 #include "vasco_gpu/internal/egrid_math.h"
+#include "carmen_compat/occupancy_value.h"
 #include "vasco_gpu/internal/finish_math.h"
 #include "vasco_gpu/internal/placed_beam.h"
 
@@ -293,6 +294,12 @@ void launch_finish_blocks(GridCells grid, int size_x, int size_y, int ds, float 
 // out[x * crop.size_y + y] = blocks[finish::cropped_block(crop, blocks_grid, x, y)].
 void launch_crop(const float *blocks, finish::Blocks blocks_grid, finish::Crop crop, float *out,
                  cudaStream_t stream);
+
+// The crop as nav_msgs/OccupancyGrid data, row-major from the lower-left
+// cell: out[y * crop.size_x + x] = occupancy_value(values, the crop's (x, y))
+// (carmen_compat/occupancy_value.h, the host conversion's own rule).
+void launch_occupancy_crop(const float *blocks, finish::Blocks blocks_grid, finish::Crop crop,
+                           carmen::OccupancyValues values, int8_t *out, cudaStream_t stream);
 
 // A window of the grid as probabilities: out[x * height + y].
 void launch_read_window(GridCells grid, int size_y, int x0, int y0, int width, int height, float *out,

@@ -50,6 +50,18 @@ __global__ void crop_kernel(const float *blocks, finish::Blocks blocks_grid, fin
   }
 }
 
+// One thread per byte of the data, in the rows' order: the writes coalesce,
+// the reads of the x-major blocks are scattered (the L2 holds them: a
+// finished map is a few MB at most in the cases the node publishes).
+__global__ void occupancy_crop_kernel(const float *blocks, finish::Blocks blocks_grid, finish::Crop crop,
+                                      carmen::OccupancyValues values, int8_t *out) {
+  const size_t n = static_cast<size_t>(crop.count());
+  for (size_t c = first_index(); c < n; c += index_stride()) {
+    const int y = static_cast<int>(c / crop.size_x), x = static_cast<int>(c % crop.size_x);
+    out[c] = carmen::occupancy_value(values, blocks[finish::cropped_block(crop, blocks_grid, x, y)]);
+  }
+}
+
 __global__ void window_kernel(GridCells grid, int size_y, int x0, int y0, int width, int height, float *out) {
   const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
   for (size_t c = first_index(); c < n; c += index_stride()) {
@@ -78,6 +90,14 @@ void launch_crop(const float *blocks, finish::Blocks blocks_grid, finish::Crop c
   const size_t n = static_cast<size_t>(crop.count());
   if (n == 0) return;
   crop_kernel<<<blocks_of(n), 256, 0, stream>>>(blocks, blocks_grid, crop, out);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+void launch_occupancy_crop(const float *blocks, finish::Blocks blocks_grid, finish::Crop crop,
+                           carmen::OccupancyValues values, int8_t *out, cudaStream_t stream) {
+  const size_t n = static_cast<size_t>(crop.count());
+  if (n == 0) return;
+  occupancy_crop_kernel<<<blocks_of(n), 256, 0, stream>>>(blocks, blocks_grid, crop, values, out);
   VG_CUDA_CHECK_LAUNCH();
 }
 

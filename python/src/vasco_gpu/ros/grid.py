@@ -12,11 +12,17 @@ from array import array
 
 from .. import _core
 
-__all__ = ["grid_values", "fill_grid"]
+__all__ = ["grid_values", "finished_grid", "fill_grid"]
 
 # The node's map_mode -> the picture mode whose levels, read as int8, are the values
 # (carmen_compat/occupancy_grid.h: "scale" is the raw picture's round(100 p)).
 _DATA_MODES = {"trinary": "trinary", "scale": "raw"}
+
+
+def _data_mode(mode: str) -> str:
+    if mode not in _DATA_MODES:
+        raise ValueError(f"map_mode {mode!r} is not trinary or scale")
+    return _DATA_MODES[mode]
 
 
 def grid_values(m, mode: str, free_thresh: float = 0.196, occupied_thresh: float = 0.65, out=None):
@@ -24,30 +30,36 @@ def grid_values(m, mode: str, free_thresh: float = 0.196, occupied_thresh: float
     into out (a writable buffer of that many bytes, returned). In C++
     (carmen_compat/occupancy_grid.h): fr101's 1302 x 1267 cells took 1.7 ms there on the 2-core
     machine, 5.4 ms in NumPy."""
-    if mode not in _DATA_MODES:
-        raise ValueError(f"map_mode {mode!r} is not trinary or scale")
-    return _core._occupancy_grid_data(m, _DATA_MODES[mode], free_thresh, occupied_thresh, out)
+    return _core._occupancy_grid_data(m, _data_mode(mode), free_thresh, occupied_thresh, out)
 
 
-def fill_grid(msg, m, *, mode: str, frame: str, stamp, free_thresh: float, occupied_thresh: float,
-              data: array | None = None) -> array:
-    """Fills a nav_msgs/OccupancyGrid (or anything shaped like one) with map m. Its data goes into
-    ``data`` (an array('b') of a previous message, once that message is published) where the
-    size is the same, else into a new array; returns the array used."""
+def finished_grid(mapper, mode: str, free_thresh: float, occupied_thresh: float, out=None):
+    """A session's finish as OccupancyGrid data: ((size_x, size_y, resolution, origin), data),
+    the values grid_values gives for mapper.finish(), converted where the grid is (on the GPU
+    for cuda, which then sends a byte a cell instead of a float). data is out (a writable
+    buffer) when the map has its size, else new bytes."""
+    return mapper._finish_occupancy_grid(_data_mode(mode), free_thresh, occupied_thresh, out)
+
+
+def fill_grid(msg, frame_of_map, data, *, frame: str, stamp) -> array:
+    """Fills a nav_msgs/OccupancyGrid (or anything shaped like one) with a finished map:
+    frame_of_map (size_x, size_y, resolution, origin) and its data (finished_grid's), as an
+    array('b'): data itself when it is one (the previous message's, written again), else a new
+    array of its bytes. Returns the array."""
+    size_x, size_y, resolution, (x, y, theta) = frame_of_map
     msg.header.frame_id = frame
     msg.header.stamp = stamp
     info = msg.info
     info.map_load_time = stamp
-    info.resolution = float(m.resolution)
-    info.width, info.height = int(m.size_x), int(m.size_y)
-    x, y, theta = m.origin
+    info.resolution = float(resolution)
+    info.width, info.height = int(size_x), int(size_y)
     info.origin.position.x, info.origin.position.y, info.origin.position.z = float(x), float(y), 0.0
     info.origin.orientation.z = math.sin(theta / 2.0)
     info.origin.orientation.w = math.cos(theta / 2.0)
     # array('b'): assigning a NumPy array to an rclpy message's data field converts element by
-    # element (~60x slower for a 2000 x 2000 map). Written in place: a new map-sized buffer for
-    # each map cost page faults each time.
-    if data is None or len(data) != m.size_x * m.size_y:
-        data = array("b", bytes(m.size_x * m.size_y))
-    msg.data = grid_values(m, mode, free_thresh, occupied_thresh, out=data)
+    # element (~60x slower for a 2000 x 2000 map). Written in place where the size is the
+    # same: a new map-sized buffer for each map cost page faults each time.
+    if not (isinstance(data, array) and data.typecode == "b"):
+        data = array("b", data)
+    msg.data = data
     return data

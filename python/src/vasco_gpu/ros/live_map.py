@@ -17,6 +17,7 @@ from array import array
 import numpy as np
 
 from .. import _core
+from .grid import finished_grid
 
 __all__ = ["LiveMap", "LiveMapError"]
 
@@ -174,3 +175,10 @@ class LiveMap:
         if len(self) == 0:
             return None
         return self.mapper.finish()
+
+    def finish_grid(self, mode: str, free_thresh: float, occupied_thresh: float, out=None):
+        """The map to publish as OccupancyGrid data, ((size_x, size_y, resolution, origin), data)
+        (grid.finished_grid: on the GPU for cuda), None while no scan is stored."""
+        if len(self) == 0:
+            return None
+        return finished_grid(self.mapper, mode, free_thresh, occupied_thresh, out)

@@ -499,18 +499,17 @@ class MappingNode(Node):
                 self.get_logger().warning(f"grid not rendered again after growing: {e}")
         if self.live.version == self._published:
             return {}
-        t0 = time.perf_counter()
-        m = self.live.finish()
-        self._published = self.live.version
-        if m is None:
-            return {}
         s = self.settings
+        t0 = time.perf_counter()
+        # the data written again into the last map's array where the size is the same (that
+        # message was published, that is serialised, by then)
+        got = self.live.finish_grid(s.map_mode, s.free_thresh, s.occupied_thresh, out=self._grid_data)
+        self._published = self.live.version
+        if got is None:
+            return {}
         t1 = time.perf_counter()
-        # one message, filled again for each map (published, that is serialised, by then), with
-        # its data array written again where the size is the same
-        msg = self._grid_msg
-        self._grid_data = fill_grid(msg, m, mode=s.map_mode, frame=s.map_frame, stamp=self.get_clock().now().to_msg(),
-                                    free_thresh=s.free_thresh, occupied_thresh=s.occupied_thresh, data=self._grid_data)
+        msg = self._grid_msg  # one message, filled again for each map
+        self._grid_data = fill_grid(msg, *got, frame=s.map_frame, stamp=self.get_clock().now().to_msg())
         t2 = time.perf_counter()
         self.map_pub.publish(msg)
         self.meta_pub.publish(msg.info)

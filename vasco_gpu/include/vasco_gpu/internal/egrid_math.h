@@ -14,11 +14,7 @@
 #include <cmath>
 #include <cstdint>
 
-#if defined(__CUDACC__)
-#define VG_HD __host__ __device__ __forceinline__
-#else
-#define VG_HD inline
-#endif
+#include "carmen_compat/host_device.h"
 
 namespace vasco {
 namespace egrid {

@@ -14,16 +14,9 @@
 #include <cstdint>
 #include <string>
 
+#include "carmen_compat/host_device.h"
 #include "vasco_gpu/error.h"
 #include "vasco_gpu/grid.h"
-
-#ifndef VG_HD
-#if defined(__CUDACC__)
-#define VG_HD __host__ __device__ __forceinline__
-#else
-#define VG_HD inline
-#endif
-#endif
 
 namespace vasco {
 namespace finish {
