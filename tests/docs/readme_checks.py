@@ -371,18 +371,14 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "sh: ros2 launch examples/ros/vasco_with_slam_toolbox.launch.py b": Check(
             "skip", reason="needs ros2 launch and slam_toolbox (a system ROS 2); python/tests/test_live_map.py "
                            "compiles the launch file and checks the node parameters it sets"),
-        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --paths 3": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h200-b.txt"),
-        "text: ## python3 bench/ros_node_bench.py --fast-rate 800": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h200.txt"),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build-gpu ros livem": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-d.txt"),
+        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --batch 0": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-c.txt"),
         "text: ## python3 bench/ros_node_bench.py --fast-rate 400 --batch 0": Check(
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-d.txt"),
         "text: ## python3 bench/live_map_steps.py": Check(
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-d.txt"),
-        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --logs lo": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-b.txt"),
-        "text: ## python3 bench/live_map_steps.py --logs logs/fr079-complet": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-b.txt"),
         "text: ## python3 bench/ros_map_transport.py": Check(
             "quoted", quote_of="bench/results/bench-ros-transport-2026-12-05-2core.txt"),
     },
