@@ -375,10 +375,8 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-d.txt"),
         "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --batch 0": Check(
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-c.txt"),
-        "text: ## python3 bench/ros_node_bench.py --fast-rate 400 --batch 0": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-d.txt"),
-        "text: ## python3 bench/live_map_steps.py": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-d.txt"),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build ros livemap": Check(
+            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-e.txt"),
         "text: ## python3 bench/ros_map_transport.py": Check(
             "quoted", quote_of="bench/results/bench-ros-transport-2026-12-05-2core.txt"),
     },

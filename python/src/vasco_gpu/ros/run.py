@@ -9,6 +9,7 @@ import sys
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
+from . import _interrupted
 from .settings import SettingsError
 from .tf_messages import MissingMessages
 
@@ -31,6 +32,8 @@ def main(argv=None) -> int:
 
             node = MappingNode()
         except (SettingsError, MissingMessages, ImportError) as e:
+            if _interrupted(e) or not rclpy.ok():  # a signal while the message packages loaded
+                return 0
             print(f"vasco_mapper: {e}", file=sys.stderr)
             return 2
         except Exception:  # rclpy's RCLError: a signal shut ROS 2 down while the node was made
