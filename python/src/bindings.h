@@ -6,6 +6,9 @@
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 
+#include <cstdint>
+#include <string>
+
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco_py {
@@ -26,6 +29,34 @@ void bind_compare(nb::module_ &m);  // Comparison, compare
 void bind_mapper(nb::module_ &m);   // Mapper
 void bind_pose_series(nb::module_ &m);  // _repose (pose_series.h)
 void bind_path_cdr(nb::module_ &m);     // _path_from_cdr (the node's Path bytes)
+
+// A caller's writable buffer of bytes (array('b'), bytearray), exported while it lives, so
+// that C++ may write into it without the GIL and it cannot be resized meanwhile. TypeError
+// naming `what` for anything else (read-only, or of wider items). Made with the GIL held.
+class WritableBytes {
+ public:
+  WritableBytes(nb::handle obj, const char *what) {
+    if (PyObject_GetBuffer(obj.ptr(), &view_, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) != 0) {
+      PyErr_Clear();
+      throw nb::type_error(message(what).c_str());
+    }
+    if (view_.itemsize != 1) {
+      PyBuffer_Release(&view_);
+      throw nb::type_error(message(what).c_str());
+    }
+  }
+  ~WritableBytes() { PyBuffer_Release(&view_); }
+  WritableBytes(const WritableBytes &) = delete;
+  WritableBytes &operator=(const WritableBytes &) = delete;
+  int8_t *data() const { return static_cast<int8_t *>(view_.buf); }
+  size_t size() const { return static_cast<size_t>(view_.len); }
+
+ private:
+  static std::string message(const char *what) {
+    return std::string(what) + ": expected a writable buffer of bytes (array('b'), bytearray)";
+  }
+  Py_buffer view_{};
+};
 
 // The batch's poses as a new (n, 3) float64 array of (x, y, theta).
 nb::ndarray<nb::numpy, double> poses_of(const vasco::ScanBatch &b);

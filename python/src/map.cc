@@ -187,17 +187,14 @@ void bind_map_files(nb::module_ &m) {
           return std::move(made);
         }
         // a writable buffer of the caller's (the node's message data, used again for each map
-        // of one size): exported while it is written, so that it cannot be resized meanwhile
-        Py_buffer view;
-        if (PyObject_GetBuffer(out.ptr(), &view, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) != 0) throw nb::python_error();
-        const std::unique_ptr<Py_buffer, void (*)(Py_buffer *)> held(&view, PyBuffer_Release);
-        if (size_t(view.len) != cells)
-          throw carmen::Error(carmen::ErrorCode::Usage, "occupancy grid data: out holds " + std::to_string(view.len) +
+        // of one size)
+        const WritableBytes view(out, "_occupancy_grid_data: out");
+        if (view.size() != cells)
+          throw carmen::Error(carmen::ErrorCode::Usage, "occupancy grid data: out holds " + std::to_string(view.size()) +
                                                             " bytes, the map has " + std::to_string(cells) + " cells");
         {
           nb::gil_scoped_release release;
-          carmen::occupancy_grid_data(mp.grid.cells.data(), mp.grid.size_x, mp.grid.size_y, values,
-                                      static_cast<int8_t *>(view.buf));
+          carmen::occupancy_grid_data(mp.grid.cells.data(), mp.grid.size_x, mp.grid.size_y, values, view.data());
         }
         return nb::borrow(out);
       },

@@ -169,22 +169,18 @@ Map finish(Session &s, std::optional<int> downsample, std::optional<int> border)
 }
 
 // finish as OccupancyGrid data (Mapper::finish_occupancy): ((size_x, size_y, resolution,
-// origin), data). The data goes into `out` (a writable buffer, exported while it is written, so
-// that it cannot be resized meanwhile) when the map has its size, else into new bytes.
+// origin), data). The data goes into `out` (a writable buffer of bytes) when the map has its
+// size, else into new bytes.
 nb::tuple finish_occupancy_grid(Session &s, const std::string &mode, double free_thresh, double occupied_thresh,
                                 nb::handle out, std::optional<int> downsample, std::optional<int> border) {
   const carmen::OccupancyValues values = occupancy_values(mode, free_thresh, occupied_thresh);
-  Py_buffer view{};
-  std::unique_ptr<Py_buffer, void (*)(Py_buffer *)> held(nullptr, PyBuffer_Release);
-  if (!out.is_none()) {
-    if (PyObject_GetBuffer(out.ptr(), &view, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) != 0) throw nb::python_error();
-    held.reset(&view);
-  }
+  std::optional<WritableBytes> given;
+  if (!out.is_none()) given.emplace(out, "Mapper._finish_occupancy_grid: out");
   std::vector<int8_t> scratch;  // when out is not given or has another size
   bool into_out = false;
   const vasco::OccupancyOut where = [&](size_t n) {
-    into_out = held && static_cast<size_t>(view.len) == n;
-    if (into_out) return static_cast<int8_t *>(view.buf);
+    into_out = given && given->size() == n;
+    if (into_out) return given->data();
     scratch.resize(n);
     return scratch.data();
   };

@@ -150,6 +150,11 @@ def test_finish_grid_is_the_values_of_the_finish_written_into_the_last_array():
     assert isinstance(live.finish_grid("scale", 0.196, 0.65, out=other)[1], bytes) and other.tobytes() == bytes(7)
     with pytest.raises(ValueError, match="map_mode 'raw'"):
         live.finish_grid("raw", 0.196, 0.65)
+    for bad in (bytes(len(want)), array("i", [0]) * len(want)):  # read-only; items wider than a byte
+        with pytest.raises(TypeError, match="out: expected a writable buffer of bytes"):
+            live.finish_grid("trinary", 0.196, 0.65, out=bad)
+        with pytest.raises(TypeError, match="out: expected a writable buffer of bytes"):
+            grid_values(m, "trinary", out=bad)
 
 
 def test_settings_refuse_naming_the_parameter(tmp_path):

@@ -27,9 +27,11 @@ struct OccupancyValues {
 VG_HD bool unknown_cell(float v) { return !(v >= 0.0f); }
 
 // raw: round(100 p), halves up, as floor(100 p + 0.5): exact for every float
-// p in [0, 1] (100 p is then a multiple of 2^-22 below 2^7: exact in double,
-// so a fused multiply-add gives the same sum, and adding 0.5 rounds nothing);
-// 1 and above (off-limits too) 100. No NaN is converted.
+// p in [0, 1]. 100 p needs at most 24 + 7 significant bits, so it is exact in
+// double and a fused multiply-add gives the same sum; the sum then rounds
+// only where 100 p + 0.5 has bits below 2^-46, that is for p below about
+// 2^-23, where it stays under 1 either way. 1 and above (off-limits too)
+// 100. No NaN is converted.
 VG_HD int8_t raw_occupancy_value(float v) {
   const double p = unknown_cell(v) ? 0.0 : (double(v) < 1.0 ? double(v) : 1.0);
   const int8_t level = static_cast<int8_t>(100.0 * p + 0.5);
