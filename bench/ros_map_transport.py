@@ -1,15 +1,19 @@
 #!/usr/bin/env python3
 """A map from one process to another over Fast DDS's shared memory, as the node publishes it:
 publish() -> the subscriber's callback, per map size, with Fast DDS's defaults (a message cut
-into fragments of 65,500 bytes) and with the node's own profile (vasco_gpu/ros/
-fastdds_shm_maps.xml: whole messages up to 4 MiB), ratios in the same run. The publisher is
-a child process (the profile is read when its participant starts); the subscriber, this one,
-keeps Fast DDS's defaults, as any subscriber of the node's map does.
+into fragments of 65,500 bytes), with the node's own profile (vasco_gpu/ros/
+fastdds_shm_maps.xml: whole messages up to 4 MiB), and with the profile and glibc's
+thresholds raised in both processes as the node raises them in its own (vasco_gpu/ros/
+message_buffers.py: the node takes Paths as large as maps; a subscriber of /map can do the
+same), ratios in the same run. The publisher is a child process (the profile is read when
+its participant starts); the subscriber is this one, which keeps Fast DDS's defaults and,
+until the last column, glibc's.
 
   map        cells (an OccupancyGrid of one byte a cell: fr079, fr101 at 0.05 m, 2000 x 2000)
   default    median ms over --maps maps, Fast DDS's defaults on the publisher
   profile    the same with the node's profile
-  ratio      default / profile
+  +buffers   the profile, and glibc's thresholds raised in both processes (measured last)
+  ratio      default / +buffers
   bench/ros_map_transport.py [--maps 20]
 """
 
@@ -41,8 +45,13 @@ def qos():
     return LATCHED
 
 
-def publish(width: int, height: int, count: int) -> int:
+def publish(width: int, height: int, count: int, buffers: int) -> int:
     """The child: count maps, 0.2 s apart, each stamped with CLOCK_MONOTONIC when published."""
+    if buffers:
+        from vasco_gpu.ros.message_buffers import keep_message_buffers
+
+        if not keep_message_buffers():
+            raise RuntimeError("glibc's thresholds could not be raised here")
     import rclpy
     from nav_msgs.msg import OccupancyGrid
 
@@ -67,7 +76,7 @@ def publish(width: int, height: int, count: int) -> int:
     return 0
 
 
-def latencies(node, executor, width: int, height: int, count: int, profile: bool) -> list[float]:
+def latencies(node, executor, width: int, height: int, count: int, profile: bool, buffers: bool = False) -> list[float]:
     from nav_msgs.msg import OccupancyGrid
 
     from vasco_gpu.ros.transport import MAP_SIZED_SHM_PROFILE
@@ -78,7 +87,8 @@ def latencies(node, executor, width: int, height: int, count: int, profile: bool
     env = {k: v for k, v in os.environ.items() if not k.endswith("_DEFAULT_PROFILES_FILE")}
     if profile:
         env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(MAP_SIZED_SHM_PROFILE)
-    child = subprocess.Popen([sys.executable, __file__, "--publish", str(width), str(height), str(count)], env=env)
+    child = subprocess.Popen([sys.executable, __file__, "--publish", str(width), str(height), str(count),
+                              str(int(buffers))], env=env)
     try:
         end = time.monotonic() + 60
         while child.poll() is None and time.monotonic() < end:
@@ -95,25 +105,34 @@ def latencies(node, executor, width: int, height: int, count: int, profile: bool
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--maps", type=int, default=20)
-    ap.add_argument("--publish", nargs=3, type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--publish", nargs=4, type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.publish:
         return publish(*args.publish)
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
 
+    from vasco_gpu.ros.message_buffers import keep_message_buffers
+
     rclpy.init()
     node = rclpy.create_node("map_transport_bench")
     executor = SingleThreadedExecutor()
     executor.add_node(node)
     print(f"# publish() -> subscriber over Fast DDS shared memory, median of {args.maps} maps")
-    print(f"{'map':>11} {'MB':>6} {'default ms':>10} {'profile ms':>10} {'ratio':>6}")
+    rows = {}
     try:
         for w, h in SIZES:
-            default = float(np.median(latencies(node, executor, w, h, args.maps, False)))
-            profile = float(np.median(latencies(node, executor, w, h, args.maps, True)))
-            print(f"{f'{w}x{h}':>11} {w * h / 1e6:>6.2f} {default:>10.2f} {profile:>10.2f} {default / profile:>5.1f}x",
-                  flush=True)
+            rows[w, h] = [float(np.median(latencies(node, executor, w, h, args.maps, False))),
+                          float(np.median(latencies(node, executor, w, h, args.maps, True)))]
+        # then both processes with glibc's thresholds raised: from here on in this one too
+        if not keep_message_buffers():
+            raise RuntimeError("glibc's thresholds could not be raised here")
+        for w, h in SIZES:
+            rows[w, h].append(float(np.median(latencies(node, executor, w, h, args.maps, True, buffers=True))))
+        print(f"{'map':>11} {'MB':>6} {'default ms':>10} {'profile ms':>10} {'+buffers ms':>11} {'ratio':>6}")
+        for (w, h), (default, profile, kept) in rows.items():
+            print(f"{f'{w}x{h}':>11} {w * h / 1e6:>6.2f} {default:>10.2f} {profile:>10.2f} {kept:>11.2f} "
+                  f"{default / kept:>5.1f}x", flush=True)
     finally:
         node.destroy_node()
         rclpy.try_shutdown()

@@ -18,8 +18,10 @@ def main(argv=None) -> int:
     # it as an ignored exception: not printed (the node exits 0, as for any SIGINT while starting)
     hook = sys.unraisablehook
     sys.unraisablehook = lambda u: None if isinstance(u.exc_value, KeyboardInterrupt) else hook(u)
+    from .message_buffers import keep_message_buffers
     from .transport import use_map_sized_shm
 
+    keep_message_buffers()  # before the large allocations start
     use_map_sized_shm()  # before rclpy loads Fast DDS
     try:
         from .run import main as run
