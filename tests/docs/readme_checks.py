@@ -378,7 +378,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "text: # vasco_gpu benchmarks: bench/run_all.sh build ros livemap": Check(
             "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-e.txt"),
         "text: ## python3 bench/ros_map_transport.py": Check(
-            "quoted", quote_of="bench/results/bench-ros-transport-2026-12-05-2core.txt"),
+            "quoted", quote_of="bench/results/bench-ros-transport-2026-12-05-2core-b.txt"),
     },
     "docs/walkthrough-bag.md": {
         # carmen2bag and mapdiff are not among test_readme.py's tools: the test runs the block
