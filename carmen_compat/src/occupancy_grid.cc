@@ -72,9 +72,13 @@ void occupancy_grid_data(const float *cells, int size_x, int size_y, const Occup
   }
 }
 
-void occupancy_grid_data(const GridMap &map, const MapServerOptions &o, int8_t *out) {
+void occupancy_grid_data(const GridMap &map, const OccupancyValues &values, int8_t *out) {
   check_map_size(map, "occupancy grid data");
-  occupancy_grid_data(map.cells.data(), map.size_x, map.size_y, occupancy_values(o), out);
+  occupancy_grid_data(map.cells.data(), map.size_x, map.size_y, values, out);
+}
+
+void occupancy_grid_data(const GridMap &map, const MapServerOptions &o, int8_t *out) {
+  occupancy_grid_data(map, occupancy_values(o), out);
 }
 
 std::vector<int8_t> occupancy_grid_data(const GridMap &map, const MapServerOptions &o) {

@@ -175,7 +175,6 @@ void bind_map_files(nb::module_ &m) {
       [](const Map &mp, const std::string &mode, double free_thresh, double occupied_thresh,
          nb::handle out) -> nb::object {
         const carmen::OccupancyValues values = occupancy_values(mode, free_thresh, occupied_thresh);
-        carmen::check_map_size(mp.grid, "occupancy grid data");
         const size_t cells = mp.grid.cells.size();
         if (out.is_none()) {
           // filled in place: a bytes object nobody else holds yet, written without the GIL
@@ -183,7 +182,7 @@ void bind_map_files(nb::module_ &m) {
           if (!made.is_valid()) throw nb::python_error();
           int8_t *data = reinterpret_cast<int8_t *>(PyBytes_AS_STRING(made.ptr()));
           nb::gil_scoped_release release;
-          carmen::occupancy_grid_data(mp.grid.cells.data(), mp.grid.size_x, mp.grid.size_y, values, data);
+          carmen::occupancy_grid_data(mp.grid, values, data);
           return std::move(made);
         }
         // a writable buffer of the caller's (the node's message data, used again for each map
@@ -194,7 +193,7 @@ void bind_map_files(nb::module_ &m) {
                                                             " bytes, the map has " + std::to_string(cells) + " cells");
         {
           nb::gil_scoped_release release;
-          carmen::occupancy_grid_data(mp.grid.cells.data(), mp.grid.size_x, mp.grid.size_y, values, view.data());
+          carmen::occupancy_grid_data(mp.grid, values, view.data());
         }
         return nb::borrow(out);
       },

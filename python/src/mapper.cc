@@ -156,13 +156,18 @@ void render(Session &s, nb::handle poses) {
   run_interruptible([&] { s.locked([&](vasco::Mapper &m) { m.render(p); }); });
 }
 
-// The defaults are the params in force when the call runs (under the lock:
-// a start_over from another thread lands before or after, never between).
+// finish's downsample and border: those given, else the params in force when
+// the call runs (read under the lock: a start_over from another thread lands
+// before or after, never between).
+std::pair<int, int> finish_arguments(const vasco::Mapper &m, std::optional<int> downsample, std::optional<int> border) {
+  return {downsample ? *downsample : static_cast<int>(m.params().downsample),
+          border ? *border : static_cast<int>(m.params().border)};
+}
+
 Map finish(Session &s, std::optional<int> downsample, std::optional<int> border) {
   return run_interruptible([&] {
     return s.locked([&](vasco::Mapper &m) {
-      const int ds = downsample ? *downsample : static_cast<int>(m.params().downsample);
-      const int b = border ? *border : static_cast<int>(m.params().border);
+      const auto [ds, b] = finish_arguments(m, downsample, border);
       return map_from_finished(m.finish(ds, b), m.frame());
     });
   });
@@ -186,8 +191,7 @@ nb::tuple finish_occupancy_grid(Session &s, const std::string &mode, double free
   };
   const auto [f, origin] = run_interruptible([&] {
     return s.locked([&](vasco::Mapper &m) {
-      const int ds = downsample ? *downsample : static_cast<int>(m.params().downsample);
-      const int b = border ? *border : static_cast<int>(m.params().border);
+      const auto [ds, b] = finish_arguments(m, downsample, border);
       vasco::FinishedMap map = m.finish_occupancy(values, where, ds, b);
       const carmen::GlobalOffset at = vasco::world_origin(map, m.frame());
       return std::make_pair(std::move(map), at);

@@ -336,11 +336,15 @@ void Mapper::render(const std::vector<Pose> &poses) {
   }
 }
 
+bool Mapper::finishes_whole_grid(const char *what, int downsample, int border) const {
+  check_grid_usable(what);
+  if (downsample < 1) throw Error(ErrorCode::Usage, std::string(what) + ": downsample must be at least 1");
+  if (border < 0) throw Error(ErrorCode::Usage, std::string(what) + ": border must not be negative");
+  return grid_.size_x == geo_.size_x && grid_.size_y == geo_.size_y;
+}
+
 FinishedMap Mapper::finish(int downsample, int border) const {
-  check_grid_usable("Mapper::finish");
-  if (downsample < 1) throw Error(ErrorCode::Usage, "Mapper::finish: downsample must be at least 1");
-  if (border < 0) throw Error(ErrorCode::Usage, "Mapper::finish: border must not be negative");
-  if (grid_.size_x == geo_.size_x && grid_.size_y == geo_.size_y) return renderer_->finish(downsample, border);
+  if (finishes_whole_grid("Mapper::finish", downsample, border)) return renderer_->finish(downsample, border);
   // A grown grid: CARMEN's finish of the frame()'s window of it, read a strip
   // of columns at a time (no copy of the whole window in host memory).
   const int dx = (grid_.size_x - geo_.size_x) / 2, dy = (grid_.size_y - geo_.size_y) / 2;
@@ -355,10 +359,7 @@ FinishedMap Mapper::finish(int downsample, int border) const {
 
 FinishedMap Mapper::finish_occupancy(const carmen::OccupancyValues &values, const OccupancyOut &out,
                                      int downsample, int border) const {
-  check_grid_usable("Mapper::finish_occupancy");
-  if (downsample < 1) throw Error(ErrorCode::Usage, "Mapper::finish_occupancy: downsample must be at least 1");
-  if (border < 0) throw Error(ErrorCode::Usage, "Mapper::finish_occupancy: border must not be negative");
-  if (grid_.size_x == geo_.size_x && grid_.size_y == geo_.size_y)
+  if (finishes_whole_grid("Mapper::finish_occupancy", downsample, border))
     return renderer_->finish_occupancy(downsample, border, values, out);
   return occupancy_of(finish(downsample, border), values, out);  // a grown grid: finished in strips on the host
 }

@@ -33,5 +33,7 @@ OccupancyValues occupancy_values(const MapServerOptions &o);
 // The same conversion of size_x * size_y cells, x-major
 // (cells[x * size_y + y]), by that rule, into out[size_x * size_y].
 void occupancy_grid_data(const float *cells, int size_x, int size_y, const OccupancyValues &values, int8_t *out);
+// `map` by that rule (its size checked as above), into out[size_x * size_y].
+void occupancy_grid_data(const GridMap &map, const OccupancyValues &values, int8_t *out);
 
 }  // namespace carmen

@@ -175,6 +175,9 @@ class Mapper {
   bool fits_memory(const GridGeometry &geo, uint64_t beams) const;
   void check_memory(const GridGeometry &geo, uint64_t beams) const;
   void check_grid_usable(const char *what) const;
+  // finish's and finish_occupancy's checks, naming `what`; whether the
+  // renderer's grid is frame() itself (not grown with a margin around it).
+  bool finishes_whole_grid(const char *what, int downsample, int border) const;
   InsertPlan plan_insert(const ScanBatch &scans) const;
   void apply_insert(const InsertPlan &plan, size_t before);
   Saved save() const { return Saved{scans_.num_scans(), geo_, grid_, extent_, stats_, shift_invariant_}; }
