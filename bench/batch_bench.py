@@ -119,6 +119,38 @@ def write_cost_model(path: str, values: dict[str, float], command: str) -> None:
             f.write(f"{name} {values[name]:.3g}\n")
 
 
+def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, formats: str, jobs: int) -> list[str]:
+    """Where a batch's time goes: one --json batch run, each stage's seconds summed over
+    the inputs (read = inflate + parse and write = deflate + write on the pool's `jobs`
+    threads; map = upload, render and download on the mappers; mapper wait = a mapper
+    idle for a read or a write slot), and each side's busy share of its threads over the
+    run's wall-clock time. The busier side is the bound."""
+    cmd = [log2map, "--backend", backend, "--quiet", "--json", "--out-dir", out, "--formats", formats]
+    if devices:
+        cmd += ["--devices", devices]
+    s, p = timed(cmd + logs)
+    if p.returncode != 0:
+        sys.exit(f"batch_bench: {' '.join(cmd[:8])} ...: exit {p.returncode}\n{p.stderr[-2000:]}")
+    done = [e for e in json.loads(p.stdout)["inputs"] if e["state"] == "done"]
+    total = {k: sum(e["seconds"][k] for e in done) for k in ("read", "map", "write", "mapper_wait")}
+    mappers = devices.count(",") + 1 if devices else 1
+    pool = (total["read"] + total["write"]) / (jobs * s)
+    mapping = total["map"] / (mappers * s)
+    n = max(1, len(done))
+    lines = [f"stages of one {backend} batch ({len(done)} logs in {s:.3f} s, {n / s:.1f} logs/s; "
+             f"pool {jobs} threads, {mappers} mapper{'s' if mappers > 1 else ''}):",
+             f"  {'stage':40} {'thread s':>9} {'ms / log':>9} {'busy':>7}"]
+    rows = [("read (inflate + parse), pool", total["read"], jobs), ("map (upload, render, download), mappers",
+            total["map"], mappers), ("write (deflate + write), pool", total["write"], jobs),
+            ("mapper wait (read, write slot)", total["mapper_wait"], mappers),
+            ("mapper other (checks, frees, start)", max(0.0, mappers * s - total["map"] - total["mapper_wait"]), mappers)]
+    for name, t, threads in rows:
+        lines.append(f"  {name:40} {t:9.3f} {1e3 * t / n:9.2f} {100 * t / (threads * s):6.1f}%")
+    bound = "the pool (read + write)" if pool >= mapping else "the mappers"
+    lines.append(f"  bound: {bound}: pool busy {100 * pool:.1f}%, mappers busy {100 * mapping:.1f}%")
+    return lines
+
+
 def gpu_count() -> int:
     try:
         p = subprocess.run(["nvidia-smi", "-L"], capture_output=True, text=True)
@@ -129,10 +161,10 @@ def gpu_count() -> int:
 
 def device_sets(gpus: int) -> list[str]:
     """The --devices of the scaling table: 1, 2, 4, 8 GPUs where there are
-    that many, and two mappers on each GPU (0,0 on one GPU)."""
+    that many, and two, three and four mappers on each GPU (0,0 on one GPU)."""
     sets = [",".join(str(d) for d in range(n)) for n in (1, 2, 4, 8) if n <= gpus]
-    if gpus >= 1:
-        sets.append(",".join(str(d) for d in range(gpus) for _ in range(2)))
+    for k in (2, 3, 4) if gpus >= 1 else ():
+        sets.append(",".join(str(d) for d in range(gpus) for _ in range(k)))
     return sets
 
 
@@ -144,6 +176,9 @@ def main() -> int:
     ap.add_argument("--per-process", type=int, default=20, help="logs run one process each (the rate's sample)")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--formats", default="map.gz")
+    ap.add_argument("--gpu-only", action="store_true",
+                    help="the cuda batch alone: its rate, the mapper scaling and the stages (no CPU rows, "
+                         "no one-log table, no cost model)")
     ap.add_argument("--cost-model-out", metavar="FILE",
                     help="write auto's measured constants as the table backend_choice.cc is built from "
                          "(vasco_gpu/app/backend_cost_model.txt)")
@@ -159,8 +194,10 @@ def main() -> int:
         backends = ["cpu_threads"]
         if gpu_usable(log2map, logs[0], os.path.join(tmp, "probe.map")):
             backends += ["cuda"]
+        elif a.gpu_only:
+            sys.exit("batch_bench: --gpu-only: no usable GPU")
         rows = []
-        for b in ["cpu_double"] + backends:
+        for b in ["cuda"] if a.gpu_only else ["cpu_double"] + backends:
             # cpu_double is the reference: one core, so a tenth of the copies, run once.
             n = max(1, len(logs) // 10) if b == "cpu_double" else len(logs)
             s = best([log2map, "--backend", b, "--quiet", "--out-dir", out, "--formats", a.formats] + logs[:n],
@@ -174,28 +211,32 @@ def main() -> int:
             per = (time.perf_counter() - t) / k
             rows.append((b, len(logs) / s, 1.0 / per))
         one = []
-        for log in sorted(os.listdir(LOGS)):
+        for log in [] if a.gpu_only else sorted(os.listdir(LOGS)):
             path = os.path.join(LOGS, log)
             t = {b: best([log2map, "--backend", b, "--quiet", path, os.path.join(tmp, "one.map.gz")], a.repeat)
                  for b in ["auto"] + backends}
             one.append((log, t))
-        model, model_values = cost_model(log2map, backends, tmp, a.repeat)
-        scaling = []
+        model, model_values = cost_model(log2map, backends, tmp, a.repeat) if not a.gpu_only else ([], {})
+        scaling, stage_lines = [], []
         if "cuda" in backends:
             for devices in device_sets(gpu_count()):
                 s = best([log2map, "--backend", "cuda", "--quiet", "--devices", devices, "--out-dir", out,
                           "--formats", a.formats] + logs, a.repeat)
                 scaling.append((devices, len(logs) / s))
+            for devices in ["0"] + ([max(device_sets(gpu_count()), key=len)] if gpu_count() else []):
+                stage_lines += stages(log2map, "cuda", devices, logs, out, a.formats, os.cpu_count() or 1) + [""]
 
     print(f"batch_bench: {a.copies} copies of {os.path.basename(a.log)}, outputs {a.formats}, "
           f"{os.cpu_count()} cores, best of {a.repeat}")
     print(f"{'backend':12} {'batch logs/s':>13} {'process-per-log logs/s':>23} {'batch / per-process':>20} "
           f"{'batch / cpu_double batch':>25}")
-    ref = rows[0][1]
+    ref = rows[0][1] if rows[0][0] == "cpu_double" else None  # --gpu-only: no reference row
     for b, batch, per in rows:
-        print(f"{b:12} {batch:13.1f} {per:23.2f} {batch / per:19.1f}x {batch / ref:24.1f}x")
+        print(f"{b:12} {batch:13.1f} {per:23.2f} {batch / per:19.1f}x " +
+              (f"{batch / ref:24.1f}x" if ref else f"{'-':>25}"))
     print()
-    print(f"{'one log':30} " + " ".join(f"{b + ' s':>14}" for b in ["auto"] + backends) + f" {'auto / fastest':>15}")
+    if one:
+        print(f"{'one log':30} " + " ".join(f"{b + ' s':>14}" for b in ["auto"] + backends) + f" {'auto / fastest':>15}")
     for log, t in one:
         fastest = min(t[b] for b in backends)
         print(f"{log:30} " + " ".join(f"{t[b]:14.3f}" for b in ["auto"] + backends) + f" {t['auto'] / fastest:15.2f}")
@@ -204,8 +245,16 @@ def main() -> int:
         print(f"{'cuda batch --devices':22} {'mappers':>8} {'logs/s':>8} {'/ one mapper':>13}")
         for devices, rate in scaling:
             print(f"{devices:22} {devices.count(',') + 1:8d} {rate:8.1f} {rate / scaling[0][1]:12.2f}x")
-    print()
-    print("auto's cost model measured here (compare vasco_gpu/app/backend_choice.cc):")
+        print(f"target: >= 250 logs/s of {os.path.basename(a.log)} to {a.formats} on one GPU: "
+              f"{max(r for d, r in scaling if set(d.split(',')) == {'0'}):.1f}, "
+              f"{'met' if max(r for d, r in scaling if set(d.split(',')) == {'0'}) >= 250 else 'missed'}")
+    if stage_lines:
+        print()
+        for line in stage_lines:
+            print(line)
+    if model:
+        print()
+        print("auto's cost model measured here (compare vasco_gpu/app/backend_choice.cc):")
     for line in model:
         print("  " + line)
     if a.cost_model_out:

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "test_seed.h"
@@ -44,14 +45,11 @@ std::vector<PlacedBeam> oracle_placement(const ScanBatch &batch, const GridGeome
   return out;
 }
 
-void expect_same_placement(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
-                           int threads) {
-  const std::vector<PlacedBeam> want = oracle_placement(batch, geo, params);
-  const PlacedBeams got = place_beams(batch, geo, params, threads);
-  ASSERT_EQ(got.beams.size(), want.size());
+void expect_same_beams(const std::vector<PlacedBeam> &want, const std::vector<PlacedBeam> &got) {
+  ASSERT_EQ(got.size(), want.size());
   size_t differ = 0;
   for (size_t i = 0; i < want.size(); ++i) {
-    const PlacedBeam &a = want[i], &b = got.beams[i];
+    const PlacedBeam &a = want[i], &b = got[i];
     if (a.x2 != b.x2 || a.y2 != b.y2 || a.scan != b.scan || std::memcmp(&a.range, &b.range, 4) != 0) {
       if (++differ <= 5)
         ADD_FAILURE() << "beam " << i << " of scan " << a.scan << ": oracle (" << a.x2 << ", " << a.y2
@@ -59,6 +57,27 @@ void expect_same_placement(const ScanBatch &batch, const GridGeometry &geo, cons
     }
   }
   EXPECT_EQ(differ, 0u);
+}
+
+// place_beams on `threads` cores, and ScanBeamPlacer a scan at a time (one
+// placer for every scan, as cpu_float places them): the oracle's beams.
+void expect_same_placement(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
+                           int threads) {
+  const std::vector<PlacedBeam> want = oracle_placement(batch, geo, params);
+  {
+    SCOPED_TRACE("place_beams");
+    expect_same_beams(want, place_beams(batch, geo, params, threads).beams);
+  }
+  SCOPED_TRACE("ScanBeamPlacer");
+  const std::vector<oracle::ScanStart> starts = place_scans(batch, geo);
+  ScanBeamPlacer placer;
+  std::vector<PlacedBeam> streamed, one;
+  for (size_t s = 0; s < batch.num_scans(); ++s) {
+    one.assign(static_cast<size_t>(batch.beams_in(s)), PlacedBeam{});
+    const size_t n = placer.place(batch, geo, params, starts[s], s, static_cast<uint32_t>(s), one.data());
+    streamed.insert(streamed.end(), one.begin(), one.begin() + static_cast<std::ptrdiff_t>(n));
+  }
+  expect_same_beams(want, streamed);
 }
 
 TEST(BeamPlacement, EndCellsOfTheBundledLogsAreTheOracles) {

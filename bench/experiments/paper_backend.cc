@@ -79,6 +79,13 @@ class PaperBackend : public PaperMapper {
     DeviceBuffer<uint8_t> d_touched(cells);
     DeviceBuffer<unsigned long long> d_counters(3);
     DeviceBuffer<cuda::KernelModel<float>> d_model(1);
+    const bool floor = variant_ == cuda::PaperVariant::FloorRegisters || variant_ == cuda::PaperVariant::FloorSharedTile;
+    const int T = params.table_size();
+    if (floor && (T <= 0 || T > cuda::kMaxFloatTable))
+      throw std::runtime_error("the float floors: no increment tables for these parameters");
+    DeviceBuffer<int2> increments(floor ? static_cast<size_t>(T) * T : 0);
+    DeviceBuffer<unsigned long long> sums(floor ? cells : 0);  // a degenerate beam still adds to its cell
+    if (floor) cuda::launch_float_tables(m, increments.get(), stream.get());
 
     e0.record(stream.get());
     if (nscans)
@@ -96,8 +103,17 @@ class PaperBackend : public PaperMapper {
     VG_CUDA_CHECK(cudaMemsetAsync(d_counters.get(), 0, 3 * sizeof(unsigned long long), stream.get()));
     const cuda::PaperVariant v = variant_;
     VG_CUDA_CHECK(cudaMemcpyAsync(d_model.get(), &m, sizeof m, cudaMemcpyHostToDevice, stream.get()));
-    cuda::run_paper_variant(v, m, d_model.get(), h_scans.get(), d_scans.get(), static_cast<int>(nscans),
-                            d_ranges.get(), d_grid.get(), d_touched.get(), stream.get());
+    if (v == cuda::PaperVariant::FloorRegisters || v == cuda::PaperVariant::FloorSharedTile) {
+      // Our kernel's walk with its tables (built before the launch, as a
+      // session builds them once), the updates where the floor puts them.
+      const cuda::FloatFloor floor =
+          v == cuda::PaperVariant::FloorRegisters ? cuda::FloatFloor::Registers : cuda::FloatFloor::SharedTile;
+      cuda::launch_float_map_floor(floor, m, increments.get(), d_scans.get(), static_cast<int>(nscans),
+                                   d_ranges.get(), sums.get(), d_counters.get(), stream.get());
+    } else {
+      cuda::run_paper_variant(v, m, d_model.get(), h_scans.get(), d_scans.get(), static_cast<int>(nscans),
+                              d_ranges.get(), d_grid.get(), d_touched.get(), stream.get());
+    }
     timer.mark("map");
     cuda::launch_float_finalize(m, d_grid.get(), d_touched.get(), cells, stream.get());
     timer.mark("finalize");

@@ -94,6 +94,8 @@ const char *paper_variant_name(PaperVariant v) {
     case PaperVariant::PerScanNoShared: return "paper: scan/launch, no shared";
     case PaperVariant::PerScanNoConst: return "paper: scan/launch, no const";
     case PaperVariant::Fused: return "paper: fused launch, shared, const";
+    case PaperVariant::FloorRegisters: return "ours: floor, updates to registers";
+    case PaperVariant::FloorSharedTile: return "ours: floor, updates to a shared tile";
   }
   return "?";
 }

@@ -10,7 +10,9 @@
 namespace vasco {
 namespace cuda {
 
-enum class PaperVariant { PerScan, PerScanNoShared, PerScanNoConst, Fused };
+// The paper's kernel and its ablation; then the floors of our float kernel's
+// accumulation (egrid_kernels.h FloatFloor: the map comes out wrong).
+enum class PaperVariant { PerScan, PerScanNoShared, PerScanNoConst, Fused, FloorRegisters, FloorSharedTile };
 const char *paper_variant_name(PaperVariant v);
 
 // Accumulates every scan into d_logodds / d_touched like launch_float_map.

@@ -18,12 +18,13 @@ void BatchReport::advance() {
   bar_.update(finished_, entries_.size());
 }
 
-void BatchReport::mapped(size_t i, const RunResult &r) {
+void BatchReport::mapped(size_t i, const RunResult &r, double waited_s) {
   std::lock_guard<std::mutex> lock(mutex_);
   BatchEntry &e = entries_[i];
   e.scans = r.scans;
   e.parse_s = r.parse_s;
   e.map_s = r.map_total_s + r.finish_s;
+  e.wait_s = waited_s;
   e.warnings = r.input.warnings;
 }
 
@@ -101,7 +102,7 @@ void BatchReport::print_json(double total_s) const {
     if (e.state == BatchEntry::State::Failed) j << ",\"error\":" << cli::json_string(e.error);
     if (e.state == BatchEntry::State::Done) {
       j << ",\"scans\":" << e.scans << ",\"seconds\":{\"read\":" << e.parse_s << ",\"map\":" << e.map_s
-        << ",\"write\":" << e.write_s << "},\"outputs\":[";
+        << ",\"write\":" << e.write_s << ",\"mapper_wait\":" << e.wait_s << "},\"outputs\":[";
       for (size_t k = 0; k < e.outputs.size(); ++k) j << (k ? "," : "") << cli::json_string(e.outputs[k]);
       j << "]";
     }

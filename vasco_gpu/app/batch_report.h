@@ -23,6 +23,9 @@ struct BatchEntry {
   std::vector<std::string> warnings;
   size_t scans = 0;
   double parse_s = 0, map_s = 0, write_s = 0;
+  // How long its mapper waited, for its read and then for a write slot:
+  // a batch whose mappers wait is bound by the pool (batch_bench's stages).
+  double wait_s = 0;
 };
 
 // Thread-safe: workers report reads and writes, the mapping thread maps.
@@ -31,8 +34,9 @@ class BatchReport {
   BatchReport(const Options &opt, std::vector<BatchEntry> entries);
 
   void set_backend(const std::string &backend) { backend_ = backend; }
-  // The input read and mapped (its map not yet written).
-  void mapped(size_t i, const RunResult &r);
+  // The input read and mapped (its map not yet written); waited_s: its
+  // mapper's wait for the read and for a write slot.
+  void mapped(size_t i, const RunResult &r, double waited_s);
   // Its outputs written, or the input failed at any step (said at once).
   void written(size_t i, double write_s);
   void failed(size_t i, const std::string &why);

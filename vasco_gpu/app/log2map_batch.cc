@@ -132,12 +132,13 @@ class BatchRun {
     size_t i;
     while (!stop_ && (i = take_next()) < n) {
       std::unique_ptr<RunResult> r;
+      const auto t = cli::Clock::now();
       try {
         r = read_[i].get();
       } catch (...) {
         fail(i, std::current_exception());
       }
-      if (r) map_one(mapper, i, std::move(r));
+      if (r) map_one(mapper, i, std::move(r), cli::seconds_since(t));
     }
   }
 
@@ -175,16 +176,18 @@ class BatchRun {
     });
   }
 
-  void map_one(vasco::Mapper &mapper, size_t i, std::unique_ptr<RunResult> r) {
+  // waited_s: how long this mapper waited for the input's read.
+  void map_one(vasco::Mapper &mapper, size_t i, std::unique_ptr<RunResult> r, double waited_s) {
     const std::string &input = opt_.inputs[i];
     try {
       map_input(mapper, input, *r);
     } catch (...) {
       return fail(i, std::current_exception());
     }
-    report_.mapped(i, *r);
     r->input.batch = vasco::ScanBatch();  // the scans are not needed to write
+    const auto t = cli::Clock::now();
     writes_.take();
+    report_.mapped(i, *r, waited_s + cli::seconds_since(t));
     std::shared_ptr<RunResult> mapped(std::move(r));
     pool_.submit(
         [this, i, mapped] {

@@ -69,8 +69,6 @@ BeamLayout lay_out_beams(const ScanBatch &batch, const GridGeometry &geo, int th
   return layout;
 }
 
-namespace {
-
 // A beam's end cell is (int)(l + w·cos(angle)/resolution) per axis, with the
 // cos and sin of glibc (oracle::beam_end). Calling both for every beam is
 // most of the placement's time, so this class derives them from the scan's
@@ -124,6 +122,8 @@ class BeamEnds {
   std::vector<double> cos_, sin_;
 };
 
+namespace {
+
 // The end cells of scan s's used beams, written from out[0] on, with
 // `scan_index` in each beam's `scan`; returns how many were written.
 size_t place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
@@ -152,6 +152,14 @@ size_t place_scan_beams(const ScanBatch &batch, const GridGeometry &geo, const M
 }
 
 }  // namespace
+
+ScanBeamPlacer::ScanBeamPlacer() : ends_(std::make_unique<BeamEnds>()) {}
+ScanBeamPlacer::~ScanBeamPlacer() = default;
+
+size_t ScanBeamPlacer::place(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
+                             const oracle::ScanStart &start, size_t s, uint32_t scan_index, PlacedBeam *out) {
+  return place_scan_beams(batch, geo, params, start, s, scan_index, *ends_, out);
+}
 
 void place_laid_out_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
                           const BeamLayout &layout, int threads, PlacedBeam *out) {

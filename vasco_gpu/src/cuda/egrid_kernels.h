@@ -265,6 +265,17 @@ void launch_float_map(const KernelModel<float> &m, const int2 *increments, const
                       const float *ranges, unsigned long long *sums, unsigned long long *across,
                       unsigned long long *counters, cudaStream_t stream);
 
+// The floors of launch_float_map's accumulation, for mapping_bench's
+// ablation only (`sums` comes out wrong): the same walk with every update
+// added to a register (no memory at all: the walk's own cost), or to a
+// 64 x 64-cell tile in shared memory at the cell's position modulo 64, never
+// flushed (what any per-tile layout pays at least, before binning the beams
+// by tile and flushing the tiles).
+enum class FloatFloor { Registers, SharedTile };
+void launch_float_map_floor(FloatFloor floor, const KernelModel<float> &m, const int2 *increments,
+                            const FloatScan *scans, int num_scans, const float *ranges, unsigned long long *sums,
+                            unsigned long long *counters, cudaStream_t stream);
+
 // Float log-odds sums (the paper's kernels, bench/experiments) ->
 // probability, in place; cells never updated become -1: those still -0.0f,
 // or, when `touched` is given, those whose flag is 0.

@@ -49,6 +49,13 @@ struct NearWindow {
   int x1, y1;                 // the scan's start cell
 };
 
+// Where the map kernel adds an update: the map's sums (every launch but
+// mapping_bench's floors), or a floor's register or shared tile (egrid_kernels.h FloatFloor).
+enum class Accumulate { Sums, Registers, SharedTile };
+constexpr int kFloorTile = 64;
+template <Accumulate kAcc>
+constexpr int kWindowCells = kAcc == Accumulate::SharedTile ? kFloorTile * kFloorTile : kWindow * kWindow;
+
 // The sums are fixed point (egrid_kernels.h kFixedCountBits): 0 means
 // "never updated", and every update adds its count bit, so no separate
 // touched array and none of its stores.
@@ -233,11 +240,12 @@ __device__ __forceinline__ void minor_offset(const BeamPlan &w, int k, int *mm, 
 // sectors per warp. With `across` (a y-major accumulator of the same cells)
 // they go there instead, to consecutive addresses; launch_float_map adds it
 // to the sums afterwards. Integer sums: the same bytes either way.
-template <bool kBanded>
+template <bool kBanded, Accumulate kAcc>
 __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, const int2 *increments,
                                                  const BeamPlan &w, int x1, int y1, int lane,
                                                  unsigned long long *sums, unsigned long long *across,
-                                                 const NearWindow &near, unsigned *updates) {
+                                                 const NearWindow &near, unsigned *updates,
+                                                 unsigned long long *sink) {
   if (lane > w.k_end) return;
   const bool steep = w.flags & kPlanSteep, flipped = w.flags & kPlanFlipped;
   const int inc = w.flags & kPlanBackward ? -1 : 1;
@@ -263,7 +271,13 @@ __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, co
       } else {
         update = fixed_increment(m, float_distance(m, abs(cx - x1), abs(cy - y1)), w.r, &q);
       }
-      if (update) {
+      if (update && kAcc == Accumulate::Registers) {
+        *sink += fixed_term(q);
+        ++*updates;
+      } else if (update && kAcc == Accumulate::SharedTile) {
+        atomicAdd(near.cells + (cx & (kFloorTile - 1)) * kFloorTile + (cy & (kFloorTile - 1)), fixed_term(q));
+        ++*updates;
+      } else if (update) {
         if (k < kNear) {  // then mm < kNear too: inside the window
           atomicAdd(near.cells + (cx - near.x1 + kNear - 1) * kWindow + (cy - near.y1 + kNear - 1), fixed_term(q));
         } else if (target == across) {
@@ -283,21 +297,22 @@ __device__ __forceinline__ void walk_closed_form(const KernelModel<float> &m, co
   }
 }
 
-template <bool kBanded>
+template <bool kBanded, Accumulate kAcc = Accumulate::Sums>
 __global__ void __launch_bounds__(kWarpsPerBlock * 32, 5)
     float_map_kernel(KernelModel<float> m, const int2 *increments, const FloatScan *scans, int num_scans, int parts,
                      const float *ranges, unsigned long long *sums, unsigned long long *across,
                      unsigned long long *counters) {
   const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
   unsigned used = 0, skipped = 0, updates = 0;
-  __shared__ unsigned long long window[kWindow * kWindow];
+  unsigned long long sink = 0;  // the Registers floor's
+  __shared__ unsigned long long window[kWindowCells<kAcc>];
   // `parts` blocks share a scan (several when a few scans are inserted, so
   // that one scan still fills the GPU), each taking every parts-th warp's beams.
   for (int sp = blockIdx.x; sp < num_scans * parts; sp += gridDim.x) {
     const FloatScan sc = scans[sp / parts];
     const int part = sp % parts;
     const NearWindow near{window, sc.x1, sc.y1};
-    for (int c = threadIdx.x; c < kWindow * kWindow; c += blockDim.x) window[c] = 0;
+    for (int c = threadIdx.x; c < kWindowCells<kAcc>; c += blockDim.x) window[c] = 0;
     __syncthreads();
     // The warp's beams are first + l * stride; a round plans 32 of them, a
     // lane each, and walks them one after the other.
@@ -310,7 +325,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32, 5)
       for (unsigned todo = __ballot_sync(0xffffffffu, mine.kind != kSkipBeam); todo != 0; todo &= todo - 1) {
         const BeamPlan w = share_plan(mine, __ffs(todo) - 1);
         if (w.kind == kClosedBeam) {
-          walk_closed_form<kBanded>(m, increments, w, sc.x1, sc.y1, lane, sums, across, near, &updates);
+          walk_closed_form<kBanded, kAcc>(m, increments, w, sc.x1, sc.y1, lane, sums, across, near, &updates, &sink);
         } else if (lane == 0) {  // degenerate line (a range of -inf): one lane walks it sequentially
           bool stop = false;
           egrid::walk_line(sc.x1, sc.y1, w.x2, w.y2, m.table_size, [&](int cx, int cy, int) {
@@ -322,13 +337,15 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32, 5)
     }
     __syncthreads();
     // The window to the sums: only cells of the grid were added to it.
-    for (int c = threadIdx.x; c < kWindow * kWindow; c += blockDim.x) {
+    for (int c = threadIdx.x; kAcc == Accumulate::Sums && c < kWindow * kWindow; c += blockDim.x) {
       if (window[c] == 0) continue;
       const int bx = sc.x1 + c / kWindow - (kNear - 1) - m.x_begin, cy = sc.y1 + c % kWindow - (kNear - 1);
       atomicAdd(sums + static_cast<size_t>(bx) * m.size_y + cy, window[c]);
     }
     __syncthreads();
   }
+  if (kAcc == Accumulate::Registers && sink != 0) atomicAdd(sums, sink);  // kept: the floor's walk is not dead code
+  if (kAcc == Accumulate::SharedTile && threadIdx.x == 0) atomicAdd(sums, window[0]);
   // counters: beams used, beams skipped, cell updates
   used = warp_sum(used);
   skipped = warp_sum(skipped);
@@ -394,6 +411,11 @@ __global__ void from_prob_kernel(KernelModel<float> m, const float *probs, unsig
 
 unsigned fill_blocks(size_t n) { return static_cast<unsigned>(std::min<size_t>((n + 255) / 256, 65536)); }
 
+// Blocks per scan of the map kernel: a full render has thousands of scans, a
+// block each; an insert of a few scans splits each over up to 48 blocks (a
+// warp per beam either way), so that one scan still fills the GPU.
+int scan_parts(int num_scans) { return num_scans >= 1024 ? 1 : std::min(48, (1024 + num_scans - 1) / num_scans); }
+
 }  // namespace
 
 bool kernels_runnable_on_current_device(std::string *why) {
@@ -436,9 +458,7 @@ void launch_float_map(const KernelModel<float> &m, const int2 *increments, const
   if (num_scans <= 0) return;
   const size_t cells = static_cast<size_t>(m.size_x) * static_cast<size_t>(m.size_y);
   if (across != nullptr) VG_CUDA_CHECK(cudaMemsetAsync(across, 0, cells * sizeof(unsigned long long), stream));
-  // A full render has thousands of scans: a block each. An insert of a few
-  // scans splits each over up to 48 blocks (a warp per beam either way).
-  const int parts = num_scans >= 1024 ? 1 : std::min(48, (1024 + num_scans - 1) / num_scans);
+  const int parts = scan_parts(num_scans);
   // A band of a split render (x_begin > 0) offsets its columns; a whole grid, or the first band, needs not.
   auto *kernel = m.x_begin != 0 ? float_map_kernel<true> : float_map_kernel<false>;
   kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, increments, scans, num_scans, parts, ranges, sums,
@@ -447,6 +467,18 @@ void launch_float_map(const KernelModel<float> &m, const int2 *increments, const
   if (across == nullptr) return;
   const dim3 tiles((m.size_x + kAcrossTile - 1) / kAcrossTile, (m.size_y + kAcrossTile - 1) / kAcrossTile), threads(kAcrossTile, kAcrossRows);
   add_across_kernel<<<tiles, threads, 0, stream>>>(m.size_x, m.size_y, across, sums);
+  VG_CUDA_CHECK_LAUNCH();
+}
+
+void launch_float_map_floor(FloatFloor floor, const KernelModel<float> &m, const int2 *increments,
+                            const FloatScan *scans, int num_scans, const float *ranges, unsigned long long *sums,
+                            unsigned long long *counters, cudaStream_t stream) {
+  if (num_scans <= 0) return;
+  const int parts = scan_parts(num_scans);
+  auto *kernel = floor == FloatFloor::Registers ? float_map_kernel<false, Accumulate::Registers>
+                                                : float_map_kernel<false, Accumulate::SharedTile>;
+  kernel<<<num_scans * parts, kWarpsPerBlock * 32, 0, stream>>>(m, increments, scans, num_scans, parts, ranges, sums,
+                                                                 nullptr, counters);
   VG_CUDA_CHECK_LAUNCH();
 }
 

@@ -8,6 +8,7 @@
 #define VASCO_GPU_BEAM_PLACEMENT_H
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "vasco_gpu/grid.h"
@@ -48,6 +49,26 @@ BeamLayout lay_out_beams(const ScanBatch &batch, const GridGeometry &geo, int th
 // pinned staging buffer.
 void place_laid_out_beams(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
                           const BeamLayout &layout, int threads, PlacedBeam *out);
+
+// One scan's used beams at a time, for a backend that adds each scan's beams
+// as it places them (they stay in cache, and a log's worth of PlacedBeam is
+// never stored): the same end cells as place_beams, with its caches.
+class BeamEnds;
+class ScanBeamPlacer {
+ public:
+  ScanBeamPlacer();
+  ~ScanBeamPlacer();
+  ScanBeamPlacer(const ScanBeamPlacer &) = delete;
+  ScanBeamPlacer &operator=(const ScanBeamPlacer &) = delete;
+  // Scan s's used beams, placed from `start` (place_scans'), written from
+  // out[0] on (batch.beams_in(s) at most) with `scan_index` as their scan;
+  // returns how many.
+  size_t place(const ScanBatch &batch, const GridGeometry &geo, const MapperParams &params,
+               const oracle::ScanStart &start, size_t s, uint32_t scan_index, PlacedBeam *out);
+
+ private:
+  std::unique_ptr<BeamEnds> ends_;
+};
 
 // The starts of scans [first, last) (all scans by default) and the end cells
 // of their used beams; threads <= 0: all cores. Throws std::runtime_error
