@@ -143,6 +143,10 @@ TEST(Log2MapBatch, JsonReportsEveryInput) {
   EXPECT_TRUE(contains(r.output, "\"state\":\"done\",\"scans\":910")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"state\":\"failed\",\"error\":")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"done\":1,\"failed\":1")) << r.output;
+  // The stages batch_bench reads: the mapper's wait beside read, map and write, and the threads.
+  EXPECT_TRUE(contains(r.output, ",\"mapper_wait\":")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"mappers\":1,")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"pool_threads\":")) << r.output;
 }
 
 TEST(Log2MapBatch, UsageErrorsBeforeAnyWork) {

@@ -34,6 +34,11 @@ class BatchReport {
   BatchReport(const Options &opt, std::vector<BatchEntry> entries);
 
   void set_backend(const std::string &backend) { backend_ = backend; }
+  // The threads that read and write, and the mappers (a thread each).
+  void set_threads(int pool, int mappers) {
+    pool_threads_ = pool;
+    mappers_ = mappers;
+  }
   // The input read and mapped (its map not yet written); waited_s: its
   // mapper's wait for the read and for a write slot.
   void mapped(size_t i, const RunResult &r, double waited_s);
@@ -56,6 +61,7 @@ class BatchReport {
   const Options &opt_;
   std::vector<BatchEntry> entries_;
   std::string backend_;
+  int pool_threads_ = 0, mappers_ = 0;
   mutable std::mutex mutex_;
   ProgressBar bar_;
   size_t finished_ = 0;

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <future>
 #include <map>
@@ -112,12 +113,22 @@ class Slots {
   size_t free_;
 };
 
+// How much nicer the pool's threads (reads, writes) run than the mappers:
+// with every core reading or writing, a mapper thread that waits for a core
+// holds its GPU up, while the pool's work has slack (reads queue ahead).
+// VASCO_BATCH_POOL_NICE sets it (0: the same priority; batch_bench's A/B).
+int pool_nice() {
+  const char *v = std::getenv("VASCO_BATCH_POOL_NICE");
+  if (v != nullptr && *v != '\0') return std::clamp(std::atoi(v), 0, 19);
+  return 5;
+}
+
 // One batch: inputs read on the pool, mapped here in order, written on the pool.
 class BatchRun {
  public:
   BatchRun(const Options &opt, const ToolSpec &spec, BatchReport &report, int jobs)
       : opt_(opt), spec_(spec), report_(report), ahead_(2 * static_cast<size_t>(jobs)), writes_(ahead_),
-        pool_(jobs), read_(opt.inputs.size()) {}
+        pool_(jobs, pool_nice()), read_(opt.inputs.size()) {}
 
   ~BatchRun() { stop_ = true; }  // queued reads return at once; the pool drains
 
@@ -222,16 +233,23 @@ class BatchRun {
 
 int all_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
 
-// The GPUs a batch maps on: --device's alone when given; else, for a backend
-// that uses GPUs (cuda, auto), every visible GPU that is usable (none: the one backend as before,
-// auto then on the CPU).
+// Mappers per GPU when the batch chooses: a mapper's thread spends most of a
+// log on the host (the upload's copy, the finish, waiting for its read), so
+// several keep one GPU busy (batch_bench's scaling table).
+constexpr int kMappersPerGpu = 2;
+
+// The GPUs a batch maps on, a mapper each: --devices' list, or --device's
+// GPU alone, when given; else, for a backend that uses GPUs (cuda, auto),
+// every visible GPU that is usable, kMappersPerGpu times (none: the one
+// backend as before, auto then on the CPU).
 std::vector<int> batch_devices(const Options &opt) {
   if (!opt.devices.empty()) return opt.devices;
   const vasco::BackendInfo *b = vasco::find_backend(opt.backend);
   if (opt.device_given || b == nullptr || !b->uses_gpus) return {opt.device};
   std::vector<int> usable;
   for (int d = 0; d < vasco::cuda_device_count(); ++d)
-    if (vasco::gpu_usable(d)) usable.push_back(d);
+    if (vasco::gpu_usable(d))
+      for (int k = 0; k < kMappersPerGpu; ++k) usable.push_back(d);
   if (usable.empty()) return {opt.device};
   return usable;
 }
@@ -277,7 +295,8 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
 
   BatchReport report(opt, std::move(entries));
   {
-    BatchRun run(opt, spec, report, opt.jobs > 0 ? opt.jobs : all_cores());
+    const int jobs = opt.jobs > 0 ? opt.jobs : all_cores();
+    BatchRun run(opt, spec, report, jobs);
     run.start_reads();  // while the backend starts
     const std::vector<int> devices = batch_devices(opt);
     // One mapper for every input (per GPU): its backend (a GPU's context
@@ -290,7 +309,9 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     const vasco::BackendInfo *chosen = vasco::find_backend(opt.backend);
     if (chosen != nullptr && chosen->chooses && !mapper.backend_traits().grid_on_device && !opt.quiet)
       std::fprintf(stderr, "%s: --backend auto: no usable GPU: using %s\n", opt.tool.c_str(), mapper.backend_name().c_str());
-    if (devices.size() > 1 && mapper.backend_traits().grid_on_device) {
+    const bool several = devices.size() > 1 && mapper.backend_traits().grid_on_device;
+    report.set_threads(jobs, several ? static_cast<int>(devices.size()) : 1);
+    if (several) {
       std::string list;
       for (int d : devices) list += (list.empty() ? "" : ",") + std::to_string(d);
       report.set_backend(mapper.backend_name() + " on GPUs " + list);

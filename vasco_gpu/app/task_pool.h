@@ -15,7 +15,10 @@ namespace cli {
 
 class TaskPool {
  public:
-  explicit TaskPool(int threads);
+  // `nice`: added to each thread's nice value (Linux: per thread; threads a
+  // task starts inherit it), so that a thread outside the pool that the
+  // pool feeds (batch mode's mappers) gets a core when it needs one.
+  explicit TaskPool(int threads, int nice = 0);
   // Runs every task still queued, then joins the threads.
   ~TaskPool();
   TaskPool(const TaskPool &) = delete;
