@@ -4,9 +4,12 @@
 #ifndef VASCO_BENCH_SUPPORT_H
 #define VASCO_BENCH_SUPPORT_H
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -36,6 +39,21 @@ inline std::string ms(double s) {
   return b;
 }
 
+// The directory of this program (where log2map is built beside it).
+inline std::string self_dir(const char *argv0) {
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  std::string p = n > 0 ? std::string(buf, static_cast<size_t>(n)) : std::string(argv0);
+  const size_t s = p.find_last_of('/');
+  return s == std::string::npos ? "." : p.substr(0, s);
+}
+
+// A temporary .map.gz path of this process, for a run's output.
+inline std::string temp_map_path() {
+  const char *tmp = std::getenv("TMPDIR");
+  return std::string(tmp ? tmp : "/tmp") + "/vasco_bench_" + std::to_string(getpid()) + ".map.gz";
+}
+
 struct Dataset {
   std::string name, path;
 };
@@ -43,6 +61,7 @@ struct Dataset {
 struct ParamSet {
   std::string name;
   vasco::MapperParams params;
+  std::string log2map_args;  // the same parameters as log2map options
 };
 
 // The logs measured, fr079 first (mapping_bench's end-to-end section uses it).
@@ -55,7 +74,7 @@ inline std::vector<Dataset> bench_datasets() {
 inline std::vector<ParamSet> bench_param_sets() {
   vasco::MapperParams paper;
   paper.range_max = 6.4;  // the paper's setting, at vasco's 2.5 cm cells
-  return {{"paper", paper}, {"vasco_default_raw", vasco::MapperParams{}}};
+  return {{"paper", paper, "--vasco_range_max 6.4"}, {"vasco_default_raw", vasco::MapperParams{}, ""}};
 }
 
 }  // namespace bench

@@ -75,6 +75,8 @@ using bench::bench_param_sets;
 using bench::Dataset;
 using bench::median;
 using bench::ms;
+using bench::self_dir;
+using bench::temp_map_path;
 using bench::now_s;
 using bench::ParamSet;
 
@@ -97,11 +99,6 @@ struct Row {
   uint64_t scans = 0, beams = 0, updates = 0;
   double parse = 0, prep = 0, upload = 0, map = 0, download = 0, finish = 0, write = 0, total = 0;
 };
-
-std::string temp_map_path() {
-  const char *tmp = std::getenv("TMPDIR");
-  return std::string(tmp ? tmp : "/tmp") + "/vasco_bench_" + std::to_string(getpid()) + ".map.gz";
-}
 
 // Writes a finished map as a .map.gz to a temporary file and removes it
 // (the write phase of a run).
@@ -184,14 +181,6 @@ double log2map_wall(const std::string &bin, const std::string &log, const std::s
     if (i > 0) t.push_back(t1 - t0);
   }
   return median(t);
-}
-
-std::string self_dir(const char *argv0) {
-  char buf[4096];
-  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
-  std::string p = n > 0 ? std::string(buf, static_cast<size_t>(n)) : std::string(argv0);
-  const size_t s = p.find_last_of('/');
-  return s == std::string::npos ? "." : p.substr(0, s);
 }
 
 // The command line.
