@@ -101,5 +101,32 @@ TEST(CpuFloat, ShortBeamsInALargeGridUpdateTheCellsCpuDoubleUpdates) {
   }
 }
 
+// Angles that overflow: each of a scan's pose angle, first angle and step is
+// finite, but the running sum of the steps reaches inf, so those beams' end
+// cells are no cells and their lines are walked to the table's cut, however
+// short the ranges (the box is then the cut around the start).
+TEST(CpuFloat, AnglesThatOverflowUpdateTheCellsCpuDoubleUpdates) {
+  for (double range_max : {10.0, 40.0}) {
+    SCOPED_TRACE("range_max " + std::to_string(range_max));
+    MapperParams params;
+    params.resolution = 0.05;
+    params.range_max = range_max;
+    ScanBatch batch;
+    const std::vector<float> ranges(4, 0.05f);
+    batch.add_scan(0.0, 0.0, 0.0, 0.0, 1e308, ranges.data(), 4, 1);
+    batch.add_scan(0.1, 0.0, 0.0, 0.0, 1e308, ranges.data(), 4, 2);
+    const GridGeometry geo = size_grid(batch, params);
+    MapStats want_stats, got_stats;
+    const std::vector<float> want = render_grid(*make_renderer("cpu_double"), batch, params, geo, &want_stats);
+    const std::vector<float> got = render_grid(*make_renderer("cpu_float"), batch, params, geo, &got_stats);
+    size_t differ = 0;
+    for (size_t i = 0; i < want.size(); ++i)
+      differ += (want[i] != egrid::kUnknown) != (got[i] != egrid::kUnknown);
+    EXPECT_EQ(differ, 0u);
+    EXPECT_EQ(got_stats.cell_updates, want_stats.cell_updates);
+    EXPECT_GT(want_stats.cell_updates, 0u);
+  }
+}
+
 }  // namespace
 }  // namespace vasco

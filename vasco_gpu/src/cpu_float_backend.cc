@@ -162,8 +162,14 @@ Box clipped_box(int64_t x0, int64_t x1, int64_t y0, int64_t y1, const GridGeomet
 // its longest used beam's end cell is at most |r + wall| / resolution + 2
 // cells away (|lx - x1| < 1, and the truncation of the end one more; one
 // more margin), and no walk goes past table_size - 1 steps (add_closed_form_beam,
-// add_walked_beam), nor does a range that is not finite (a line walked to that cut).
-int64_t scan_reach(const ScanBatch &batch, size_t s, double wall, double resolution, int64_t cut) {
+// add_walked_beam), nor does a range that is not finite, or a beam whose angle
+// is not (a running sum of finite values can overflow to inf: its end cell
+// is then no cell, and the line is walked to that cut).
+int64_t scan_reach(const ScanBatch &batch, const oracle::ScanStart &start, size_t s, double wall, double resolution,
+                   int64_t cut) {
+  const double angles = std::fabs(start.theta) + std::fabs(batch.first_angle[s]) +
+                        batch.beams_in(s) * std::fabs(batch.angle_step[s]);
+  if (!std::isfinite(angles)) return cut;
   const float *r = batch.ranges_of(s);
   double longest = 0;
   for (int b = 0; b < batch.beams_in(s); ++b) {
@@ -187,7 +193,7 @@ Box reach_of(const ScanBatch &batch, const std::vector<oracle::ScanStart> &start
   int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
   for (size_t i = 0; i < starts.size(); ++i) {
     const oracle::ScanStart &s = starts[i];
-    const int64_t r = scan_reach(batch, first + i, params.wall_size, geo.resolution, cut);
+    const int64_t r = scan_reach(batch, s, first + i, params.wall_size, geo.resolution, cut);
     x0 = std::min<int64_t>(x0, s.x1 - r), x1 = std::max<int64_t>(x1, s.x1 + r);
     y0 = std::min<int64_t>(y0, s.y1 - r), y1 = std::max<int64_t>(y1, s.y1 + r);
   }
@@ -448,6 +454,8 @@ uint64_t add_walked_beam(const EvidenceTable &ev, int x1, int y1, int x2, int y2
     if (i < 0 || j < 0 || i >= t || j >= t) return false;  // kFarDistance: stops
     const int64_t n = int64_t(i) * i + int64_t(j) * j;
     if (n >= ev.n_stop()) return false;
+    // reach_of's box holds every cell a walk reaches; past it would be past the sums.
+    if (cx < box.x_lo || cx >= box.x_hi || cy < box.y_lo || cy >= box.y_hi) return true;
     acc[static_cast<size_t>(cx - box.x_lo) * box.height() + static_cast<size_t>(cy - box.y_lo)] +=
         ev.increment(n, n < n_free);
     ++updates;
