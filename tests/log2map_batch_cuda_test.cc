@@ -81,6 +81,22 @@ TEST_F(Log2MapBatchCuda, SeveralMappersGiveTheOneMappersMaps) {
   }
 }
 
+// Several mappers on one GPU: an input that runs out of memory beside the
+// others is mapped again at the end, alone, and reported once if it fails
+// again. With --max-memory 1, intel's map runs out (tried twice, reported
+// once) and fr079's read already does (reported at once, never deferred).
+TEST_F(Log2MapBatchCuda, OutOfMemoryBesideAnotherMapperIsTriedAgainAlone) {
+  TempDir dir;
+  const ToolRun r = log2map({"--backend", "cuda", "--devices", "0,0", "--max-memory", "1", "--out-dir",
+                             dir.file("maps"), kIntel, kFr079});
+  EXPECT_EQ(r.status, 1) << r.output;
+  size_t failed = 0;
+  for (size_t at = r.output.find("FAILED: "); at != std::string::npos; at = r.output.find("FAILED: ", at + 1)) ++failed;
+  EXPECT_EQ(failed, 2u) << "each input once, after its second try\n" << r.output;
+  EXPECT_TRUE(contains(r.output, "memory")) << r.output;
+  EXPECT_TRUE(contains(r.output, "0 of 2 inputs mapped")) << r.output;
+}
+
 // One render split in bands (--split-devices 0,0: two bands on GPU 0 where
 // there is one): exact mode writes CARMEN's map, float mode one GPU's.
 TEST_F(Log2MapBatchCuda, ASplitRenderWritesTheOneGpuMap) {

@@ -532,8 +532,13 @@ void print_target(const std::vector<Row> &rows) {
 double log2map_map_seconds(const std::string &log2map, const Dataset &ds, const ParamSet &ps, int runs) {
   if (access(log2map.c_str(), X_OK) != 0) return -1;
   const std::string out = temp_map_path();
-  const std::string cmd = log2map + " --quiet --json --backend cpu_float " + ps.log2map_args + " " + ds.path + " " +
-                          out + " 2>/dev/null";
+  auto quoted = [](const std::string &path) {  // for the shell: inside single quotes, ' as '\''
+    std::string q = "'";
+    for (char c : path) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+  };
+  const std::string cmd = quoted(log2map) + " --quiet --json --backend cpu_float " + ps.log2map_args + " " +
+                          quoted(ds.path) + " " + quoted(out) + " 2>/dev/null";
   std::vector<double> t;
   for (int i = 0; i < runs; ++i) {
     FILE *p = popen(cmd.c_str(), "r");

@@ -153,6 +153,32 @@ class BatchRun {
     }
   }
 
+  // Whether several mappers share a GPU: then an input that runs out of GPU
+  // memory may have lacked only what another mapper holds, and is mapped
+  // again at the end, alone (map_deferred). Set before the mappers start.
+  void share_gpus(bool shared) { shares_gpu_ = shared; }
+
+  // After every other mapper is gone (its GPU memory given back): the inputs
+  // that ran out of memory beside them, read again and mapped on `mapper`;
+  // a second failure is reported as any other.
+  void map_deferred(vasco::Mapper &mapper) {
+    shares_gpu_ = false;
+    for (size_t i : deferred_) {
+      if (stop_) break;  // report_not_run names them
+      auto r = std::make_unique<RunResult>();
+      try {
+        const auto t = cli::Clock::now();
+        r->input = read_input(opt_, opt_.inputs[i], spec_, nullptr);
+        r->parse_s = cli::seconds_since(t);
+      } catch (...) {
+        fail(i, std::current_exception());
+        continue;
+      }
+      map_one(mapper, i, std::move(r), 0.0);
+    }
+    deferred_.clear();
+  }
+
   // After every map_all has returned.
   void report_not_run() {
     if (!stop_) return;
@@ -192,6 +218,9 @@ class BatchRun {
     const std::string &input = opt_.inputs[i];
     try {
       map_input(mapper, input, *r);
+    } catch (const carmen::Error &e) {
+      if (shares_gpu_ && e.code() == ErrorCode::OutOfMemory) return defer(i);
+      return fail(i, std::current_exception());
     } catch (...) {
       return fail(i, std::current_exception());
     }
@@ -214,6 +243,11 @@ class BatchRun {
         true);
   }
 
+  void defer(size_t i) {
+    std::lock_guard<std::mutex> lock(deferred_mutex_);
+    deferred_.push_back(i);
+  }
+
   void fail(size_t i, const std::exception_ptr &error) {
     report_.failed(i, what_of(error));
     if (opt_.fail_fast) stop_ = true;
@@ -225,6 +259,9 @@ class BatchRun {
   const size_t ahead_;
   Slots writes_;
   std::atomic<bool> stop_{false};
+  std::atomic<bool> shares_gpu_{false};
+  std::mutex deferred_mutex_;
+  std::vector<size_t> deferred_;  // out of memory beside another mapper: mapped again at the end
   std::mutex next_mutex_;
   size_t next_ = 0;
   cli::TaskPool pool_;  // after what its tasks use: joined first
@@ -315,9 +352,11 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
       std::string list;
       for (int d : devices) list += (list.empty() ? "" : ",") + std::to_string(d);
       report.set_backend(mapper.backend_name() + " on GPUs " + list);
+      run.share_gpus(true);
       std::thread others = map_on_other_devices(run, opt, std::vector<int>(devices.begin() + 1, devices.end()));
       run.map_all(mapper);
-      others.join();
+      others.join();  // their mappers gone, and their GPU memory with them
+      run.map_deferred(mapper);
     } else {
       run.map_all(mapper);
     }

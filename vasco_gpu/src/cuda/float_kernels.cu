@@ -344,7 +344,10 @@ __global__ void __launch_bounds__(kWarpsPerBlock * 32, 5)
     }
     __syncthreads();
   }
-  if (kAcc == Accumulate::Registers && sink != 0) atomicAdd(sums, sink);  // kept: the floor's walk is not dead code
+  if (kAcc == Accumulate::Registers) {  // kept, so the floor's walk is not dead code: one add a warp
+    for (int offset = 16; offset > 0; offset >>= 1) sink += __shfl_xor_sync(0xffffffffu, sink, offset);
+    if (lane == 0 && sink != 0) atomicAdd(sums, sink);
+  }
   if (kAcc == Accumulate::SharedTile && threadIdx.x == 0) atomicAdd(sums, window[0]);
   // counters: beams used, beams skipped, cell updates
   used = warp_sum(used);
