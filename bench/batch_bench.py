@@ -38,14 +38,16 @@ def timed(cmd: list[str], pool_nice: str = "") -> tuple[float, subprocess.Comple
     return time.perf_counter() - t, p
 
 
+def timed_ok(cmd: list[str], pool_nice: str = "") -> tuple[float, subprocess.CompletedProcess]:
+    """timed, and the end of the bench if cmd fails (its command and the tail of its stderr said)."""
+    s, p = timed(cmd, pool_nice)
+    if p.returncode != 0:
+        sys.exit(f"batch_bench: {' '.join(cmd[:10])} ...: exit {p.returncode}\n{p.stderr[-2000:]}")
+    return s, p
+
+
 def best(cmd: list[str], repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        s, p = timed(cmd)
-        if p.returncode != 0:
-            sys.exit(f"batch_bench: {' '.join(cmd[:6])} ...: exit {p.returncode}\n{p.stderr[-2000:]}")
-        times.append(s)
-    return min(times)
+    return min(timed_ok(cmd)[0] for _ in range(repeat))
 
 
 def gpu_usable(log2map: str, log: str, out: str) -> bool:
@@ -134,9 +136,7 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
     cmd = [log2map, "--backend", backend, "--quiet", "--json", "--out-dir", out, "--formats", formats]
     if devices:
         cmd += ["--devices", devices]
-    s, p = timed(cmd + logs, pool_nice)
-    if p.returncode != 0:
-        sys.exit(f"batch_bench: {' '.join(cmd[:8])} ...: exit {p.returncode}\n{p.stderr[-2000:]}")
+    s, p = timed_ok(cmd + logs, pool_nice)
     report = json.loads(p.stdout)
     done = [e for e in report["inputs"] if e["state"] == "done"]
     total = {k: sum(e["seconds"][k] for e in done) for k in ("read", "map", "write", "mapper_wait")}
@@ -215,9 +215,7 @@ def main() -> int:
             k = min(a.per_process, len(logs))
             t = time.perf_counter()
             for i in range(k):
-                _, p = timed([log2map, "--backend", b, "--quiet", logs[i], os.path.join(tmp, f"one.{a.formats}")])
-                if p.returncode != 0:
-                    sys.exit(f"batch_bench: log2map {b} {logs[i]}: exit {p.returncode}\n{p.stderr}")
+                timed_ok([log2map, "--backend", b, "--quiet", logs[i], os.path.join(tmp, f"one.{a.formats}")])
             per = (time.perf_counter() - t) / k
             rows.append((b, len(logs) / s, 1.0 / per))
         one = []
@@ -237,10 +235,7 @@ def main() -> int:
             for _ in range(a.repeat):
                 for d, n in configs:
                     cmd = [log2map, "--backend", "cuda", "--quiet", "--out-dir", out, "--formats", a.formats]
-                    s, p = timed(cmd + (["--devices", d] if d else []) + logs, pool_nice=n)
-                    if p.returncode != 0:
-                        sys.exit(f"batch_bench: {' '.join(cmd)} --devices {d}: exit {p.returncode}\n{p.stderr[-2000:]}")
-                    times[(d, n)].append(s)
+                    times[(d, n)].append(timed_ok(cmd + (["--devices", d] if d else []) + logs, n)[0])
             scaling = [(d, n, len(logs) / min(times[(d, n)])) for d, n in configs]
             stage_lines += stages(log2map, "cuda", "0", logs, out, a.formats, "0") + [""]
             stage_lines += stages(log2map, "cuda", "", logs, out, a.formats, "") + [""]

@@ -48,6 +48,13 @@ inline std::string self_dir(const char *argv0) {
   return s == std::string::npos ? "." : p.substr(0, s);
 }
 
+// `path` for a shell command line: inside single quotes, each ' as '\''.
+inline std::string shell_quoted(const std::string &path) {
+  std::string q = "'";
+  for (char c : path) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
 // A temporary .map.gz path of this process, for a run's output.
 inline std::string temp_map_path() {
   const char *tmp = std::getenv("TMPDIR");

@@ -76,6 +76,7 @@ using bench::Dataset;
 using bench::median;
 using bench::ms;
 using bench::self_dir;
+using bench::shell_quoted;
 using bench::temp_map_path;
 using bench::now_s;
 using bench::ParamSet;
@@ -171,7 +172,8 @@ double log2map_wall(const std::string &bin, const std::string &log, const std::s
   std::vector<double> t;
   const std::string out = temp_map_path();
   const std::string cmd =
-      bin + " --quiet --backend " + backend + " " + log + " " + out + " > /dev/null 2>&1";
+      shell_quoted(bin) + " --quiet --backend " + backend + " " + shell_quoted(log) + " " + shell_quoted(out) +
+      " > /dev/null 2>&1";
   for (int i = 0; i < runs + 1; ++i) {
     const double t0 = now_s();
     const int rc = std::system(cmd.c_str());

@@ -72,10 +72,13 @@ class PaperBackend : public PaperMapper {
     if (nbeams > UINT32_MAX) throw std::runtime_error("the paper's kernels: more than 2^32 beams");
     check_fits(cells * (sizeof(float) + 1) + nbeams * sizeof(float) + nscans * sizeof(cuda::FloatScan),
                "float mode (grid and beams)");
-    if (variant_ == cuda::PaperVariant::FloorRegisters || variant_ == cuda::PaperVariant::FloorSharedTile)
-      check_fits(cells * sizeof(unsigned long long) +
-                     static_cast<size_t>(params.table_size()) * static_cast<size_t>(params.table_size()) * sizeof(int2),
-                 "the float floors (sums and tables)");
+    // A floor of our kernel (mapping_bench's ablation) runs on its tables and fixed-point sums.
+    const bool floor = variant_ == cuda::PaperVariant::FloorRegisters || variant_ == cuda::PaperVariant::FloorSharedTile;
+    const int T = params.table_size();
+    if (floor && (T <= 0 || T > cuda::kMaxFloatTable))
+      throw std::runtime_error("the float floors: no increment tables for these parameters");
+    const size_t table_cells = floor ? static_cast<size_t>(T) * static_cast<size_t>(T) : 0;
+    if (floor) check_fits(cells * sizeof(unsigned long long) + table_cells * sizeof(int2), "the float floors (sums and tables)");
     Stream stream;
     Event e0, e_up, e_map, e_down, e_floor0, e_floor1;
     DeviceBuffer<cuda::FloatScan> d_scans(nscans);
@@ -83,11 +86,7 @@ class PaperBackend : public PaperMapper {
     DeviceBuffer<uint8_t> d_touched(cells);
     DeviceBuffer<unsigned long long> d_counters(3);
     DeviceBuffer<cuda::KernelModel<float>> d_model(1);
-    const bool floor = variant_ == cuda::PaperVariant::FloorRegisters || variant_ == cuda::PaperVariant::FloorSharedTile;
-    const int T = params.table_size();
-    if (floor && (T <= 0 || T > cuda::kMaxFloatTable))
-      throw std::runtime_error("the float floors: no increment tables for these parameters");
-    DeviceBuffer<int2> increments(floor ? static_cast<size_t>(T) * T : 0);
+    DeviceBuffer<int2> increments(table_cells);
     DeviceBuffer<unsigned long long> sums(floor ? cells : 0);  // a degenerate beam still adds to its cell
     if (floor) cuda::launch_float_tables(m, increments.get(), stream.get());
 
@@ -107,14 +106,14 @@ class PaperBackend : public PaperMapper {
     VG_CUDA_CHECK(cudaMemsetAsync(d_counters.get(), 0, 3 * sizeof(unsigned long long), stream.get()));
     const cuda::PaperVariant v = variant_;
     VG_CUDA_CHECK(cudaMemcpyAsync(d_model.get(), &m, sizeof m, cudaMemcpyHostToDevice, stream.get()));
-    if (v == cuda::PaperVariant::FloorRegisters || v == cuda::PaperVariant::FloorSharedTile) {
+    if (floor) {
       // Our kernel's walk with its tables (built before the launch, as a
       // session builds them once), the updates where the floor puts them.
-      const cuda::FloatFloor floor =
+      const cuda::FloatFloor where =
           v == cuda::PaperVariant::FloorRegisters ? cuda::FloatFloor::Registers : cuda::FloatFloor::SharedTile;
       // Timed alone, as the library's rows time their kernels (not the clears and finalize around them).
       e_floor0.record(stream.get());
-      cuda::launch_float_map_floor(floor, m, increments.get(), d_scans.get(), static_cast<int>(nscans),
+      cuda::launch_float_map_floor(where, m, increments.get(), d_scans.get(), static_cast<int>(nscans),
                                    d_ranges.get(), sums.get(), d_counters.get(), stream.get());
       e_floor1.record(stream.get());
     } else {

@@ -52,6 +52,7 @@ using bench::ms;
 using bench::now_s;
 using bench::ParamSet;
 using bench::self_dir;
+using bench::shell_quoted;
 using bench::temp_map_path;
 
 const char *const kMrptLabel = "MRPT COccupancyGridMap2D";
@@ -532,13 +533,8 @@ void print_target(const std::vector<Row> &rows) {
 double log2map_map_seconds(const std::string &log2map, const Dataset &ds, const ParamSet &ps, int runs) {
   if (access(log2map.c_str(), X_OK) != 0) return -1;
   const std::string out = temp_map_path();
-  auto quoted = [](const std::string &path) {  // for the shell: inside single quotes, ' as '\''
-    std::string q = "'";
-    for (char c : path) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-  };
-  const std::string cmd = quoted(log2map) + " --quiet --json --backend cpu_float " + ps.log2map_args + " " +
-                          quoted(ds.path) + " " + quoted(out) + " 2>/dev/null";
+  const std::string cmd = shell_quoted(log2map) + " --quiet --json --backend cpu_float " + ps.log2map_args + " " +
+                          shell_quoted(ds.path) + " " + shell_quoted(out) + " 2>/dev/null";
   std::vector<double> t;
   for (int i = 0; i < runs; ++i) {
     FILE *p = popen(cmd.c_str(), "r");

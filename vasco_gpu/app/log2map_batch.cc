@@ -165,11 +165,9 @@ class BatchRun {
     shares_gpu_ = false;
     for (size_t i : deferred_) {
       if (stop_) break;  // report_not_run names them
-      auto r = std::make_unique<RunResult>();
+      std::unique_ptr<RunResult> r;
       try {
-        const auto t = cli::Clock::now();
-        r->input = read_input(opt_, opt_.inputs[i], spec_, nullptr);
-        r->parse_s = cli::seconds_since(t);
+        r = read_one(i);
       } catch (...) {
         fail(i, std::current_exception());
         continue;
@@ -196,17 +194,22 @@ class BatchRun {
   }
 
  private:
+  // Input i read (inflated and parsed), timed.
+  std::unique_ptr<RunResult> read_one(size_t i) const {
+    auto r = std::make_unique<RunResult>();
+    const auto t = cli::Clock::now();
+    r->input = read_input(opt_, opt_.inputs[i], spec_, nullptr);
+    r->parse_s = cli::seconds_since(t);
+    return r;
+  }
+
   void submit_read(size_t i) {
     auto done = std::make_shared<std::promise<std::unique_ptr<RunResult>>>();
     read_[i] = done->get_future();
     pool_.submit([this, i, done] {
       if (stop_) return done->set_value(nullptr);
       try {
-        auto r = std::make_unique<RunResult>();
-        const auto t = cli::Clock::now();
-        r->input = read_input(opt_, opt_.inputs[i], spec_, nullptr);
-        r->parse_s = cli::seconds_since(t);
-        done->set_value(std::move(r));
+        done->set_value(read_one(i));
       } catch (...) {
         done->set_exception(std::current_exception());
       }
