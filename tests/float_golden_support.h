@@ -24,10 +24,16 @@
 //     or twice. Fringe cells are a small part of the known area and 4 % of
 //     them at most change, so we allow 1 in 1000 known cells.
 //  3. Values. Both float paths add log-odds increments rounded to float
-//     (cpu_float: 2^-24 relative, summed in double; CUDA: to 2^-24 log-odds,
-//     summed in fixed point): about 1e-7 per update, far below
-//     one update's step, so on its own it cannot move a cell's class or its p
-//     by 0.1 in fewer than 10^4 updates. It can however decide when a cell
+//     (cpu_float: 2^-24 relative; CUDA: to 2^-24 log-odds): about 1e-7 per
+//     update, far below one update's step. CUDA sums them in fixed point,
+//     exactly; cpu_float in float per call, each add off by at most 2^-24 of
+//     the running sum, so n updates of size <= t are off by at most
+//     n^2 2^-24 t: below 0.4 in log-odds (p moved by 0.1 near 0.5) while
+//     n < 1,700 updates of the cell in one call at the paper's t = 2.2, and
+//     n < 5,700 at vasco's t = 0.2. So on its own rounding does not move a
+//     cell's class or its p by 0.1 but in a cell updated thousands of times
+//     in one call, which the evidence has pushed to 0 or 1 unless its
+//     updates nearly cancel. It can however decide when a cell
 //     saturates: CARMEN stores exactly 0 or 1 once 1 - 1/(1+t) rounds there,
 //     and a saturated cell never moves again (odds 0 or inf), while the other
 //     path's cell keeps moving. So max |dp| is not bounded below 1, and with the

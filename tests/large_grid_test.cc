@@ -174,11 +174,11 @@ TEST(LargeGrid, AFixedFramePast2To31CellsIsCheckedAgainstTheBudgetAtItsFirstInse
 TEST(LargeGrid, EachBackendStatesItsHostBytesACell) {
   EXPECT_EQ(make_renderer("cpu_double")->traits().host_bytes_per_cell, 4.0);
   EXPECT_EQ(make_renderer("cpu_threads")->traits().host_bytes_per_cell, 4.0);
-  EXPECT_EQ(make_renderer("cpu_float")->traits().host_bytes_per_cell, 12.0);  // the grid and a double scratch
+  EXPECT_EQ(make_renderer("cpu_float")->traits().host_bytes_per_cell, 8.0);  // the grid and a float scratch
   Mapper f(MapperParams{}, "cpu_float");
   GridGeometry g;
   g.size_x = g.size_y = 40000;
-  EXPECT_DOUBLE_EQ(f.memory_need(g, 0), 12.5 * 1.6e9);
+  EXPECT_DOUBLE_EQ(f.memory_need(g, 0), 8.5 * 1.6e9);
 }
 
 TEST(LargeGrid, CellIndicesAre64Bit) {

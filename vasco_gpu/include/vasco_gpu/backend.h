@@ -32,7 +32,7 @@ enum class CudaMode { Float, Exact };
 // The host-memory budget of a mapping session by default: 2 GiB, which a
 // laptop has to spare. There is no cap on a grid's cells: the budget is what
 // bounds a host grid (4.5 bytes a cell on cpu_double and cpu_threads at
-// vasco_downsample 4, 12.5 on cpu_float: a 546 m or a 327 m square at 2.5
+// vasco_downsample 4, 8.5 on cpu_float: a 546 m or a 397 m square at 2.5
 // cm), and a grid of 10^9 cells (two scans 400 m apart) is refused before
 // anything is allocated, naming the need and how to raise the budget. It
 // stays 2 GiB rather than a share of the machine's memory because what it
