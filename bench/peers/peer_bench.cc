@@ -10,6 +10,7 @@
 // holds as occupied and as free beside cpu_double's, to show the maps cover the same ground.
 //
 //   peer_bench [--runs N] [--dataset fr079|fr101|all]
+#include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -74,6 +75,7 @@ struct Row {
   std::string data, params, mapper, missing;
   uint64_t scans = 0, beams = 0;
   double map_s = -1;
+  double first_s = -1;  // cpu_float: a fresh renderer's first apply (first_render_seconds)
 };
 
 // A peer's map beside cpu_double's, for the sanity lines.
@@ -162,6 +164,23 @@ Row run_ours(const Job &job, const std::string &label, const std::string &backen
   row.beams = stats.beams_used;
   if (counts != nullptr) *counts = count_ours(cells);
   return row;
+}
+
+// A backend's first render in a fresh renderer, as log2map's map phase is one: its tables built and its
+// scratch mapped and touched for the first time. Large blocks go back to the system when freed here
+// (M_MMAP_THRESHOLD fixed, which also stops glibc raising it as they are freed), so each run's memory is
+// new, as in a fresh process. Apply's own map_s (as log2map's seconds.map), median of `runs`.
+double first_render_seconds(const Job &job, const std::string &backend) {
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+  std::vector<double> t;
+  for (int r = 0; r < job.runs; ++r) {
+    auto renderer = vasco::make_renderer(backend, vasco::BackendOptions{});
+    renderer->reset(job.geo, job.p);
+    vasco::MapStats stats;
+    renderer->apply(job.batch, 0, job.batch.num_scans(), &stats);
+    t.push_back(stats.map_s);
+  }
+  return median(t);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -413,7 +432,10 @@ void bench_param_set(Bench *b, const Dataset &ds, const ParamSet &ps) {
   b->rows.push_back(run_ours(job, "cpu_double", "cpu_double", 1, &ours));
   b->rows.push_back(run_ours(job, "cpu_threads (" + std::to_string(b->threads) + ")", "cpu_threads", b->threads, nullptr));
   b->rows.push_back(run_ours(job, "cpu_float", "cpu_float", 1, nullptr));
+  const size_t float_row = b->rows.size() - 1;
   bench_peers(b, job, ours);
+  // After the peers: it fixes malloc's threshold for the rest of the process.
+  b->rows[float_row].first_s = first_render_seconds(job, "cpu_float");
 }
 
 // Parses the command line into *o; false, after the usage line on stderr, for anything it does not know.
@@ -552,12 +574,19 @@ double log2map_map_seconds(const std::string &log2map, const Dataset &ds, const 
   return median(t);
 }
 
+double first_render_of(const std::vector<Row> &rows, const Row &r) {
+  for (const Row &o : rows)
+    if (o.data == r.data && o.params == r.params && o.first_s > 0) return o.first_s;
+  return -1;
+}
+
 // The target where a user sees it: log2map's map phase against MRPT's
-// insertion measured above (the same minutes); the gap to the render row is
-// a fresh process's first touch of its memory.
+// insertion measured above (the same minutes), beside a fresh renderer's
+// first render in this process, which measures why it is above the render row.
 void print_cli_target(const Bench &b, const char *argv0) {
   const std::string log2map = self_dir(argv0) + "/log2map";
-  bool header = false;
+  bool header = false, missed = false;
+  double first_over_render = 0;  // the largest, over the cases
   for (const Dataset &ds : bench_datasets())
     for (const ParamSet &ps : bench_param_sets()) {
       Row key;
@@ -571,11 +600,19 @@ void print_cli_target(const Bench &b, const char *argv0) {
         std::printf("\nWhere a user sees it: log2map --json --backend cpu_float, seconds.map (median of %d, a "
                     "process each), against MRPT's insertion above:\n", b.opt.runs);
       header = true;
-      const double x = mrpt / cli;
-      std::printf("  %s / %s: log2map %s ms (render above %s ms, +%.0f%%), MRPT %s ms: %.2fx: %s\n", ds.name.c_str(),
-                  ps.name.c_str(), ms(cli).c_str(), ms(render).c_str(), 100.0 * (cli / render - 1.0),
-                  ms(mrpt).c_str(), x, x >= kTargetOverMrpt ? "met" : "missed");
+      const double x = mrpt / cli, first = first_render_of(b.rows, key);
+      std::printf("  %s / %s: log2map %s ms (render above %s ms, %+.0f%%; a first render here %s ms, %+.0f%%), "
+                  "MRPT %s ms: %.2fx: %s\n", ds.name.c_str(), ps.name.c_str(), ms(cli).c_str(), ms(render).c_str(),
+                  100.0 * (cli / render - 1.0), ms(first).c_str(), 100.0 * (first / render - 1.0), ms(mrpt).c_str(),
+                  x, x >= kTargetOverMrpt ? "met" : "missed");
+      missed |= x < kTargetOverMrpt;
+      first_over_render = std::max(first_over_render, first / render - 1.0);
     }
+  if (missed)
+    std::printf("  why: log2map's map is a first render: a fresh renderer builds its evidence table and maps and "
+                "touches its sums for the first time, up to %.0f%% over a warm render here (\"a first render\": a "
+                "new renderer each run, its memory new); the rest of the gap is the render's own (the target "
+                "above)\n", 100.0 * first_over_render);
 }
 
 void print_sanity(const std::vector<Sanity> &sanity) {
