@@ -340,9 +340,9 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         )
     } | {
         "text: Target: cpu_float at least 1.25x MRPT's speed, one core each": Check(
-            "quoted", quote_of="bench/results/peers-2026-12-05-2core-b.txt"),
+            "quoted", quote_of="bench/results/peers-2026-12-06-2core.txt"),
         "text: Where a user sees it: log2map --json --backend cpu_float, se": Check(
-            "quoted", quote_of="bench/results/peers-2026-12-05-2core-b.txt"),
+            "quoted", quote_of="bench/results/peers-2026-12-06-2core.txt"),
     },
     "docs/python.md": {
         "sh: pip install .": Check(
