@@ -39,6 +39,8 @@ class BatchReport {
     pool_threads_ = pool;
     mappers_ = mappers;
   }
+  // A mapper that could not start (its GPU said and left out): not counted.
+  void mapper_left_out();
   // The input read and mapped (its map not yet written); waited_s: its
   // mapper's wait for the read and for a write slot.
   void mapped(size_t i, const RunResult &r, double waited_s);

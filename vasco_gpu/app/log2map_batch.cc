@@ -294,17 +294,35 @@ std::vector<int> batch_devices(const Options &opt) {
   return usable;
 }
 
+// The mappers' GPUs for the report: "GPUs 0,1", "GPU 0, 2 mappers",
+// "GPUs 0,1, 2 mappers each"; a list with a GPU named more often than
+// another as given ("GPUs 0,0,1").
+std::string gpus_label(const std::vector<int> &devices) {
+  std::vector<int> distinct;
+  for (int d : devices)
+    if (std::find(distinct.begin(), distinct.end(), d) == distinct.end()) distinct.push_back(d);
+  const auto each = std::count(devices.begin(), devices.end(), distinct.front());
+  bool even = true;
+  for (int d : distinct) even &= std::count(devices.begin(), devices.end(), d) == each;
+  const std::vector<int> &named = even ? distinct : devices;
+  std::string list;
+  for (int d : named) list += (list.empty() ? "" : ",") + std::to_string(d);
+  std::string label = (named.size() > 1 ? "GPUs " : "GPU ") + list;
+  if (even && each > 1) label += ", " + std::to_string(each) + (distinct.size() > 1 ? " mappers each" : " mappers");
+  return label;
+}
+
 // The GPUs after the first, a thread and a mapper each, sharing the inputs
 // with the first's (run.map_all on the calling thread): each log is mapped
 // whole by one mapper (start_over between logs), so its bytes are those of a
 // one-GPU batch. A GPU whose mapper cannot start is said and left out: the
 // others map its share.
-std::thread map_on_other_devices(BatchRun &run, const Options &opt, std::vector<int> devices) {
-  return carmen::start_thread([&run, &opt, devices] {
+std::thread map_on_other_devices(BatchRun &run, BatchReport &report, const Options &opt, std::vector<int> devices) {
+  return carmen::start_thread([&run, &report, &opt, devices] {
     std::vector<std::thread> workers;
     workers.reserve(devices.size());  // a push_back that throws would drop a running thread
     for (int d : devices) {
-      workers.push_back(carmen::start_thread([&run, &opt, d] {
+      workers.push_back(carmen::start_thread([&run, &report, &opt, d] {
         try {
           vasco::BackendOptions b = backend_options(opt);
           b.cuda_device = d;
@@ -312,6 +330,7 @@ std::thread map_on_other_devices(BatchRun &run, const Options &opt, std::vector<
           run.map_all(mapper);
         } catch (const std::exception &e) {
           std::fprintf(stderr, "%s: GPU %d left out: %s\n", opt.tool.c_str(), d, carmen::printable(e.what()).c_str());
+          report.mapper_left_out();
         }
       }));
     }
@@ -352,11 +371,9 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     const bool several = devices.size() > 1 && mapper.backend_traits().grid_on_device;
     report.set_threads(jobs, several ? static_cast<int>(devices.size()) : 1);
     if (several) {
-      std::string list;
-      for (int d : devices) list += (list.empty() ? "" : ",") + std::to_string(d);
-      report.set_backend(mapper.backend_name() + " on GPUs " + list);
+      report.set_backend(mapper.backend_name() + " on " + gpus_label(devices));
       run.share_gpus(true);
-      std::thread others = map_on_other_devices(run, opt, std::vector<int>(devices.begin() + 1, devices.end()));
+      std::thread others = map_on_other_devices(run, report, opt, std::vector<int>(devices.begin() + 1, devices.end()));
       run.map_all(mapper);
       others.join();  // their mappers gone, and their GPU memory with them
       run.map_deferred(mapper);
