@@ -132,7 +132,10 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
     the inputs (read = inflate + parse and write = deflate + write on the pool's
     threads; map = upload, render and download on the mappers; mapper wait = a mapper
     idle for a read or a write slot), and each side's busy share of its threads over the
-    run's wall-clock time. The busier side is the bound."""
+    run's wall-clock time; then the run's phases (the backend's start-up, while the pool
+    reads; the mapping; the last writes) and the bound over the mapping phase: the pool
+    where the mappers waited for reads or write slots more than a tenth of it, else the
+    mappers."""
     cmd = [log2map, "--backend", backend, "--quiet", "--json", "--out-dir", out, "--formats", formats]
     if devices:
         cmd += ["--devices", devices]
@@ -154,8 +157,18 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
             ("mapper other (checks, frees, start)", max(0.0, mappers * s - total["map"] - total["mapper_wait"]), mappers)]
     for name, t, threads in rows:
         lines.append(f"  {name:40} {t:9.3f} {1e3 * t / n:9.2f} {100 * t / (threads * s):6.1f}%")
-    bound = "the pool (read + write)" if pool >= mapping else "the mappers"
-    lines.append(f"  bound: {bound}: pool busy {100 * pool:.1f}%, mappers busy {100 * mapping:.1f}%")
+    phases = report.get("phases", {})
+    window = phases.get("mapping", 0.0)
+    if window <= 0:
+        bound = "the pool (read + write)" if pool >= mapping else "the mappers"
+        lines.append(f"  bound: {bound}: pool busy {100 * pool:.1f}%, mappers busy {100 * mapping:.1f}%")
+        return lines
+    waited = total["mapper_wait"] / (mappers * window)
+    lines.append(f"  phases: start-up {phases['start']:.3f} s (the backend starts, the pool reads), mapping "
+                 f"{window:.3f} s ({n / window:.1f} logs/s), drain {phases['drain']:.3f} s (the last writes)")
+    bound = "the pool (read + write)" if waited > 0.1 else "the mappers"
+    lines.append(f"  bound over the mapping phase: {bound}: the mappers waited {100 * waited:.1f}% of it, mapped "
+                 f"{100 * total['map'] / (mappers * window):.1f}%; over the run, pool busy {100 * pool:.1f}%")
     return lines
 
 

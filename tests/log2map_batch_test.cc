@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -147,6 +148,18 @@ TEST(Log2MapBatch, JsonReportsEveryInput) {
   EXPECT_TRUE(contains(r.output, ",\"mapper_wait\":")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"mappers\":1,")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"pool_threads\":")) << r.output;
+  // The phases: the start-up, then the mapping, which holds the one input's map, then the last writes.
+  const auto number_after = [&](const std::string &key) {
+    const size_t at = r.output.find(key);
+    return at == std::string::npos ? -1.0 : std::strtod(r.output.c_str() + at + key.size(), nullptr);
+  };
+  const double start = number_after("\"phases\":{\"start\":"), mapping = number_after(",\"mapping\":"),
+               drain = number_after(",\"drain\":"), map = number_after(",\"map\":");
+  EXPECT_GT(start, 0) << r.output;
+  EXPECT_GT(map, 0) << r.output;
+  EXPECT_GE(mapping, map) << r.output;
+  EXPECT_GE(drain, 0) << r.output;
+  EXPECT_LE(start + mapping + drain, number_after("\"failed\":1,\"seconds\":") + 1e-6) << r.output;
 }
 
 TEST(Log2MapBatch, UsageErrorsBeforeAnyWork) {

@@ -41,6 +41,14 @@ class BatchReport {
   }
   // A mapper that could not start (its GPU said and left out): not counted.
   void mapper_left_out();
+  // The run's phases, in seconds: until the first mapper had started (its
+  // backend; the pool reads meanwhile), until the last map was done, and
+  // until the last output was written. For --json.
+  void set_phases(double start_s, double mapping_s, double drain_s) {
+    start_s_ = start_s;
+    mapping_s_ = mapping_s;
+    drain_s_ = drain_s;
+  }
   // The input read and mapped (its map not yet written); waited_s: its
   // mapper's wait for the read and for a write slot.
   void mapped(size_t i, const RunResult &r, double waited_s);
@@ -64,6 +72,7 @@ class BatchReport {
   std::vector<BatchEntry> entries_;
   std::string backend_;
   int pool_threads_ = 0, mappers_ = 0;
+  double start_s_ = 0, mapping_s_ = 0, drain_s_ = 0;
   mutable std::mutex mutex_;
   ProgressBar bar_;
   size_t finished_ = 0;

@@ -353,6 +353,7 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
   vasco::pipeline::check_outputs(inputs, files);
 
   BatchReport report(opt, std::move(entries));
+  double start_s = 0, mapped_s = 0;
   {
     const int jobs = opt.jobs > 0 ? opt.jobs : all_cores();
     BatchRun run(opt, spec, report, jobs);
@@ -364,6 +365,7 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     vasco::BackendOptions first = backend_options(opt);
     first.cuda_device = devices.front();
     vasco::Mapper mapper(vasco::MapperParams{}, opt.backend, first);
+    start_s = cli::seconds_since(t_start);
     report.set_backend(mapper.backend_name());
     const vasco::BackendInfo *chosen = vasco::find_backend(opt.backend);
     if (chosen != nullptr && chosen->chooses && !mapper.backend_traits().grid_on_device && !opt.quiet)
@@ -380,9 +382,12 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     } else {
       run.map_all(mapper);
     }
+    mapped_s = cli::seconds_since(t_start);
     run.report_not_run();
   }  // every write done
-  report.print_end(cli::seconds_since(t_start));
+  const double total_s = cli::seconds_since(t_start);
+  report.set_phases(start_s, mapped_s - start_s, total_s - mapped_s);
+  report.print_end(total_s);
   return report.failures() > 0 ? 1 : 0;
 }
 
