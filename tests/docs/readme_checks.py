@@ -343,6 +343,10 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "quoted", quote_of="bench/results/peers-2026-12-06-2core.txt"),
         "text: Where a user sees it: log2map --json --backend cpu_float, se": Check(
             "quoted", quote_of="bench/results/peers-2026-12-06-2core.txt"),
+        "text: | data | backend | place | upload | map | finish + download": Check(
+            "quoted", quote_of="bench/results/session-2026-12-06-h100.txt"),
+        "text: batch_bench: 200 copies of fr079-complete.gfs.log.gz, output": Check(
+            "quoted", quote_of="bench/results/batch-2026-12-06-h100.txt"),
     },
     "docs/python.md": {
         "sh: pip install .": Check(
