@@ -127,7 +127,7 @@ def write_cost_model(path: str, values: dict[str, float], command: str) -> None:
 
 
 def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, formats: str,
-           pool_nice: str = "") -> list[str]:
+           pool_nice: str = "") -> tuple[list[str], dict]:
     """Where a batch's time goes: one --json batch run, each stage's seconds summed over
     the inputs (read = inflate + parse and write = deflate + write on the pool's
     threads; map = upload, render and download on the mappers; mapper wait = a mapper
@@ -135,7 +135,8 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
     run's wall-clock time; then the run's phases (the backend's start-up, while the pool
     reads; the mapping; the last writes) and the bound over the mapping phase: the pool
     where the mappers waited for reads or write slots more than a tenth of it, else the
-    mappers."""
+    mappers. Returns the lines and the run's phases with its seconds and logs done
+    (for the target's reason)."""
     cmd = [log2map, "--backend", backend, "--quiet", "--json", "--out-dir", out, "--formats", formats]
     if devices:
         cmd += ["--devices", devices]
@@ -159,17 +160,18 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
         lines.append(f"  {name:40} {t:9.3f} {1e3 * t / n:9.2f} {100 * t / (threads * s):6.1f}%")
     phases = report.get("phases", {})
     window = phases.get("mapping", 0.0)
+    phases = dict(phases, seconds=s, done=len(done))
     if window <= 0:
         bound = "the pool (read + write)" if pool >= mapping else "the mappers"
         lines.append(f"  bound: {bound}: pool busy {100 * pool:.1f}%, mappers busy {100 * mapping:.1f}%")
-        return lines
+        return lines, phases
     waited = total["mapper_wait"] / (mappers * window)
     lines.append(f"  phases: start-up {phases['start']:.3f} s (the backend starts, the pool reads), mapping "
                  f"{window:.3f} s ({n / window:.1f} logs/s), drain {phases['drain']:.3f} s (the last writes)")
     bound = "the pool (read + write)" if waited > 0.1 else "the mappers"
     lines.append(f"  bound over the mapping phase: {bound}: the mappers waited {100 * waited:.1f}% of it, mapped "
                  f"{100 * total['map'] / (mappers * window):.1f}%; over the run, pool busy {100 * pool:.1f}%")
-    return lines
+    return lines, phases
 
 
 def gpu_count() -> int:
@@ -238,7 +240,7 @@ def main() -> int:
                  for b in ["auto"] + backends}
             one.append((log, t))
         model, model_values = cost_model(log2map, backends, tmp, a.repeat) if not a.gpu_only else ([], {})
-        scaling, stage_lines = [], []
+        scaling, stage_lines, chosen_phases = [], [], {}
         if "cuda" in backends:
             # Each --devices set with the pool at the mappers' priority (nice 0) and at the default
             # (nicer), and the batch's own choice (no --devices), the runs interleaved; the first row,
@@ -250,8 +252,9 @@ def main() -> int:
                     cmd = [log2map, "--backend", "cuda", "--quiet", "--out-dir", out, "--formats", a.formats]
                     times[(d, n)].append(timed_ok(cmd + (["--devices", d] if d else []) + logs, n)[0])
             scaling = [(d, n, len(logs) / min(times[(d, n)])) for d, n in configs]
-            stage_lines += stages(log2map, "cuda", "0", logs, out, a.formats, "0") + [""]
-            stage_lines += stages(log2map, "cuda", "", logs, out, a.formats, "") + [""]
+            stage_lines += stages(log2map, "cuda", "0", logs, out, a.formats, "0")[0] + [""]
+            lines, chosen_phases = stages(log2map, "cuda", "", logs, out, a.formats, "")
+            stage_lines += lines + [""]
 
     print(f"batch_bench: {a.copies} copies of {os.path.basename(a.log)}, outputs {a.formats}, "
           f"{os.cpu_count()} cores, best of {a.repeat}")
@@ -277,6 +280,11 @@ def main() -> int:
         print(f"target: >= 250 logs/s of {os.path.basename(a.log)} to {a.formats} on one GPU, the batch's own "
               f"choice: {chosen:.1f}, " + (("met" if chosen >= 250 else "missed") if gpus == 1 else
                                           f"not judged here ({gpus} GPUs: the target is one GPU's)"))
+        if gpus == 1 and chosen < 250 and chosen_phases.get("mapping", 0) > 0:
+            ph = chosen_phases
+            print(f"  why: its start-up (the first mapper's GPU backend, while the pool reads) took {ph['start']:.3f} s "
+                  f"of {ph['seconds']:.3f} s in the stages' run below; its mapping phase ran at "
+                  f"{ph['done'] / ph['mapping']:.1f} logs/s, its last writes {ph['drain']:.3f} s")
     if stage_lines:
         print()
         for line in stage_lines:
