@@ -133,7 +133,8 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
     threads; map = upload, render and download on the mappers; mapper wait = a mapper
     idle for a read or a write slot), and each side's busy share of its threads over the
     run's wall-clock time; then the run's phases (the backend's start-up, while the pool
-    reads; the mapping; the last writes) and the bound over the mapping phase: the pool
+    reads; the mapping, which holds the other mappers' own start-up; the last writes)
+    and the bound over the mapping phase: the pool
     where the mappers waited for reads or write slots more than a tenth of it, else the
     mappers. Returns the lines and the run's phases with its seconds and logs done
     (for the target's reason)."""
@@ -160,7 +161,7 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
         lines.append(f"  {name:40} {t:9.3f} {1e3 * t / n:9.2f} {100 * t / (threads * s):6.1f}%")
     phases = report.get("phases", {})
     window = phases.get("mapping", 0.0)
-    phases = dict(phases, seconds=s, done=len(done))
+    phases = dict(phases, seconds=report["seconds"], done=len(done))
     if window <= 0:
         bound = "the pool (read + write)" if pool >= mapping else "the mappers"
         lines.append(f"  bound: {bound}: pool busy {100 * pool:.1f}%, mappers busy {100 * mapping:.1f}%")

@@ -133,9 +133,4 @@ void BatchReport::print_end(double total_s) {
                                                            "written to standard output: ") + std::strerror(errno));
 }
 
-void BatchReport::mapper_left_out() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (mappers_ > 1) --mappers_;
-}
-
 }  // namespace log2map

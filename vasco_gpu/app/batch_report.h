@@ -39,8 +39,6 @@ class BatchReport {
     pool_threads_ = pool;
     mappers_ = mappers;
   }
-  // A mapper that could not start (its GPU said and left out): not counted.
-  void mapper_left_out();
   // The run's phases, in seconds: until the first mapper had started (its
   // backend; the pool reads meanwhile), until the last map was done, and
   // until the last output was written. For --json.

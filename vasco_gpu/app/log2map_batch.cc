@@ -317,20 +317,25 @@ std::string gpus_label(const std::vector<int> &devices) {
 // whole by one mapper (start_over between logs), so its bytes are those of a
 // one-GPU batch. A GPU whose mapper cannot start is said and left out: the
 // others map its share.
-std::thread map_on_other_devices(BatchRun &run, BatchReport &report, const Options &opt, std::vector<int> devices) {
-  return carmen::start_thread([&run, &report, &opt, devices] {
+// `started` gets each GPU's entry once its mapper has started (a mapper that
+// fails later still counts: it mapped).
+std::thread map_on_other_devices(BatchRun &run, const Options &opt, std::vector<int> devices,
+                                 std::vector<char> *started) {
+  started->assign(devices.size(), 0);
+  return carmen::start_thread([&run, &opt, devices, started] {
     std::vector<std::thread> workers;
     workers.reserve(devices.size());  // a push_back that throws would drop a running thread
-    for (int d : devices) {
-      workers.push_back(carmen::start_thread([&run, &report, &opt, d] {
+    for (size_t k = 0; k < devices.size(); ++k) {
+      workers.push_back(carmen::start_thread([&run, &opt, d = devices[k], flag = &(*started)[k]] {
         try {
           vasco::BackendOptions b = backend_options(opt);
           b.cuda_device = d;
           vasco::Mapper mapper(vasco::MapperParams{}, opt.backend, b);
+          *flag = 1;  // its own element: read after the join
           run.map_all(mapper);
         } catch (const std::exception &e) {
-          std::fprintf(stderr, "%s: GPU %d left out: %s\n", opt.tool.c_str(), d, carmen::printable(e.what()).c_str());
-          report.mapper_left_out();
+          std::fprintf(stderr, "%s: GPU %d %s: %s\n", opt.tool.c_str(), d, *flag ? "stopped mapping" : "left out",
+                       carmen::printable(e.what()).c_str());
         }
       }));
     }
@@ -373,11 +378,16 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     const bool several = devices.size() > 1 && mapper.backend_traits().grid_on_device;
     report.set_threads(jobs, several ? static_cast<int>(devices.size()) : 1);
     if (several) {
-      report.set_backend(mapper.backend_name() + " on " + gpus_label(devices));
       run.share_gpus(true);
-      std::thread others = map_on_other_devices(run, report, opt, std::vector<int>(devices.begin() + 1, devices.end()));
+      std::vector<char> started;
+      std::thread others = map_on_other_devices(run, opt, std::vector<int>(devices.begin() + 1, devices.end()), &started);
       run.map_all(mapper);
       others.join();  // their mappers gone, and their GPU memory with them
+      std::vector<int> mapped_on = {devices.front()};
+      for (size_t k = 0; k < started.size(); ++k)
+        if (started[k]) mapped_on.push_back(devices[k + 1]);
+      report.set_threads(jobs, static_cast<int>(mapped_on.size()));
+      report.set_backend(mapper.backend_name() + " on " + gpus_label(mapped_on));
       run.map_deferred(mapper);
     } else {
       run.map_all(mapper);

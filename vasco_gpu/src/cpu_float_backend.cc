@@ -49,6 +49,10 @@
 namespace vasco {
 namespace {
 
+#if defined(__FAST_MATH__)
+#error "cpu_float's never-updated mark is -0.0: it needs signed zeros (no -ffast-math)"
+#endif
+
 // The scratch's "never updated" mark: -0.0. Every increment is normalized
 // to never be -0.0 (x + 0.0f turns -0.0 into +0.0), and in round-to-nearest
 // a sum with a term other than -0.0 is never -0.0 (x + (-x) is +0.0), so a
