@@ -134,10 +134,9 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
     idle for a read or a write slot), and each side's busy share of its threads over the
     run's wall-clock time; then the run's phases (the backend's start-up, while the pool
     reads; the mapping, which holds the other mappers' own start-up; the last writes)
-    and the bound over the mapping phase: the pool
-    where the mappers waited for reads or write slots more than a tenth of it, else the
-    mappers. Returns the lines and the run's phases with its seconds and logs done
-    (for the target's reason)."""
+    and the bound over the mapping phase: the pool where the mappers waited for reads or
+    write slots more than a tenth of it, else the mappers. Returns the lines and the
+    run's phases with its seconds and logs done (for the target's reason)."""
     cmd = [log2map, "--backend", backend, "--quiet", "--json", "--out-dir", out, "--formats", formats]
     if devices:
         cmd += ["--devices", devices]

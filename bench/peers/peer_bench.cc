@@ -122,6 +122,15 @@ Row make_row(const Job &job, const std::string &mapper) {
   return row;
 }
 
+// The row of `mapper` (a label's prefix) for r's log and parameter set (rows const or not); null when
+// there is none.
+template <class Rows>
+auto row_of(Rows &rows, const Row &r, const std::string &mapper) -> decltype(&rows[0]) {
+  for (auto &o : rows)
+    if (o.data == r.data && o.params == r.params && o.mapper.rfind(mapper, 0) == 0) return &o;
+  return nullptr;
+}
+
 // The row of a peer this binary was built without.
 [[maybe_unused]] Row missing_row(const Job &job, const std::string &mapper, const std::string &package) {
   Row row = make_row(job, mapper);
@@ -441,9 +450,8 @@ Job bench_param_set(Bench *b, const Dataset &ds, const ParamSet &ps) {
 // the process, which must not change how the tables' rows were measured.
 void first_renders(Bench *b, const std::vector<Job> &jobs) {
   for (const Job &job : jobs) {
-    const double first = first_render_seconds(job, "cpu_float");
-    for (Row &r : b->rows)
-      if (r.data == job.data && r.params == job.params && r.mapper == "cpu_float") r.first_s = first;
+    Row *r = row_of(b->rows, make_row(job, ""), "cpu_float");
+    if (r != nullptr) r->first_s = first_render_seconds(job, "cpu_float");
   }
 }
 
@@ -478,9 +486,8 @@ std::string ratio(double base, double t) {
 
 // The map time of the row of `mapper` (a prefix of its label) on the same data and parameters.
 double time_of(const std::vector<Row> &rows, const Row &r, const std::string &mapper) {
-  for (const Row &o : rows)
-    if (o.data == r.data && o.params == r.params && o.mapper.rfind(mapper, 0) == 0) return o.map_s;
-  return -1;
+  const Row *o = row_of(rows, r, mapper);
+  return o != nullptr ? o->map_s : -1;
 }
 
 void print_header(const Bench &b) {
@@ -589,12 +596,6 @@ std::string pct(double share) {
   return buf;
 }
 
-double first_render_of(const std::vector<Row> &rows, const Row &r) {
-  for (const Row &o : rows)
-    if (o.data == r.data && o.params == r.params && o.first_s > 0) return o.first_s;
-  return -1;
-}
-
 // Why a case missed where a user sees it: its render row already misses
 // (the render's own, the target above), or log2map's gap over the render row
 // against a fresh renderer's first render here: covered when the first render
@@ -630,7 +631,7 @@ void print_cli_target(const Bench &b, const char *argv0) {
         std::printf("\nWhere a user sees it: log2map --json --backend cpu_float, seconds.map (median of %d, a "
                     "process each), against MRPT's insertion above:\n", b.opt.runs);
       header = true;
-      const double x = mrpt / cli, first = first_render_of(b.rows, key);
+      const double x = mrpt / cli, first = row_of(b.rows, key, "cpu_float")->first_s;
       const std::string first_text = first > 0 ? ms(first) + " ms, " + pct(first / render - 1.0) : "not measured";
       std::printf("  %s / %s: log2map %s ms (render above %s ms, %s; a first render here %s), MRPT %s ms: %.2fx: %s\n",
                   ds.name.c_str(), ps.name.c_str(), ms(cli).c_str(), ms(render).c_str(), pct(cli / render - 1.0).c_str(),

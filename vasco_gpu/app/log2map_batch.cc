@@ -376,7 +376,7 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     if (chosen != nullptr && chosen->chooses && !mapper.backend_traits().grid_on_device && !opt.quiet)
       std::fprintf(stderr, "%s: --backend auto: no usable GPU: using %s\n", opt.tool.c_str(), mapper.backend_name().c_str());
     const bool several = devices.size() > 1 && mapper.backend_traits().grid_on_device;
-    report.set_threads(jobs, several ? static_cast<int>(devices.size()) : 1);
+    report.set_threads(jobs, 1);  // several: the mappers that started, once they are joined
     if (several) {
       run.share_gpus(true);
       std::vector<char> started;
