@@ -27,20 +27,21 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LOGS = os.path.join(ROOT, "logs")
 
 
-def timed(cmd: list[str], pool_nice: str = "") -> tuple[float, subprocess.CompletedProcess]:
-    """Wall-clock seconds of cmd; pool_nice: VASCO_BATCH_POOL_NICE for it ("": the default)."""
+def timed(cmd: list[str], read_ahead: str = "") -> tuple[float, subprocess.CompletedProcess]:
+    """Wall-clock seconds of cmd; read_ahead: VASCO_BATCH_READ_AHEAD for it (inputs read ahead
+    of the mappers per pool thread; "": the default)."""
     env = dict(os.environ)
-    env.pop("VASCO_BATCH_POOL_NICE", None)
-    if pool_nice:
-        env["VASCO_BATCH_POOL_NICE"] = pool_nice
+    env.pop("VASCO_BATCH_READ_AHEAD", None)
+    if read_ahead:
+        env["VASCO_BATCH_READ_AHEAD"] = read_ahead
     t = time.perf_counter()
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     return time.perf_counter() - t, p
 
 
-def timed_ok(cmd: list[str], pool_nice: str = "") -> tuple[float, subprocess.CompletedProcess]:
+def timed_ok(cmd: list[str], read_ahead: str = "") -> tuple[float, subprocess.CompletedProcess]:
     """timed, and the end of the bench if cmd fails (its command and the tail of its stderr said)."""
-    s, p = timed(cmd, pool_nice)
+    s, p = timed(cmd, read_ahead)
     if p.returncode != 0:
         sys.exit(f"batch_bench: {' '.join(cmd[:10])} ...: exit {p.returncode}\n{p.stderr[-2000:]}")
     return s, p
@@ -127,7 +128,7 @@ def write_cost_model(path: str, values: dict[str, float], command: str) -> None:
 
 
 def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, formats: str,
-           pool_nice: str = "") -> tuple[list[str], dict]:
+           read_ahead: str = "") -> tuple[list[str], dict]:
     """Where a batch's time goes: one --json batch run, each stage's seconds summed over
     the inputs (read = inflate + parse and write = deflate + write on the pool's
     threads; map = upload, render and download on the mappers; mapper wait = a mapper
@@ -140,7 +141,7 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
     cmd = [log2map, "--backend", backend, "--quiet", "--json", "--out-dir", out, "--formats", formats]
     if devices:
         cmd += ["--devices", devices]
-    s, p = timed_ok(cmd + logs, pool_nice)
+    s, p = timed_ok(cmd + logs, read_ahead)
     report = json.loads(p.stdout)
     done = [e for e in report["inputs"] if e["state"] == "done"]
     total = {k: sum(e["seconds"][k] for e in done) for k in ("read", "map", "write", "mapper_wait")}
@@ -148,8 +149,8 @@ def stages(log2map: str, backend: str, devices: str, logs: list[str], out: str, 
     pool = (total["read"] + total["write"]) / (jobs * s)
     mapping = total["map"] / (mappers * s)
     n = max(1, len(done))
-    lines = [f"stages of one {backend} batch, --devices {devices or '(its choice)'}, pool nice "
-             f"{pool_nice or 'default'} ({len(done)} logs in {s:.3f} s, {n / s:.1f} logs/s; "
+    lines = [f"stages of one {backend} batch, --devices {devices or '(its choice)'}, read-ahead "
+             f"{read_ahead or 'default'} ({len(done)} logs in {s:.3f} s, {n / s:.1f} logs/s; "
              f"pool {jobs} threads, {mappers} mapper{'s' if mappers > 1 else ''}):",
              f"  {'stage':40} {'thread s':>9} {'ms / log':>9} {'busy':>7}"]
     rows = [("read (inflate + parse), pool", total["read"], jobs), ("map (upload, render, download), mappers",
@@ -242,17 +243,18 @@ def main() -> int:
         model, model_values = cost_model(log2map, backends, tmp, a.repeat) if not a.gpu_only else ([], {})
         scaling, stage_lines, chosen_phases = [], [], {}
         if "cuda" in backends:
-            # Each --devices set with the pool at the mappers' priority (nice 0) and at the default
-            # (nicer), and the batch's own choice (no --devices), the runs interleaved; the first row,
-            # one mapper at nice 0, is what a batch did before either change.
-            configs = [(d, n) for d in device_sets(gpu_count()) for n in ("0", "")] + [("", "")]
+            # Each --devices set with the read-ahead of before (2 inputs a pool thread) and the
+            # default (deeper, within its byte budget), and the batch's own choice (no --devices),
+            # the runs interleaved; the first row, one mapper reading 2 ahead, is what a batch did
+            # before either change.
+            configs = [(d, n) for d in device_sets(gpu_count()) for n in ("2", "")] + [("", "")]
             times = {c: [] for c in configs}
             for _ in range(a.repeat):
                 for d, n in configs:
                     cmd = [log2map, "--backend", "cuda", "--quiet", "--out-dir", out, "--formats", a.formats]
                     times[(d, n)].append(timed_ok(cmd + (["--devices", d] if d else []) + logs, n)[0])
             scaling = [(d, n, len(logs) / min(times[(d, n)])) for d, n in configs]
-            stage_lines += stages(log2map, "cuda", "0", logs, out, a.formats, "0")[0] + [""]
+            stage_lines += stages(log2map, "cuda", "0", logs, out, a.formats, "2")[0] + [""]
             lines, chosen_phases = stages(log2map, "cuda", "", logs, out, a.formats, "")
             stage_lines += lines + [""]
 
@@ -272,9 +274,9 @@ def main() -> int:
         print(f"{log:30} " + " ".join(f"{t[b]:14.3f}" for b in ["auto"] + backends) + f" {t['auto'] / fastest:15.2f}")
     if scaling:
         print()
-        print(f"{'cuda batch --devices':22} {'pool nice':>10} {'logs/s':>8} {'/ first row':>12}")
-        for devices, nice, rate in scaling:
-            print(f"{devices or '(its choice)':22} {nice or 'default':>10} {rate:8.1f} {rate / scaling[0][2]:11.2f}x")
+        print(f"{'cuda batch --devices':22} {'read-ahead':>10} {'logs/s':>8} {'/ first row':>12}")
+        for devices, ahead, rate in scaling:
+            print(f"{devices or '(its choice)':22} {ahead or 'default':>10} {rate:8.1f} {rate / scaling[0][2]:11.2f}x")
         chosen = scaling[-1][2]
         gpus = gpu_count()
         print(f"target: >= 250 logs/s of {os.path.basename(a.log)} to {a.formats} on one GPU, the batch's own "

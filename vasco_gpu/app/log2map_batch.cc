@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <atomic>
 #include <cerrno>
 #include <condition_variable>
@@ -22,6 +23,7 @@
 #include "carmen_compat/termination_signals.h"
 #include "cli_support.h"
 #include "log2map_steps.h"
+#include "read_ahead.h"
 #include "task_pool.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/pipeline/outputs.h"
@@ -123,17 +125,48 @@ int pool_nice() {
   return 5;
 }
 
+// How many inputs, per pool thread, may be read ahead of the mappers: deep
+// enough that the pool reads on while a GPU backend starts (~0.3 s) instead
+// of idling after a few inputs. VASCO_BATCH_READ_AHEAD sets it (2: what a
+// batch did before; batch_bench's A/B).
+size_t read_ahead_per_thread() {
+  const char *v = std::getenv("VASCO_BATCH_READ_AHEAD");
+  if (v != nullptr && *v != '\0') return static_cast<size_t>(std::clamp(std::atoi(v), 1, 64));
+  return 8;
+}
+
+// The bytes parsed inputs waiting for a mapper may hold: 1 GiB (some 140
+// fr079-size logs), at most an eighth of the machine's memory.
+uint64_t read_ahead_budget() {
+  uint64_t budget = uint64_t{1} << 30;
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  if (pages > 0 && page > 0) budget = std::min(budget, static_cast<uint64_t>(pages) * static_cast<uint64_t>(page) / 8);
+  return budget;
+}
+
+// The bytes a read input holds until it is mapped: its scans' arrays and
+// the per-scan records beside them (what grows with the log).
+uint64_t bytes_held(const vasco::LogInput &in) {
+  auto of = [](const auto &v) { return static_cast<uint64_t>(v.capacity()) * sizeof(v[0]); };
+  const vasco::ScanBatch &b = in.batch;
+  return of(b.x) + of(b.y) + of(b.theta) + of(b.first_angle) + of(b.angle_step) + of(b.beam_offset) + of(b.line) +
+         of(b.range) + of(in.stamps) + of(in.load.stamps) + of(in.load.robot_poses);
+}
+
 // One batch: inputs read on the pool, mapped here in order, written on the pool.
 class BatchRun {
  public:
   BatchRun(const Options &opt, const ToolSpec &spec, BatchReport &report, int jobs)
-      : opt_(opt), spec_(spec), report_(report), ahead_(2 * static_cast<size_t>(jobs)), writes_(ahead_),
+      : opt_(opt), spec_(spec), report_(report), writes_(2 * static_cast<size_t>(jobs)),
+        ahead_(opt.inputs.size(), 2 * static_cast<size_t>(jobs), read_ahead_per_thread() * static_cast<size_t>(jobs),
+               read_ahead_budget()),
         pool_(jobs, pool_nice()), read_(opt.inputs.size()) {}
 
-  ~BatchRun() { stop_ = true; }  // queued reads return at once; the pool drains
+  ~BatchRun() { stop_reads(); }  // queued reads return at once; the pool drains
 
   void start_reads() {
-    for (size_t i = 0; i < std::min(ahead_, read_.size()); ++i) submit_read(i);
+    std::lock_guard<std::mutex> lock(ahead_mutex_);
+    submit_admitted();
   }
 
   // Maps inputs until none is left, each on `mapper`; several callers (one
@@ -150,6 +183,7 @@ class BatchRun {
         fail(i, std::current_exception());
       }
       if (r) map_one(mapper, i, std::move(r), cli::seconds_since(t));
+      release(i);  // its scans are gone (mapped, failed or put off)
     }
   }
 
@@ -183,13 +217,13 @@ class BatchRun {
     for (size_t i = 0; i < read_.size(); ++i) report_.not_run(i);
   }
 
-  // The next input to map, its read queued `ahead_` inputs in advance: the
-  // read of an input is submitted when the one ahead_ before it is taken,
-  // so it exists before anyone can take it.
+  // The next input to map; its read was submitted before (read-ahead) or
+  // is now, so its future exists before it is waited for.
   size_t take_next() {
-    std::lock_guard<std::mutex> lock(next_mutex_);
+    std::lock_guard<std::mutex> lock(ahead_mutex_);
     const size_t i = next_++;
-    if (i + ahead_ < read_.size() && !stop_) submit_read(i + ahead_);
+    if (i < read_.size()) ahead_.taken(i);
+    submit_admitted();
     return i;
   }
 
@@ -203,17 +237,44 @@ class BatchRun {
     return r;
   }
 
+  // Under ahead_mutex_: the reads the read-ahead lets through now.
+  void submit_admitted() {
+    for (size_t i : ahead_.admit()) submit_read(i);
+  }
+
   void submit_read(size_t i) {
     auto done = std::make_shared<std::promise<std::unique_ptr<RunResult>>>();
     read_[i] = done->get_future();
     pool_.submit([this, i, done] {
-      if (stop_) return done->set_value(nullptr);
-      try {
-        done->set_value(read_one(i));
-      } catch (...) {
-        done->set_exception(std::current_exception());
+      std::unique_ptr<RunResult> r;
+      std::exception_ptr error;
+      if (!stop_) {
+        try {
+          r = read_one(i);
+        } catch (...) {
+          error = std::current_exception();
+        }
       }
+      {  // counted before a mapper can have it (and release it)
+        std::lock_guard<std::mutex> lock(ahead_mutex_);
+        ahead_.read(i, r ? bytes_held(r->input) : 0);
+        submit_admitted();
+      }
+      if (error) return done->set_exception(error);
+      done->set_value(std::move(r));
     });
+  }
+
+  void release(size_t i) {
+    std::lock_guard<std::mutex> lock(ahead_mutex_);
+    ahead_.released(i);
+    submit_admitted();
+  }
+
+  void stop_reads() {
+    stop_ = true;
+    std::lock_guard<std::mutex> lock(ahead_mutex_);
+    ahead_.stop();
   }
 
   // waited_s: how long this mapper waited for the input's read.
@@ -253,19 +314,19 @@ class BatchRun {
 
   void fail(size_t i, const std::exception_ptr &error) {
     report_.failed(i, what_of(error));
-    if (opt_.fail_fast) stop_ = true;
+    if (opt_.fail_fast) stop_reads();
   }
 
   const Options &opt_;
   const ToolSpec &spec_;
   BatchReport &report_;
-  const size_t ahead_;
   Slots writes_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> shares_gpu_{false};
   std::mutex deferred_mutex_;
   std::vector<size_t> deferred_;  // out of memory beside another mapper: mapped again at the end
-  std::mutex next_mutex_;
+  std::mutex ahead_mutex_;  // ahead_, next_, read_'s futures as they are made
+  cli::ReadAhead ahead_;
   size_t next_ = 0;
   cli::TaskPool pool_;  // after what its tasks use: joined first
   std::vector<std::future<std::unique_ptr<RunResult>>> read_;
