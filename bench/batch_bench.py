@@ -31,7 +31,8 @@ def timed(cmd: list[str], read_ahead: str = "") -> tuple[float, subprocess.Compl
     """Wall-clock seconds of cmd; read_ahead: VASCO_BATCH_READ_AHEAD for it (inputs read ahead
     of the mappers per pool thread; "": the default)."""
     env = dict(os.environ)
-    env.pop("VASCO_BATCH_READ_AHEAD", None)
+    for knob in ("VASCO_BATCH_READ_AHEAD", "VASCO_BATCH_POOL_NICE"):  # none exported leaks into a row
+        env.pop(knob, None)
     if read_ahead:
         env["VASCO_BATCH_READ_AHEAD"] = read_ahead
     t = time.perf_counter()
@@ -246,7 +247,8 @@ def main() -> int:
             # Each --devices set with the read-ahead of before (2 inputs a pool thread) and the
             # default (deeper, within its byte budget), and the batch's own choice (no --devices),
             # the runs interleaved; the first row, one mapper reading 2 ahead, is what a batch did
-            # before either change.
+            # before the read-ahead and the second mapper. The two stage tables below are that
+            # first row and the batch's own choice.
             configs = [(d, n) for d in device_sets(gpu_count()) for n in ("2", "")] + [("", "")]
             times = {c: [] for c in configs}
             for _ in range(a.repeat):

@@ -59,9 +59,9 @@ TEST_F(Log2MapBatchCuda, FloatModeGivesEachLogsOneRunMap) {
   }
 }
 
-// Several mappers share a batch (one per GPU, or two on one GPU with
-// --devices 0,0): each log is mapped whole by one of them, so the outputs are
-// those of one mapper, in either mode.
+// Several mappers share a batch (one per GPU, two on one GPU with --devices
+// 0,0, three per GPU when the batch chooses): each log is mapped whole by one
+// of them, so the outputs are those of one mapper, in either mode.
 TEST_F(Log2MapBatchCuda, SeveralMappersGiveTheOneMappersMaps) {
   TempDir dir;
   const std::vector<std::string> logs = {kIntel, kFr079, kLogs + "/fr101.carmen.log.gz"};
@@ -79,6 +79,17 @@ TEST_F(Log2MapBatchCuda, SeveralMappersGiveTheOneMappersMaps) {
       EXPECT_EQ(map_file_digest(one + "/" + stem + ".map.gz"), map_file_digest(two + "/" + stem + ".map.gz"))
           << mode << " " << stem;
   }
+  // The batch's own choice: three mappers on every GPU, the same maps.
+  const std::string own = dir.file("own");
+  std::vector<std::string> c = {"--backend", "cuda", "--cuda-mode", "exact", "--out-dir", own};
+  c.insert(c.end(), logs.begin(), logs.end());
+  const ToolRun r3 = log2map(c);
+  ASSERT_EQ(r3.status, 0) << r3.output;
+  EXPECT_TRUE(contains(r3.output, ", 3 mappers")) << r3.output;
+  for (const std::string stem : {"intel.gfs", "fr079-complete.gfs", "fr101.carmen"})
+    EXPECT_EQ(map_file_digest(dir.file("one_exact") + "/" + stem + ".map.gz"),
+              map_file_digest(own + "/" + stem + ".map.gz"))
+        << stem;
 }
 
 // Several mappers on one GPU: an input that runs out of memory beside the
