@@ -340,13 +340,15 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         )
     } | {
         "text: Target: cpu_float at least 1.25x MRPT's speed, one core each": Check(
-            "quoted", quote_of="bench/results/peers-2026-12-06-2core.txt"),
+            "quoted", quote_of="bench/results/peers-2026-12-06b-2core.txt"),
         "text: Where a user sees it: log2map --json --backend cpu_float, se": Check(
-            "quoted", quote_of="bench/results/peers-2026-12-06-2core.txt"),
+            "quoted", quote_of="bench/results/peers-2026-12-06b-2core.txt"),
         "text: | data | backend | place | upload | map | finish + download": Check(
             "quoted", quote_of="bench/results/session-2026-12-06-h100.txt"),
         "text: batch_bench: 200 copies of fr079-complete.gfs.log.gz, output": Check(
-            "quoted", quote_of="bench/results/batch-2026-12-06-h100.txt"),
+            "quoted", quote_of="bench/results/batch-2026-12-06b-h100.txt"),
+        "text: Targets (fr079, map phase):": Check(
+            "quoted", quote_of="bench/results/mapping-2026-12-06-h100.txt"),
     },
     "docs/python.md": {
         "sh: pip install .": Check(
