@@ -347,6 +347,8 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "quoted", quote_of="bench/results/session-2026-12-06-h100.txt"),
         "text: batch_bench: 200 copies of fr079-complete.gfs.log.gz, output": Check(
             "quoted", quote_of="bench/results/batch-2026-12-06b-h100.txt"),
+        "text: cuda batch --devices read-ahead logs/s / first row": Check(
+            "quoted", quote_of="bench/results/batch-2026-12-06c-h100.txt"),
         "text: Targets (fr079, map phase):": Check(
             "quoted", quote_of="bench/results/mapping-2026-12-06-h100.txt"),
     },
