@@ -246,9 +246,9 @@ def main() -> int:
         if "cuda" in backends:
             # Each --devices set with the read-ahead of before (2 inputs a pool thread) and the
             # default (deeper, within its byte budget), and the batch's own choice (no --devices),
-            # the runs interleaved; the first row, one mapper reading 2 ahead, is what a batch did
-            # before the read-ahead and the second mapper. The two stage tables below are that
-            # first row and the batch's own choice.
+            # the runs interleaved, the pool at its default priority; the first row, one mapper
+            # reading 2 ahead, is what a batch did before the read-ahead and the mappers sharing a
+            # GPU. The two stage tables below are that first row and the batch's own choice.
             configs = [(d, n) for d in device_sets(gpu_count()) for n in ("2", "")] + [("", "")]
             times = {c: [] for c in configs}
             for _ in range(a.repeat):

@@ -350,8 +350,9 @@ int all_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_con
 // Mappers per GPU when the batch chooses: a mapper's thread spends most of a
 // log on the host (the upload's copy, the finish), so several keep one GPU
 // busy. batch_bench's scaling table, with the pool reading ahead while the
-// backend starts: 239 logs/s with two mappers on one H100, 270 with three,
-// 275 with four (2026-12-06); three, as each keeps its GPU buffers.
+// backend starts, on one H100: 239 logs/s with two mappers, 270 with three,
+// 275 with four (best of one: a row moves 9 % between runs); 186, 194 and
+// 203 in a second run (best of three). Three, as each keeps its GPU buffers.
 constexpr int kMappersPerGpu = 3;
 
 // The GPUs a batch maps on, a mapper each: --devices' list, or --device's

@@ -58,7 +58,7 @@ void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchT
       ->check(CLI::Range(0, vasco::kMaxThreads));
   app.add_option("--devices", raw.devices,
                  "batch mode: the GPUs to map on, a mapper each, e.g. 0,1 (a GPU named twice runs two mappers on it; "
-                 "default: every usable GPU)")
+                 "default: every usable GPU, three mappers each)")
       ->type_name("LIST");
   app.add_option("--split-devices", raw.split_devices,
                  "one map rendered across GPUs, the grid's columns in a band on each, e.g. 0,1: the same bytes as one "

@@ -2,7 +2,7 @@
 //
 // Reading (inflate + parse) runs on the pool while the mappers map; how far
 // it may run ahead decides whether the pool idles while a GPU backend starts
-// (~0.3 s, a third of a 200-log batch) and how much memory parsed inputs
+// (0.2-0.3 s, up to a third of a 200-log batch) and how much memory parsed inputs
 // hold. Inputs are let through in order while all of these hold: fewer than
 // `in_flight` reads are under way (the pool runs only so many at once);
 // fewer than `most` inputs are read or being read and not yet taken by a
