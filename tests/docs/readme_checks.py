@@ -73,6 +73,11 @@ class Check:
     quote_of: str = ""  # quoted: the results file the block comes from
 
 
+def quoted(results_file: str) -> Check:
+    """A block quoted, line for line, from a saved benchmark run (bench/results/...)."""
+    return Check("quoted", quote_of=results_file)
+
+
 # ---------------------------------------------------------------------------------------
 # Compile harnesses: the fragment's #include lines go to @INCLUDES@, the rest to @BODY@.
 
@@ -329,7 +334,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
                                              "--source ${VASCO_SOURCE_DIR}", "--bin ${CMAKE_BINARY_DIR}/bin"])]),
     },
     "docs/performance.md": {
-        key: Check("quoted", quote_of=BENCH_RUN) for key in (
+        key: quoted(BENCH_RUN) for key in (
             "text: vasco_gpu mapping_bench: median of 5 runs after a warm-up; t",
             "text: Ablation of the paper's kernel (float, no lost updates), map",
             "text: file MB messages median s MB/s",
@@ -339,18 +344,18 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "text: batch_bench: 120 copies of fr079-complete.gfs.log.gz, output",
         )
     } | {
-        "text: Target: cpu_float at least 1.25x MRPT's speed, one core each": Check(
-            "quoted", quote_of="bench/results/peers-2026-12-06b-2core.txt"),
-        "text: Where a user sees it: log2map --json --backend cpu_float, se": Check(
-            "quoted", quote_of="bench/results/peers-2026-12-06b-2core.txt"),
-        "text: | data | backend | place | upload | map | finish + download": Check(
-            "quoted", quote_of="bench/results/session-2026-12-06-h100.txt"),
-        "text: batch_bench: 200 copies of fr079-complete.gfs.log.gz, output": Check(
-            "quoted", quote_of="bench/results/batch-2026-12-06b-h100.txt"),
-        "text: cuda batch --devices read-ahead logs/s / first row": Check(
-            "quoted", quote_of="bench/results/batch-2026-12-06c-h100.txt"),
-        "text: Targets (fr079, map phase):": Check(
-            "quoted", quote_of="bench/results/mapping-2026-12-06-h100.txt"),
+        "text: Target: cpu_float at least 1.25x MRPT's speed, one core each":
+            quoted("bench/results/peers-2026-12-06b-2core.txt"),
+        "text: Where a user sees it: log2map --json --backend cpu_float, se":
+            quoted("bench/results/peers-2026-12-06b-2core.txt"),
+        "text: | data | backend | place | upload | map | finish + download":
+            quoted("bench/results/session-2026-12-06-h100.txt"),
+        "text: batch_bench: 200 copies of fr079-complete.gfs.log.gz, output":
+            quoted("bench/results/batch-2026-12-06b-h100.txt"),
+        "text: cuda batch --devices read-ahead logs/s / first row":
+            quoted("bench/results/batch-2026-12-06c-h100.txt"),
+        "text: Targets (fr079, map phase):":
+            quoted("bench/results/mapping-2026-12-06-h100.txt"),
     },
     "docs/python.md": {
         "sh: pip install .": Check(
@@ -381,14 +386,14 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "sh: ros2 launch examples/ros/vasco_with_slam_toolbox.launch.py b": Check(
             "skip", reason="needs ros2 launch and slam_toolbox (a system ROS 2); python/tests/test_live_map.py "
                            "compiles the launch file and checks the node parameters it sets"),
-        "text: # vasco_gpu benchmarks: bench/run_all.sh build-gpu ros livem": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-d.txt"),
-        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --batch 0": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-h100-c.txt"),
-        "text: # vasco_gpu benchmarks: bench/run_all.sh build ros livemap": Check(
-            "quoted", quote_of="bench/results/bench-ros-2026-12-05-2core-e.txt"),
-        "text: ## python3 bench/ros_map_transport.py": Check(
-            "quoted", quote_of="bench/results/bench-ros-transport-2026-12-05-2core-b.txt"),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build-gpu ros livem":
+            quoted("bench/results/bench-ros-2026-12-05-h100-d.txt"),
+        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --batch 0":
+            quoted("bench/results/bench-ros-2026-12-05-h100-c.txt"),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build ros livemap":
+            quoted("bench/results/bench-ros-2026-12-05-2core-e.txt"),
+        "text: ## python3 bench/ros_map_transport.py":
+            quoted("bench/results/bench-ros-transport-2026-12-05-2core-b.txt"),
     },
     "docs/walkthrough-bag.md": {
         # carmen2bag and mapdiff are not among test_readme.py's tools: the test runs the block

@@ -4,10 +4,10 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdint>
 #include <atomic>
 #include <cerrno>
 #include <condition_variable>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -115,25 +115,25 @@ class Slots {
   size_t free_;
 };
 
+// A batch knob from the environment (batch_bench's A/Bs): `name`'s integer
+// clamped to [lo, hi], or `fallback` when it is unset or empty.
+int env_knob(const char *name, int lo, int hi, int fallback) {
+  const char *v = std::getenv(name);
+  if (v != nullptr && *v != '\0') return std::clamp(std::atoi(v), lo, hi);
+  return fallback;
+}
+
 // How much nicer the pool's threads (reads, writes) run than the mappers:
 // with every core reading or writing, a mapper thread that waits for a core
 // holds its GPU up, while the pool's work has slack (reads queue ahead).
 // VASCO_BATCH_POOL_NICE sets it (0: the same priority).
-int pool_nice() {
-  const char *v = std::getenv("VASCO_BATCH_POOL_NICE");
-  if (v != nullptr && *v != '\0') return std::clamp(std::atoi(v), 0, 19);
-  return 5;
-}
+int pool_nice() { return env_knob("VASCO_BATCH_POOL_NICE", 0, 19, 5); }
 
 // How many inputs, per pool thread, may be read ahead of the mappers: deep
 // enough that the pool reads on while a GPU backend starts (~0.3 s) instead
 // of idling after a few inputs. VASCO_BATCH_READ_AHEAD sets it (2: what a
 // batch did before; batch_bench's A/B).
-size_t read_ahead_per_thread() {
-  const char *v = std::getenv("VASCO_BATCH_READ_AHEAD");
-  if (v != nullptr && *v != '\0') return static_cast<size_t>(std::clamp(std::atoi(v), 1, 64));
-  return 8;
-}
+size_t read_ahead_per_thread() { return static_cast<size_t>(env_knob("VASCO_BATCH_READ_AHEAD", 1, 64, 8)); }
 
 // The memory this process may use: the machine's, or its cgroup's limit
 // (cgroup v2's memory.max) where that is less.
