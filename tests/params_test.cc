@@ -189,7 +189,7 @@ TEST(ParamTable, IniErrorsAreFileErrorsOfBadInputAndOverridesAreUsage) {
   }
 }
 
-// --resolution's rule (docs/parameters.md): the expected values are worked
+// --resolution's rule (docs/cli.md, "Map resolution"): the expected values are worked
 // out by hand from the rule, and 0.1 and 0.05 must land on CARMEN's own
 // evidence cell (0.025) exactly, so that a default map stays CARMEN's bytes.
 TEST(MapResolution, KeepsTheEvidenceCellWhenABlockFits) {

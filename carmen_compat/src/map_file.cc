@@ -1,5 +1,7 @@
 // CARMEN map files: what the reader and the writer share (chunk names, cell
-// values, GridMap). Reading is map_file_read.cc, writing map_file_write.cc.
+// values, GridMap). Reading is map_file_reader.h (map_file_read.cc, its
+// chunks' data map_file_read_chunks.cc, map_file_payloads.cc), writing
+// map_file_write.cc.
 #include "carmen_compat/map_file.h"
 
 #include <stdexcept>

@@ -132,10 +132,12 @@ def shell_commands(text: str) -> List[Tuple[int, str]]:
 
 def doc_files(source, readme=None) -> List[Path]:
     """The Markdown files the docs test walks: the README (README.md of the source tree
-    unless given), then every .md file under the source tree's docs/, sorted."""
+    unless given), then every .md file under the source tree's docs/, sorted, then the notes
+    beside the benchmark runs (bench/results/*.md)."""
     source = Path(source)
     readme = Path(readme) if readme else source / "README.md"
     docs = sorted(p for p in (source / "docs").rglob("*.md") if p.is_file())
+    docs += sorted(p for p in (source / "bench" / "results").glob("*.md") if p.is_file())
     return [readme] + [p for p in docs if p.resolve() != readme.resolve()]
 
 

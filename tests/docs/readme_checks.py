@@ -33,7 +33,9 @@ Kinds of check:
                `subs` stated here, `outputs` must exist afterwards); skipped by the docs test.
   quoted       a benchmark's output quoted from a results file: the block's lines must be a
                run of consecutive lines of `quote_of` (a file of bench/results/, made by one
-               bench/run_all.sh run under a header naming its date, machine and commit).
+               bench/run_all.sh run under a header naming its date, machine and commit), or
+               with `picked` lines of it in its order (its header lines and the rows
+               wanted); the document must link the file (readme_quotes.py).
   skip         not checked: `reason` says why.
 """
 
@@ -71,11 +73,25 @@ class Check:
     subs: Sequence[Tuple[str, str]] = ()
     needs: Sequence[str] = ()  # Python modules a python check needs (skipped without them)
     quote_of: str = ""  # quoted: the results file the block comes from
+    picked: bool = False  # quoted: lines of it in its order, not one run of them
 
 
-def quoted(results_file: str) -> Check:
-    """A block quoted, line for line, from a saved benchmark run (bench/results/...)."""
-    return Check("quoted", quote_of=results_file)
+def quoted(results_file: str, picked: bool = False) -> Check:
+    """A block quoted, line for line, from a saved benchmark run (bench/results/...): a run
+    of its lines, or with picked its header and the rows wanted, in its order."""
+    return Check("quoted", quote_of=results_file, picked=picked)
+
+
+def picked(results_file: str) -> Check:
+    return quoted(results_file, picked=True)
+
+
+# Pages of benchmark figures: no Markdown table typed by hand (readme_quotes.py).
+NO_HAND_TABLES = ("docs/performance.md",)
+
+# A document's summary section: its figures with a decimal point must be in the results
+# files the document quotes or the section links (readme_quotes.py).
+SUMMARIES = {"docs/performance.md": "What to expect"}
 
 
 # ---------------------------------------------------------------------------------------
@@ -233,8 +249,10 @@ FIXTURES: Dict[str, Callable[[Path, Path, Path], None]] = {
 # ---------------------------------------------------------------------------------------
 # The table: document -> block key -> check.
 
-# The bench run docs/performance.md quotes.
+# The bench runs docs/performance.md quotes most.
 BENCH_RUN = "bench/results/bench-2026-12-04-h200.txt"
+MAPPING_RUN = "bench/results/mapping-2026-12-06-h100.txt"
+PEERS_RUN = "bench/results/peers-2026-12-06b-2core.txt"
 
 CHECKS: Dict[str, Dict[str, Check]] = {
     "README.md": {
@@ -334,28 +352,30 @@ CHECKS: Dict[str, Dict[str, Check]] = {
                                              "--source ${VASCO_SOURCE_DIR}", "--bin ${CMAKE_BINARY_DIR}/bin"])]),
     },
     "docs/performance.md": {
-        key: quoted(BENCH_RUN) for key in (
-            "text: vasco_gpu mapping_bench: median of 5 runs after a warm-up; t",
-            "text: Ablation of the paper's kernel (float, no lost updates), map",
-            "text: file MB messages median s MB/s",
-            "text: fr079, vasco defaults, median of 5 runs (one core):",
-            "text: log2map end to end (process start to .map.gz written), fr079",
-            "text: Mapping session (vasco defaults; re-render = new poses in ho",
-            "text: batch_bench: 120 copies of fr079-complete.gfs.log.gz, output",
-        )
-    } | {
-        "text: Target: cpu_float at least 1.25x MRPT's speed, one core each":
-            quoted("bench/results/peers-2026-12-06b-2core.txt"),
-        "text: Where a user sees it: log2map --json --backend cpu_float, se":
-            quoted("bench/results/peers-2026-12-06b-2core.txt"),
+        "sh: bench/run_all.sh build parse mapping session": Check(
+            "covered-by", files=[("bench/run_all.sh", [
+                "steps: parse oracle mapping large scaling session batch", "parse) run", "mapping) run",
+                "session) run"])]),
+        "text: # vasco_gpu benchmarks: build-gpu/bin/mapping_bench --datase": picked(MAPPING_RUN),
+        "text: Targets (fr079, map phase):": quoted(MAPPING_RUN),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build-bench parse o": picked(BENCH_RUN),
+        "text: ## build-bench/bin/parse_bench": quoted(BENCH_RUN),
+        "text: # vasco_gpu benchmarks: build-gpu/bin/session_bench --gpu-on":
+            picked("bench/results/session-2026-12-06-h100.txt"),
+        "text: ## build-bench/bin/session_bench": picked(BENCH_RUN),
+        "text: ## python3 bench/batch_bench.py --bin build-bench/bin --copi": picked(BENCH_RUN),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build-gpu batch":
+            picked("bench/results/batch-2026-12-06c-h100.txt"),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build peers": picked(PEERS_RUN),
+        "text: Where a user sees it: log2map --json --backend cpu_float, se": quoted(PEERS_RUN),
+    },
+    "bench/results/HISTORY.md": {
+        "text: cuda batch --devices read-ahead logs/s / first row":
+            picked("bench/results/batch-2026-12-06b-h100.txt"),
+        "text: stages of one cuda batch, --devices (its choice), read-ahead":
+            quoted("bench/results/batch-2026-12-06c-h100.txt"),
         "text: | data | backend | place | upload | map | finish + download":
             quoted("bench/results/session-2026-12-06-h100.txt"),
-        "text: batch_bench: 200 copies of fr079-complete.gfs.log.gz, output":
-            quoted("bench/results/batch-2026-12-06b-h100.txt"),
-        "text: cuda batch --devices read-ahead logs/s / first row":
-            quoted("bench/results/batch-2026-12-06c-h100.txt"),
-        "text: Targets (fr079, map phase):":
-            quoted("bench/results/mapping-2026-12-06-h100.txt"),
     },
     "docs/python.md": {
         "sh: pip install .": Check(
@@ -386,12 +406,9 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "sh: ros2 launch examples/ros/vasco_with_slam_toolbox.launch.py b": Check(
             "skip", reason="needs ros2 launch and slam_toolbox (a system ROS 2); python/tests/test_live_map.py "
                            "compiles the launch file and checks the node parameters it sets"),
-        "text: # vasco_gpu benchmarks: bench/run_all.sh build-gpu ros livem":
-            quoted("bench/results/bench-ros-2026-12-05-h100-d.txt"),
-        "text: ## python3 bench/ros_node_bench.py --fast-rate 800 --batch 0":
-            quoted("bench/results/bench-ros-2026-12-05-h100-c.txt"),
-        "text: # vasco_gpu benchmarks: bench/run_all.sh build ros livemap":
-            quoted("bench/results/bench-ros-2026-12-05-2core-e.txt"),
+        "text: # date: 2026-12-05 15:09 UTC": picked("bench/results/bench-ros-2026-12-05-h100-d.txt"),
+        "text: # date: 2026-12-05 14:58 UTC": picked("bench/results/bench-ros-2026-12-05-h100-c.txt"),
+        "text: # date: 2026-12-05 15:13 UTC": picked("bench/results/bench-ros-2026-12-05-2core-e.txt"),
         "text: ## python3 bench/ros_map_transport.py":
             quoted("bench/results/bench-ros-transport-2026-12-05-2core-b.txt"),
     },

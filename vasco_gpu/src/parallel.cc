@@ -7,44 +7,15 @@
 #include <condition_variable>
 #include <cstdint>
 #include <exception>
-#include <fstream>
 #include <mutex>
 #include <thread>
 #include <vector>
 
 #include "carmen_compat/termination_signals.h"
-
-#ifdef __linux__
-#include <sched.h>
-#endif
+#include "carmen_compat/usable_cores.h"
 
 namespace vasco {
 namespace {
-
-// cgroup v2's "quota period" (e.g. "1600000 100000" = 16 cores); 0 if none.
-int cgroup_cpu_quota() {
-  std::ifstream in("/sys/fs/cgroup/cpu.max");
-  std::string quota;
-  long long period = 0;
-  if (!(in >> quota >> period) || quota == "max" || period <= 0) return 0;
-  try {
-    const long long q = std::stoll(quota);
-    return q > 0 ? static_cast<int>((q + period - 1) / period) : 0;
-  } catch (const std::exception &) {
-    return 0;
-  }
-}
-
-int usable_cores() {
-  int n = static_cast<int>(std::thread::hardware_concurrency());
-#ifdef __linux__
-  cpu_set_t set;
-  if (sched_getaffinity(0, sizeof(set), &set) == 0) n = CPU_COUNT(&set);
-#endif
-  const int quota = cgroup_cpu_quota();
-  if (quota > 0) n = std::min(n, quota);
-  return std::max(1, n);
-}
 
 // Helper threads that sleep between calls. One call at a time (busy_); the
 // workers take indices from next_, and the caller waits until every index is
@@ -161,7 +132,7 @@ void run_on_new_threads(int n, const std::function<void(int)> &fn) {
 }  // namespace
 
 int hardware_threads() {
-  static const int n = usable_cores();
+  static const int n = carmen::usable_cores();
   return n;
 }
 

@@ -13,8 +13,8 @@
 // fails with a clean error before the claimed size is ever allocated), and
 // every error is a carmen::FileError naming the file, the chunk and the offset.
 // Whether a file is gzip is told by its name (file_names.h: ".gz" in any case).
-// Reading is map_file_read.cc, writing map_file_write.cc; map_format.h picks a
-// format (CARMEN map, PGM + YAML, PNG) by extension.
+// Reading is map_file_reader.h (carmen_compat/src), writing map_file_write.cc;
+// map_format.h picks a format (CARMEN map, PGM + YAML, PNG) by extension.
 #ifndef CARMEN_COMPAT_MAP_FILE_H
 #define CARMEN_COMPAT_MAP_FILE_H
 

@@ -2,8 +2,8 @@
 // --png: a tiny built-in 5 x 7 bitmap font (upper case letters, digits and
 // a little punctuation; anything else is drawn as a blank) and the legend
 // that explains the difference picture's colours.
-#ifndef VASCO_GPU_TOOLS_PICTURE_LEGEND_H
-#define VASCO_GPU_TOOLS_PICTURE_LEGEND_H
+#ifndef VASCO_GPU_APP_PICTURE_LEGEND_H
+#define VASCO_GPU_APP_PICTURE_LEGEND_H
 
 #include <cstdint>
 #include <string>
@@ -57,4 +57,4 @@ constexpr Rgb kRule{96, 96, 96};  // the line between picture and legend
 
 }  // namespace picture
 
-#endif  // VASCO_GPU_TOOLS_PICTURE_LEGEND_H
+#endif  // VASCO_GPU_APP_PICTURE_LEGEND_H
