@@ -4,7 +4,7 @@ process per log, on this host, for every backend that runs here, in one run;
 then one-log runs of each bundled log with --backend auto against
 cpu_threads and cuda (auto should never be more than 10 % slower than the
 faster of the two); last, the constants of auto's cost model
-(vasco_gpu/app/backend_choice.cc) as measured on this host.
+(vasco_gpu/src/backend_choice.cc) as measured on this host.
 
     python3 bench/batch_bench.py [--bin build/bin] [--copies 200] [--per-process 20]
 
@@ -107,7 +107,7 @@ def cost_model(log2map: str, backends: list[str], tmp: str, repeat: int) -> tupl
 
 
 def write_cost_model(path: str, values: dict[str, float], command: str) -> None:
-    """The measured table backend_choice.cc is built from (vasco_gpu/app/CMakeLists.txt reads
+    """The measured table backend_choice.cc is built from (vasco_gpu/CMakeLists.txt reads
     it): a header saying which run made it, then one "name value" line per constant."""
     if set(values) != {"cpu_cells_per_core_second", "gpu_cells_per_second", "gpu_start_seconds"}:
         sys.exit(f"batch_bench: --cost-model-out needs a usable GPU (measured only {sorted(values)})")
@@ -120,7 +120,7 @@ def write_cost_model(path: str, values: dict[str, float], command: str) -> None:
     gpu = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"], capture_output=True,
                          text=True).stdout.strip().splitlines()
     with open(path, "w") as f:
-        f.write("# auto's cost model (vasco_gpu/app/backend_choice.cc), as measured by one run of\n")
+        f.write("# auto's cost model (vasco_gpu/src/backend_choice.cc), as measured by one run of\n")
         f.write(f"#   {command}\n")
         f.write(f"# date: {time.strftime('%Y-%m-%d', time.gmtime())}, commit: {commit}, "
                 f"cores: {os.cpu_count()}, GPU: {gpu[0] if gpu else 'none'}\n")
@@ -206,7 +206,7 @@ def main() -> int:
                          "no one-log table, no cost model)")
     ap.add_argument("--cost-model-out", metavar="FILE",
                     help="write auto's measured constants as the table backend_choice.cc is built from "
-                         "(vasco_gpu/app/backend_cost_model.txt)")
+                         "(vasco_gpu/src/backend_cost_model.txt)")
     a = ap.parse_args()
     if a.gpu_only and a.cost_model_out:
         ap.error("--cost-model-out measures the CPU too: not with --gpu-only")
@@ -295,7 +295,7 @@ def main() -> int:
             print(line)
     if model:
         print()
-        print("auto's cost model measured here (compare vasco_gpu/app/backend_choice.cc):")
+        print("auto's cost model measured here (compare vasco_gpu/src/backend_choice.cc):")
     for line in model:
         print("  " + line)
     if a.cost_model_out:

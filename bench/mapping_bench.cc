@@ -62,7 +62,7 @@
 #include "vasco_gpu/internal/parallel.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/renderer.h"
-#include "vasco_gpu/scan_batch.h"
+#include "vasco_gpu/pipeline/log_scans.h"
 #if defined(VASCO_HAVE_CUDA)
 #include "paper_backend.h"
 #include "vasco_gpu/cuda_backend.h"

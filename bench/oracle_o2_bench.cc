@@ -19,7 +19,7 @@
 #include "vasco_gpu/internal/oracle.h"
 #include "vasco_gpu/internal/sensor_params.h"
 #include "vasco_gpu/params.h"
-#include "vasco_gpu/scan_batch.h"
+#include "vasco_gpu/pipeline/log_scans.h"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #                                          peers, MRPT's and OctoMap's grids beside ours (peer_bench, built by
 #                                          make bench-peers), only when named)
 # COST_MODEL_OUT=FILE: batch_bench also writes auto's measured constants there
-# (vasco_gpu/app/backend_cost_model.txt is such a file); BATCH_ARGS: more of
+# (vasco_gpu/src/backend_cost_model.txt is such a file); BATCH_ARGS: more of
 # batch_bench's options; BENCH_COMMIT: the commit to name where the tree is
 # a copy without its git history; PYTHON: the interpreter of the ros step (one with vasco_gpu,
 # rclpy and tf2_msgs), ROS_BENCH_ARGS: more of ros_node_bench.py's options; LIVEMAP_ARGS: live_map_steps.py's; PEER_ARGS: peer_bench's.

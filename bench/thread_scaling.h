@@ -26,7 +26,7 @@
 #include "vasco_gpu/internal/parallel.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/renderer.h"
-#include "vasco_gpu/scan_batch.h"
+#include "vasco_gpu/pipeline/log_scans.h"
 
 namespace bench {
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Fuzzes the tf tree of the bag reader and the ROS node: vasco_gpu.bags.TfBuffer
-(python/src/vasco_gpu/bags/tf.py), fed TFMessages as a bag's /tf and /tf_static or a live
+(python/src/vasco_gpu/msgs/tf.py), fed TFMessages as a bag's /tf and /tf_static or a live
 subscription feed them, then asked for transforms at stamps.
 
 A random and structured fuzzer, time-bounded, with no dependency beyond NumPy (libFuzzer's
@@ -20,7 +20,7 @@ Invariants, each a violation when broken:
   * a live buffer (keep=) holds no more samples a link than it may: those within keep of the
     link's newest stamp at some time, plus the 256 appended between two prunings, plus two.
 
-It loads the bags subpackage by file path (no compiled extension, no rosbags needed).
+It loads the msgs subpackage by file path (no compiled extension, no rosbags needed).
 Prints one summary line; exits 0 when no invariant broke, 1 on a violation (after printing
 the case's seed, the violation, and a reproducer script written beside the artifacts), 2 on
 a usage error.
@@ -32,12 +32,13 @@ a usage error.
 from __future__ import annotations
 
 import argparse
-import importlib.util
+import importlib
 import math
 import random
 import sys
 import time
 import traceback
+import types
 from bisect import bisect_left, insort
 from collections import Counter
 from pathlib import Path
@@ -45,7 +46,7 @@ from types import SimpleNamespace as NS
 
 import numpy as np
 
-BAGS = Path(__file__).resolve().parent.parent / "python" / "src" / "vasco_gpu" / "bags"
+BAGS = Path(__file__).resolve().parent.parent / "python" / "src" / "vasco_gpu" / "msgs"
 NS_PER_S = 1_000_000_000
 INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
 # An error's length at most: this, plus QUOTED_NAMES times the longest frame name of the case
@@ -59,14 +60,15 @@ SAMPLE_SLACK = 258  # samples appended between two prunings (256) and the two al
 
 
 def load_bags(directory: Path):
-    """The bags subpackage from its directory, as its own top-level package: it needs NumPy
-    only (vasco_gpu's __init__ would load the compiled extension)."""
-    spec = importlib.util.spec_from_file_location("vasco_gpu_bags_fuzzed", directory / "__init__.py",
-                                                  submodule_search_locations=[str(directory)])
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    """TfBuffer and BagError of the msgs subpackage in directory, imported under a parent package
+    whose __init__ is not run: they need NumPy only (vasco_gpu's __init__ would load the
+    compiled extension)."""
+    parent = types.ModuleType("vasco_gpu_fuzzed")
+    parent.__path__ = [str(directory.parent)]
+    sys.modules[parent.__name__] = parent
+    tf = importlib.import_module(f"{parent.__name__}.{directory.name}.tf")
+    errors = importlib.import_module(f"{parent.__name__}.{directory.name}.errors")
+    return NS(TfBuffer=tf.TfBuffer, BagError=errors.BagError)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -510,11 +512,12 @@ def py(v) -> str:
 def reproducer(keywords: dict, ops: list[tuple], violation: Violation, bags_dir: Path) -> str:
     """A standalone script that replays ops on a fresh buffer; the last op is the violation's."""
     lines = ["# A reproducer written by fuzz/fuzz_bag_tf.py", f"# {violation}",
-             "import importlib.util, math, sys", "from types import SimpleNamespace as NS", "import numpy as np",
-             f"BAGS = {str(bags_dir)!r}",
-             "spec = importlib.util.spec_from_file_location('bags', BAGS + '/__init__.py', "
-             "submodule_search_locations=[BAGS])",
-             "bags = importlib.util.module_from_spec(spec); sys.modules['bags'] = bags; spec.loader.exec_module(bags)",
+             "import importlib, math, sys, types", "from types import SimpleNamespace as NS", "import numpy as np",
+             f"MSGS = {str(bags_dir)!r}",
+             "parent = types.ModuleType('package'); parent.__path__ = [MSGS.rsplit('/', 1)[0]]",
+             "sys.modules['package'] = parent",
+             "bags = NS(TfBuffer=importlib.import_module('package.msgs.tf').TfBuffer,",
+             "          BagError=importlib.import_module('package.msgs.errors').BagError)",
              "def link(parent, child, sec, nanosec, t, q):",
              "    return NS(header=NS(frame_id=parent, stamp=NS(sec=sec, nanosec=nanosec)), child_frame_id=child,",
              "              transform=NS(translation=NS(x=t[0], y=t[1], z=t[2]), "
@@ -597,7 +600,7 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=None, help="the run's seed (default: from the clock, printed)")
     p.add_argument("--call-limit", type=float, default=1.0, help="seconds a call may take (default 1)")
     p.add_argument("--artifact-dir", default=".", help="where a reproducer is written (default: here)")
-    p.add_argument("--bags", type=Path, default=BAGS, help="the vasco_gpu/bags directory to fuzz")
+    p.add_argument("--bags", type=Path, default=BAGS, help="the vasco_gpu/msgs directory to fuzz")
     p.add_argument("--replay", type=int, default=None, metavar="CASE_SEED", help="run one case, verbosely")
     try:
         a = p.parse_args(argv)

@@ -9,7 +9,7 @@
 
 #include "carmen_compat/error.h"
 #include "fuzz_support.h"
-#include "vasco_gpu/pose_file.h"
+#include "vasco_gpu/pipeline/pose_match.h"
 
 namespace {
 

@@ -189,7 +189,7 @@ TEST(CudaExact, RandomScansWithOddRangesMatchTheOracle) {
 }
 
 // A robot that stands still: thousands of beams from one start cell cross
-// the tiles around it, so those tiles run as heavy tiles (exact_kernels.cu
+// the tiles around it, so those tiles run as heavy tiles (exact_tiles.cu
 // kHeavyList: their own launch, 256 threads, words of beams with one start
 // counted without walking once their cells settle). A second pose in the
 // same tile mixes two start cells in a word; soft evidence (0.499 / 0.501)

@@ -14,8 +14,8 @@
 
 #include "carmen_compat/error.h"
 #include "temp_dir.h"
+#include "vasco_gpu/pipeline/log_scans.h"
 #include "vasco_gpu/pipeline/mapped.h"
-#include "vasco_gpu/scan_batch.h"
 
 namespace {
 

@@ -1,7 +1,7 @@
 // Tests of planar poses along a trajectory (vasco_gpu/pose_series.h): the
 // interpolation written once for pose files, bags' pose topics and the live
 // node's Path. Expected values are worked out by hand here.
-#include "vasco_gpu/pose_series.h"
+#include "vasco_gpu/internal/se2.h"
 
 #include <gtest/gtest.h>
 

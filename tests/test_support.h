@@ -18,6 +18,7 @@
 #include "vasco_gpu/renderer.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/pipeline/log_scans.h"
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco {

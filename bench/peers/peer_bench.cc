@@ -32,7 +32,7 @@
 #include "vasco_gpu/internal/parallel.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/renderer.h"
-#include "vasco_gpu/scan_batch.h"
+#include "vasco_gpu/pipeline/log_scans.h"
 
 #if defined(VASCO_HAVE_MRPT)
 #include <mrpt/maps/COccupancyGridMap2D.h>

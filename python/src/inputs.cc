@@ -22,6 +22,7 @@
 #include "carmen_compat/error.h"
 #include "log2map_app.h"
 #include "param_keys.h"
+#include "vasco_gpu/pipeline/pose_source_options.h"
 
 namespace vasco_py {
 
@@ -59,28 +60,43 @@ double map_resolution_of(nb::handle v) {
   return cell;
 }
 
+// The pose-source rows' names (pose_source_options.h) and the sessions' own.
 const std::set<std::string> &input_keywords() {
-  static const std::set<std::string> k = {"poses",        "pose_format", "pose_match",  "pose_tolerance",
-                                          "pose_max_gap", "pose_ids",    "skip_unposed", "pose_frame",
-                                          "laser_mount",  "transform",   "add",          "map_resolution"};
+  static const std::set<std::string> k = [] {
+    std::set<std::string> names = {"transform", "add", "map_resolution"};
+    for (const vasco::OptionSpec &row : vasco::pipeline::pose_source_option_table()) names.insert(row.name);
+    return names;
+  }();
   return k;
 }
 
+// A Choice row's value, checked by the row (UsageError naming the keyword).
+std::string choice_of(const std::string &key, nb::handle v) {
+  const std::string text = nb::cast<std::string>(v);
+  vasco::check_option_choice(vasco::option_row(vasco::pipeline::pose_source_option_table(), key), text, key);
+  return text;
+}
+
+// A Real row's value, checked by the row.
+double number_of(const std::string &key, nb::handle v) {
+  const double d = nb::cast<double>(v);
+  vasco::check_option_number(vasco::option_row(vasco::pipeline::pose_source_option_table(), key), d, key);
+  return d;
+}
+
+// One pose-source keyword, `key` a row of the table.
 void set_pose_options(vasco::PoseSource &p, const std::string &key, nb::handle v) {
   if (key == "poses") p.file = as_path(v);
-  else if (key == "pose_format") p.format = vasco::pose_file_format_from_name(nb::cast<std::string>(v));
-  else if (key == "pose_match") p.match.matching = vasco::pose_matching_from_name(nb::cast<std::string>(v));
-  else if (key == "pose_tolerance") p.match.tolerance = nb::cast<double>(v);
-  else if (key == "pose_max_gap") p.match.max_gap = nb::cast<double>(v);
+  else if (key == "pose_format") p.format = vasco::pose_file_format_from_name(choice_of(key, v));
+  else if (key == "pose_match") p.match.matching = vasco::pose_matching_from_name(choice_of(key, v));
+  else if (key == "pose_tolerance") p.match.tolerance = number_of(key, v);
+  else if (key == "pose_max_gap") p.match.max_gap = number_of(key, v);
   else if (key == "pose_ids") p.id_map_file = as_path(v);
   else if (key == "skip_unposed") p.match.skip_unmatched = nb::cast<bool>(v);
+  else if (key == "pose_frame") p.robot_frame = choice_of(key, v) == "robot";
   else if (key == "laser_mount") {
     p.mount = pose_triple(v, "laser_mount");
     p.has_mount = true;
-  } else if (key == "pose_frame") {
-    const std::string f = nb::cast<std::string>(v);
-    if (f != "laser" && f != "robot") throw Error(ErrorCode::Usage, "pose_frame '" + f + "': expected 'laser' or 'robot'");
-    p.robot_frame = f == "robot";
   }
 }
 
@@ -193,7 +209,7 @@ void fill_input_options(vasco::LogInputOptions &o, const std::string &path, std:
       o.overrides[name] = nb::cast<std::string>(nb::str(v));
     }
   }
-  bool pose_options = false;
+  std::vector<std::string> pose_options;  // the pose-source keywords given
   for (auto [k, v] : kwargs) {
     const std::string key = nb::cast<std::string>(k);
     if (!input_keywords().count(key)) throw nb::type_error(("unexpected keyword argument '" + key + "'").c_str());
@@ -203,16 +219,10 @@ void fill_input_options(vasco::LogInputOptions &o, const std::string &path, std:
     else if (key == "add") o.more_logs = sessions_of(v);
     else {
       set_pose_options(o.poses, key, v);
-      pose_options |= key != "poses";
+      pose_options.push_back(key);
     }
   }
-  if (pose_options && o.poses.file.empty())
-    throw Error(ErrorCode::Usage, "pose_format, pose_match, pose_tolerance, pose_max_gap, pose_ids, skip_unposed, "
-                                  "pose_frame and laser_mount go with poses=FILE");
-  if (!(o.poses.match.tolerance >= 0) || !std::isfinite(o.poses.match.tolerance))
-    throw Error(ErrorCode::Usage, "pose_tolerance must be a finite number of seconds >= 0");
-  if (!(o.poses.match.max_gap >= 0))
-    throw Error(ErrorCode::Usage, "pose_max_gap must be a number of seconds >= 0 (math.inf: any gap)");
+  vasco::pipeline::check_pose_options_given(pose_options, false, vasco::pipeline::OptionNaming::Keyword);
 }
 
 void bind_inputs(nb::module_ &m) {

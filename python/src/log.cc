@@ -16,6 +16,7 @@
 #include "inputs.h"
 #include "param_keys.h"
 #include "vasco_gpu/pipeline/log_input.h"
+#include "vasco_gpu/pipeline/pose_source_options.h"
 
 namespace vasco_py {
 
@@ -69,22 +70,27 @@ constexpr const char *kLogDoc =
     "(keywords > ini > the log's PARAM lines > defaults), the PROTOCOL frame and\n"
     "what the reader counted.";
 
-// The docs name the scan messages from the engine's list (scan_batch.h).
+// The pose keywords, one line each from its row (pose_source_options.h).
+std::string pose_keywords_doc() {
+  std::string text;
+  for (const vasco::OptionSpec &row : vasco::pipeline::pose_source_option_table())
+    text += "\n- ``" + row.name + "``: " + (row.type == vasco::OptionType::Flag ? row.help : row.help_with_default());
+  return text;
+}
+
+// The docs name the scan messages from the pipeline's list (vasco_gpu/pipeline/log_scans.h).
 const char *load_log_doc() {
   static const std::string doc =
-    "Reads a CARMEN log (.log, .clf, gzipped if the name ends in .gz) as log2map does.\n\n"
+    "Reads a CARMEN log (" + vasco::pipeline::carmen_log_extensions_text(", ") +
+    ", gzipped if the name ends in .gz) as log2map does.\n\n"
     "Every " + vasco::scan_message_names(" and ") + " line is a scan; ``param_file`` is a carmen.ini (``robot`` its\n"
     "section), ``overrides`` keys as in Params (they win over the ini, which wins over the log's\n"
     "PARAM lines). Strict by default: a bad line raises FileError with ``.file`` and ``.line``;\n"
     "``lenient=True`` skips bad lines and counts them in ``Log.stats['bad_lines']``. The GIL is\n"
     "released while the log is read.\n\n"
-    "Poses from a SLAM back end (log2map --poses): ``poses`` a TUM trajectory, g2o file or CARMEN log;\n"
-    "with it (None: the default) ``pose_format`` 'auto' | 'tum' | 'g2o' | 'carmen'; ``pose_match`` 'auto' |\n"
-    "'order' | 'id' | 'time'; by time, a scan between two poses at most ``pose_max_gap`` seconds apart (5;\n"
-    "math.inf: any) takes their interpolation, one before the first, after the last or in a wider gap the\n"
-    "nearest pose if at most ``pose_tolerance`` seconds (0.1) away; ``pose_ids`` a file of 'id scan' pairs;\n"
-    "``skip_unposed`` leave out scans without a pose; ``pose_frame`` 'laser' | 'robot'; ``laser_mount``\n"
-    "(x, y, theta) of the laser on the robot. Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared\n"
+    "Poses from a SLAM back end (log2map --poses), the other pose keywords only with ``poses``\n"
+    "(None: the default; a pose keyword without ``poses`` is a UsageError):" + pose_keywords_doc() + "\n\n"
+    "Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared\n"
     "frame, ``add`` further logs, each a path or (path, (x, y, theta)).\n\n"
     "``map_resolution``: the written map's cell in metres (log2map --resolution; ROS's resolution), set over\n"
     "the keys by Params.map_resolution's rule (vasco_downsample kept where the ini, the log or overrides set\n"

@@ -20,6 +20,7 @@
 #include "map_files.h"
 #include "carmen_compat/map_digest.h"
 #include "carmen_compat/occupancy_grid.h"
+#include "vasco_gpu/pipeline/map_output_options.h"
 
 namespace vasco_py {
 
@@ -41,13 +42,28 @@ constexpr const char *kMapDoc =
     "ValueError, naming the first bad cell); values later written into the ``cells`` view are\n"
     "checked when the map is written (write_map) or compared (compare).";
 
-constexpr const char *kWriteMapDoc =
-    "Writes a map, the format chosen by the name: ``.map`` / ``.map.gz`` (CARMEN, with an OFFSET\n"
-    "chunk when the map has an origin), ``.pgm`` (ROS map_server image plus a ``.yaml`` beside it;\n"
-    "``mode`` trinary, scale or raw) or ``.png`` (grey: white free, black occupied, mid grey\n"
-    "unknown). Atomic: a failure leaves no file behind. Raises FileError naming the file, and\n"
-    "BadInputError (a ValueError) for a map read_map would refuse: a cell that is not -1 or a\n"
-    "probability (NaN among them), or, for .map and .pgm, a resolution that is not positive.";
+const vasco::OptionSpec &output_row(const char *name) {
+  return vasco::option_row(vasco::pipeline::map_output_option_table(), name);
+}
+
+// write_map's docstring, its mode from the row (map_output_options.h).
+const char *write_map_doc() {
+  static const std::string doc =
+      "Writes a map, the format chosen by the name: ``.map`` / ``.map.gz`` (CARMEN, with an OFFSET\n"
+      "chunk when the map has an origin), ``.pgm`` (ROS map_server image plus a ``.yaml`` beside it;\n"
+      "``mode``: " + output_row("mode").help_with_default() + ") or ``.png`` (grey: white free, black\n"
+      "occupied, mid grey unknown). Atomic: a failure leaves no file behind. Raises FileError naming the\n"
+      "file, and BadInputError (a ValueError) for a map read_map would refuse: a cell that is not -1 or a\n"
+      "probability (NaN among them), or, for .map and .pgm, a resolution that is not positive.";
+  return doc.c_str();
+}
+
+// write_map's signature, the mode's default from the row.
+const char *write_map_sig() {
+  static const std::string sig = "def write_map(path: str | os.PathLike, map: Map, mode: str = '" +
+                                 output_row("mode").default_text + "', description: str = '') -> None";
+  return sig.c_str();
+}
 
 // A side of a map: CARMEN stores it as an int.
 int map_side(size_t n, const char *axis) {
@@ -158,16 +174,15 @@ void bind_map_files(nb::module_ &m) {
         nb::gil_scoped_release release;
         write_map(path.string(), mp, mode, description);
       },
-      "path"_a, "map"_a, "mode"_a = "trinary", "description"_a = "",
-      nb::sig("def write_map(path: str | os.PathLike, map: Map, mode: str = 'trinary', description: str = '') -> None"),
-      kWriteMapDoc);
+      "path"_a, "map"_a, "mode"_a = output_row("mode").default_text, "description"_a = "", nb::sig(write_map_sig()),
+      write_map_doc());
   m.def(
       "_write_maps",
       [](const std::vector<std::string> &paths, const Map &mp, const std::string &mode, const std::string &description) {
         nb::gil_scoped_release release;
         write_maps(paths, mp, mode, description);
       },
-      "paths"_a, "map"_a, "mode"_a = "trinary", "description"_a = "",
+      "paths"_a, "map"_a, "mode"_a = output_row("mode").default_text, "description"_a = "",
       "write_map to every one of ``paths`` as one transaction: all are written to temporaries, then\n"
       "renamed; a failure touches no output and leaves no temporary.");
   m.def(
@@ -198,10 +213,10 @@ void bind_map_files(nb::module_ &m) {
         return nb::borrow(out);
       },
       "map"_a, "mode"_a, "free_thresh"_a, "occupied_thresh"_a, "out"_a = nb::none(),
-      "The map as nav_msgs/OccupancyGrid data (int8): rows from the lower-left cell; mode\n"
-      "trinary (100 / 0 / -1 by the thresholds, as map_server reads a trinary picture) or raw\n"
-      "(round(100 p), -1 unknown). carmen_compat/occupancy_grid.h. Into ``out`` (a writable buffer\n"
-      "of size_x * size_y bytes, returned) when given, else a new bytes object.");
+      "The map as nav_msgs/OccupancyGrid data (int8): rows from the lower-left cell; mode the\n"
+      "map_mode: trinary (100 / 0 / -1 by the thresholds, as map_server reads a trinary picture) or\n"
+      "scale, also called raw (round(100 p), -1 unknown). carmen_compat/occupancy_grid.h. Into ``out``\n"
+      "(a writable buffer of size_x * size_y bytes, returned) when given, else a new bytes object.");
   m.def("_fail_rename_for_testing", &carmen::OutputTransaction::fail_rename_for_testing, "n"_a, "err"_a,
         "Tests only: the n-th rename (1-based) of the next transaction's commit in this process fails\n"
         "with errno ``err``; 0 disarms.");

@@ -8,6 +8,7 @@
 #include "carmen_compat/map_format.h"
 #include "carmen_compat/occupancy_grid.h"
 #include "vasco_gpu/map_output.h"
+#include "vasco_gpu/pipeline/map_output_options.h"
 #include "vasco_gpu/pipeline/outputs.h"
 #include "vasco_gpu/version.h"
 
@@ -29,8 +30,7 @@ Map map_from_finished(vasco::FinishedMap &&f, const vasco::GridGeometry &geo) {
 
 carmen::OccupancyValues occupancy_values(const std::string &mode, double free_thresh, double occupied_thresh) {
   carmen::MapServerOptions o;
-  if (!carmen::parse_pgm_mode(mode, &o.mode) || o.mode == carmen::PgmMode::Scale)
-    throw carmen::Error(carmen::ErrorCode::Usage, "occupancy grid data: mode '" + mode + "': expected trinary or raw");
+  o.mode = vasco::pipeline::occupancy_data_mode(mode, vasco::pipeline::OptionNaming::Keyword);
   o.free_thresh = free_thresh;
   o.occupied_thresh = occupied_thresh;
   return carmen::occupancy_values(o);
@@ -80,8 +80,9 @@ carmen::MapToWrite to_write(const Map &m, const std::string &pgm_mode, const std
   w.creator_origin = "python";
   w.description = description.empty() ? "vasco_gpu " + std::string(vasco::version()) : description;
   w.time = static_cast<int64_t>(std::time(nullptr));
-  if (!carmen::parse_pgm_mode(pgm_mode, &w.pgm_mode))
-    throw carmen::Error(carmen::ErrorCode::Usage, "write_map: mode '" + pgm_mode + "': expected trinary, scale or raw");
+  const vasco::OptionSpec &mode = vasco::option_row(vasco::pipeline::map_output_option_table(), "mode");
+  vasco::check_option_choice(mode, pgm_mode, "write_map: mode");
+  carmen::parse_pgm_mode(pgm_mode, &w.pgm_mode);
   return w;
 }
 

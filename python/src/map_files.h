@@ -39,8 +39,9 @@ void write_maps(const std::vector<std::string> &paths, const Map &m, const std::
                 const std::string &description);
 
 // The per-cell rule of OccupancyGrid data (carmen_compat/occupancy_value.h)
-// for a mode ("trinary" or "raw") and map_server's thresholds; Error(Usage)
-// for another mode.
+// for a map_mode (map_output_options.h: "trinary", "scale" or its alias
+// "raw") and map_server's thresholds; Error(Usage) naming map_mode for
+// another mode.
 carmen::OccupancyValues occupancy_values(const std::string &mode, double free_thresh, double occupied_thresh);
 
 // Error(BadInput) naming `what` when a cell of `m` is not a CARMEN cell value.

@@ -29,8 +29,10 @@
 #include "interruptible.h"
 #include "map_files.h"
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/backend_choice.h"
 #include "vasco_gpu/map_output.h"
 #include "vasco_gpu/mapper.hpp"
+#include "vasco_gpu/option_schema.h"
 #include "vasco_gpu/pipeline/mapped.h"
 
 namespace vasco_py {
@@ -43,7 +45,6 @@ namespace {
 
 static_assert(sizeof(vasco::Pose) == 3 * sizeof(double), "Pose must be three packed doubles");
 
-using vasco::kMaxThreads;  // as log2map's --threads: refused beyond, not capped
 
 // What the state properties report, as of the end of the last call.
 struct Snapshot {
@@ -52,6 +53,8 @@ struct Snapshot {
   vasco::MapStats stats;
   size_t renders = 0;
   vasco::MapperParams params;  // start_over replaces them
+  std::string backend;         // "auto" until an auto session chooses (its first insert)
+  std::optional<vasco::AutoChoice> auto_choice;
 };
 
 struct Session {
@@ -59,11 +62,12 @@ struct Session {
   std::mutex lock;  // serialises calls on mapper; taken only with the GIL released
   std::mutex snapshot_lock;  // held only to copy `snapshot`
   Snapshot snapshot;
-  std::string backend;
 
   // Publishes the mapper's state; call with `lock` held.
   void publish() {
-    Snapshot s{mapper->num_scans(), mapper->frame(), mapper->last_stats(), mapper->renders(), mapper->params()};
+    Snapshot s{mapper->num_scans(), mapper->frame(), mapper->last_stats(), mapper->renders(), mapper->params(),
+               mapper->backend_name(), std::nullopt};
+    if (mapper->auto_choice() != nullptr) s.auto_choice = *mapper->auto_choice();
     std::lock_guard<std::mutex> g(snapshot_lock);
     snapshot = s;
   }
@@ -84,22 +88,27 @@ struct Session {
   }
 };
 
+// The keywords checked by the session's option table (option_schema.h).
+const vasco::OptionSpec &session_row(const char *name) {
+  return vasco::option_row(vasco::session_option_table(), name);
+}
+
 vasco::CudaMode cuda_mode_of(const std::string &mode) {
-  if (mode == "float") return vasco::CudaMode::Float;
-  if (mode == "exact") return vasco::CudaMode::Exact;
-  throw Error(ErrorCode::Usage, "cuda_mode '" + mode + "': expected 'float' or 'exact'");
+  vasco::check_option_choice(session_row("cuda_mode"), mode, "cuda_mode");
+  return mode == "exact" ? vasco::CudaMode::Exact : vasco::CudaMode::Float;
 }
 
 vasco::BackendOptions backend_options(const std::string &backend, const std::optional<std::string> &cuda_mode,
-                                      int threads, int cuda_device, uint64_t max_memory_bytes, std::string *name) {
+                                      int threads, int cuda_device, uint64_t max_memory_bytes, int expected_renders,
+                                      std::string *name) {
   vasco::BackendOptions o;
   if (cuda_mode) o.cuda_mode = cuda_mode_of(*cuda_mode);
-  if (threads < 0 || threads > kMaxThreads)
-    throw Error(ErrorCode::Usage, "threads " + std::to_string(threads) + ": must be 0 (all cores) to " +
-                                      std::to_string(kMaxThreads));
+  vasco::check_option_number(session_row("threads"), threads, "threads");
+  vasco::check_option_number(session_row("expected_renders"), expected_renders, "expected_renders");
   o.threads = threads;
   o.cuda_device = cuda_device;
   o.max_memory_bytes = max_memory_bytes;
+  o.expected_renders = expected_renders;
   o.budget_hint = "Mapper(max_memory_bytes=...)";
   const vasco::CudaMode asked = o.cuda_mode;
   *name = vasco::resolve_backend_name(backend, &o);
@@ -131,9 +140,10 @@ std::vector<vasco::Pose> poses_from(nb::handle obj) {
 
 void init_mapper(Session *self, std::optional<vasco::MapperParams> params, const std::string &backend,
                  std::optional<std::string> cuda_mode, int threads, std::optional<vasco::GridGeometry> frame,
-                 int cuda_device, uint64_t max_memory_bytes) {
+                 int cuda_device, uint64_t max_memory_bytes, int expected_renders) {
   std::string name;
-  const vasco::BackendOptions o = backend_options(backend, cuda_mode, threads, cuda_device, max_memory_bytes, &name);
+  const vasco::BackendOptions o =
+      backend_options(backend, cuda_mode, threads, cuda_device, max_memory_bytes, expected_renders, &name);
   const vasco::MapperParams p = params ? *params : vasco::MapperParams();
   std::unique_ptr<vasco::Mapper> mp;
   {
@@ -142,7 +152,6 @@ void init_mapper(Session *self, std::optional<vasco::MapperParams> params, const
     mp = frame ? std::make_unique<vasco::Mapper>(p, *frame, name, o) : std::make_unique<vasco::Mapper>(p, name, o);
   }
   auto *s = new (self) Session();
-  s->backend = mp->backend_name();
   s->mapper = std::move(mp);
   s->publish();
 }
@@ -241,6 +250,52 @@ nb::ndarray<nb::numpy, double> poses(Session &s) {
   return owned(std::move(flat), {p.size(), 3});
 }
 
+nb::dict auto_choice_dict(const vasco::AutoChoice &c) {
+  nb::dict d;
+  d["cell_updates"] = c.cell_updates;
+  d["cores"] = c.cores;
+  d["expected_renders"] = c.renders;
+  d["cpu_s"] = c.cpu_s;
+  d["gpu_s"] = c.gpu_s;
+  d["gpu_faster"] = c.gpu_faster;
+  d["gpu_usable"] = c.gpu_usable;
+  d["backend"] = c.backend;
+  d["why"] = c.why;
+  return d;
+}
+
+nb::dict auto_choice(double cell_updates, int threads, int expected_renders, std::optional<bool> gpu_usable,
+                     int cuda_device) {
+  vasco::BackendOptions o;
+  o.threads = threads;
+  o.cuda_device = cuda_device;
+  const int cores = vasco::auto_cores(o);
+  std::string why;
+  bool usable = false;
+  if (gpu_usable) {
+    usable = *gpu_usable;
+    why = "no usable GPU (given)";
+  } else {
+    nb::gil_scoped_release release;
+    usable = vasco::gpu_usable(cuda_device, &why);
+  }
+  return auto_choice_dict(vasco::choose_auto(cell_updates, cores, expected_renders, usable, why));
+}
+
+void bind_auto_choice(nb::module_ &m) {
+  m.def("estimated_cell_updates", &vasco::estimated_cell_updates, "scans"_a, "params"_a,
+        "The cells the used beams of ``scans`` cross with ``params`` (each traced from the laser to\n"
+        "min(range + wall, range_max), one cell a resolution step): the workload auto weighs.");
+  m.def("auto_choice", &auto_choice, "cell_updates"_a, "threads"_a = 0, "expected_renders"_a = 1,
+        "gpu_usable"_a = nb::none(), "cuda_device"_a = 0,
+        "What backend='auto' runs for ``cell_updates`` (estimated_cell_updates) mapped\n"
+        "``expected_renders`` times (0: a workload without end) on cpu_threads' ``threads`` (0: every\n"
+        "core) or the GPU: the rule log2map --backend auto and Mapper(backend='auto') share. A dict\n"
+        "with 'cell_updates', 'cores', 'expected_renders', 'cpu_s', 'gpu_s', 'gpu_faster',\n"
+        "'gpu_usable', 'backend' ('cuda' or 'cpu_threads') and 'why' (log2map's note).\n"
+        "``gpu_usable``: True or False, or None to ask about ``cuda_device`` (which starts CUDA).");
+}
+
 constexpr const char *kMapperDoc =
     "A mapping session (DESIGN section 7): scans stored once (on the GPU for ``cuda``), poses\n"
     "replaceable as a whole, the evidence grid kept between calls.\n\n"
@@ -250,7 +305,8 @@ constexpr const char *kMapperDoc =
     "    m = mapper.finish()               # CARMEN's finish -> Map\n\n"
     "Backends: cpu_double (CARMEN's routine, bit-identical), cpu_threads (the same bytes on every\n"
     "core), cpu_float (single precision), cuda (cuda_mode 'float', the default, or 'exact':\n"
-    "CARMEN's bytes), auto (cuda when a GPU is usable, else cpu_threads); 'cuda_exact' and\n"
+    "CARMEN's bytes), auto (cuda or cpu_threads, by the cost model log2map --backend auto uses);\n"
+    "'cuda_exact' and\n"
     "'cuda_float' name the CUDA modes too. The GIL is released while the session maps; calls on\n"
     "one Mapper from several threads are serialised, and len, frame, last_stats, renders and\n"
     "repr answer at once even while another thread maps (as of the end of the last call).\n\n"
@@ -264,13 +320,17 @@ constexpr const char *kMapperInitDoc =
     "cuda_mode: 'float' (default) or 'exact'. threads: cpu_threads' threads (0: all cores; at\n"
     "most 1024, as log2map's --threads). frame: a fixed Frame (cells outside it are skipped, as\n"
     "CARMEN does) instead of the PROTOCOL frame, which grows as scans arrive. max_memory_bytes:\n"
-    "host memory the session may use (0: no limit). Raises ValueError for bad parameters or an\n"
-    "unknown backend, RuntimeError when the backend cannot run here (e.g. cuda without a GPU).";
+    "host memory the session may use (0: no limit). expected_renders: what auto weighs the GPU's\n"
+    "start-up against (vasco_gpu.auto_choice): 1, the default, chooses at the first insert by its\n"
+    "scans, as log2map --backend auto does for a log; more, a session that will render its scans\n"
+    "again; 0, a workload without end (a live map): the GPU when one is usable, chosen now.\n"
+    "Raises ValueError for bad parameters or an unknown backend, RuntimeError when the backend\n"
+    "cannot run here (e.g. cuda without a GPU).";
 
 void bind_mapper_constructor(nb::class_<Session> &cls) {
   cls.def("__init__", &init_mapper, "params"_a = nb::none(), "backend"_a = "cpu_double", "cuda_mode"_a = nb::none(),
           "threads"_a = 0, "frame"_a = nb::none(), "cuda_device"_a = 0,
-          "max_memory_bytes"_a = vasco::kDefaultMaxMemoryBytes, kMapperInitDoc);
+          "max_memory_bytes"_a = vasco::kDefaultMaxMemoryBytes, "expected_renders"_a = 1, kMapperInitDoc);
 }
 
 void bind_mapper_mapping(nb::class_<Session> &cls) {
@@ -315,8 +375,18 @@ void bind_mapper_state(nb::class_<Session> &cls) {
       .def_prop_ro("frame", [](Session &s) { return s.state().frame; }, "The current frame (a copy).")
       .def_prop_ro("params", [](Session &s) { return s.state().params; },
                    "The session's parameters (a copy; start_over replaces them).")
-      .def_prop_ro("backend", [](Session &s) { return s.backend; },
-                   "The backend's name (cpu_double, cpu_threads, cpu_float, cuda_float, cuda_exact).")
+      .def_prop_ro("backend", [](Session &s) { return s.state().backend; },
+                   "The backend's name (cpu_double, cpu_threads, cpu_float, cuda_float, cuda_exact); 'auto'\n"
+                   "while an auto session has not chosen (until its first insert).")
+      .def_prop_ro(
+          "auto_choice",
+          [](Session &s) -> nb::object {
+            const Snapshot st = s.state();
+            return st.auto_choice ? nb::object(auto_choice_dict(*st.auto_choice)) : nb::none();
+          },
+          nb::sig("def auto_choice(self) -> dict[str, typing.Any] | None"),
+          "What backend='auto' chose and why (a dict as vasco_gpu.auto_choice returns); None for\n"
+          "another backend and while auto has not chosen.")
       .def_prop_ro("last_stats", [](Session &s) { return stats_dict(s.state().stats); },
                    "Counts and phase times of the last insert or render.")
       .def_prop_ro("renders", [](Session &s) { return s.state().renders; },
@@ -331,13 +401,15 @@ void bind_mapper_state(nb::class_<Session> &cls) {
           "FileError naming ``input`` when ``map`` (this session's finished map) has no known cell, saying\n"
           "why (the pipeline's rule: such a map is not written).")
       .def("__repr__", [](Session &s) {
-        return nb::str("Mapper(backend='{}', {} scans)").format(s.backend, s.state().num_scans);
+        const Snapshot st = s.state();
+        return nb::str("Mapper(backend='{}', {} scans)").format(st.backend, st.num_scans);
       });
 }
 
 }  // namespace
 
 void bind_mapper(nb::module_ &m) {
+  bind_auto_choice(m);
   nb::class_<Session> cls(m, "Mapper", kMapperDoc);
   bind_mapper_constructor(cls);
   bind_mapper_mapping(cls);

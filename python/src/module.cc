@@ -55,7 +55,8 @@ std::string backends_doc() {
   }
   std::string doc = "Returns the names Mapper(backend=...) takes in this build:\n\n  [" + names + "]\n\n";
   doc += has_auto ? "That is every backend compiled into this build, then 'auto', which is no backend of its own\n"
-                    "but picks one of them when the Mapper is made. "
+                    "but picks cuda or cpu_threads by the cost model log2map --backend auto uses (at the\n"
+                    "Mapper's first insert, or when it is made with expected_renders=0). "
                   : "That is every backend compiled into this build. ";
   doc += "Aliases are not listed; each follows its\nbackend's line:\n";
   for (const vasco::BackendInfo &b : vasco::backend_registry()) {

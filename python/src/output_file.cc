@@ -1,7 +1,9 @@
 // output_file.cc — carmen_compat's atomic output file (atomic_file.h) as
-// Python's _OutputFile, for what Python writes itself (bag2carmen's log):
-// the same temporary, checks and rename as every map the engine writes, so
-// no Python file keeps a transaction of its own.
+// Python's _OutputFile, for what Python writes itself (bag2carmen's log,
+// carmen2bag's bag): the same temporary, checks and rename as every map the
+// engine writes, so no Python file keeps a transaction of its own; and its
+// TemporaryOnSignal as _TemporaryOnSignal, for the scratch files a writer
+// that takes only a path (rosbags') makes before its output is copied in.
 #include <nanobind/nanobind.h>
 #include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/string.h>
@@ -29,6 +31,11 @@ struct OutputFile {
     if (!out) throw carmen::Error(carmen::ErrorCode::State, "_OutputFile: already committed or abandoned");
     return *out;
   }
+};
+
+// A path registered with the signal clean-up until released.
+struct ScratchPath {
+  std::unique_ptr<carmen::TemporaryOnSignal> registered;
 };
 
 }  // namespace
@@ -63,6 +70,19 @@ void bind_output_file(nb::module_ &m) {
       .def(
           "abandon", [](OutputFile &f) { f.out.reset(); },
           "Removes the temporary now, unless committed (then it does nothing).");
+  nb::class_<ScratchPath>(m, "_TemporaryOnSignal",
+                          "A path of the caller's making (a file, or a directory: removed once empty) that the\n"
+                          "signal handlers of _remove_temporaries_on_signals remove, until release(). Register it\n"
+                          "before it is made; removing it otherwise is the caller's job.")
+      .def(
+          "__init__",
+          [](ScratchPath *self, const std::filesystem::path &path) {
+            new (self) ScratchPath{std::make_unique<carmen::TemporaryOnSignal>(path.string())};
+          },
+          "path"_a)
+      .def(
+          "release", [](ScratchPath &p) { p.registered.reset(); },
+          "No longer removed on a signal (once the caller has removed it).");
 }
 
 }  // namespace vasco_py

@@ -1,6 +1,7 @@
 // The live node's Path onto its stored scans (ros.live_map.LiveMap.repose) by
-// vasco_gpu/pose_series.h, in one call instead of dozens of NumPy calls (each
-// costing a live node several times what it costs in a loop).
+// vasco_gpu/pose_series.h and internal/se2.h, in one call instead of dozens
+// of NumPy calls (each costing a live node several times what it costs in a
+// loop).
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/tuple.h>
@@ -13,6 +14,7 @@
 #include "arrays.h"
 #include "bindings.h"
 #include "carmen_compat/error.h"
+#include "vasco_gpu/internal/se2.h"
 #include "vasco_gpu/pose_series.h"
 
 namespace vasco_py {

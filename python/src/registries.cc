@@ -1,22 +1,29 @@
 // registries.cc — the engine's lists as Python reads them: the backends
-// (backend.h), the map formats (map_format.h) and the pipeline's rules for
-// outputs (vasco_gpu/pipeline/outputs.h), so that no Python file lists a
-// backend, a format or an output rule of its own.
+// (backend.h), the option tables
+// (option_schema.h), the map formats (map_format.h) and the pipeline's rules
+// for outputs (vasco_gpu/pipeline/outputs.h), so that no Python file lists a
+// backend, an option, a format or an output rule of its own.
 #include <nanobind/nanobind.h>
 #include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "bindings.h"
+#include "carmen_compat/error.h"
 #include "carmen_compat/map_format.h"
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/option_schema.h"
+#include "vasco_gpu/pipeline/map_output_options.h"
 #include "vasco_gpu/pipeline/outputs.h"
+#include "vasco_gpu/pipeline/pose_source_options.h"
 
 namespace vasco_py {
 
@@ -79,9 +86,74 @@ nb::list format_rows() {
   return rows;
 }
 
+// A row's default as a Python value of its type (None: none; the text itself
+// where it is not a number, a computed default).
+nb::object typed_default(const vasco::OptionSpec &o) {
+  const std::string &t = o.default_text;
+  if (t.empty()) return nb::none();
+  char *end = nullptr;
+  switch (o.type) {
+    case vasco::OptionType::Flag: return nb::bool_(t == "true");
+    case vasco::OptionType::Whole: {
+      const long long v = std::strtoll(t.c_str(), &end, 10);
+      return *end == '\0' ? nb::object(nb::int_(v)) : nb::object(nb::str(t.c_str()));
+    }
+    case vasco::OptionType::Bytes: {  // default_text in MiB, Python's value in bytes
+      const unsigned long long mib = std::strtoull(t.c_str(), &end, 10);
+      return *end == '\0' ? nb::object(nb::int_(uint64_t(mib) << 20)) : nb::object(nb::str(t.c_str()));
+    }
+    case vasco::OptionType::Real: {
+      const double v = std::strtod(t.c_str(), &end);
+      return *end == '\0' ? nb::object(nb::float_(v)) : nb::object(nb::str(t.c_str()));
+    }
+    default: return nb::str(t.c_str());
+  }
+}
+
+nb::dict option_dict(const vasco::OptionSpec &o) {
+  const bool bounded = !(o.lo == 0 && o.hi == 0);
+  nb::dict d;
+  d["name"] = o.name;
+  d["type"] = vasco::option_type_name(o.type);
+  d["default"] = typed_default(o);
+  d["default_text"] = o.default_text;
+  d["help"] = o.help;
+  d["choices"] = o.choices;
+  d["lo"] = bounded ? nb::object(nb::float_(o.lo)) : nb::none();
+  d["hi"] = bounded ? nb::object(nb::float_(o.hi)) : nb::none();
+  d["lo_open"] = o.lo_open;
+  d["hi_open"] = o.hi_open;
+  d["flag"] = o.flag();
+  d["rule"] = o.rule();
+  return d;
+}
+
+const vasco::OptionTable &option_table(const std::string &component) {
+  if (component == "session") return vasco::session_option_table();
+  if (component == "pose_source") return vasco::pipeline::pose_source_option_table();
+  if (component == "map_output") return vasco::pipeline::map_output_option_table();
+  throw carmen::Error(carmen::ErrorCode::Usage, "option_schema: no component '" + carmen::printable(component) +
+                                                    "' (known: session, pose_source, map_output)");
+}
+
+nb::list option_rows(const std::string &component) {
+  nb::list rows;
+  for (const vasco::OptionSpec &o : option_table(component)) rows.append(option_dict(o));
+  return rows;
+}
+
 }  // namespace
 
 void bind_registries(nb::module_ &m) {
+  m.def("option_schema", &option_rows, "component"_a,
+        nb::sig("def option_schema(component: str) -> list[dict[str, typing.Any]]"),
+        "The options of ``component`` ('session': a Mapper's backend, cuda_mode, threads, ...;\n"
+        "'pose_source': poses from a file; 'map_output': how a map is written), one dict per option\n"
+        "in the order of its table: 'name' (the keyword), 'type' ('flag', 'whole', 'real', 'bytes',\n"
+        "'choice', 'text' or 'whole_list'), 'default' (a value of the type, None for none; 'bytes'\n"
+        "in bytes), 'default_text' (as --help prints it; 'bytes' in MiB), 'help', 'choices', 'lo' and\n"
+        "'hi' (None: unbounded), 'lo_open', 'hi_open', 'flag' (log2map's: --max-memory) and 'rule'\n"
+        "(the accepted values in words). UsageError for another component.");
   m.def("backend_registry", &backend_rows,
         nb::sig("def backend_registry() -> list[dict[str, typing.Any]]"),
         "Every backend of the engine's registry, compiled into this build or not, in the order the\n"
@@ -96,6 +168,9 @@ void bind_registries(nb::module_ &m) {
         "'name' (what map_logs' formats and log2map --formats take: 'map.gz'), 'extension' ('.map.gz'),\n"
         "'what' and 'kind' ('carmen', 'map_server' or 'picture'). A path's extension (any case) picks\n"
         "its format in read_map and write_map.");
+  m.def("carmen_log_extensions", &vasco::pipeline::carmen_log_extensions,
+        "The extensions of a CARMEN log (``.log``, ``.clf``), each also gzipped (``.gz`` after it),\n"
+        "as log2map and load_log take them.");
   m.def(
       "output_stem", [](const std::filesystem::path &path) { return vasco::pipeline::output_stem(path.string()); },
       "path"_a, nb::sig("def output_stem(path: str | os.PathLike) -> str"),

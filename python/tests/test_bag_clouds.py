@@ -16,10 +16,11 @@ import pytest
 pytest.importorskip("rosbags")
 
 import vasco_gpu as vg  # noqa: E402
-from vasco_gpu.bags import cloud as vc  # noqa: E402
-from vasco_gpu.bags.carmen2bag import write_bag  # noqa: E402
-from vasco_gpu.bags.errors import BagError  # noqa: E402
-from vasco_gpu.bags.scans import COUNT_KEYS  # noqa: E402
+from vasco_gpu.bags.bag_writer import write_bag  # noqa: E402
+from vasco_gpu.msgs import cloud as vc  # noqa: E402
+from vasco_gpu.msgs.errors import BagError  # noqa: E402
+from vasco_gpu.msgs.laser import COUNT_KEYS  # noqa: E402
+from vasco_gpu.msgs.scan_options import SCAN_DEFAULTS, check_cloud_options  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_bags import ANGLE_BOUND, INTEL, assert_within_angle_bound, finished, run_script  # noqa: E402
@@ -147,9 +148,10 @@ def test_what_read_cloud_refuses():
         read(bad)
     for kw, word in [(dict(z_band=(1.0, 0.5)), "z_band"), (dict(angle_step=0.0), "cloud_angle_step"),
                      (dict(range_max=-1.0), "cloud_range_max")]:
-        opts = {**vc.CLOUD_DEFAULTS, **kw}
+        opts = {"z_band": SCAN_DEFAULTS["z_band"], "angle_step": math.radians(SCAN_DEFAULTS["cloud_angle_step"]),
+                "range_max": SCAN_DEFAULTS["cloud_range_max"], **kw}
         with pytest.raises(ValueError, match=word):
-            vc.check_cloud_options(opts["z_band"], opts["angle_step"], opts["range_max"])
+            check_cloud_options(opts["z_band"], opts["angle_step"], opts["range_max"])
 
 
 def test_a_cloud_frame_without_a_mount_is_an_error_that_says_what_to_do(cloud_bag):

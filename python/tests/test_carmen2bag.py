@@ -18,6 +18,7 @@ import gzip
 import importlib.util
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -28,7 +29,7 @@ import pytest
 pytest.importorskip("rosbags")
 
 import vasco_gpu as vg  # noqa: E402
-from vasco_gpu.bags import carmen2bag as c2b  # noqa: E402
+from vasco_gpu.bags import bag_writer as c2b  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 INTEL = ROOT / "logs" / "intel.gfs.log.gz"
@@ -248,6 +249,45 @@ def test_output_is_replaced_whole_or_not_at_all(tmp_path, intel):
     assert run_script("carmen2bag", "-q", INTEL, out).returncode == 0
     assert len(vg.load_bag(out)) == len(intel)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.db3", "same.log"]
+
+
+@pytest.mark.parametrize("ext", EXTENSIONS)
+def test_a_writer_that_fails_part_way_leaves_nothing(tmp_path, intel, monkeypatch, ext):
+    out = tmp_path / f"run{ext}"
+    out.write_bytes(b"yesterday")
+    real = c2b._write_messages
+
+    def half(w, log, ns, cloud, topic):  # the messages written, then the writer fails
+        real(w, log, ns, cloud, topic)
+        raise RuntimeError("disk gone")
+
+    monkeypatch.setattr(c2b, "_write_messages", half)
+    with pytest.raises(c2b.Carmen2BagError, match="disk gone") as e:
+        c2b.write_bag(intel, out)
+    assert isinstance(e.value, vg.Error) and str(e.value).startswith(str(out))
+    assert out.read_bytes() == b"yesterday"
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]  # no scratch bag, no temporary
+
+
+@pytest.mark.parametrize("ext", EXTENSIONS)
+def test_a_run_ended_by_a_signal_leaves_nothing(tmp_path, ext):
+    # SIGTERM once the bag is in its scratch path: the handlers remove it and the transaction's
+    # temporary, and the process dies of the signal.
+    out = tmp_path / f"run{ext}"
+    out.write_bytes(b"yesterday")
+    code = ("import os, signal, sys\n"
+            "from vasco_gpu.bags import bag_writer, carmen2bag\n"
+            "real = bag_writer._write_messages\n"
+            "def then_killed(*args):\n"
+            "    real(*args)\n"
+            "    os.kill(os.getpid(), signal.SIGTERM)\n"
+            "bag_writer._write_messages = then_killed\n"
+            "sys.exit(carmen2bag.main(sys.argv[1:]))\n")
+    r = subprocess.run([sys.executable, "-c", code, str(INTEL), str(out)], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == -signal.SIGTERM, r.stderr
+    assert out.read_bytes() == b"yesterday"
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]
 
 
 def test_walkthrough_runs(tmp_path):

@@ -18,7 +18,7 @@ import vasco_gpu as vg
 from conftest import golden_cases, gridmap_digest
 from vasco_gpu.ros.grid import grid_values
 from vasco_gpu.ros.live_map import LiveMap, LiveMapError
-from vasco_gpu.ros.settings import NODE_PARAMETERS, Settings, SettingsError, mapper_parameter_names
+from vasco_gpu.ros.settings import NODE_PARAMETERS, mapper_parameter_names
 
 CASES = {name: (log, ini, digest) for name, log, ini, digest in golden_cases()}
 
@@ -157,57 +157,7 @@ def test_finish_grid_is_the_values_of_the_finish_written_into_the_last_array():
             grid_values(m, "trinary", out=bad)
 
 
-def test_settings_refuse_naming_the_parameter(tmp_path):
-    assert "vasco_resolution" in mapper_parameter_names() and "vasco_p_occ" in mapper_parameter_names()
-    s = Settings.from_values({}, {})
-    assert s.scan_topics == ["scan"] and s.map_mode == "trinary"
-    # resolution 0.05 by default, ROS's cell: CARMEN's 0.025 m evidence grid in blocks of 2
-    assert (s.params.resolution, s.params.downsample, s.params.map_resolution) == (0.025, 2, 0.05)
-    assert s.params == vg.Params(downsample=2)
-    for node, mapper, word in [({"map_mode": "ternary"}, {}, "map_mode"), ({"scan_topics": "scan"}, {}, "scan_topics"),
-                               ({"transform_timeout": -1.0}, {}, "transform_timeout"),
-                               ({"backend": "gpu9"}, {}, "backend"), ({}, {"vasco_p_occ": 1.5}, "vasco_p_occ"),
-                               ({}, {"vasco_resolutoin": 0.1}, "vasco_resolutoin"), ({}, {"p_occ": 0.6}, "p_occ"),
-                               ({"resolution": -0.05}, {}, "resolution"), ({"resolution": 1e-9}, {}, "resolution"),
-                               ({}, {"vasco_resolution": 0.05}, "vasco_resolution and resolution"),
-                               ({"free_thresh": 0.7}, {}, "free_thresh"),
-                               ({"param_file": str(tmp_path / "none.ini")}, {}, "param_file")]:
-        with pytest.raises(SettingsError, match=word):
-            Settings.from_values(node, mapper)
-    assert Settings.from_values({"resolution": 0}, {"vasco_resolution": 0.05}).params.map_resolution == 0.2
-    one = Settings.from_values({"resolution": 0.05}, {"vasco_downsample": 1}).params  # a given block stays
-    assert (one.resolution, one.downsample) == (0.05, 1)
-    ini = tmp_path / "carmen.ini"
-    ini.write_text("[*]\nvasco_resolution 0.1\nvasco_p_occ 0.8\n")
-    s = Settings.from_values({"param_file": str(ini), "resolution": 0}, {"vasco_p_occ": 0.6})
-    assert s.params.resolution == 0.1 and s.params.p_occ == 0.6  # given over the file
-    s = Settings.from_values({"param_file": str(ini)}, {})  # resolution over the file's vasco_resolution
-    assert (s.params.resolution, s.params.downsample, s.params.p_occ) == (0.05, 1, 0.8)  # round(0.05 / 0.1) = 1
-
-
 ROOT = Path(__file__).resolve().parents[2]
-
-
-def _docs_rows():
-    """The rows of docs/ros.md's table of the node's own parameters: name -> (default, meaning)."""
-    text = (ROOT / "docs" / "ros.md").read_text()
-    table = text.split("| parameter | default | meaning |", 1)[1].split("\n\n", 1)[0]
-    rows = {}
-    for line in table.splitlines()[2:]:
-        name, default, meaning = (c.strip() for c in line.strip("|").split("|"))
-        rows[name.strip("`")] = (default.strip("`"), meaning)
-    return rows
-
-
-def test_the_docs_table_is_the_nodes_schema():
-    rows = _docs_rows()
-    assert list(rows) == [p.name for p in NODE_PARAMETERS]
-    for p in NODE_PARAMETERS:
-        default, meaning = rows[p.name]
-        want = "[" + ", ".join(str(v) for v in p.default) + "]" if isinstance(p.default, list) else \
-            ("''" if p.default == "" else str(p.default))
-        assert default == want, p.name
-        assert meaning == p.meaning + (" (may change while running)" if p.dynamic else ""), p.name
 
 
 def test_the_launch_example_names_parameters_the_node_has():

@@ -310,7 +310,7 @@ def test_batches_come_on_the_steady_clock_under_sim_time(ros, node, intel):
 def test_point_clouds_map_as_their_scans(ros, node, intel):
     """The first 60 scans as PointCloud2 (carmen2bag --cloud's points: walls at 0.5 m, floor and
     ceiling points the default z_band leaves out): the map of those scans."""
-    from vasco_gpu.bags.carmen2bag import cloud_points
+    from vasco_gpu.bags.bag_writer import cloud_points
 
     assert ros.call(Trigger, "/vasco_mapper/reset", Trigger.Request()).success
     n = ros.map_count()

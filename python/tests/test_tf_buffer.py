@@ -3,33 +3,20 @@
 between two, in both directions, and the errors for what tf cannot answer. The expected
 transforms are worked out by hand in the comments.
 
-The subpackage is loaded by file path, without vasco_gpu's compiled extension.
+The subpackage is loaded by file path, without vasco_gpu's compiled extension (package_under_test).
 """
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
-from pathlib import Path
 from types import SimpleNamespace as NS
 
 import numpy as np
 import pytest
 
-BAGS = Path(__file__).resolve().parent.parent / "src" / "vasco_gpu" / "bags"
+import package_under_test
 
-
-def _load_package(name: str, directory: Path):
-    spec = importlib.util.spec_from_file_location(name, directory / "__init__.py",
-                                                  submodule_search_locations=[str(directory)])
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-bags = _load_package("vasco_gpu_bags_tf_under_test", BAGS)
+bags = package_under_test.load("bags")
 
 SEC0 = 1_700_000_000  # the stamps: SEC0 + 1 s, + 2 s, + 3 s
 R = math.sqrt(0.5)  # sin 45 deg = cos 45 deg

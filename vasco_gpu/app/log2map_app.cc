@@ -18,7 +18,6 @@
 #include <map>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "carmen_compat/atomic_file.h"
@@ -28,14 +27,15 @@
 #include "cli_support.h"
 #include "vasco_gpu/pipeline/outputs.h"
 #include "log2map_app.h"
-#include "backend_choice.h"
 #include "log2map_batch.h"
 #include "log2map_options.h"
 #include "log2map_steps.h"
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/backend_choice.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/pipeline/log_input.h"
+#include "vasco_gpu/pipeline/pose_source_options.h"
 #include "vasco_gpu/map_output.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/params.h"
@@ -72,17 +72,6 @@ std::future<bool> start_cuda(const Options &opt, const vasco::BackendOptions &bo
   (void)bopt;
 #endif
   return ready;
-}
-
-// Why the GPU backend is not used, for the --backend auto note.
-std::string no_gpu_reason(const vasco::BackendOptions &bopt) {
-#if defined(VASCO_HAVE_CUDA)
-  std::string why;
-  return vasco::cuda_usable(bopt.cuda_device, &why) ? "GPU usable" : "no usable GPU (" + why + ")";
-#else
-  (void)bopt;
-  return "this build has no CUDA backend";
-#endif
 }
 
 void print_summary(const Options &opt, const RunResult &r) {
@@ -204,18 +193,10 @@ void check_before_work(const Options &opt) {
 std::string chosen_backend(const Options &opt, const vasco::BackendOptions &bopt, const vasco::LogInput &in) {
   const vasco::BackendInfo *b = vasco::find_backend(opt.backend);
   if (b == nullptr || !b->chooses) return opt.backend;
-  const int cores = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const BackendChoice c = choose_backend(estimated_cell_updates(in.batch, in.params), cores);
-  std::string backend = "cpu_threads", why = c.why;
-  if (c.gpu) {
-    const std::string gpu = no_gpu_reason(bopt);
-    if (gpu == "GPU usable")
-      backend = "cuda";
-    else
-      why += "; " + gpu;
-  }
-  if (!opt.quiet) std::fprintf(stderr, "%s: --backend auto: %s: using %s\n", opt.tool.c_str(), why.c_str(), backend.c_str());
-  return backend;
+  const vasco::AutoChoice c = vasco::choose_auto(&in.batch, in.params, bopt);
+  if (!opt.quiet)
+    std::fprintf(stderr, "%s: --backend auto: %s: using %s\n", opt.tool.c_str(), c.why.c_str(), c.backend.c_str());
+  return c.backend;
 }
 
 // The mapping session in the PROTOCOL frame, fed every scan at once.
@@ -297,7 +278,7 @@ ToolSpec log2map_spec() {
       "log2map: builds a CARMEN evidence-grid map (vasco/egrid.c) from a laser log.\n"
       "Outputs by extension: " + carmen::known_map_extensions() + ".";
   spec.input_name = "LOG";
-  spec.input_help = "CARMEN log (.log, .clf, or gzipped .gz)";
+  spec.input_help = "CARMEN log (" + vasco::pipeline::carmen_log_extensions_text(", ") + ", or gzipped .gz)";
   return spec;
 }
 

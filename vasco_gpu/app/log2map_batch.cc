@@ -442,8 +442,9 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     run.start_reads();  // while the backend starts
     const std::vector<int> devices = batch_devices(opt);
     // One mapper for every input (per GPU): its backend (a GPU's context
-    // and scratch) starts once. auto is the GPU when one is usable: its
-    // start-up is paid once for the whole batch.
+    // and scratch) starts once. auto weighs a workload without end
+    // (backend_options: expected_renders 0): the GPU when one is usable, its
+    // start-up paid once for the whole batch.
     vasco::BackendOptions first = backend_options(opt);
     first.cuda_device = devices.front();
     vasco::Mapper mapper(vasco::MapperParams{}, opt.backend, first);

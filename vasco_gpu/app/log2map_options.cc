@@ -11,8 +11,11 @@
 #include "carmen_compat/map_format.h"
 #include "cli_support.h"
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/option_schema.h"
 #include "vasco_gpu/params.h"
+#include "vasco_gpu/pipeline/map_output_options.h"
 #include "vasco_gpu/pipeline/outputs.h"
+#include "vasco_gpu/pipeline/pose_source_options.h"
 #include "vasco_gpu/version.h"
 
 namespace log2map {
@@ -21,6 +24,9 @@ namespace {
 
 using carmen::Error;
 using carmen::ErrorCode;
+using vasco::OptionSpec;
+using vasco::OptionType;
+namespace pl = vasco::pipeline;
 
 // One number in the C locale, the whole text.
 bool parse_double(const std::string &text, double *out) {
@@ -28,6 +34,45 @@ bool parse_double(const std::string &text, double *out) {
   if (b != e && *b == '+') ++b;
   const auto r = std::from_chars(b, e, *out);
   return r.ec == std::errc() && r.ptr == e && b != e;
+}
+
+// An option of the pipeline's tables (pose_source_options.h,
+// map_output_options.h): its flag, help, default and check from its row.
+std::string flag_help(const OptionSpec &row) {
+  return row.type == OptionType::Flag ? row.help : row.help_with_default();
+}
+
+// CLI11's check of a row's value: one of the choices, or a number within
+// the bounds (the tables live as long as the program: `row` outlives it).
+CLI::Validator row_check(const OptionSpec &row) {
+  if (row.type == OptionType::Choice) return CLI::IsMember(row.choices);
+  return CLI::Validator(
+      [&row](std::string &v) -> std::string {
+        double d = 0;
+        return parse_double(v, &d) && row.in_bounds(d) ? std::string() : "expected " + row.rule() + ", not " + v;
+      },
+      "");
+}
+
+template <typename T>
+CLI::Option *add_row_option(CLI::App &app, const OptionSpec &row, T &target, const std::string &type_name = "") {
+  CLI::Option *o = app.add_option(row.flag(), target, flag_help(row));
+  if (!type_name.empty()) o->type_name(type_name);
+  if (row.type == OptionType::Choice || row.type == OptionType::Real || row.type == OptionType::Whole)
+    o->check(row_check(row));
+  return o;
+}
+
+CLI::Option *add_row_flag(CLI::App &app, const OptionSpec &row, bool &target) {
+  return app.add_flag(row.flag(), target, flag_help(row));
+}
+
+// The names of `table`'s rows whose flags were given.
+std::vector<std::string> given_rows(const CLI::App &app, const vasco::OptionTable &table) {
+  std::vector<std::string> given;
+  for (const OptionSpec &row : table)
+    if (app.count(row.flag()) > 0) given.push_back(row.name);
+  return given;
 }
 
 void add_input_options(CLI::App &app, const ToolSpec &spec, Options &opt) {
@@ -42,7 +87,7 @@ void add_input_options(CLI::App &app, const ToolSpec &spec, Options &opt) {
 
 // What --out-dir takes along; checked after parsing.
 struct BatchText {
-  std::string formats = "map.gz";
+  std::string formats = vasco::option_row(pl::map_output_option_table(), "formats").default_text;
   std::string devices;
   std::string split_devices;  // not batch mode: one render's GPUs
 };
@@ -51,8 +96,7 @@ void add_batch_options(CLI::App &app, const ToolSpec &spec, Options &opt, BatchT
   app.add_option("--out-dir", opt.out_dir,
                  "batch mode: map every " + spec.input_name + " given, in one process, to DIR/NAME.FORMAT")
       ->type_name("DIR");
-  app.add_option("--formats", raw.formats, "batch mode: the outputs of each input, of " + carmen::known_map_format_names() + " (default map.gz)")
-      ->type_name("LIST");
+  add_row_option(app, vasco::option_row(pl::map_output_option_table(), "formats"), raw.formats, "LIST");
   app.add_flag("--fail-fast", opt.fail_fast, "batch mode: stop at the first input that fails (default: report it, go on)");
   app.add_option("--jobs", opt.jobs, "batch mode: threads reading inputs and writing maps (default: all cores)")
       ->check(CLI::Range(0, vasco::kMaxThreads));
@@ -85,38 +129,39 @@ std::vector<int> parse_devices(const std::string &text, const char *option) {
   return devices;
 }
 
-// The map_server outputs' options; checked after parsing.
+// The map_server outputs' options (their rows in map_output_options.h);
+// checked after parsing.
 struct MapServerText {
-  std::string mode = "trinary";
+  std::string mode = vasco::option_row(pl::map_output_option_table(), "mode").default_text;
 };
 
 void add_map_server_options(CLI::App &app, Options &opt, MapServerText &raw) {
   carmen::MapServerOptions &o = opt.map_server;
-  app.add_option("--mode", raw.mode,
-                 "grey levels of " + carmen::known_map_extensions(carmen::MapFormatKind::MapServer) +
-                     " outputs: trinary (default), scale (unknown transparent "
-                 "in a PNG; a PGM cannot say unknown in scale mode) or raw")
-      ->check(CLI::IsMember({"trinary", "scale", "raw"}));
-  // 0.196 is what ROS 1's map_saver writes; nav2's map_saver writes 0.25.
-  app.add_option("--free-thresh", o.free_thresh,
-                 "map_server outputs: p below it is free, the YAML's free_thresh (default 0.196, as ROS 1's "
-                 "map_saver writes; nav2's map_saver: 0.25)")
-      ->type_name("P");
-  app.add_option("--occupied-thresh", o.occupied_thresh,
-                 "map_server outputs: p above it is occupied, the YAML's occupied_thresh (default 0.65)")
-      ->type_name("P");
-  app.add_flag("--negate", o.negate, "map_server outputs: negate 1 (black free, white occupied; not with --mode raw)");
+  const vasco::OptionTable &t = pl::map_output_option_table();
+  add_row_option(app, vasco::option_row(t, "mode"), raw.mode);
+  // The thresholds' bounds are checked after parsing (checked_map_server_options), in a
+  // message that names the value given: "--occupied-thresh 2: expected a number in [0, 1]".
+  const auto add_threshold = [&](const char *name, double &target) {
+    const OptionSpec &row = vasco::option_row(t, name);
+    app.add_option(row.flag(), target, flag_help(row))->type_name("P");
+  };
+  add_threshold("free_thresh", o.free_thresh);
+  add_threshold("occupied_thresh", o.occupied_thresh);
+  add_row_flag(app, vasco::option_row(t, "negate"), o.negate);
 }
 
 // Checks the map_server options: a usage error naming the option, or a
 // warning when no output is a map_server pair.
 void finish_map_server_options(const CLI::App &app, const MapServerText &raw, Options &opt) {
-  carmen::parse_pgm_mode(raw.mode, &opt.map_server.mode);
-  const std::string problem =
-      carmen::map_server_options_problem(opt.map_server, "--free-thresh", "--occupied-thresh", "--negate");
-  if (!problem.empty()) throw Error(ErrorCode::Usage, problem);
-  const bool given = app.count("--mode") || app.count("--free-thresh") || app.count("--occupied-thresh") ||
-                     app.count("--negate");
+  const carmen::MapServerOptions &o = opt.map_server;
+  opt.map_server = pl::checked_map_server_options(raw.mode, o.free_thresh, o.occupied_thresh, o.negate,
+                                                  pl::OptionNaming::Flag);
+  std::vector<const OptionSpec *> rows;
+  bool given = false;
+  for (const std::string &name : pl::map_server_option_names()) {
+    rows.push_back(&vasco::option_row(pl::map_output_option_table(), name));
+    given = given || app.count(rows.back()->flag()) > 0;
+  }
   if (!given) return;
   bool pair = false;
   for (const std::string &f : opt.formats) {
@@ -131,7 +176,7 @@ void finish_map_server_options(const CLI::App &app, const MapServerText &raw, Op
   std::string pairs = carmen::known_map_extensions(carmen::MapFormatKind::MapServer);  // ".pgm, .png+yaml or .yaml"
   const size_t last = pairs.rfind(", ");
   if (last != std::string::npos) pairs.replace(last, 2, " or ");
-  const std::string w = "--mode, --free-thresh, --occupied-thresh and --negate do nothing without a " + pairs + " output";
+  const std::string w = pl::option_names_text(rows, pl::OptionNaming::Flag) + " do nothing without a " + pairs + " output";
   opt.warnings.push_back(w);
   std::fprintf(stderr, "%s: warning: %s\n", opt.tool.c_str(), w.c_str());
 }
@@ -164,18 +209,20 @@ void add_backend_options(CLI::App &app, Options &opt) {
         }
       },
       "");
+  // The session's rows (option_schema.h): help, default, bounds and choices.
+  const auto row = [](const char *name) -> const OptionSpec & {
+    return vasco::option_row(vasco::session_option_table(), name);
+  };
   app.add_option("--backend", opt.backend,
-                 "the backend (default: auto; for one LOG, auto takes the one a cost model expects to finish "
-                 "first), one of:\n" +
-                     vasco::backend_help() + backend_aliases_help())
+                 row("backend").help_with_default() + ", one of:\n" + vasco::backend_help() + backend_aliases_help())
       ->type_name("NAME")
       ->check(known_backend);
-  app.add_option("--threads", opt.threads,
-                 "threads of cpu_threads, 1 to " + std::to_string(vasco::kMaxThreads) + " (default: all cores)")
-      ->check(CLI::Range(0, vasco::kMaxThreads));
+  const OptionSpec &threads = row("threads");
+  app.add_option("--threads", opt.threads, threads.help_with_default())
+      ->check(CLI::Range(static_cast<int>(threads.lo), static_cast<int>(threads.hi)));
   app.add_option("--device", opt.device, "the CUDA device of the cuda backend (default 0; a batch: every usable GPU)")->check(CLI::NonNegativeNumber);
-  app.add_option("--cuda-mode", opt.cuda_mode, "float (fastest) | exact (bit-identical to cpu_double)")
-      ->check(CLI::IsMember({"float", "exact"}));
+  app.add_option("--cuda-mode", opt.cuda_mode, row("cuda_mode").help_with_default())
+      ->check(CLI::IsMember(row("cuda_mode").choices));
   app.add_flag("--lenient", opt.lenient, "skip bad log lines (and report them) instead of stopping");
   app.add_flag("--json", opt.json, "print machine-readable statistics on stdout");
   app.add_flag("-q,--quiet", opt.quiet, "no progress and no summary");
@@ -183,43 +230,27 @@ void add_backend_options(CLI::App &app, Options &opt) {
 
 // What --poses and --add take; checked after parsing (raw holds the text).
 struct PoseText {
-  std::string format = "auto", match = "auto", frame = "laser", mount, transform;
+  std::string format, match, frame, mount, transform;
   std::vector<std::string> adds;
 };
 
+// The pose-source options, each from its row (pose_source_options.h), then
+// the sessions' --transform and --add.
 void add_pose_options(CLI::App &app, Options &opt, PoseText &raw) {
-  app.add_option("--poses", opt.poses.file,
-                 "replace each scan's laser pose by a SLAM back end's: a TUM trajectory, a g2o file "
-                 "(VERTEX_SE2) or a CARMEN log")
-      ->type_name("FILE");
-  app.add_option("--pose-format", raw.format, "auto (by extension: .g2o, .log/.clf[.gz], else TUM) | tum | g2o | carmen")
-      ->check(CLI::IsMember({"auto", "tum", "g2o", "carmen"}));
-  app.add_option("--pose-match", raw.match,
-                 "auto (time when the file has stamps, else order) | order | id | time")
-      ->check(CLI::IsMember({"auto", "order", "id", "time"}));
-  app.add_option("--pose-ids", opt.poses.id_map_file, "g2o vertex id -> scan index pairs ('id scan' lines) for --pose-match id")
-      ->type_name("FILE");
-  app.add_option("--pose-max-gap", opt.poses.match.max_gap,
-                 "time matching: a scan between two poses at most this far apart, in s, takes their interpolation "
-                 "(default 5; inf: any gap)")
-      ->type_name("SECONDS")
-      ->check(CLI::Validator(
-          [](std::string &v) -> std::string {
-            double d = 0;
-            return parse_double(v, &d) && d >= 0 ? std::string() : "expected seconds >= 0 (inf: any gap), not " + v;
-          },
-          ""));
-  app.add_option("--pose-tolerance", opt.poses.match.tolerance,
-                 "time matching: a scan before the first pose, after the last or in a wider gap takes the nearest "
-                 "pose if at most this far, in s (default 0.1)")
-      ->type_name("SECONDS")
-      ->check(CLI::NonNegativeNumber);
-  app.add_flag("--skip-unposed", opt.poses.match.skip_unmatched, "leave out (and count) scans without a pose instead of stopping");
-  app.add_option("--pose-frame", raw.frame, "the poses are of the laser (default) or of the robot")
-      ->check(CLI::IsMember({"laser", "robot"}));
-  app.add_option("--laser-mount", raw.mount,
-                 "the laser in the robot's frame, for --pose-frame robot (default: from each scan)")
-      ->type_name("X,Y,THETA");
+  const vasco::OptionTable &t = pl::pose_source_option_table();
+  const auto row = [&t](const char *name) -> const OptionSpec & { return vasco::option_row(t, name); };
+  raw.format = row("pose_format").default_text;
+  raw.match = row("pose_match").default_text;
+  raw.frame = row("pose_frame").default_text;
+  add_row_option(app, row("poses"), opt.poses.file, "FILE");
+  add_row_option(app, row("pose_format"), raw.format);
+  add_row_option(app, row("pose_match"), raw.match);
+  add_row_option(app, row("pose_ids"), opt.poses.id_map_file, "FILE");
+  add_row_option(app, row("pose_max_gap"), opt.poses.match.max_gap, "SECONDS");
+  add_row_option(app, row("pose_tolerance"), opt.poses.match.tolerance, "SECONDS");
+  add_row_flag(app, row("skip_unposed"), opt.poses.match.skip_unmatched);
+  add_row_option(app, row("pose_frame"), raw.frame);
+  add_row_option(app, row("laser_mount"), raw.mount, "X,Y,THETA");
   app.add_option("--transform", raw.transform, "the input into the shared frame of several sessions (default: identity)")
       ->type_name("X,Y,THETA");
   // One value an occurrence: what follows it is OUT (or the next input).
@@ -334,11 +365,8 @@ void finish_options(const CLI::App &app, const ToolSpec &spec, const PoseText &r
   opt.device_given = app.count("--device") > 0;
   // A bag reader takes --laser-mount (a pose topic's mount) and --skip-unposed
   // (scans outside the poses' time span) without --poses too.
-  const bool pose_options = app.count("--pose-format") || app.count("--pose-match") || app.count("--pose-ids") ||
-                            app.count("--pose-tolerance") || app.count("--pose-max-gap") || app.count("--pose-frame") ||
-                            ((app.count("--laser-mount") || app.count("--skip-unposed")) && !spec.read);
-  if (pose_options && opt.poses.file.empty())
-    throw Error(ErrorCode::Usage, "the --pose-* options, --skip-unposed and --laser-mount go with --poses FILE");
+  pl::check_pose_options_given(given_rows(app, pl::pose_source_option_table()), static_cast<bool>(spec.read),
+                               pl::OptionNaming::Flag);
   warn_about_idle_options(app, opt);
 }
 
@@ -440,7 +468,8 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
   BatchText raw_batch;
   add_batch_options(app, spec, *opt, raw_batch);
   std::string max_memory;
-  app.add_option("--max-memory", max_memory, "host memory the map may use, in MiB (default 2048; 0: no limit)")
+  app.add_option("--max-memory", max_memory,
+                 vasco::option_row(vasco::session_option_table(), "max_memory").help_with_default())
       ->type_name("MiB");
   PoseText raw_poses;
   add_pose_options(app, *opt, raw_poses);

@@ -11,8 +11,9 @@
 
 #include "carmen_compat/image_io.h"
 #include "log2map_app.h"
+#include "vasco_gpu/option_schema.h"
 #include "vasco_gpu/pipeline/log_input.h"
-#include "vasco_gpu/pose_file.h"
+#include "vasco_gpu/pipeline/pose_match.h"
 
 namespace log2map {
 
@@ -33,8 +34,9 @@ struct Options {
   std::vector<int> split_devices;  // --split-devices LIST: one render in bands across them
   std::string param_file;
   std::string robot;
-  std::string backend = "auto";
-  std::string cuda_mode = "float";
+  // The session's defaults (option_schema.h; its table is built on first use).
+  std::string backend = vasco::option_row(vasco::session_option_table(), "backend").default_text;
+  std::string cuda_mode = vasco::option_row(vasco::session_option_table(), "cuda_mode").default_text;
   int threads = 0;
   uint64_t max_memory_bytes = 0;
   bool lenient = false, json = false, quiet = false;

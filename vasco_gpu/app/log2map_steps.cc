@@ -90,6 +90,9 @@ vasco::BackendOptions backend_options(const Options &opt) {
   bopt.split_devices = opt.split_devices;
   bopt.max_memory_bytes = opt.max_memory_bytes;
   bopt.budget_hint = "--max-memory MiB";
+  // auto's renders (backend_choice.h): one input is mapped once; a batch's
+  // mapper maps every input, its start-up paid once (a workload without end).
+  bopt.expected_renders = opt.out_dir.empty() ? 1 : 0;
   return bopt;
 }
 

@@ -69,7 +69,8 @@ std::string basename_of(const std::string &path);
 std::vector<std::string> files_written(const std::vector<std::string> &outputs);
 
 // The backend options of the command line (--cuda-mode, --threads,
-// --device, --max-memory).
+// --device, --max-memory; auto's expected renders: 1 for one input, 0 for a
+// batch).
 vasco::BackendOptions backend_options(const Options &opt);
 
 // What mapping one input produced.

@@ -26,6 +26,7 @@
 #include "carmen_compat/map_format.h"
 #include "cli_support.h"
 #include "mapconvert_info.h"
+#include "vasco_gpu/pipeline/map_output_options.h"
 #include "vasco_gpu/pipeline/outputs.h"
 #include "vasco_gpu/version.h"
 
@@ -33,6 +34,7 @@ namespace mapconvert {
 namespace {
 
 using carmen::MapFormatKind;
+namespace pl = vasco::pipeline;
 
 const char kUsageHead[] =
     "Usage: mapconvert [-q] [--mode trinary|scale|raw] [--free-thresh F] [--occupied-thresh O]\n"
@@ -58,11 +60,26 @@ std::string usage_options() {
          "), written to the YAML:\n";
 }
 
+// The map_server options' lines: their choices and defaults are the
+// map_output rows' (pipeline/map_output_options.h), written once there.
+std::string usage_option_lines() {
+  const vasco::OptionTable &t = pl::map_output_option_table();
+  const vasco::OptionSpec &mode = vasco::option_row(t, "mode"), &free_row = vasco::option_row(t, "free_thresh"),
+                          &occupied = vasco::option_row(t, "occupied_thresh");
+  std::string modes;
+  for (size_t i = 0; i < mode.choices.size(); ++i) {
+    const std::string &c = mode.choices[i];
+    modes += (i == 0 ? "" : i + 1 == mode.choices.size() ? " or " : ", ") + c +
+             (c == mode.default_text ? " (default)" : "");
+  }
+  return "  --mode M             " + modes + " grey levels\n" +
+         "  --free-thresh F      p below F is free (default " + free_row.default_text +
+         ", what ROS 1's map_saver\n"
+         "                       writes; nav2's map_saver writes 0.25)\n"
+         "  --occupied-thresh O  p above O is occupied (default " + occupied.default_text + "); 0 <= F < O <= 1\n";
+}
+
 const char kUsageOptions[] =
-    "  --mode M             trinary (default), scale or raw grey levels\n"
-    "  --free-thresh F      p below F is free (default 0.196, what ROS 1's map_saver\n"
-    "                       writes; nav2's map_saver writes 0.25)\n"
-    "  --occupied-thresh O  p above O is occupied (default 0.65); 0 <= F < O <= 1\n"
     "  --negate             negate 1: black free, white occupied (not with raw)\n"
     "--info prints the size, resolution, chunks, unknown fraction and value range.\n"
     "-q, --quiet leaves out the notes (chunks not copied); errors are still said.\n"
@@ -80,7 +97,7 @@ const std::string &usage() {
       ext.resize(std::max<size_t>(ext.size(), 11), ' ');
       t += "  " + ext + f.what + "\n";
     }
-    return t + kUsageNotes + usage_options() + kUsageOptions;
+    return t + kUsageNotes + usage_options() + usage_option_lines() + kUsageOptions;
   }();
   return text;
 }
@@ -156,17 +173,22 @@ int parse_args(int argc, const char *const *argv, Args *a) {
     return usage_error(e.what());
   }
   if (a->help || a->version) return 0;
+  const vasco::OptionTable &rows = pl::map_output_option_table();
   if (app.count("--mode")) {
-    if (!carmen::parse_pgm_mode(mode, &a->map_server.mode))
-      return usage_error("unknown --mode '" + mode + "' (trinary, scale or raw)");
+    const vasco::OptionSpec &row = vasco::option_row(rows, "mode");
+    if (std::find(row.choices.begin(), row.choices.end(), mode) == row.choices.end() ||
+        !carmen::parse_pgm_mode(mode, &a->map_server.mode))
+      return usage_error("unknown --mode '" + mode + "' (" + row.rule() + ")");
     a->mode_given = true;
   }
-  for (const auto &[name, text, value] : {std::make_tuple("--free-thresh", &free_thresh, &a->map_server.free_thresh),
-                                          std::make_tuple("--occupied-thresh", &occupied_thresh,
+  for (const auto &[name, text, value] : {std::make_tuple("free_thresh", &free_thresh, &a->map_server.free_thresh),
+                                          std::make_tuple("occupied_thresh", &occupied_thresh,
                                                           &a->map_server.occupied_thresh)}) {
-    if (!app.count(name)) continue;
-    if (!parse_threshold(*text, value))
-      return usage_error(std::string(name) + " '" + *text + "': expected a number from 0 to 1");
+    const vasco::OptionSpec &row = vasco::option_row(rows, name);
+    if (!app.count(row.flag())) continue;
+    // A number out of the row's bounds is said by map_server_options_problem
+    // below, as for every front end: "--free-thresh 1.5: must be a number from 0 to 1".
+    if (!parse_threshold(*text, value)) return usage_error(row.flag() + " '" + *text + "': expected " + row.rule());
     a->thresholds_given = true;
   }
   a->thresholds_given = a->thresholds_given || a->map_server.negate;

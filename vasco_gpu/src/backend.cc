@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "host_renderer.h"
+#include "vasco_gpu/backend_choice.h"
 #include "vasco_gpu/error.h"
 #include "vasco_gpu/renderer.h"
 
@@ -49,9 +50,11 @@ std::unique_ptr<Renderer> cuda(const BackendOptions &o) {
 #endif
 }
 
-// cuda when a GPU is usable, else cpu_threads: cpu_double's bytes on every core.
+// backend_choice.h's rule without a workload, as for a workload without
+// end (a session that knows its workload decides in Mapper instead): cuda
+// when a GPU is usable, else cpu_threads, cpu_double's bytes on every core.
 std::unique_ptr<Renderer> automatic(const BackendOptions &o) {
-  return cuda_unusable_reason(o).empty() ? cuda(o) : cpu_threads(o);
+  return choose_auto(nullptr, MapperParams{}, o).backend == "cuda" ? cuda(o) : cpu_threads(o);
 }
 
 }  // namespace
@@ -87,7 +90,8 @@ const std::vector<BackendInfo> &backend_registry() {
        kCudaCompiled, "the GPU: float mode (fastest) or exact mode (bit-identical to cpu_double)", true, false, false,
        cuda},
       {"auto", {}, Exactness::ByCudaMode, false, true,
-       "cuda when a GPU is usable, else cpu_threads", true, true, true, automatic},
+       "cuda or cpu_threads, whichever a cost model expects to finish first (cuda only where a GPU is usable)",
+       true, true, true, automatic},
   };
   return rows;
 }

@@ -95,6 +95,7 @@ std::unique_ptr<Session> open_session(const evidence_grid *g, const std::string 
   if (backend == "cpu_double") return nullptr;
   try {
     vasco::BackendOptions opt;
+    opt.expected_renders = 0;  // scans mapped as they come: a workload without end (backend_choice.h)
     const std::string name = vasco::resolve_backend_name(backend, &opt);
     vasco::GridGeometry frame;
     frame.size_x = g->size_x;

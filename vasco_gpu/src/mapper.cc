@@ -50,6 +50,28 @@ void check_threads(int threads) {
                                       std::to_string(kMaxThreads));
 }
 
+void check_options(const BackendOptions &options) {
+  check_threads(options.threads);
+  if (options.expected_renders < 0)
+    throw Error(ErrorCode::Usage, "Mapper: expected_renders = " + std::to_string(options.expected_renders) +
+                                      " is negative (0: a workload without end)");
+}
+
+// The renderer a session on `backend` starts with: null for auto with
+// expected renders (it chooses at its first insert, by the workload);
+// `choice` is set when auto chose now.
+std::unique_ptr<Renderer> first_renderer(const std::string &backend, const BackendOptions &options,
+                                         std::optional<AutoChoice> *choice) {
+  BackendOptions o = options;
+  const BackendInfo *b = find_backend(resolve_backend_name(backend, &o));
+  if (!b->chooses) return make_renderer(backend, options);
+  if (options.expected_renders > 0) return nullptr;
+  AutoChoice c = choose_auto(nullptr, MapperParams{}, o);
+  std::unique_ptr<Renderer> r = make_renderer(c.backend, o);
+  *choice = std::move(c);
+  return r;
+}
+
 // Whether every used beam of `scans` ends a safe number of cells from its
 // start: then the end cell never wraps CARMEN's 32-bit ints and a scan maps
 // to the same cells, shifted, in a larger grid. A -inf or huge negative range
@@ -95,13 +117,36 @@ constexpr uint64_t kFinishStripCells = uint64_t(16) << 20;
 }  // namespace
 
 Mapper::Mapper(const MapperParams &params, const std::string &backend, const BackendOptions &options)
-    : Mapper(params, (check_threads(options.threads), make_renderer(backend, options)), options) {}
+    : params_(params), options_(options) {
+  check_options(options);
+  renderer_ = first_renderer(backend, options, &auto_choice_);
+  params_.validate();
+}
 
 Mapper::Mapper(const MapperParams &params, std::unique_ptr<Renderer> renderer, const BackendOptions &options)
     : params_(params), options_(options), renderer_(std::move(renderer)) {
   if (!renderer_) throw Error(ErrorCode::Usage, "Mapper: no renderer");
-  check_threads(options.threads);
+  check_options(options);
   params_.validate();
+}
+
+bool Mapper::choose_renderer(const ScanBatch &scans) {
+  if (renderer_) return false;
+  AutoChoice c = choose_auto(&scans, params_, options_);
+  renderer_ = make_renderer(c.backend, options_);
+  auto_choice_ = std::move(c);
+  return true;
+}
+
+void Mapper::undo_choice() noexcept {
+  renderer_.reset();
+  auto_choice_.reset();
+}
+
+RendererTraits Mapper::backend_traits() const {
+  if (renderer_) return renderer_->traits();
+  static const RendererTraits host_grid = make_renderer("cpu_threads")->traits();  // auto's fallback
+  return host_grid;
 }
 
 Mapper::Mapper(const MapperParams &params, const GridGeometry &frame, const std::string &backend,
@@ -158,7 +203,7 @@ std::string need_above(double need, double budget, int budget_decimals) {
 }  // namespace
 
 double Mapper::memory_need(const GridGeometry &geo, uint64_t beams) const {
-  return session_memory_need(geo, beams, renderer_->traits(), params_.downsample);
+  return session_memory_need(geo, beams, backend_traits(), params_.downsample);
 }
 
 bool Mapper::fits_memory(const GridGeometry &geo, uint64_t beams) const {
@@ -175,7 +220,7 @@ void Mapper::check_memory(const GridGeometry &geo, uint64_t beams) const {
   const double per_cell = (need - 68.0 * static_cast<double>(beams)) / std::max(1.0, static_cast<double>(geo.num_cells()));
   m << "the map needs about " << need_above(need, static_cast<double>(b), budget_decimals) << " MiB of memory (a grid of "
     << geo.size_x << " x " << geo.size_y << " = " << geo.num_cells() << " cells at " << geo.resolution << " m, "
-    << std::setprecision(3) << per_cell << " bytes a cell on " << renderer_->name() << ", and " << beams
+    << std::setprecision(3) << per_cell << " bytes a cell on " << backend_name() << ", and " << beams
     << " beams), more than the budget of " << budget << " MiB: ";
   if (!options_.budget_hint.empty()) m << "raise it (" << options_.budget_hint << "), or ";
   m << "use a coarser vasco_resolution";
@@ -204,7 +249,7 @@ void Mapper::start_over(const MapperParams &params) {
   grid_lost_ = false;
   shift_invariant_ = true;
   if (!fixed_frame_) geo_ = grid_ = GridGeometry();
-  renderer_->forget_scans();  // the next log's beams are not the last one's
+  if (renderer_) renderer_->forget_scans();  // the next log's beams are not the last one's
 }
 
 void Mapper::check_grid_usable(const char *what) const {
@@ -274,14 +319,20 @@ void Mapper::apply_insert(const InsertPlan &plan, size_t before) {
 void Mapper::insert(const ScanBatch &scans) {
   scans.validate_for_mapping();
   if (scans.num_scans() == 0) return;
-  const InsertPlan plan = plan_insert(scans);  // throws before anything changes
-  const Saved saved = save();
-  scans_.append(scans);  // all or nothing
+  const bool chosen_now = choose_renderer(scans);  // auto, undecided: these scans are the workload
   try {
-    apply_insert(plan, saved.scans);
+    const InsertPlan plan = plan_insert(scans);  // throws before anything changes
+    const Saved saved = save();
+    scans_.append(scans);  // all or nothing
+    try {
+      apply_insert(plan, saved.scans);
+    } catch (...) {
+      scans_.truncate(saved.scans);
+      restore(saved);
+      throw;
+    }
   } catch (...) {
-    scans_.truncate(saved.scans);
-    restore(saved);
+    if (chosen_now) undo_choice();
     throw;
   }
 }
@@ -290,15 +341,21 @@ void Mapper::insert(ScanBatch &&scans) {
   if (scans_.num_scans() > 0) return insert(static_cast<const ScanBatch &>(scans));  // appended: one copy
   scans.validate_for_mapping();
   if (scans.num_scans() == 0) return;
-  const InsertPlan plan = plan_insert(scans);
-  const Saved saved = save();
-  scans_ = std::move(scans);
+  const bool chosen_now = choose_renderer(scans);
   try {
-    apply_insert(plan, 0);
+    const InsertPlan plan = plan_insert(scans);
+    const Saved saved = save();
+    scans_ = std::move(scans);
+    try {
+      apply_insert(plan, 0);
+    } catch (...) {
+      scans = std::move(scans_);
+      scans_ = ScanBatch();
+      restore(saved);
+      throw;
+    }
   } catch (...) {
-    scans = std::move(scans_);
-    scans_ = ScanBatch();
-    restore(saved);
+    if (chosen_now) undo_choice();
     throw;
   }
 }

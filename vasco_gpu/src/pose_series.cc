@@ -2,24 +2,11 @@
 #include "vasco_gpu/pose_series.h"
 
 #include <algorithm>
-#include <cmath>
 #include <numeric>
 
+#include "vasco_gpu/internal/se2.h"
+
 namespace vasco {
-
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}  // namespace
-
-double angle_difference(double a, double b) {
-  double d = std::remainder(b - a, 2 * kPi);
-  if (d >= kPi) d -= 2 * kPi;
-  return d;
-}
-
-Pose2 pose_between(const Pose2 &a, const Pose2 &b, double u) {
-  return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * angle_difference(a.theta, b.theta)};
-}
 
 bool strictly_ascending(const int64_t *stamps, size_t n) {
   for (size_t i = 1; i < n; ++i)

@@ -23,7 +23,7 @@ import time
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import _core
-from ._errors import FileError
+from ._errors import Error, FileError
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -60,7 +60,7 @@ class LogResult:
     exception: Optional[BaseException] = dataclasses.field(default=None, repr=False, compare=False)
 
 
-class BatchError(RuntimeError):
+class BatchError(Error, RuntimeError):
     """:func:`map_logs` with ``fail_fast=True``: a log failed.
 
     ``str(error)`` is the failed log's error. Attributes: ``result``, that log's
@@ -165,8 +165,10 @@ def _map_one(path: PathLike, outputs: Sequence[str], backend: str = "auto", cuda
         with entry.lock:
             if entry.mapper is None:
                 kw = {} if max_memory_bytes is None else {"max_memory_bytes": max_memory_bytes}
+                # Many logs on one mapper: its start-up is paid once, so auto weighs a workload
+                # without end (expected_renders=0), as log2map's batch mode does.
                 entry.mapper = _core.Mapper(backend=backend, cuda_mode=cuda_mode, threads=threads,
-                                            cuda_device=cuda_device, **kw)
+                                            cuda_device=cuda_device, expected_renders=0, **kw)
             mapper = entry.mapper
             result.backend = mapper.backend
             try:
@@ -204,17 +206,20 @@ def _check_formats(formats: Union[str, Sequence[str]]) -> List[str]:
 
 
 def _check_options(backend: str, cuda_mode: Optional[str], threads: int, load_options: Dict[str, Any]) -> None:
-    names = _core.backend_names()  # compiled here or not: the workers may have what this process lacks
-    if backend not in names:
-        raise ValueError(f"map_logs: backend {backend!r}: expected one of {', '.join(names)}")
-    if cuda_mode not in (None, "float", "exact"):
-        raise ValueError(f"map_logs: cuda_mode {cuda_mode!r}: expected 'float' or 'exact'")
+    # The session's option table: its backend names (compiled here or not: the workers may have
+    # what this process lacks), CUDA modes and threads' bounds.
+    rows = {row["name"]: row for row in _core.option_schema("session")}
+    for name, value in (("backend", backend), ("cuda_mode", cuda_mode)):
+        choices = rows[name]["choices"]
+        if value not in choices and not (name == "cuda_mode" and value is None):  # None: Mapper's default
+            raise ValueError(f"map_logs: {name} {value!r}: expected one of {', '.join(choices)}")
     try:
         n = operator.index(threads)
     except TypeError:
         n = -1
-    if isinstance(threads, bool) or not 0 <= n <= 1024:
-        raise ValueError(f"map_logs: threads {threads!r}: must be 0 (all cores) to 1024")
+    lo, hi = rows["threads"]["lo"], rows["threads"]["hi"]
+    if isinstance(threads, bool) or not lo <= n <= hi:
+        raise ValueError(f"map_logs: threads {threads!r}: {rows['threads']['help']}, {int(lo)} to {int(hi)}")
     # load_log's own checks of its options, before any work: a call on no file binds the
     # keywords (TypeError for an unknown one), reads the ini and the overrides (errors naming
     # them) and fails on the empty path, the one error expected here.
@@ -263,9 +268,10 @@ def map_logs(paths: Sequence[PathLike], out_dir: PathLike, formats: Union[str, S
     them and renamed at the end, so a failed log leaves no file behind and an existing output
     untouched.
 
-    ``backend``: as Mapper's (``auto``: cuda when a GPU is usable where the log is mapped, else
-    cpu_threads); ``cuda_mode``, ``threads``, ``cuda_device`` and ``max_memory_bytes`` are
-    Mapper's too (None: its defaults).
+    ``backend``: as Mapper's (``auto``: as log2map's batch mode, a workload without end whose
+    start-up each worker pays once, so cuda when a GPU is usable where the log is mapped, else
+    cpu_threads: :func:`auto_choice` with ``expected_renders=0``); ``cuda_mode``, ``threads``,
+    ``cuda_device`` and ``max_memory_bytes`` are Mapper's too (None: its defaults).
 
     ``executor=None`` maps the logs here, one after the other. Any
     :class:`concurrent.futures.Executor` maps them where it runs tasks: one task a log

@@ -61,6 +61,11 @@ struct BackendOptions {
   // How the caller raises max_memory_bytes, as a refusal names it ("log2map
   // --max-memory MiB", "vasco_mapper_set_max_memory"); empty: not named.
   std::string budget_hint;
+  // auto: the renders expected of the workload (backend_choice.h): 1, a
+  // session's first insert mapped once (log2map's rule, decided at that
+  // insert); more, a session that renders again; 0, a workload without end
+  // (batches, live maps: decided when the session is made). At least 0.
+  int expected_renders = 1;
 };
 
 class Renderer;
@@ -101,7 +106,7 @@ const std::vector<BackendInfo> &backend_registry();
 const BackendInfo *find_backend(const std::string &name_or_alias);
 
 // The names make_renderer accepts in this build, "auto" included (it always
-// runs: cuda when a GPU is usable, else cpu_threads).
+// runs: cuda or cpu_threads by backend_choice.h's rule).
 std::vector<std::string> compiled_backends();
 
 // The session APIs' names (C API, egrid.h, Python, log2map's --backend): a

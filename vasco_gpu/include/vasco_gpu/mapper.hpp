@@ -50,6 +50,14 @@
 // Error(State) until an insert or render() has rendered the grid again: a
 // map that does not match the stored scans is never returned.
 //
+// auto. A session on "auto" runs cuda or cpu_threads by backend_choice.h's
+// rule. With options.expected_renders N >= 1 (the default 1) it chooses at its
+// first insert, that insert's scans being the workload: a Mapper fed a log
+// and finished chooses as log2map does for that log. Until then
+// backend_name() is "auto" and memory_need() counts a host grid; a first
+// insert that fails leaves it undecided. With N = 0 (a workload without end)
+// it chooses when it is made. auto_choice() says what it chose and why.
+//
 // Threads: a Mapper is one session; calls on one Mapper from several threads
 // must be serialized by the caller (the C API's handle does it).
 #ifndef VASCO_GPU_MAPPER_HPP
@@ -58,10 +66,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "vasco_gpu/backend.h"
+#include "vasco_gpu/backend_choice.h"
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/renderer.h"
@@ -73,7 +83,8 @@ class Mapper {
  public:
   // PROTOCOL frame. Throws for bad parameters or an unknown backend, and when
   // the backend cannot run here (the registry's errors); Error(Usage) for
-  // options.threads outside 0 (all cores) .. kMaxThreads (1024).
+  // options.threads outside 0 (all cores) .. kMaxThreads (1024) or a
+  // negative options.expected_renders.
   Mapper(const MapperParams &params, const std::string &backend = "cpu_double",
          const BackendOptions &options = {});
   // Fixed frame: `frame.size_x`, `size_y`, `resolution` (must equal
@@ -144,9 +155,14 @@ class Mapper {
   // scans in this grid, byte for byte.
   const GridGeometry &grid_frame() const { return grid_; }
   const MapperParams &params() const { return params_; }
-  std::string backend_name() const { return renderer_->name(); }
-  // What the backend is: exact or not, grid on the GPU or in host memory.
-  RendererTraits backend_traits() const { return renderer_->traits(); }
+  // The renderer's name; "auto" while an auto session has not chosen.
+  std::string backend_name() const { return renderer_ ? renderer_->name() : "auto"; }
+  // What the backend is: exact or not, grid on the GPU or in host memory
+  // (an auto session that has not chosen: cpu_threads', a host grid).
+  RendererTraits backend_traits() const;
+  // What an auto session chose and why; null for another backend and while
+  // undecided.
+  const AutoChoice *auto_choice() const { return auto_choice_ ? &*auto_choice_ : nullptr; }
   // Counts and times of the last insert or render (a growth re-render included).
   const MapStats &last_stats() const { return stats_; }
   // Full renders since construction: one per render(), per growth, the first
@@ -170,6 +186,10 @@ class Mapper {
     bool shift_invariant;
   };
 
+  // The renderer of an auto session still undecided, chosen for `scans`;
+  // whether it was chosen now (a failed insert undoes that: undo_choice).
+  bool choose_renderer(const ScanBatch &scans);
+  void undo_choice() noexcept;
   GridGeometry frame_for(const PoseExtent &extent, const ScanBatch &scans) const;
   GridGeometry grown_frame(const GridGeometry &need, uint64_t beams) const;
   bool fits_memory(const GridGeometry &geo, uint64_t beams) const;
@@ -191,7 +211,8 @@ class Mapper {
   GridGeometry grid_;  // what the renderer holds: geo_, or geo_ with a margin after growth
   ScanBatch scans_;
   PoseExtent extent_;  // of the stored scans' poses
-  std::unique_ptr<Renderer> renderer_;
+  std::unique_ptr<Renderer> renderer_;  // null: an auto session that has not chosen
+  std::optional<AutoChoice> auto_choice_;
   MapStats stats_;
   size_t renders_ = 0;
   bool grid_lost_ = false;        // a failed restore: the grid does not match the stored scans

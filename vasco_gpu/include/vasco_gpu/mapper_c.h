@@ -66,14 +66,17 @@ typedef struct {
 void vasco_mapper_params_default(vasco_mapper_params *params);
 
 /* backend: "cpu_double", "cpu_threads", "cpu_float", "cuda" (float mode),
- * "cuda_exact", or "auto"; NULL means "cpu_double". */
+ * "cuda_exact", or "auto"; NULL means "cpu_double". "auto" chooses cuda or
+ * cpu_threads at the first insert, by that insert's scans mapped once
+ * (vasco_gpu/backend_choice.h: the rule log2map --backend auto follows). */
 vasco_status vasco_mapper_create(const vasco_mapper_params *params, const char *backend, vasco_mapper **out);
 /* A fixed frame of size_x x size_y cells with heading theta_offset, centred
  * on the first scan, as CARMEN's carmen_mapper_initialize_evidence_grid. */
 vasco_status vasco_mapper_create_fixed(const vasco_mapper_params *params, const char *backend, int size_x,
                                        int size_y, double theta_offset, vasco_mapper **out);
 void vasco_mapper_destroy(vasco_mapper *m);
-/* The host-memory budget of the session in bytes (0: none; by default 2 GiB).
+/* The host-memory budget of the session in bytes (0: none; by default the
+ * session option max_memory's, kDefaultMaxMemoryBytes in vasco_gpu/backend.h).
  * An insert or render that would need more fails with VASCO_ERR_OUT_OF_MEMORY
  * and changes nothing; so does this call, keeping the old budget, when the
  * session already needs more than `bytes`. */

@@ -56,7 +56,7 @@ struct MapperParams {
   double map_resolution() const { return resolution * static_cast<double>(downsample); }
 
   // Makes the written map's cells `cell` metres: the one rule from ROS's
-  // resolution to CARMEN's two keys (docs/parameters.md). A downsample that
+  // resolution to CARMEN's two keys (docs/cli.md, "Map resolution"). A downsample that
   // was given (keep_downsample) stays and resolution = cell / downsample;
   // otherwise the evidence grid stays as near `resolution` as a whole block
   // allows: downsample = max(1, round(cell / resolution)), then resolution =

@@ -1,7 +1,8 @@
-// pose_series.h — planar poses along a trajectory: the pose between two of
-// its poses (the --poses interpolation, written once for pose files, bags'
-// pose topics and the live node's Path), and the pose at a nanosecond stamp
-// among a trajectory's poses (a bag's pose topic, the node's Path).
+// pose_series.h — planar poses along a trajectory: the planar pose, and the
+// pose at a nanosecond stamp among a trajectory's poses (a bag's pose topic,
+// the node's Path), between two of them by the --poses interpolation
+// (internal/se2.h pose_between, written once for pose files, bags' pose
+// topics and the live node's Path).
 //
 //   vasco::Pose2 p;
 //   if (vasco::pose_at_stamp(series, scan_ns, max_gap_ns, p) <= vasco::SeriesPlace::Between) ...
@@ -12,17 +13,12 @@
 #include <cstdint>
 #include <vector>
 
-#include "vasco_gpu/pose_file.h"
-
 namespace vasco {
 
-// b - a taken into [-pi, pi): the shorter way round. Exact for a difference
-// already in that range (remainder() is exact).
-double angle_difference(double a, double b);
-
-// The pose a fraction u of the way from a to b: x and y linear, theta along
-// the shorter arc; u = 0 gives a's x and y and theta.
-Pose2 pose_between(const Pose2 &a, const Pose2 &b, double u);
+// A planar pose: x, y in metres, theta in radians.
+struct Pose2 {
+  double x = 0, y = 0, theta = 0;
+};
 
 // Where a stamp lies in a trajectory.
 enum class SeriesPlace : uint8_t {

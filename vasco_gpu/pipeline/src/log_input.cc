@@ -8,6 +8,7 @@
 
 #include "carmen_compat/error.h"
 #include "carmen_compat/ini_file.h"
+#include "vasco_gpu/internal/se2.h"
 
 namespace vasco {
 

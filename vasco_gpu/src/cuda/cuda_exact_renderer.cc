@@ -17,7 +17,7 @@
 
 namespace vasco {
 
-using cuda_host::reserve;
+using cuda_host::grow_to;
 
 // kTile x kTile tiles of a grid, in 64 bits (sides up to kMaxGridSide).
 size_t CudaExactRenderer::tiles_of(const GridGeometry &geo) {
@@ -47,8 +47,8 @@ void CudaExactRenderer::reserve_grid(const GridGeometry &geo) {
   size_t scratch = cuda_host::growth_bytes(order_tmp_, order_tmp);
   for (auto *b : per_tile) scratch += cuda_host::growth_bytes(*b, tiles);
   grow_grid(grid_, geo, scratch);
-  for (auto *b : per_tile) reserve(*b, tiles);
-  reserve(order_tmp_, order_tmp);
+  for (auto *b : per_tile) grow_to(*b, tiles);
+  grow_to(order_tmp_, order_tmp);
 }
 
 void CudaExactRenderer::clear_grid() {
@@ -67,8 +67,8 @@ void CudaExactRenderer::ensure_tables() {
   use_tables_ = T > 0 && T <= cuda::kMaxExactTable && !cuda_host::tables_disabled();
   if (!use_tables_) return;
   tables_key_.ensure(params(), [&] {
-    reserve(factors_, static_cast<size_t>(T) * static_cast<size_t>(T));
-    reserve(reach_, static_cast<size_t>(T));
+    grow_to(factors_, static_cast<size_t>(T) * static_cast<size_t>(T));
+    grow_to(reach_, static_cast<size_t>(T));
     cuda::launch_exact_tables(kernel_model_of<double>(params(), grid_geo()), factors_.get(), reach_.get(), stream());
   });
 }
@@ -132,8 +132,8 @@ uint64_t CudaExactRenderer::place_beams(const ScanBatch &scans, size_t first, si
   st->beams_used += beams_;
   st->beams_skipped += layout.skipped;
   VG_CUDA_CHECK(cudaStreamSynchronize(stream()));  // staging is free (every call ends idle)
-  reserve(staging_beams_, std::max<uint64_t>(beams_, 1));
-  reserve(staging_starts_, std::max<size_t>(scans_, 1));
+  grow_to(staging_beams_, std::max<uint64_t>(beams_, 1));
+  grow_to(staging_starts_, std::max<size_t>(scans_, 1));
   PlacedBeam *beams = staging_beams_.get();
   place_laid_out_beams(scans, geo(), params(), layout, 0, beams);
   for (size_t s = 0; s < scans_; ++s) staging_starts_[s] = {layout.starts[s].x1, layout.starts[s].y1};
@@ -144,23 +144,23 @@ uint64_t CudaExactRenderer::place_beams(const ScanBatch &scans, size_t first, si
 
 void CudaExactRenderer::reserve_scratch(uint64_t pair_bound, size_t tiles) {
   const size_t nb = beams_, ns = scans_;
-  reserve(beams_dev_, nb);
-  reserve(starts_, ns);
-  reserve(lines_, nb);
-  reserve(counts_, nb + 1);
-  reserve(offsets_, nb + 1);
-  for (auto *b : {&tile_begin_, &tile_end_, &order_, &order_keys_, &order_keys_out_, &order_ids_}) reserve(*b, tiles);
-  reserve(scan_tmp_, std::max<size_t>(cuda::exact_scan_temp_bytes(nb), 1));
-  reserve(order_tmp_, std::max<size_t>(cuda::exact_order_temp_bytes(tiles), 1));
-  reserve(updates_, 2);
-  reserve(heavy_count_, 1);
-  reserve(staging_counters_, 2);
+  grow_to(beams_dev_, nb);
+  grow_to(starts_, ns);
+  grow_to(lines_, nb);
+  grow_to(counts_, nb + 1);
+  grow_to(offsets_, nb + 1);
+  for (auto *b : {&tile_begin_, &tile_end_, &order_, &order_keys_, &order_keys_out_, &order_ids_}) grow_to(*b, tiles);
+  grow_to(scan_tmp_, std::max<size_t>(cuda::exact_scan_temp_bytes(nb), 1));
+  grow_to(order_tmp_, std::max<size_t>(cuda::exact_order_temp_bytes(tiles), 1));
+  grow_to(updates_, 2);
+  grow_to(heavy_count_, 1);
+  grow_to(staging_counters_, 2);
   const size_t pairs = std::max<size_t>(pair_bound, 1);
   if (pairs > pair_tile_.size())
     cuda_host::check_fits(4 * (cuda_host::grown_size(pair_tile_.size(), pairs) - pair_tile_.size()) * sizeof(uint32_t),
                           "exact mode (tile lists)");
-  for (auto *b : {&pair_tile_, &pair_beam_, &sorted_tile_, &sorted_beam_}) reserve(*b, pairs);
-  reserve(sort_tmp_, std::max<size_t>(cuda::exact_sort_temp_bytes(pairs), 1));
+  for (auto *b : {&pair_tile_, &pair_beam_, &sorted_tile_, &sorted_beam_}) grow_to(*b, pairs);
+  grow_to(sort_tmp_, std::max<size_t>(cuda::exact_sort_temp_bytes(pairs), 1));
 }
 
 // The (tile, beam) pairs of the uploaded beams, sorted by tile in (scan,

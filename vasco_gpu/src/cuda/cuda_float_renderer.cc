@@ -9,7 +9,7 @@
 
 namespace vasco {
 
-using cuda_host::reserve;
+using cuda_host::grow_to;
 
 // The sums are what the grid needs (8 bytes a cell); the y-major accumulator
 // (8 more) is taken only where it fits (across_scratch).
@@ -55,7 +55,7 @@ const int2 *CudaFloatRenderer::tables() {
   const int T = params().table_size();
   if (T <= 0 || T > cuda::kMaxFloatTable || cuda_host::tables_disabled()) return nullptr;
   increments_key_.ensure(params(), [&] {
-    reserve(increments_, static_cast<size_t>(T) * static_cast<size_t>(T));
+    grow_to(increments_, static_cast<size_t>(T) * static_cast<size_t>(T));
     cuda::launch_float_tables(model(), increments_.get(), stream());
   });
   return increments_.get();
@@ -84,7 +84,7 @@ unsigned long long *CudaFloatRenderer::across_scratch(size_t num_scans) {
     VG_CUDA_CHECK(cudaMemGetInfo(&free_b, &total_b));
     const size_t bytes = (cuda_host::grown_size(across_.size(), cells) - across_.size()) * sizeof(unsigned long long);
     if (bytes + (size_t(256) << 20) > free_b) return nullptr;  // a margin for the rest of the session
-    reserve(across_, cells);
+    grow_to(across_, cells);
   }
   return across_.get();
 }
@@ -99,9 +99,9 @@ void CudaFloatRenderer::apply_scans(const ScanBatch &scans, size_t first, size_t
   const int2 *increments = tables();
   ranges_.upload(scans, last, stream());
   stage_scan_records(scans, first, last);
-  reserve(scan_records_, last - first);
-  reserve(counters_, 3);
-  reserve(staging_counters_, 3);
+  grow_to(scan_records_, last - first);
+  grow_to(counters_, 3);
+  grow_to(staging_counters_, 3);
   unsigned long long *across = across_scratch(last - first);
   st->prep_s += seconds_since(t_prep);
   begin_update();
@@ -120,7 +120,7 @@ void CudaFloatRenderer::stage_scan_records(const ScanBatch &scans, size_t first,
   frame.resolution = geo().resolution;
   frame.theta_offset = geo().theta_offset;
   oracle::scan_start(frame, scans.x[0], scans.y[0], scans.theta[0]);
-  reserve(staging_scans_, last - first);
+  grow_to(staging_scans_, last - first);
   for (size_t s = first; s < last; ++s) {
     const oracle::ScanStart p = oracle::scan_start(frame, scans.x[s], scans.y[s], scans.theta[s]);
     cuda::FloatScan &f = staging_scans_[s - first];

@@ -104,7 +104,7 @@ class StageTimer {
 // so that a session appending scans reallocates rarely).
 inline size_t grown_size(size_t have, size_t n) { return n > have ? std::max(n, have + have / 2) : have; }
 
-// The device memory reserve(b, n) would take beyond what b holds (it frees
+// The device memory grow_to(b, n) would take beyond what b holds (it frees
 // the old buffer before allocating the grown one); 0 when b holds n already.
 template <class T>
 size_t growth_bytes(const cuda::DeviceBuffer<T> &b, size_t n) {
@@ -113,17 +113,17 @@ size_t growth_bytes(const cuda::DeviceBuffer<T> &b, size_t n) {
 
 // Grows a buffer to at least n elements; its contents are dropped.
 template <class Buffer>
-void reserve(Buffer &b, size_t n) {
+void grow_to(Buffer &b, size_t n) {
   if (n > b.size()) b.resize(grown_size(b.size(), n));
 }
 
-// reserve() of a device buffer, refused first (check_fits) when the growth
+// grow_to() of a device buffer, refused first (check_fits) when the growth
 // would not fit in GPU memory: a refusal leaves the buffer as it was.
 template <class T>
-void reserve_checked(cuda::DeviceBuffer<T> &b, size_t n, const char *what) {
+void grow_to_checked(cuda::DeviceBuffer<T> &b, size_t n, const char *what) {
   if (n <= b.size()) return;
   check_fits((grown_size(b.size(), n) - b.size()) * sizeof(T), what);
-  reserve(b, n);
+  grow_to(b, n);
 }
 
 }  // namespace cuda_host

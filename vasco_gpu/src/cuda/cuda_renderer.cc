@@ -10,7 +10,7 @@
 
 namespace vasco {
 
-using cuda_host::reserve;
+using cuda_host::grow_to;
 
 CudaRenderer::CudaRenderer(const BackendOptions &options, cudaStream_t stream, bool exact)
     : options_(options), exact_(exact) {
@@ -80,7 +80,7 @@ void CudaRenderer::PhaseEvents::add_times(MapStats *st) const {
 
 // n floats of device memory into pinned staging (the stream idle after).
 cuda::PinnedBuffer<float> &CudaRenderer::download(const float *device, size_t n) {
-  reserve(staging_out_, std::max<size_t>(n, 1));
+  grow_to(staging_out_, std::max<size_t>(n, 1));
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_out_.get(), device, n * sizeof(float), cudaMemcpyDeviceToHost, stream_));
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
   return staging_out_;
@@ -112,8 +112,8 @@ FinishedMap CudaRenderer::finish_occupancy(int downsample, int border, const car
   FinishedMap m = finish_frame(downsample, border, &crop);
   const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, downsample);
   const size_t n = static_cast<size_t>(crop.count());
-  cuda_host::reserve_checked(occupancy_, std::max<size_t>(n, 1), "the finished map's OccupancyGrid data");
-  reserve(staging_occupancy_, std::max<size_t>(n, 1));
+  cuda_host::grow_to_checked(occupancy_, std::max<size_t>(n, 1), "the finished map's OccupancyGrid data");
+  grow_to(staging_occupancy_, std::max<size_t>(n, 1));
   cuda::launch_occupancy_crop(blocks_.get(), blocks, crop, values, occupancy_.get(), stream_);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_occupancy_.get(), occupancy_.get(), n, cudaMemcpyDeviceToHost, stream_));
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
@@ -126,10 +126,10 @@ finish::KnownBox CudaRenderer::finish_blocks(int downsample) {
   require_grid("finish");
   select_device();
   const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, downsample);
-  cuda_host::reserve_checked(blocks_, std::max<size_t>(static_cast<size_t>(blocks.count()), 1),
+  cuda_host::grow_to_checked(blocks_, std::max<size_t>(static_cast<size_t>(blocks.count()), 1),
                              "the finish's block means");
-  reserve(known_, 1);
-  reserve(staging_known_, 1);
+  grow_to(known_, 1);
+  grow_to(staging_known_, 1);
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
   staging_known_[0] = finish::KnownBox{};
   VG_CUDA_CHECK(cudaMemcpyAsync(known_.get(), staging_known_.get(), sizeof(finish::KnownBox),
@@ -149,7 +149,7 @@ std::vector<float> CudaRenderer::read_blocks(const finish::Crop &crop) {
   select_device();
   const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, blocks_ds_);
   const size_t n = static_cast<size_t>(crop.count());
-  cuda_host::reserve_checked(finished_, std::max<size_t>(n, 1), "the finished map");
+  cuda_host::grow_to_checked(finished_, std::max<size_t>(n, 1), "the finished map");
   cuda::launch_crop(blocks_.get(), blocks, crop, finished_.get(), stream_);
   const cuda::PinnedBuffer<float> &out = download(finished_.get(), n);
   return std::vector<float>(out.get(), out.get() + n);
@@ -159,7 +159,7 @@ std::vector<float> CudaRenderer::read(const GridWindow &w) {
   require_grid("read");
   select_device();
   const size_t n = static_cast<size_t>(w.width) * static_cast<size_t>(w.height);
-  cuda_host::reserve_checked(window_, std::max<size_t>(n, 1), "the window read");
+  cuda_host::grow_to_checked(window_, std::max<size_t>(n, 1), "the window read");
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
   cuda::launch_read_window(cells(), grid_geo_.size_y, w.x0, w.y0, w.width, w.height, window_.get(), stream_);
   const cuda::PinnedBuffer<float> &out = download(window_.get(), n);

@@ -106,7 +106,7 @@ class CudaRenderer : public Renderer {
     cuda_host::check_fits(growth + extra_bytes, cuda_host::grid_description(geo, per_cell).c_str());
     if (cells <= grid.size()) return;
     state_ = GridState::Lost;  // the reallocation drops the old grid
-    cuda_host::reserve(grid, cells);
+    cuda_host::grow_to(grid, cells);
   }
   void begin_update() { state_ = GridState::Lost; }  // until end_update: a throw leaves it lost
   void end_update() { state_ = GridState::Valid; }

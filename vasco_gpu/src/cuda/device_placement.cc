@@ -21,8 +21,8 @@ constexpr uint32_t kUnsureCapacity = 1 << 14;
 void DevicePlacement::stage_scans(const ScanBatch &scans, size_t first, size_t last, const GridGeometry &geo) {
   starts_host_ = place_scans(scans, geo, first, last);
   const size_t n = last - first;
-  reserve(staging_scans_, std::max<size_t>(n, 1));
-  reserve(staging_starts_, std::max<size_t>(n, 1));
+  grow_to(staging_scans_, std::max<size_t>(n, 1));
+  grow_to(staging_starts_, std::max<size_t>(n, 1));
   const uint64_t base = scans.beam_offset[first];
   for (size_t i = 0; i < n; ++i) {
     const oracle::ScanStart &p = starts_host_[i];
@@ -43,16 +43,16 @@ void DevicePlacement::stage_scans(const ScanBatch &scans, size_t first, size_t l
 void DevicePlacement::reserve_scratch(size_t num_beams, size_t num_scans) {
   const char *what = "exact mode (beam placement)";
   const size_t nb = std::max<size_t>(num_beams, 1);
-  reserve_checked(scans_dev_, std::max<size_t>(num_scans, 1), what);
-  reserve_checked(angles_, nb, what);
-  reserve_checked(scan_of_, nb, what);
-  reserve_checked(used_, nb + 1, what);
-  reserve_checked(slots_, nb + 1, what);
-  reserve_checked(scan_tmp_, std::max<size_t>(cuda::exact_scan_temp_bytes(num_beams), 1), what);
-  reserve(unsure_, kUnsureCapacity);
-  reserve(counters_, 2);
-  reserve(staging_counters_, 2);
-  reserve(staging_used_, 1);
+  grow_to_checked(scans_dev_, std::max<size_t>(num_scans, 1), what);
+  grow_to_checked(angles_, nb, what);
+  grow_to_checked(scan_of_, nb, what);
+  grow_to_checked(used_, nb + 1, what);
+  grow_to_checked(slots_, nb + 1, what);
+  grow_to_checked(scan_tmp_, std::max<size_t>(cuda::exact_scan_temp_bytes(num_beams), 1), what);
+  grow_to(unsure_, kUnsureCapacity);
+  grow_to(counters_, 2);
+  grow_to(staging_counters_, 2);
+  grow_to(staging_used_, 1);
 }
 
 DevicePlacement::Placed DevicePlacement::place(const ScanBatch &scans, size_t first, size_t last,
@@ -64,8 +64,8 @@ DevicePlacement::Placed DevicePlacement::place(const ScanBatch &scans, size_t fi
   VG_CUDA_CHECK(cudaStreamSynchronize(stream));  // the staging buffers are free
   stage_scans(scans, first, last, geo);
   reserve_scratch(nb, ns);
-  reserve_checked(beams, std::max<uint64_t>(nb, 1), "exact mode (placed beams)");
-  reserve(starts, std::max<size_t>(ns, 1));
+  grow_to_checked(beams, std::max<uint64_t>(nb, 1), "exact mode (placed beams)");
+  grow_to(starts, std::max<size_t>(ns, 1));
   VG_CUDA_CHECK(cudaMemcpyAsync(scans_dev_.get(), staging_scans_.get(), ns * sizeof(cuda::ExactScan),
                                 cudaMemcpyHostToDevice, stream));
   VG_CUDA_CHECK(cudaMemcpyAsync(starts.get(), staging_starts_.get(), ns * sizeof(cuda::StartCell),
@@ -98,9 +98,9 @@ DevicePlacement::Placed DevicePlacement::place(const ScanBatch &scans, size_t fi
 // over the device's.
 void DevicePlacement::fix_unsure(size_t n, const cuda::PlacementModel &m, PlacedBeam *device_beams,
                                  cudaStream_t stream) {
-  reserve(staging_unsure_, n);
-  reserve(staging_fixes_, n);
-  reserve(fixes_, n);
+  grow_to(staging_unsure_, n);
+  grow_to(staging_fixes_, n);
+  grow_to(fixes_, n);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_unsure_.get(), unsure_.get(), n * sizeof(cuda::UnsureBeam),
                                 cudaMemcpyDeviceToHost, stream));
   VG_CUDA_CHECK(cudaStreamSynchronize(stream));

@@ -14,7 +14,7 @@ void DeviceRanges::upload(const ScanBatch &scans, size_t last, cudaStream_t stre
   if (need <= stored_) return;
   if (need > ranges_.size()) grow(need, stream);
   const size_t n = need - stored_;
-  reserve(staging_, n);
+  grow_to(staging_, n);
   std::memcpy(staging_.get(), scans.range.data() + stored_, n * sizeof(float));
   VG_CUDA_CHECK(cudaMemcpyAsync(ranges_.get() + stored_, staging_.get(), n * sizeof(float),
                                 cudaMemcpyHostToDevice, stream));

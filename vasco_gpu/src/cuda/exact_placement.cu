@@ -1,7 +1,7 @@
 // Exact mode's beam placement on the device (egrid_kernels.h says what and
 // why): the beam angles per scan, the used beams' slots, their end cells,
 // and the bound on their (tile, beam) pairs. Built with --fmad=false, as
-// exact_kernels.cu: the end cell's arithmetic is the oracle's expression,
+// the other exact_*.cu: the end cell's arithmetic is the oracle's expression,
 // each operation rounded on its own.
 
 #include <cmath>

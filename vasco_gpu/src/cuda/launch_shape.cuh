@@ -1,5 +1,5 @@
 // launch_shape.cuh — the grid size of a launch of one thread per item, for
-// the kernels' launchers (exact_kernels.cu, exact_placement.cu).
+// the kernels' launchers (exact_*.cu).
 #ifndef VASCO_CUDA_LAUNCH_SHAPE_CUH
 #define VASCO_CUDA_LAUNCH_SHAPE_CUH
 

@@ -13,23 +13,26 @@ The bags are read with the pure-Python ``rosbags`` package (its ``AnyReader``), 
 deserializes with the type definitions stored in the bag; a ROS 2 bag without them falls back
 to the ROS 2 Humble definitions. Only :mod:`.storage` and :mod:`.reader` need rosbags:
 ``read_bag`` imports it when first asked for (an ImportError then when it is not installed).
-The modules here never import the compiled extension, except :mod:`.load` and :mod:`.cli`:
-the rest returns plain NumPy data.
+The modules here never import the compiled extension, except :mod:`.load`, :mod:`.cli`,
+:mod:`.bag_writer` and :mod:`.carmen2bag` (which write through it or hand the scans to it):
+the rest returns plain NumPy data. What a message means (LaserScan, MultiEchoLaserScan,
+PointCloud2, tf) is :mod:`vasco_gpu.msgs`'s, which the ROS 2 node shares.
 
-The parts, one job each: :mod:`.errors` (BagError, TfError), :mod:`.header` (stamps, frame
-names), :mod:`.series` (samples over time), :mod:`.geometry` (quaternions, slerp, planar
-poses), :mod:`.tf` (TfBuffer), :mod:`.topics` (which topics to read), :mod:`.storage`
-(opening a bag with rosbags), :mod:`.scans` (LaserScans by REP 117, BagScans), :mod:`.poses`
-(the laser pose at each scan), :mod:`.reader` (read_bag), :mod:`.carmen_writer`
-(write_carmen_log), :mod:`.load` (load_bag), :mod:`.cli` (bag2map, bag2carmen).
+The parts, one job each: :mod:`.errors` (BagError, TfError, BagWarning), :mod:`.topics`
+(which topics to read), :mod:`.storage` (opening a bag with rosbags), :mod:`.scans` (a
+topic's scans through the message table, BagScans), :mod:`.poses` (the laser pose at each
+scan), :mod:`.reader` (read_bag), :mod:`.carmen_writer` (write_carmen_log), :mod:`.load`
+(load_bag), :mod:`.bag_writer` (a CARMEN log as a bag), and the console tools :mod:`.cli`
+(bag2map, bag2carmen) and :mod:`.carmen2bag` (carmen2bag).
 """
 
 from __future__ import annotations
 
+from ..msgs.laser import NO_RETURN_FREE
+from ..msgs.tf import TfBuffer
 from .carmen_writer import write_carmen_log
 from .errors import BagError, BagWarning, TfError
-from .scans import NO_RETURN_FREE, BagScans
-from .tf import TfBuffer
+from .scans import BagScans
 
 __all__ = ["BagError", "BagScans", "BagWarning", "NO_RETURN_FREE", "TfBuffer", "TfError", "read_bag", "write_carmen_log"]
 

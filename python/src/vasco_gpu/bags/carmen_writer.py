@@ -10,7 +10,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from .geometry import planar_uncompose
+from ..msgs.geometry import planar_uncompose
 from .scans import BagScans
 
 __all__ = ["write_carmen_log"]

@@ -17,6 +17,7 @@ import sys
 from dataclasses import dataclass
 
 from .. import _core
+from ..msgs.scan_options import SCAN_DEFAULTS
 from .carmen_writer import write_carmen_log
 from .errors import BagError
 from .load import reader_module, read_for_engine
@@ -55,9 +56,9 @@ BAG_OPTIONS = (
               "(the laser mount from /tf_static or --laser-mount; without one, the laser's pose)", "X,Y,THETA"),
     BagOption("no-return", "no_return", "what a +inf range (REP 117: no return) does: skip (default; CARMEN's "
               "max-range readings) or free (clears up to vasco_range_max, as ROS mappers do)", "skip|free",
-              default="skip"),
+              default=SCAN_DEFAULTS["no_return"]),
     BagOption("echo", "echo", "the echo a MultiEchoLaserScan beam gives: first, last (default) or strongest "
-              "(the largest intensity)", "first|last|strongest", default="last"),
+              "(the largest intensity)", "first|last|strongest", default=SCAN_DEFAULTS["echo"]),
     BagOption("z-band", "z_band", "point clouds: the heights kept, in metres in the base frame (--base-frame), "
               "MIN,MAX (default 0.2,1.8: the floor and the ceiling out)", "MIN,MAX"),
     BagOption("cloud-angle-step", "cloud_angle_step", "point clouds: the beams' angle step in degrees, the "
@@ -150,12 +151,18 @@ def bag2map_main(argv: list[str] | None = None) -> int:
                            [(o.flag, o.help, o.metavar) for o in BAG_OPTIONS], _tool_reader)
 
 
+def _carmen_log_names() -> str:
+    """".log or .clf": the pipeline's CARMEN log extensions, for a message."""
+    return " or ".join(_core.carmen_log_extensions())
+
+
 def _bag2carmen_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="bag2carmen", description=(
         "Writes a ROS bag's laser scans and poses as a CARMEN log (ROBOTLASER1 lines), for CARMEN's own "
         "tools and log2map. The output is written whole or not at all."))
     p.add_argument("bag", metavar="BAG", help="ROS 1 .bag, ROS 2 bag directory (sqlite3 or MCAP) or .mcap file")
-    p.add_argument("out", metavar="OUT", help="the CARMEN log to write (.log, .clf; gzipped if .gz)")
+    p.add_argument("out", metavar="OUT",
+                   help=f"the CARMEN log to write ({', '.join(_core.carmen_log_extensions())}; gzipped if .gz)")
     for o in BAG_OPTIONS:
         repeated = {"action": "append"} if o.flag == "scan-topic" else {}
         p.add_argument("--" + o.flag, dest=o.keyword, help=o.help, metavar=o.metavar, **repeated)
@@ -185,10 +192,10 @@ def bag2carmen_main(argv: list[str] | None = None) -> int:
         d = read_for_engine(a.bag, laser_mount=mount, **{o.keyword: o.value(a) for o in BAG_OPTIONS})
         _warn(d.pop("warnings", []), "bag2carmen")
         ext = a.out.lower()
-        if not (ext.endswith(".log") or ext.endswith(".clf") or ext.endswith(".log.gz") or ext.endswith(".clf.gz")):
-            print(f"bag2carmen: {a.out}: expected a .log or .clf name (gzipped if .gz)", file=sys.stderr)
-            return 2
         gz = ext.endswith(".gz")
+        if not (ext[:-3] if gz else ext).endswith(tuple(_core.carmen_log_extensions())):
+            print(f"bag2carmen: {a.out}: expected a {_carmen_log_names()} name (gzipped if .gz)", file=sys.stderr)
+            return 2
 
         # The engine's output file (atomic_file.h): a hidden temporary beside the target, renamed
         # over it only when complete; a FIFO or directory target refused; gone on a failure.

@@ -16,6 +16,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .. import _core
+from ..msgs.scan_options import SCAN_DEFAULTS
 from .errors import BagError, BagWarning
 
 
@@ -38,7 +39,8 @@ def edge_warning(b) -> str | None:
 
 
 def read_for_engine(path, *, scan_topic=None, fixed_frame=None, base_frame=None, pose_topic=None, laser_mount=None,
-                    no_return="skip", need_poses=True, skip_unposed=False, progress=None, echo="last",
+                    no_return=SCAN_DEFAULTS["no_return"], need_poses=True, skip_unposed=False, progress=None,
+                    echo=SCAN_DEFAULTS["echo"],
                     stamp="header", z_band=None, cloud_angle_step=None, cloud_range_max=None, static_pose=None):
     """The bag's scans as the engine takes them: {'scans', 'stamps', 'mounts', 'unposed', 'edges',
     'warnings', 'bag'}. The scans before the first and after the last pose of their chain are
@@ -80,10 +82,11 @@ def _none_posed_text(b, n: int, stamp: str) -> str:
 
 def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame: str | None = None,
              base_frame: str | None = None, pose_topic: str | None = None,
-             laser_mount: tuple[float, float, float] | None = None, no_return: str = "skip",
+             laser_mount: tuple[float, float, float] | None = None, no_return: str = SCAN_DEFAULTS["no_return"],
              param_file: str | os.PathLike | None = None, robot: str = "",
              overrides: dict[str, float | int] | None = None,
-             progress: Callable[[int, int], Any] | None = None, echo: str = "last", stamp: str = "header",
+             progress: Callable[[int, int], Any] | None = None, echo: str = SCAN_DEFAULTS["echo"],
+             stamp: str = "header",
              z_band: tuple[float, float] | None = None, cloud_angle_step: float | None = None,
              cloud_range_max: float | None = None, static_pose: tuple[float, float, float] | None = None,
              **pose_keywords) -> _core.Log:

@@ -8,11 +8,11 @@ from array import array
 
 import numpy as np
 
-from .errors import BagError
-from .geometry import planar, planar_compose, unit_quaternion, wrap_angle, yaw
-from .header import frame_name, stamp_ns, stamp_seconds, stamp_text
-from .series import bracket, first_outside, sorted_samples
-from .tf import TfBuffer
+from ..msgs.errors import BagError
+from ..msgs.geometry import planar, planar_compose, unit_quaternion, wrap_angle, yaw
+from ..msgs.header import frame_name, stamp_ns, stamp_seconds, stamp_text
+from ..msgs.series import bracket, first_outside, sorted_samples
+from ..msgs.tf import TfBuffer, static_mount
 
 
 class PoseSeries:
@@ -125,20 +125,6 @@ def planar_at(times: np.ndarray, vals: np.ndarray, ns: np.ndarray) -> np.ndarray
         between[:, 2] = a[:, 2] + wrap_angle(b[:, 2] - a[:, 2]) * f
         out[miss] = between
     return out
-
-
-def static_mount(path, tf: TfBuffer | None, base: str, frame: str) -> np.ndarray | None:
-    """The laser pose (x, y, yaw) in base from static tf links only; (0, 0, 0) when the frames
-    are equal; None when there is no static chain."""
-    if base == frame:
-        return np.zeros(3)
-    if tf is None or base not in tf.frames() or frame not in tf.frames():
-        return None
-    try:
-        t, q = tf.lookup(base, frame, np.zeros(1, dtype=np.int64), static_only=True)
-    except BagError:  # no chain, or a /tf link on it (TfError)
-        return None
-    return planar(path, t, q, f"the laser frame {frame!r} in {base!r}")[0]
 
 
 def _inside(ns: np.ndarray, inside: np.ndarray | None, pose_at) -> np.ndarray:

@@ -11,22 +11,22 @@ Importing this module raises ImportError when rosbags is not installed.
 
 from __future__ import annotations
 
-import math
 import os
 from typing import Callable
 
 import numpy as np
 
-from .errors import BagError
-from .geometry import check_mount
-from .cloud import CLOUD_DEFAULTS, check_cloud_options, cloud_mount
-from .header import stamp_seconds, stamp_text
+from ..msgs.cloud import cloud_mount
+from ..msgs.errors import BagError
+from ..msgs.geometry import check_mount
+from ..msgs.header import stamp_seconds, stamp_text
+from ..msgs.scan_options import SCAN_DEFAULTS, ScanSettings, check_choice, check_cloud_options
+from ..msgs.table import message_type
+from ..msgs.tf import TfBuffer
 from .poses import PoseSeries, poses_for
-from .scans import ECHO_MODES, NO_RETURN_MODES, STAMP_MODES, BagScans, ScanAccumulator
+from .scans import STAMP_MODES, BagScans, ScanAccumulator
 from .storage import open_bag, read_messages
-from .tf import TfBuffer
-from .topics import (MULTI_ECHO, POINT_CLOUD2, check_pose_topic, choose_pose_source, norm_type, pick_scan_topics,
-                     tf_topics)
+from .topics import check_pose_topic, choose_pose_source, pick_scan_topics, tf_topics
 
 __all__ = ["read_bag"]
 
@@ -62,25 +62,23 @@ TF_MAX_GAP = 10.0
 OUTSIDE_SPAN = ("error", "edges", "skip")
 
 
-def _check_arguments(pose_source, no_return, pose_topic, outside_span="error", echo="last", stamp="header"):
+def _check_arguments(pose_source, no_return, pose_topic, outside_span, echo, stamp):
     """ValueError for arguments that no bag could make valid."""
-    if no_return not in NO_RETURN_MODES:
-        raise ValueError(f"no_return must be one of {NO_RETURN_MODES}, not {no_return!r}")
+    check_choice("no_return", no_return)
     if pose_source not in POSE_SOURCES:
         raise ValueError(f"pose_source must be one of {POSE_SOURCES}, not {pose_source!r}")
     if pose_source == "topic" and pose_topic is None:
         raise ValueError("pose_source 'topic' needs pose_topic")
     if outside_span not in OUTSIDE_SPAN:
         raise ValueError(f"outside_span must be one of {OUTSIDE_SPAN}, not {outside_span!r}")
-    if echo not in ECHO_MODES:
-        raise ValueError(f"echo must be one of {ECHO_MODES}, not {echo!r}")
+    check_choice("echo", echo)
     if stamp not in STAMP_MODES:
         raise ValueError(f"stamp must be one of {STAMP_MODES}, not {stamp!r}")
 
 
 def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_topic=None,
-             laser_mount=None, pose_source="auto", no_return="skip", progress=None,
-             outside_span="error", echo="last", stamp="header", z_band=None, cloud_angle_step=None,
+             laser_mount=None, pose_source="auto", no_return=SCAN_DEFAULTS["no_return"], progress=None,
+             outside_span="error", echo=SCAN_DEFAULTS["echo"], stamp="header", z_band=None, cloud_angle_step=None,
              cloud_range_max=None, static_pose=None) -> BagScans:
     """The scans of the bag's laser scan topics at path, with the laser pose at each stamp.
 
@@ -96,7 +94,7 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     the mount; text "X,Y,THETA" too); pose_source "static" then, the bag needs no poses. laser_mount: (x, y, yaw) of the laser in the base frame, instead of /tf_static (one
     topic only). pose_source: "auto" (pose_topic if given, else tf), "tf", "topic" or "none"
     (NaN poses; the caller brings them). no_return: "skip" or "free" (see
-    :mod:`vasco_gpu.bags.scans`). progress: progress(done_messages, total_messages).
+    :mod:`vasco_gpu.msgs.laser`). progress: progress(done_messages, total_messages).
     outside_span: a scan stamp without a pose (outside the time span of the poses: of a /tf link
     on the chain, or of the pose topic; or in a gap of over TF_MAX_GAP seconds of a /tf link) is
     a BagError ("error", the default), or gets a NaN pose ("skip": the caller leaves those scans
@@ -105,7 +103,7 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     MultiEchoLaserScan beam gives, "first", "last" (default) or "strongest". stamp: a scan's
     stamp is its "header" stamp (default) or the time the bag received it ("receive", for a
     driver whose clock is wrong); the poses are looked up at it. A sensor_msgs/PointCloud2 topic
-    is read as a scan (:mod:`vasco_gpu.bags.cloud`): z_band (min, max) in metres in the base
+    is read as a scan (:mod:`vasco_gpu.msgs.cloud`): z_band (min, max) in metres in the base
     frame, cloud_angle_step in degrees (default 0.25), cloud_range_max in metres (default 50); each
     may be given as text too (bag2map's options: "0.2,1.8").
 
@@ -137,9 +135,9 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
         if tf_topics(topics):
             tf = TfBuffer(path, stamp_name="scan stamp", max_gap=TF_MAX_GAP, refuse_repeats=True,
                           outside_hint="skip_unposed / --skip-unposed leaves such scans out")
-        cloud = cloud_options(path, tf, base_frame, z_band, cloud_angle_step, cloud_range_max)
-        accs = [ScanAccumulator(path, name, no_return, norm_type(topics[name].msgtype) == MULTI_ECHO, echo, stamp,
-                                cloud if norm_type(topics[name].msgtype) == POINT_CLOUD2 else None)
+        settings = scan_settings(no_return, echo, z_band, cloud_angle_step, cloud_range_max)
+        mount_of = cloud_mount_of(path, tf, base_frame)
+        accs = [ScanAccumulator(path, name, message_type(topics[name].msgtype), settings, stamp, mount_of)
                 for name in names]
         handlers = {acc.topic: acc.add for acc in accs}
         if tf is not None:
@@ -180,17 +178,25 @@ def _numbers(value, what: str) -> list[float]:
         raise ValueError(f"{what}: {value!r} is not a number") from None
 
 
-def cloud_options(path, tf, base_frame, z_band, angle_step, range_max) -> dict:
-    """read_cloud's keywords for a bag: the band, the bins, the range, and mount_of(frame, ns),
-    the cloud frame's transform in the base frame from what /tf_static has given by then."""
+def scan_settings(no_return, echo, z_band, angle_step, range_max) -> ScanSettings:
+    """The scan adapters' options from read_bag's keywords: the cloud options as numbers, or as
+    text (bag2map's options: "0.2,1.8"); None takes the default."""
     if isinstance(z_band, str):
         z_band = _numbers(z_band, "z_band (--z-band MIN,MAX)")
-    options = {"z_band": tuple(float(v) for v in (CLOUD_DEFAULTS["z_band"] if z_band is None else z_band)),
-               "angle_step": CLOUD_DEFAULTS["angle_step"] if angle_step is None else
-               math.radians(_numbers(angle_step, "cloud_angle_step (--cloud-angle-step DEGREES)")[0]),
-               "range_max": CLOUD_DEFAULTS["range_max"] if range_max is None else
-               _numbers(range_max, "cloud_range_max (--cloud-range-max M)")[0]}
-    check_cloud_options(**options)
+    settings = ScanSettings(
+        no_return=no_return, echo=echo,
+        z_band=tuple(float(v) for v in (SCAN_DEFAULTS["z_band"] if z_band is None else z_band)),
+        cloud_angle_step=SCAN_DEFAULTS["cloud_angle_step"] if angle_step is None else
+        _numbers(angle_step, "cloud_angle_step (--cloud-angle-step DEGREES)")[0],
+        cloud_range_max=SCAN_DEFAULTS["cloud_range_max"] if range_max is None else
+        _numbers(range_max, "cloud_range_max (--cloud-range-max M)")[0])
+    check_cloud_options(settings.z_band, settings.angle_step, settings.cloud_range_max)
+    return settings
+
+
+def cloud_mount_of(path, tf, base_frame):
+    """mount_of(frame, ns): a cloud frame's transform in the base frame from what /tf_static has
+    given by then (the height band is in the base frame)."""
     base = base_frame or "base_link"
 
     def mount_of(frame: str, ns: int):
@@ -204,8 +210,7 @@ def cloud_options(path, tf, base_frame, z_band, angle_step, range_max) -> dict:
                                  f"{stamp_text(ns)}): {e.message}; pass --base-frame {frame} (base_frame="
                                  f"{frame!r}) to take heights in the cloud's own frame", stamp=stamp_seconds(ns)) from None
 
-    options["mount_of"] = mount_of
-    return options
+    return mount_of
 
 
 def _merge(path, parts) -> BagScans:

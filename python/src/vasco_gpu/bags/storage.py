@@ -13,9 +13,9 @@ from pathlib import Path
 from rosbags.highlevel import AnyReader  # an ImportError here: rosbags is not installed
 from rosbags.typesys import Stores, get_typestore
 
-from .errors import BagError
-from .header import stamp_text
-from .topics import short_type
+from ..msgs.errors import BagError
+from ..msgs.header import stamp_text
+from ..msgs.table import short_type
 
 _MAGICS = (  # (first bytes, what it is, the suffix rosbags needs for it)
     (b"#ROSBAG V", "a ROS 1 bag", ".bag"),

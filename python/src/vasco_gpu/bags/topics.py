@@ -1,56 +1,14 @@
-"""The bag's topics: message type names, the scan topics to read (LaserScan, MultiEchoLaserScan,
-PointCloud2;
-a clear word on sensors that are neither), the tf topics, the pose source (tf or a pose topic)
-and the pose topic's type."""
+"""The bag's topics: the scan topics to read (the message table's scan types: LaserScan,
+MultiEchoLaserScan, PointCloud2; a clear word on sensors that are none of them), the tf topics,
+the pose source (tf or a pose topic) and the pose topic's type."""
 
 from __future__ import annotations
 
-import difflib
+from ..msgs.errors import BagError
+from ..msgs.header import did_you_mean
+from ..msgs.table import POSE_TYPES, SCAN_TYPES, TF_TYPES, UNSUPPORTED_SENSORS, norm_type, short_type
 
-from .errors import BagError
-
-LASER_SCAN = "sensor_msgs/msg/LaserScan"
-MULTI_ECHO = "sensor_msgs/msg/MultiEchoLaserScan"
-POINT_CLOUD2 = "sensor_msgs/msg/PointCloud2"
-SCAN_TYPES = (LASER_SCAN, MULTI_ECHO, POINT_CLOUD2)
-# Sensors a bag may hold that are not laser scans: why each is not mapped, and what turns it into
-# a LaserScan.
-_DEPTH = "an image; depthimage_to_laserscan turns a depth image into a LaserScan"
-UNSUPPORTED_SENSORS = {
-    "sensor_msgs/msg/PointCloud": "a point cloud of the old type (sensor_msgs/PointCloud): "
-                                  "point_cloud_converter turns it into a PointCloud2",
-    "sensor_msgs/msg/Image": _DEPTH,
-    "sensor_msgs/msg/CompressedImage": _DEPTH,
-    "sensor_msgs/msg/Range": "one range a message (a sonar or infrared ranger), not a scan",
-    "sensor_msgs/msg/Imu": "an inertial unit: no ranges",
-}
-TF_TYPES = ("tf2_msgs/msg/TFMessage", "tf/msg/tfMessage")  # ROS 2 / ROS 1 tf2, old ROS 1 tf
 TF_TOPICS = ("/tf", "/tf_static")
-POSE_TYPES = (
-    "nav_msgs/msg/Odometry",
-    "nav_msgs/msg/Path",
-    "geometry_msgs/msg/PoseStamped",
-    "geometry_msgs/msg/PoseWithCovarianceStamped",
-)
-
-
-def did_you_mean(name: str, names) -> str:
-    """': did you mean '/scan'?' for the closest of names to a mistyped one, else ''."""
-    close = difflib.get_close_matches(name, list(names), n=1, cutoff=0.6)
-    return f": did you mean {close[0]!r}?" if close else ""
-
-
-def norm_type(msgtype: str | None) -> str | None:
-    """ROS 2 spelling of a message type: sensor_msgs/LaserScan -> sensor_msgs/msg/LaserScan."""
-    if msgtype and msgtype.count("/") == 1:
-        pkg, name = msgtype.split("/")
-        return f"{pkg}/msg/{name}"
-    return msgtype
-
-
-def short_type(msgtype: str | None) -> str:
-    """ROS 1 spelling for messages: sensor_msgs/msg/LaserScan -> sensor_msgs/LaserScan."""
-    return (msgtype or "mixed types").replace("/msg/", "/")
 
 
 def resolve_topic(name: str, topics) -> str | None:

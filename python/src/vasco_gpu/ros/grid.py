@@ -14,23 +14,27 @@ from .. import _core
 
 __all__ = ["grid_values", "finished_grid", "fill_grid"]
 
-# The node's map_mode -> the picture mode whose levels, read as int8, are the values
-# (carmen_compat/occupancy_grid.h: "scale" is the raw picture's round(100 p)).
-_DATA_MODES = {"trinary": "trinary", "scale": "raw"}
+# The map output's rows (vasco_gpu/pipeline/map_output_options.h): map_mode's choices and the
+# thresholds' defaults.
+_ROWS = {row["name"]: row for row in _core.option_schema("map_output")}
+_MAP_MODES = tuple(_ROWS["map_mode"]["choices"])
 
 
-def _data_mode(mode: str) -> str:
-    if mode not in _DATA_MODES:
-        raise ValueError(f"map_mode {mode!r} is not trinary or scale")
-    return _DATA_MODES[mode]
+def _map_mode(mode: str) -> str:
+    # The engine also takes "raw" for scale (carmen_compat's name for the mode); the node's
+    # map_mode is one of the row's choices only.
+    if mode not in _MAP_MODES:
+        raise ValueError(f"map_mode {mode!r} is not {' or '.join(_MAP_MODES)}")
+    return mode
 
 
-def grid_values(m, mode: str, free_thresh: float = 0.196, occupied_thresh: float = 0.65, out=None):
+def grid_values(m, mode: str, free_thresh: float = _ROWS["free_thresh"]["default"],
+                occupied_thresh: float = _ROWS["occupied_thresh"]["default"], out=None):
     """(size_y * size_x) int8 OccupancyGrid data of map m (-1: unknown): new bytes, or written
     into out (a writable buffer of that many bytes, returned). In C++
     (carmen_compat/occupancy_grid.h): fr101's 1302 x 1267 cells took 1.7 ms there on the 2-core
     machine, 5.4 ms in NumPy."""
-    return _core._occupancy_grid_data(m, _data_mode(mode), free_thresh, occupied_thresh, out)
+    return _core._occupancy_grid_data(m, _map_mode(mode), free_thresh, occupied_thresh, out)
 
 
 def finished_grid(mapper, mode: str, free_thresh: float, occupied_thresh: float, out=None):
@@ -38,7 +42,7 @@ def finished_grid(mapper, mode: str, free_thresh: float, occupied_thresh: float,
     the values grid_values gives for mapper.finish(), converted where the grid is (on the GPU
     for cuda, which then sends a byte a cell instead of a float). data is out (a writable
     buffer) when the map has its size, else new bytes."""
-    return mapper._finish_occupancy_grid(_data_mode(mode), free_thresh, occupied_thresh, out)
+    return mapper._finish_occupancy_grid(_map_mode(mode), free_thresh, occupied_thresh, out)
 
 
 def fill_grid(msg, frame_of_map, data, *, frame: str, stamp) -> array:

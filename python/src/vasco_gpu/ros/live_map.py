@@ -17,6 +17,7 @@ from array import array
 import numpy as np
 
 from .. import _core
+from .._errors import Error
 from .grid import finished_grid
 
 __all__ = ["LiveMap", "LiveMapError"]
@@ -24,8 +25,11 @@ __all__ = ["LiveMap", "LiveMapError"]
 # Bytes stored here per scan besides its ranges: stamp, pose (3), mount (3), first angle, step.
 _SCAN_BYTES = 8 * 9
 
+# The session's host-memory budget by default, in bytes (vasco_gpu/option_schema.h).
+_DEFAULT_MAX_MEMORY = next(row["default"] for row in _core.option_schema("session") if row["name"] == "max_memory")
 
-class LiveMapError(RuntimeError):
+
+class LiveMapError(Error, RuntimeError):
     """A scan or render the session refused (memory, a frame too large); the session is as before."""
 
 
@@ -37,11 +41,12 @@ class LiveMap:
     stored scan with new mapper parameters; ``finish`` gives the map to publish."""
 
     def __init__(self, params: _core.Params, *, backend: str = "auto", cuda_mode: str = "float",
-                 device: int = 0, threads: int = 0, max_memory: int = 2 << 30):
+                 device: int = 0, threads: int = 0, max_memory: int = _DEFAULT_MAX_MEMORY):
         self.max_memory = int(max_memory)
-        # cuda_mode and device are ignored by the CPU backends
+        # cuda_mode and device are ignored by the CPU backends. A live map is a workload without
+        # end (expected_renders=0): auto weighs the GPU's start-up against no known amount of work.
         self.mapper = _core.Mapper(params, backend=backend, cuda_mode=cuda_mode, threads=threads, cuda_device=device,
-                                   max_memory_bytes=self.max_memory)
+                                   max_memory_bytes=self.max_memory, expected_renders=0)
         self.version = 0  # changes whenever the grid does
         self._clear()
 

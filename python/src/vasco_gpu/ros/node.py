@@ -1,37 +1,35 @@
 """vasco_mapper, the ROS 2 node: scans in (posed by tf, or moved by the optimizer's Path), the
 whole map out on /map within milliseconds of every Path. The mapping is LiveMap's (the same
-Mapper, parameter table and map formats as log2map, bag2map and Python), the scan adapter and
-the tf buffer the bag reader's; this file only wires them to rclpy."""
+Mapper, parameter table and map formats as log2map, bag2map and Python), the posing Posing's
+(tf, the message table's adapters: those of the bag reader); this file only wires them to rclpy:
+subscriptions (one per topic of each scan type of the message table), timers, services,
+parameters, /map."""
 
 from __future__ import annotations
 
-import math
+import importlib
 import time
 from array import array
 
 import numpy as np
 import rclpy
 from nav_msgs.msg import MapMetaData, OccupancyGrid, Path
-from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
-from sensor_msgs.msg import LaserScan, MultiEchoLaserScan, PointCloud2
 from std_srvs.srv import SetBool, Trigger
 
 from .. import _core
-from ..bags.errors import BagError
-from ..bags.geometry import QUAT_TOL, planar, yaw
-from ..bags.header import frame_name, stamp_ns, stamp_text
-from ..bags.poses import static_mount
-from ..bags.cloud import cloud_mount, read_cloud
-from ..bags.scans import COUNT_KEYS, read_laser
-from ..bags.tf import TfBuffer
+from ..msgs.errors import BagError
+from ..msgs.header import stamp_text
+from ..msgs.table import MESSAGE_TYPES, MessageType
 from .batches import Batches
 from .grid import fill_grid
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
-from .settings import NODE_PARAMETERS, Settings, SettingsError, mapper_parameter_names
+from .posing import Posing, Refused, check_path
+from .settings import Effect, Settings, SettingsError, declare_parameters
 from .tf_messages import tf_message_type
 from .transport import map_sized_shm_in_use
 
@@ -51,26 +49,12 @@ PATH = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=Histo
 # laser at 1 kHz for scan_batch_interval 0.1 s, or at 40 Hz for 2.5 s
 SENSOR = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE,
                     history=HistoryPolicy.KEEP_LAST)
-TF_KEEP_S = 60.0  # seconds of stamps each /tf link keeps
+SCAN_TYPES = tuple(t for t in MESSAGE_TYPES if t.role == "scan")
 
 
-class Refused(Exception):
-    """A message the node does not map; the text names the topic and stamp, cause the kind."""
-
-    def __init__(self, text: str, cause: str = "bad messages"):
-        super().__init__(text)
-        self.cause = cause
-
-
-class _Pending:
-    """A scan waiting for its transform until the deadline (monotonic seconds)."""
-
-    __slots__ = ("topic", "ns", "reading", "deadline", "received", "cloud")
-
-    def __init__(self, topic, ns, reading, deadline, received, cloud=None):
-        self.topic, self.ns, self.reading, self.deadline = topic, ns, reading, deadline
-        self.received = received  # when received, on perf_counter's clock (DDS's time in a batch)
-        self.cloud = cloud  # a PointCloud2 waiting for its mount (reading is None until read)
+def message_class(kind: MessageType):
+    """The rclpy message class of a row of the message table (sensor_msgs.msg.LaserScan, ...)."""
+    return getattr(importlib.import_module(f"{kind.package}.msg"), kind.class_name)
 
 
 class MappingNode(Node):
@@ -78,20 +62,16 @@ class MappingNode(Node):
 
     def __init__(self, **node_kwargs):
         super().__init__(NODE_NAME, **node_kwargs)
-        self._declare()
-        self.settings = Settings.from_values(self._node_values(), self._mapper_values())
+        self.settings = declare_parameters(self)  # settings.py's rows and the mapper's keys, checked
         s = self.settings
         try:
             self.live = LiveMap(s.params, backend=s.backend, cuda_mode=s.cuda_mode, device=s.device,
                                 threads=s.threads, max_memory=s.max_memory)
         except (RuntimeError, ValueError) as e:  # e.g. cuda without a usable GPU
             raise SettingsError(f"backend {s.backend!r}: {e}") from None
-        self.tf = TfBuffer(stamp_name="scan stamp", keep=TF_KEEP_S)
         self.paused = False
-        self.pending: list[_Pending] = []
-        self.range_counts = dict.fromkeys(COUNT_KEYS, 0)
         self.refused: dict[tuple[str, str], int] = {}
-        self._mounts: dict[str, np.ndarray | None] = {}
+        self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse)
         self._published = -1
         self._grid_msg = OccupancyGrid()  # /map's message, filled again for each map
         self._grid_data = None  # its data array, written again for a map of its size
@@ -127,7 +107,7 @@ class MappingNode(Node):
     def announce_ready(self) -> None:
         """The 'ready' line (tests and launch files wait for it), once the executor spins."""
         s = self.settings
-        topics = s.scan_topics + s.multi_echo_topics + s.cloud_topics
+        topics = [t for kind in SCAN_TYPES for t in getattr(s, kind.topics)]
         self.get_logger().info(
             f"ready: backend {self.live.backend}, scans on {', '.join(topics)}, poses from tf {s.map_frame} -> "
             f"the scans' frames and from the Path on "
@@ -144,44 +124,30 @@ class MappingNode(Node):
         return "each scan mapped on arrival"
 
     # -- parameters -------------------------------------------------------------------------
-    def _declare(self) -> None:
-        for p in NODE_PARAMETERS:
-            self.declare_parameter(p.name, p.default, ParameterDescriptor(
-                description=p.meaning, dynamic_typing=True, read_only=not p.dynamic))
-        for name in mapper_parameter_names():  # unset unless given: param_file and defaults apply
-            self.declare_parameter(name, None, ParameterDescriptor(
-                description=f"{name} (log2map --help lists its meaning)", dynamic_typing=True))
-
-    def _node_values(self, changed=()) -> dict:
-        values = {p.name: self.get_parameter(p.name).value for p in NODE_PARAMETERS}
-        values.update({c.name: c.value for c in changed if c.name in values})
-        return values
-
-    def _mapper_values(self, changed=()) -> dict:
-        values = {n: self.get_parameter(n).value for n in mapper_parameter_names()}
-        values.update({c.name: c.value for c in changed if c.name in values})
-        return {k: v for k, v in values.items() if v is not None}
-
     def _on_parameters(self, changed) -> SetParametersResult:
+        """A change taken whole or refused whole: settings.py checks it and says what it asks."""
         try:
-            new = Settings.from_values(self._node_values(changed), self._mapper_values(changed))
-            if new.params != self.settings.params:
-                self.live.set_params(new.params)
+            new, effects = self.settings.changed({c.name: c.value for c in changed})
+            if Effect.REMAP in effects:
+                self.live.set_params(new.params)  # every stored scan mapped again
         except (SettingsError, LiveMapError, ValueError) as e:
             return SetParametersResult(successful=False, reason=str(e))
-        if new.map_update_interval != self.settings.map_update_interval:
+        for effect in effects:
+            self._apply(effect, new)
+        self.settings = new
+        return SetParametersResult(successful=True)
+
+    def _apply(self, effect: Effect, new: Settings) -> None:
+        """What a parameter change asks of the running node, beside the mapper's (REMAP)."""
+        if effect is Effect.PUBLISH_PERIOD:
             self._timer.timer_period_ns = int(new.map_update_interval * 1e9)
-        if new.scan_batch_interval != self.settings.scan_batch_interval:
-            self._flush()  # the scans gathered so far, before the period changes
+        elif effect is Effect.BATCH_PERIOD:
+            self._flush()  # the scans gathered so far, at the old period's settings
             self._retry.timer_period_ns = int(self._retry_period(new) * 1e9)
             self._batches.start(new.scan_batch_interval)
             self._arm()
-        mode_changed = (new.map_mode, new.free_thresh, new.occupied_thresh) != (
-            self.settings.map_mode, self.settings.free_thresh, self.settings.occupied_thresh)
-        self.settings = new
-        if mode_changed:
+        elif effect is Effect.REPUBLISH:
             self._published = -1
-        return SetParametersResult(successful=True)
 
     # -- inputs -----------------------------------------------------------------------------
     @staticmethod
@@ -197,7 +163,7 @@ class MappingNode(Node):
 
     def _arm(self) -> None:
         """The batch timer runs while batches are taken, or some scan waits; else it sleeps."""
-        need = self._batches.running or bool(self.pending)
+        need = self._batches.running or bool(self.posing.pending)
         if need and self._retry.is_canceled():
             self._retry.reset()
         elif not need and not self._retry.is_canceled():
@@ -220,18 +186,18 @@ class MappingNode(Node):
         tf_type = tf_message_type()
         self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
         inputs = [(tf_type, "/tf", TF, lambda m, received: self._on_tf(m, False))]
-        inputs += [(LaserScan, t, qos, lambda m, received, t=t: self._on_scan(m, t, False, received))
-                   for t in s.scan_topics]
-        inputs += [(MultiEchoLaserScan, t, qos, lambda m, received, t=t: self._on_scan(m, t, True, received))
-                   for t in s.multi_echo_topics]
+        inputs += [(message_class(kind), t, qos, lambda m, received, t=t, k=kind: self._on_scan(m, t, k, received))
+                   for kind in SCAN_TYPES if kind.batched for t in getattr(s, kind.topics)]
         for kind, topic, topic_qos, handler in inputs:
             self._batches.add(self.create_subscription(kind, topic, lambda m, h=handler: self._on_input(h, m),
                                                        topic_qos, callback_group=self._batches.group), handler)
         # clouds (megabytes each) a callback each, as they come: their reading costs far more than
         # a wake-up, and a batch's queue of them would hold hundreds of megabytes
-        cloud_qos = qos_profile_sensor_data if s.scan_qos == "sensor_data" else REPLAY
-        for topic in s.cloud_topics:
-            self.create_subscription(PointCloud2, topic, lambda m, t=topic: self._on_cloud(m, t), cloud_qos)
+        alone_qos = qos_profile_sensor_data if s.scan_qos == "sensor_data" else REPLAY
+        for kind in SCAN_TYPES:
+            for topic in getattr(s, kind.topics) if not kind.batched else ():
+                self.create_subscription(message_class(kind), topic,
+                                         lambda m, t=topic, k=kind: self._on_scan(m, t, k), alone_qos)
         if s.path_topic:  # as bytes: path_cdr.py reads them far faster than rclpy's objects
             self.create_subscription(Path, s.path_topic, self._on_path, PATH, raw=True)
 
@@ -245,13 +211,11 @@ class MappingNode(Node):
     def _on_tf(self, msg, static: bool) -> None:
         topic = "/tf_static" if static else "/tf"
         try:
-            self.tf.add_message(msg, static)
+            self.posing.add_tf(msg, static)
         except BagError as e:
             self._refuse(topic, "bad transforms", f"{topic}: {e.message}")
             return
-        if static:
-            self._mounts.clear()
-        if self.pending:
+        if self.posing.pending:
             self._pose_soon()
 
     def _paused_on(self, topic: str) -> bool:
@@ -260,144 +224,24 @@ class MappingNode(Node):
             self.refused[(topic, "paused")] = self.refused.get((topic, "paused"), 0) + 1
         return self.paused
 
-    def _on_scan(self, msg, topic: str, multi_echo: bool, received: float | None = None) -> None:
+    def _on_scan(self, msg, topic: str, kind: MessageType, received: float | None = None) -> None:
         if self._paused_on(topic):
             return
-        ns = stamp_ns(msg.header.stamp)
-        try:
-            # the scan's name made only for a refusal: per scan it cost more than the reading
-            reading = read_laser(msg, no_return=self.settings.no_return, counts=self.range_counts,
-                                 multi_echo=multi_echo, echo=self.settings.echo,
-                                 fail=lambda what: Refused(f"{self.resolve_topic_name(topic)}: scan at stamp "
-                                                           f"{stamp_text(ns)} {what}"))
-        except Refused as e:
-            self._refuse(topic, "bad scans", f"{e}; not mapped")  # the first of each topic
-            return
-        now = time.perf_counter()
-        received = now if received is None else min(received, now)  # a batch's: when DDS received it
-        self.pending.append(_Pending(topic, ns, reading,
-                                     time.monotonic() - (now - received) + self.settings.transform_timeout, received))
+        self.posing.add_scan(msg, topic, kind, received)
         self._pose_soon()
-
-    def _on_cloud(self, msg, topic: str) -> None:
-        """A PointCloud2: read once its frame's mount is known (the height band is in base_frame)."""
-        if self._paused_on(topic):
-            return
-        self.pending.append(_Pending(topic, stamp_ns(msg.header.stamp), None,
-                                     time.monotonic() + self.settings.transform_timeout, time.perf_counter(), msg))
-        self._pose_soon()
-
-    def _read_cloud(self, p: _Pending) -> bool:
-        """Turns a waiting cloud into its reading; False while its mount is not known yet.
-        Raises Refused for a cloud that cannot be read."""
-        s, frame = self.settings, frame_name(p.cloud.header.frame_id)
-        try:
-            mount = cloud_mount(self.tf, s.base_frame, frame)
-        except BagError as e:
-            if time.monotonic() < p.deadline:
-                return False
-            raise Refused(f"{self._where(p)} not mapped: its height band is in {s.base_frame!r}, and "
-                          f"there is no /tf_static chain {s.base_frame} -> {frame!r} within "
-                          f"transform_timeout: {e.message}", "clouds without a mount") from None
-        where = self._where(p)
-        p.reading = read_cloud(p.cloud, no_return=s.no_return, counts=self.range_counts,
-                               fail=lambda what: Refused(f"{where} {what}; not mapped", "bad clouds"),
-                               z_band=tuple(float(v) for v in s.z_band),
-                               angle_step=math.radians(s.cloud_angle_step), range_max=float(s.cloud_range_max),
-                               mount=mount)
-        p.cloud = None
-        return True
-
-    def _where(self, p: _Pending) -> str:
-        return f"{self.resolve_topic_name(p.topic)}: {'cloud' if p.cloud is not None else 'scan'} at stamp {stamp_text(p.ns)}"
-
-    def _mount(self, frame: str):
-        """The laser frame in base_frame from /tf_static (cached until /tf_static changes)."""
-        if frame not in self._mounts:
-            try:
-                self._mounts[frame] = static_mount(None, self.tf, self.settings.base_frame, frame)
-            except BagError:
-                self._mounts[frame] = None
-        return self._mounts[frame]
 
     def _pose_pending(self) -> None:
         """Maps every waiting scan whose transform is there; drops those past their deadline."""
-        if self.pending:
-            self._pose_waiting()
+        if self.posing.pending:
+            self._insert(self.posing.take_posed())
         self._arm()
-
-    def _pose_waiting(self) -> None:
-        now, keep, ready = time.monotonic(), [], []
-        for p in self.pending:
-            if p.cloud is not None:
-                try:
-                    if not self._read_cloud(p):
-                        keep.append(p)
-                        continue
-                except Refused as e:
-                    self._refuse(p.topic, e.cause, str(e))
-                    continue
-            ready.append(p)
-        by_frame: dict[str, list[_Pending]] = {}
-        for p in ready:
-            by_frame.setdefault(p.reading.frame, []).append(p)
-        posed = {}  # id(pending) -> laser pose
-        for frame, waiting in by_frame.items():
-            self._pose_frame(frame, waiting, now, keep, posed)
-        self.pending = keep
-        # in the order they were taken: each topic's in the order they came, a batch's topic by
-        # topic (sorted by DDS's reception times, the first scans of a replay came out of order)
-        self._insert([(p, posed[id(p)]) for p in ready if id(p) in posed])
-
-    def _pose_frame(self, frame: str, waiting: list, now: float, keep: list, posed: dict) -> None:
-        """The laser poses of the waiting scans in one frame, by one tf lookup where every stamp
-        has its transform; the others one by one (each kept, or refused past its deadline)."""
-        target = self.settings.map_frame
-        ns = np.fromiter((p.ns for p in waiting), dtype=np.int64, count=len(waiting))
-        wait = self.tf.waiting_for(target, frame, ns)  # its /tf not there yet: no lookup until it is
-        try:
-            ok = ~wait & self.tf.covers(target, frame, ns)
-        except BagError:  # no chain to the frame (yet): each scan's own lookup says why
-            ok = np.zeros(len(ns), dtype=bool)
-        if ok.any():
-            try:
-                t, q = self.tf.lookup(target, frame, ns[ok])
-                poses = planar(None, t, q, f"the laser frame {frame!r} in {target!r}")
-                for p, pose in zip((p for p, k in zip(waiting, ok) if k), poses):
-                    posed[id(p)] = pose
-            except BagError:  # one of them refused (upside down): each its own below
-                ok[:] = False
-        for p, k, w in zip(waiting, ok, wait):
-            if k:
-                continue
-            if w and now < p.deadline:
-                keep.append(p)
-                continue
-            pose = self._pose_one(p, now)
-            if pose is not None:
-                posed[id(p)] = pose
-            elif now < p.deadline:
-                keep.append(p)
-
-    def _pose_one(self, p: _Pending, now: float):
-        """One scan's laser pose; None while it has none (refused once past its deadline)."""
-        try:
-            t, q = self.tf.lookup(self.settings.map_frame, p.reading.frame, [p.ns])
-            return planar(None, t, q, f"the laser frame {p.reading.frame!r} in {self.settings.map_frame!r}")[0]
-        except BagError as e:
-            if now >= p.deadline:
-                where = f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)}"
-                self._refuse(p.topic, "scans without a transform",
-                             f"{where} not mapped: no transform within transform_timeout "
-                             f"{self.settings.transform_timeout:g} s: {e.message}")
-            return None
 
     def _insert(self, posed: list) -> None:
         """Maps the posed scans [(pending, laser pose)], in one insert; when that is refused
         (max_memory), one by one, so that each refusal names its scan."""
         if not posed:
             return
-        mounts = [self._mount(p.reading.frame) for p, _ in posed]
+        mounts = [self.posing.mount(p.reading.frame) for p, _ in posed]
         try:
             self.live.add_many([p.ns for p, _ in posed], [pose for _, pose in posed],
                                [p.reading.ranges for p, _ in posed], [p.reading.first_angle for p, _ in posed],
@@ -451,38 +295,13 @@ class MappingNode(Node):
 
     def _path_poses(self, raw: bytes):
         """(stamps (k,) int64 ns, base poses (k, 3)) of a serialized nav_msgs/Path; Refused
-        naming the topic and stamp for a Path in another frame, a pose in another frame or not
-        a number."""
+        naming the topic and stamp for one that cannot be read or does not fit (posing.py)."""
         topic = self.resolve_topic_name(self.settings.path_topic)
         try:
             path = read_path(raw, Path)
         except ValueError as e:
             raise Refused(f"{topic}: {e}", "paths not readable") from None
-        frame, want = frame_name(path.frame_id), self.settings.map_frame
-        if frame != want:
-            raise Refused(f"{topic}: Path at stamp {stamp_text(path.stamp_ns)} is in frame {frame!r}, not "
-                          f"map_frame {want!r}", "paths in another frame")
-        # the distinct frame_ids first (a Path's are nearly always one): a loop over every pose's
-        # cost ~1 ms for fr079's 4,791
-        if any(f and frame_name(f) != want for f in path.distinct_frames):
-            k = next(k for k, f in enumerate(path.frame_ids) if f and frame_name(f) != want)
-            raise Refused(f"{topic}: pose {k} (stamp {stamp_text(int(path.stamps[k]))}) is in frame "
-                          f"{frame_name(path.frame_ids[k])!r}, not {want!r}", "paths in another frame")
-        pos, q = path.positions, path.orientations
-        x, y, z, w = q.T  # a sum over rows of 4 is NumPy's slow reduction (0.07 ms here, 0.01 by columns)
-        norm = np.sqrt(x * x + y * y + z * z + w * w)
-        # whole-array checks first, the rows only for a refusal: every NumPy call costs a Path
-        # in a live node several times what it costs in a loop
-        if not (np.isfinite(pos).all() and np.isfinite(norm).all() and norm.min(initial=1.0) >= 1e-6):
-            k = int(np.argmax(~np.isfinite(pos).all(axis=1) | ~np.isfinite(norm) | (norm < 1e-6)))
-            raise Refused(f"{topic}: pose {k} (stamp {stamp_text(int(path.stamps[k]))}) has position "
-                          f"{tuple(pos[k].tolist())}, orientation {tuple(q[k].tolist())}", "paths with a bad pose")
-        off = np.abs(norm - 1.0) > QUAT_TOL
-        if off.any():
-            q = np.where(off[:, None], q / norm[:, None], q)
-        poses = np.empty((len(q), 3))
-        poses[:, :2], poses[:, 2] = pos[:, :2], yaw(q)
-        return path.stamps, poses
+        return check_path(path, self.settings.map_frame, topic)
 
     # -- outputs ----------------------------------------------------------------------------
     def _publish_if_changed(self, settle: bool = True) -> dict:
@@ -536,7 +355,7 @@ class MappingNode(Node):
     def _reset(self, request, response):
         self._flush()  # the scans received before the reset are dropped with the others
         n = self.live.reset()
-        self.pending.clear()
+        self.posing.pending.clear()
         response.success, response.message = True, f"dropped {n} scans and the grid"
         self.get_logger().info(response.message)
         return response

@@ -1,154 +1,277 @@
-"""The node's parameters, one schema: the node's own (topics, frames, QoS, publishing, the
-session's backend, ``resolution``: the map's cell as ROS says it) and every key of the mapper's
-parameter table under its carmen.ini name, as log2map's flags spell them (``vasco_p_occ``,
-``vasco_downsample``, ...; read from ``vasco_gpu.Params``, never listed here).
+"""The node's parameters, one schema: :data:`NODE_PARAMETERS` has a row a parameter (name, default,
+help, check, and for a dynamic one the effect a change has on the running node), and every key of
+the mapper's parameter table is a parameter too, under its carmen.ini name as log2map's flags
+spell it (``vasco_p_occ``, ``vasco_downsample``, ...; read from ``vasco_gpu.Params``, never
+listed here). Options another component defines are rows that take their default, choices or
+bounds, and help from that component's table, not spelled again: the session's backend,
+cuda_mode, cuda_device (``device``), threads and max_memory, the map output's map_mode and
+thresholds and the pose source's largest gap from the C++ tables (:func:`core_option`), the scan
+adapters' options from :mod:`vasco_gpu.msgs.scan_options`; a row narrows a check or a meaning
+only where the node's is narrower, and says why.
 
-``Settings.from_values`` validates a whole set at once, so that a bad value is refused before
-anything starts and a dynamic change is taken whole or not at all. No rclpy here: the node
-declares what :data:`NODE_PARAMETERS` and :func:`mapper_parameter_names` name.
+From the rows: the validation (:meth:`Settings.from_values`, each value checked under its row's
+name), the declared ROS parameters with their descriptors (:func:`declare_parameters`), what a
+change does (:meth:`Settings.changed`) and the parameter table of docs/ros.md
+(:func:`parameter_table`; ``python -m vasco_gpu.ros.settings`` prints it). Adding a parameter is a
+row here and a test. rclpy is imported only inside :func:`declare_parameters`.
 """
 
 from __future__ import annotations
 
+import enum
 import math
 import os
 from dataclasses import dataclass, field
 
 from .. import _core
-from ..bags.cloud import check_cloud_options
+from .._errors import Error
+from ..msgs.scan_options import SCAN_OPTIONS
 
-__all__ = ["NODE_PARAMETERS", "NodeParameter", "Settings", "SettingsError", "mapper_parameter_names"]
+__all__ = ["NODE_PARAMETERS", "Effect", "NodeParameter", "Settings", "SettingsError", "core_option",
+           "declare_parameters", "mapper_parameter_names", "parameter_table"]
 
 
-class SettingsError(ValueError):
+class SettingsError(Error, ValueError):
     """A parameter value the node refuses; the message names the parameter."""
 
 
+class Effect(enum.Enum):
+    """What a change of a dynamic parameter asks of the running node, in the order it is done;
+    the value is the docs' words."""
+
+    REMAP = "every stored scan mapped again"  # the mapper's Params changed: LiveMap.set_params
+    PUBLISH_PERIOD = "the publishing timer's period"
+    BATCH_PERIOD = "the scans gathered so far mapped, then batches at the new period"
+    REPUBLISH = "the map published again"
+    READ_WHEN_USED = "used the next time"  # nothing to do: the node reads it when it needs it
+
+
+# -- checks: each knows its rule in words, and the range a ROS descriptor can carry -----------------
+def _number_text(x) -> str:
+    return "" if x is None else str(int(x)) if float(x).is_integer() else f"{x:g}"
+
+
+@dataclass(frozen=True)
+class Number:
+    """A finite number (not a bool) within [lo, hi]; lo_open/hi_open leave the bound out; whole:
+    an integer. words: the rule as the refusal says it, where the bounds alone do not."""
+
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    whole: bool = False
+    words: str = ""
+
+    def __call__(self, name, v):
+        ok = isinstance(v, int if self.whole else (int, float)) and not isinstance(v, bool) and (
+            isinstance(v, int) or math.isfinite(v))
+        if not (ok and (self.lo is None or (v > self.lo if self.lo_open else v >= self.lo))
+                and (self.hi is None or (v < self.hi if self.hi_open else v <= self.hi))):
+            raise SettingsError(f"{name}: {v!r} must be {self.rule()}")
+
+    def rule(self) -> str:
+        if self.words:
+            return self.words
+        kind = "a whole number" if self.whole else "a finite number"
+        lo, hi = _number_text(self.lo), _number_text(self.hi)
+        if self.hi is None:
+            return f"{kind} {'>' if self.lo_open else '>='} {lo}"
+        if not (self.whole or self.lo_open or self.hi_open):
+            return f"between {lo} and {hi}"
+        return f"{kind} in {'(' if self.lo_open else '['}{lo}, {hi}{')' if self.hi_open else ']'}"
+
+    def ros_range(self):
+        """(lo, hi) for a descriptor's range: closed bounds only (ROS's ranges include both ends)."""
+        if self.lo is None or self.lo_open or self.hi_open:
+            return None
+        top = (2**63 - 1 if self.whole else math.inf) if self.hi is None else self.hi
+        return (self.lo, top)
+
+
+@dataclass(frozen=True)
+class Choice:
+    """One of names; what: the refusal's word for them ("a backend"), else "one of"."""
+
+    names: tuple
+    what: str = ""
+
+    def __call__(self, name, v):
+        if v not in self.names:
+            listed = ", ".join(self.names)
+            raise SettingsError(f"{name}: {v!r} is not {self.what} ({listed})" if self.what else
+                                f"{name}: {v!r} is not one of {listed}")
+
+    def rule(self) -> str:
+        return f"one of: {', '.join(self.names)}"
+
+    def ros_range(self):
+        return None
+
+
+@dataclass(frozen=True)
+class Text:
+    """A string; kind "frame": not empty once its slashes are stripped."""
+
+    kind: str = ""
+
+    def __call__(self, name, v):
+        if not isinstance(v, str) or (self.kind == "frame" and not v.strip("/")):
+            raise SettingsError(f"{name}: {v!r} must be {self.rule()}")
+
+    def rule(self) -> str:
+        return "a frame name" if self.kind == "frame" else "a string"
+
+    def ros_range(self):
+        return None
+
+
+@dataclass(frozen=True)
+class Names:
+    """A list of non-empty strings: topic names or file names."""
+
+    kind: str
+
+    def __call__(self, name, v):
+        if not isinstance(v, (list, tuple)) or not all(isinstance(t, str) and t for t in v):
+            raise SettingsError(f"{name}: {v!r} must be {self.rule()}")
+
+    def rule(self) -> str:
+        return f"a list of {self.kind} names"
+
+    def ros_range(self):
+        return None
+
+
+@dataclass(frozen=True)
+class Band:
+    """Two finite heights [min, max], min < max."""
+
+    def __call__(self, name, v):
+        if not (isinstance(v, (list, tuple)) and len(v) == 2 and all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)
+                and v[0] < v[1]):
+            raise SettingsError(f"{name}: {v!r} must be {self.rule()}")
+
+    def rule(self) -> str:
+        return "two finite heights [min, max], min < max"
+
+    def ros_range(self):
+        return None
+
+
+# -- the rows -------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class NodeParameter:
+    """One parameter of the node: effect None is a static one (read-only once started)."""
+
     name: str
     default: object
-    meaning: str
-    dynamic: bool = False  # may change while the node runs
+    check: object  # Number, Choice, Text, Names or Band: check(name, value) raises SettingsError
+    help: str
+    effect: Effect | None = None
+
+    @property
+    def dynamic(self) -> bool:
+        return self.effect is not None
+
+    @property
+    def meaning(self) -> str:
+        return self.help
 
 
-def _choice(*names):
-    def check(name, v):
-        if v not in names:
-            raise SettingsError(f"{name}: {v!r} is not one of {', '.join(names)}")
-    return check
+def core_option(component: str, name: str) -> dict:
+    """An option the engine or the pipeline defines ("session", "map_output", "pose_source"):
+    {name, type, default, help, choices, lo, hi, lo_open, hi_open, ...} from that component's
+    table (vasco_gpu/option_schema.h)."""
+    for row in _core.option_schema(component):
+        if row["name"] == name:
+            return row
+    raise KeyError(f"the {component} options have no {name!r}")
 
 
-def _positive(name, v):
-    if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-        raise SettingsError(f"{name}: {v!r} must be a finite number > 0")
+def _from_core(component: str, option: str, check, *, name: str = "", help: str = "",
+               effect: Effect | None = None) -> NodeParameter:
+    """A row for a component's option: its default, and its help unless the node's meaning is
+    narrower (help); check: the node's check, built from the option's choices or bounds."""
+    o = core_option(component, option)
+    return NodeParameter(name or option, o["default"], check(o), help or o["help"], effect)
 
 
-def _not_negative(name, v):
-    if isinstance(v, bool) or not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
-        raise SettingsError(f"{name}: {v!r} must be a finite number >= 0")
+def _choices(o) -> Choice:
+    """The option's choices as the check."""
+    return Choice(tuple(o["choices"]))
 
 
-def _topics(name, v):
-    if not isinstance(v, (list, tuple)) or not all(isinstance(t, str) and t for t in v):
-        raise SettingsError(f"{name}: {v!r} must be a list of topic names")
+def _bounds(**node_rule):
+    """The option's bounds as the check (whole for a whole number); node_rule overrides them
+    where the node's are narrower."""
+    return lambda o: Number(**{"lo": o["lo"], "hi": o["hi"], "lo_open": o["lo_open"], "hi_open": o["hi_open"],
+                               "whole": o["type"] in ("whole", "bytes"), **node_rule})
 
 
-def _frame(name, v):
-    if not isinstance(v, str) or not v.strip("/"):
-        raise SettingsError(f"{name}: {v!r} must be a frame name")
+def _from_scan(name: str, check=None) -> NodeParameter:
+    """A row for a scan adapters' option (vasco_gpu.msgs): its default and meaning; check: the
+    node's, where the option has no choices."""
+    o = next(o for o in SCAN_OPTIONS if o.name == name)
+    default = list(o.default) if isinstance(o.default, tuple) else o.default
+    return NodeParameter(name, default, check or Choice(o.choices), o.meaning)
 
 
-def _threshold(name, v):
-    if not (isinstance(v, (int, float)) and 0 <= v <= 1):
-        raise SettingsError(f"{name}: {v!r} must be between 0 and 1")
+_SECONDS = Number(lo=0, lo_open=True)  # a finite number > 0
+_SESSION = "session"
+_MAP_OUTPUT = "map_output"
 
-
-def _whole(lo):
-    def check(name, v):
-        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-            raise SettingsError(f"{name}: {v!r} must be a whole number >= {lo}")
-    return check
-
-
-def _backend(name, v):
-    if v not in _core.backend_names():
-        raise SettingsError(f"{name}: {v!r} is not a backend ({', '.join(_core.backend_names())})")
-
-
-def _string(name, v):
-    if not isinstance(v, str):
-        raise SettingsError(f"{name}: {v!r} must be a string")
-
-
-def _band(name, v):
-    if not (isinstance(v, (list, tuple)) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v)):
-        raise SettingsError(f"{name}: {v!r} must be two heights [min, max]")
-
-
-def _cell(name, v):
-    if isinstance(v, bool) or not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
-        raise SettingsError(f"{name}: {v!r} must be a cell size in metres > 0 (0: vasco_resolution x "
-                            f"vasco_downsample)")
-
-
-def _paths(name, v):
-    if not isinstance(v, (list, tuple)) or not all(isinstance(t, str) and t for t in v):
-        raise SettingsError(f"{name}: {v!r} must be a list of file names")
-
-
-# name, default, meaning, dynamic; the check of each value is in _CHECKS.
 NODE_PARAMETERS = (
-    NodeParameter("scan_topics", ["scan"], "sensor_msgs/LaserScan topics"),
-    NodeParameter("multi_echo_topics", [], "sensor_msgs/MultiEchoLaserScan topics (one echo a beam: echo)"),
-    NodeParameter("echo", "last", "the echo a MultiEchoLaserScan beam gives: first, last or strongest"),
-    NodeParameter("cloud_topics", [], "sensor_msgs/PointCloud2 topics (3-D lidar: the points in z_band as beams)"),
-    NodeParameter("z_band", [0.2, 1.8], "clouds: the heights kept, min and max, in metres in base_frame"),
-    NodeParameter("cloud_angle_step", 0.25, "clouds: the beams' angle step in degrees (nearest point per step)"),
-    NodeParameter("cloud_range_max", 50.0, "clouds: points farther than this (m) are no return"),
-    NodeParameter("scan_qos", "sensor_data", "the scans' QoS: sensor_data (best effort, depth 100; clouds 5) or "
-                                             "reliable (reliable, depth 1000: a replay loses no scan)"),
-    NodeParameter("resolution", _core.ROS_MAP_RESOLUTION, "the map's cell size (m), /map's info.resolution, as log2map --resolution "
-                                      "sets it (vasco_resolution = resolution / vasco_downsample; the downsample "
-                                      "kept where given, else max(1, round(resolution / vasco_resolution))); 0: "
-                                      "vasco_resolution x vasco_downsample alone", dynamic=True),
-    NodeParameter("no_return", "skip", "+inf ranges (REP 117 no return): skip, or free (clears up to "
-                                       "range_max)", dynamic=False),
-    NodeParameter("map_frame", "map", "the fixed frame: the map's frame and the poses' frame"),
-    NodeParameter("base_frame", "base_link", "the robot's frame, whose poses the Path carries"),
-    NodeParameter("path_topic", "trajectory", "nav_msgs/Path of base_frame poses from the optimizer"),
-    NodeParameter("transform_timeout", 0.5, "seconds a scan waits for its transform map_frame -> its frame"),
-    NodeParameter("scan_batch_interval", 0.1, "seconds scans gather before they are posed and mapped together "
-                                              "(one tf lookup, one insert: less CPU a scan); 0: each scan on "
-                                              "arrival", dynamic=True),
-    NodeParameter("pose_max_gap", 5.0, "seconds: a scan between two Path poses further apart keeps its pose"),
-    NodeParameter("map_update_interval", 0.5, "seconds between two map publications at most", dynamic=True),
-    NodeParameter("map_mode", "trinary", "OccupancyGrid values: trinary (0/100/-1 by the thresholds) or "
-                                         "scale (round(100 p), -1 unknown)", dynamic=True),
-    NodeParameter("free_thresh", 0.196, "trinary: p below it is free (0)", dynamic=True),
-    NodeParameter("occupied_thresh", 0.65, "trinary: p above it is occupied (100)", dynamic=True),
-    NodeParameter("save_map_path", [], "the files ~/save_map writes, one transaction (.map.gz, .pgm, .png, "
-                                       "...)", dynamic=True),
-    NodeParameter("param_file", "", "a carmen.ini with vasco_* keys (as log2map's --param-file)"),
-    NodeParameter("robot", "", "the carmen.ini robot section (as log2map's --robot)"),
-    NodeParameter("backend", "auto", "the mapping backend (as log2map's --backend)"),
-    NodeParameter("cuda_mode", "float", "cuda's mode: float or exact"),
-    NodeParameter("device", 0, "the CUDA device"),
-    NodeParameter("threads", 0, "cpu_threads' threads (0: all cores)"),
-    NodeParameter("max_memory", 2 << 30, "bytes the session may hold (scans and grid); 0: no limit"),
+    NodeParameter("scan_topics", ["scan"], Names("topic"), "sensor_msgs/LaserScan topics"),
+    NodeParameter("multi_echo_topics", [], Names("topic"),
+                  "sensor_msgs/MultiEchoLaserScan topics (one echo a beam: echo)"),
+    _from_scan("echo"),
+    NodeParameter("cloud_topics", [], Names("topic"),
+                  "sensor_msgs/PointCloud2 topics (3-D lidar: the points in z_band as beams)"),
+    _from_scan("z_band", Band()),
+    # the bounds of the adapters' check_cloud_options (a test holds them equal)
+    _from_scan("cloud_angle_step", Number(lo=0.01, hi=10)),
+    _from_scan("cloud_range_max", Number(lo=0, hi=1000, lo_open=True)),
+    NodeParameter("scan_qos", "sensor_data", Choice(("sensor_data", "reliable")),
+                  "the scans' QoS: sensor_data (best effort, depth 100; clouds 5) or reliable (reliable, depth 1000: "
+                  "a replay loses no scan)"),
+    NodeParameter("resolution", _core.ROS_MAP_RESOLUTION,
+                  Number(lo=0, words="a cell size in metres > 0 (0: vasco_resolution x vasco_downsample)"),
+                  "the map's cell size (m), /map's info.resolution, as log2map --resolution sets it (vasco_resolution "
+                  "= resolution / vasco_downsample; the downsample kept where given, else max(1, round(resolution / "
+                  "vasco_resolution))); 0: vasco_resolution x vasco_downsample alone", Effect.REMAP),
+    _from_scan("no_return"),
+    NodeParameter("map_frame", "map", Text("frame"), "the fixed frame: the map's frame and the poses' frame"),
+    NodeParameter("base_frame", "base_link", Text("frame"), "the robot's frame, whose poses the Path carries"),
+    NodeParameter("path_topic", "trajectory", Text(), "nav_msgs/Path of base_frame poses from the optimizer"),
+    NodeParameter("transform_timeout", 0.5, _SECONDS, "seconds a scan waits for its transform map_frame -> its frame"),
+    NodeParameter("scan_batch_interval", 0.1, Number(lo=0),
+                  "seconds scans gather before they are posed and mapped together (one tf lookup, one insert: less "
+                  "CPU a scan); 0: each scan on arrival", Effect.BATCH_PERIOD),
+    # nanoseconds in the node: finite and > 0, where a pose file also takes 0 and inf
+    _from_core("pose_source", "pose_max_gap", _bounds(lo=0, hi=None, lo_open=True, hi_open=False),
+               help="seconds: a scan between two Path poses further apart keeps its pose"),
+    NodeParameter("map_update_interval", 0.5, _SECONDS, "seconds between two map publications at most",
+                  Effect.PUBLISH_PERIOD),
+    _from_core(_MAP_OUTPUT, "map_mode", _choices, effect=Effect.REPUBLISH),
+    # /map's values as well as the map_server files of save_map_path
+    _from_core(_MAP_OUTPUT, "free_thresh", _bounds(), help="trinary: p below it is free (0)", effect=Effect.REPUBLISH),
+    _from_core(_MAP_OUTPUT, "occupied_thresh", _bounds(), help="trinary: p above it is occupied (100)",
+               effect=Effect.REPUBLISH),
+    NodeParameter("save_map_path", [], Names("file"),
+                  "the files ~/save_map writes, one transaction (.map.gz, .pgm, .png, ...)", Effect.READ_WHEN_USED),
+    NodeParameter("param_file", "", Text(), "a carmen.ini with vasco_* keys (as log2map's --param-file)"),
+    NodeParameter("robot", "", Text(), "the carmen.ini robot section (as log2map's --robot)"),
+    _from_core(_SESSION, "backend", lambda o: Choice(tuple(o["choices"]), "a backend")),
+    _from_core(_SESSION, "cuda_mode", _choices),
+    _from_core(_SESSION, "cuda_device", _bounds(), name="device"),
+    _from_core(_SESSION, "threads", _bounds()),
+    # bytes, a ROS integer (log2map's flag takes MiB)
+    _from_core(_SESSION, "max_memory", _bounds(lo=0), help="bytes the session may hold (scans and grid); 0: no limit"),
 )
 
-_CHECKS = {
-    "scan_topics": _topics, "multi_echo_topics": _topics, "echo": _choice("first", "last", "strongest"),
-    "resolution": _cell, "cloud_topics": _topics, "z_band": _band, "cloud_angle_step": _positive, "cloud_range_max": _positive,
-    "scan_qos": _choice("sensor_data", "reliable"), "no_return": _choice("skip", "free"),
-    "map_frame": _frame, "base_frame": _frame, "path_topic": _string,
-    "transform_timeout": _positive, "scan_batch_interval": _not_negative,
-    "pose_max_gap": _positive, "map_update_interval": _positive,
-    "map_mode": _choice("trinary", "scale"), "free_thresh": _threshold, "occupied_thresh": _threshold,
-    "save_map_path": _paths, "param_file": _string, "robot": _string, "backend": _backend,
-    "cuda_mode": _choice("float", "exact"), "device": _whole(0), "threads": _whole(0), "max_memory": _whole(0),
-}
+_ROWS = {p.name: p for p in NODE_PARAMETERS}
 
 
 def mapper_parameter_names() -> list[str]:
@@ -157,10 +280,11 @@ def mapper_parameter_names() -> list[str]:
     return list(_core.Params.keys())
 
 
+# -- a validated set --------------------------------------------------------------------------------
 @dataclass
 class Settings:
     """A validated set of the node's parameters: ``node`` (name -> value, every NODE_PARAMETERS
-    entry) and ``params`` (the mapper's Params: the keys given, over param_file, over vasco's
+    row) and ``params`` (the mapper's Params: the keys given, over param_file, over vasco's
     defaults, as log2map ranks --vasco_KEY over --param-file)."""
 
     node: dict
@@ -178,24 +302,40 @@ class Settings:
         """node_values: the node's own parameters (missing ones take their default);
         mapper_values: the mapper keys that were set (keyword names). SettingsError naming the
         parameter for any bad value."""
-        node = {p.name: node_values.get(p.name, p.default) for p in NODE_PARAMETERS}
-        for name, value in node.items():
-            if isinstance(value, tuple):
-                node[name] = value = list(value)
-            _CHECKS[name](name, value)
+        node = {}
+        for p in NODE_PARAMETERS:
+            value = node_values.get(p.name, p.default)
+            node[p.name] = value = list(value) if isinstance(value, tuple) else value
+            p.check(p.name, value)
         if not node["free_thresh"] < node["occupied_thresh"]:
             raise SettingsError(f"free_thresh {node['free_thresh']} must be below occupied_thresh "
                                 f"{node['occupied_thresh']}")
         if not node["scan_topics"] and not node["multi_echo_topics"] and not node["cloud_topics"]:
             raise SettingsError("scan_topics, multi_echo_topics and cloud_topics are all empty: nothing to map")
-        try:
-            check_cloud_options(tuple(float(v) for v in node["z_band"]), math.radians(node["cloud_angle_step"]),
-                                float(node["cloud_range_max"]))
-        except ValueError as e:
-            raise SettingsError(str(e).replace("z_band (--z-band MIN,MAX)", "z_band").replace(
-                "cloud_angle_step (--cloud-angle-step)", "cloud_angle_step").replace(
-                "cloud_range_max (--cloud-range-max)", "cloud_range_max")) from None
         return cls(node, _mapper_params(node, mapper_values), dict(mapper_values))
+
+    def changed(self, values: dict) -> tuple["Settings", tuple[Effect, ...]]:
+        """These settings with values (name -> value) over them, validated whole, and what the
+        running node must do for them, in Effect's order (READ_WHEN_USED left out). A mapper key
+        set to None is unset; a name that is not the node's (rclpy's use_sim_time) is passed
+        over. SettingsError naming the parameter for a bad value or a static parameter."""
+        node, given = dict(self.node), dict(self.given)
+        mapper = set(mapper_parameter_names())
+        for name, value in values.items():
+            if name in _ROWS:
+                if not _ROWS[name].dynamic:
+                    raise SettingsError(f"{name}: read-only while the node runs")
+                node[name] = value
+            elif name in mapper and value is None:
+                given.pop(name, None)
+            elif name in mapper:
+                given[name] = value
+        new = Settings.from_values(node, given)
+        effects = {p.effect for p in NODE_PARAMETERS if p.dynamic and new.node[p.name] != self.node[p.name]}
+        effects.discard(Effect.REMAP)  # resolution's: only where the Params it makes differ
+        if new.params != self.params:
+            effects.add(Effect.REMAP)
+        return new, tuple(e for e in Effect if e in effects and e is not Effect.READ_WHEN_USED)
 
 
 def _mapper_params(node: dict, given: dict) -> _core.Params:
@@ -218,3 +358,60 @@ def _mapper_params(node: dict, given: dict) -> _core.Params:
         if isinstance(e, SettingsError):
             raise
         raise SettingsError(str(e)) from None
+
+
+# -- ROS: the declarations ------------------------------------------------------------------------
+def parameter_descriptor(p: NodeParameter, with_range: bool = True):
+    """p's ParameterDescriptor: its help, read-only unless dynamic, its rule as the additional
+    constraints, and its bounds as ROS's range where they are closed. Types stay dynamic: a ROS
+    integer where a number is asked (resolution:=0) is the check's to judge."""
+    from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+
+    d = ParameterDescriptor(description=p.help, read_only=not p.dynamic, dynamic_typing=True,
+                            additional_constraints=p.check.rule())
+    bounds = p.check.ros_range() if with_range else None
+    if bounds and isinstance(p.check, Number) and p.check.whole:
+        d.integer_range = [IntegerRange(from_value=int(bounds[0]), to_value=int(bounds[1]), step=0)]
+    elif bounds:
+        d.floating_point_range = [FloatingPointRange(from_value=float(bounds[0]), to_value=float(bounds[1]), step=0.0)]
+    return d
+
+
+def declare_parameters(node) -> Settings:
+    """Declares the node's parameters on an rclpy Node (the rows, then every mapper key, unset
+    unless given: param_file and the defaults apply) and returns the Settings of their values.
+    SettingsError naming the parameter for a bad value, in the check's words."""
+    from rcl_interfaces.msg import ParameterDescriptor
+    from rclpy.exceptions import InvalidParameterValueException
+
+    for p in NODE_PARAMETERS:
+        try:
+            node.declare_parameter(p.name, p.default, parameter_descriptor(p))
+        except InvalidParameterValueException:  # outside ROS's range: refused below in the check's words
+            node.declare_parameter(p.name, p.default, parameter_descriptor(p, with_range=False))
+    for name in mapper_parameter_names():
+        node.declare_parameter(name, None, ParameterDescriptor(
+            description=f"{name} (log2map --help lists its meaning)", dynamic_typing=True))
+    values = {p.name: node.get_parameter(p.name).value for p in NODE_PARAMETERS}
+    given = {n: node.get_parameter(n).value for n in mapper_parameter_names()}
+    return Settings.from_values(values, {k: v for k, v in given.items() if v is not None})
+
+
+# -- docs -----------------------------------------------------------------------------------------
+def _default_text(v) -> str:
+    if isinstance(v, list):
+        return "[" + ", ".join(f"{x:g}" if isinstance(x, float) else str(x) for x in v) + "]"
+    return "''" if v == "" else str(v)
+
+
+def parameter_table() -> str:
+    """docs/ros.md's table of the node's own parameters, from the rows."""
+    lines = ["| parameter | default | valid values | meaning | when changed while running |", "|---|---|---|---|---|"]
+    for p in NODE_PARAMETERS:
+        lines.append(f"| `{p.name}` | `{_default_text(p.default)}` | {p.check.rule()} | {p.help} | "
+                     f"{p.effect.value if p.dynamic else 'read-only'} |")
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    print(parameter_table(), end="")

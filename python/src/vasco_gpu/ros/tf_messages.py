@@ -3,13 +3,15 @@ ROS 2 do not, and the repository's ros/tf2_msgs package generates it (docs/ros.m
 
 from __future__ import annotations
 
+from .._errors import Error
+
 __all__ = ["MissingMessages", "tf_message_type"]
 
 HOW = ("install it with `pip install ./ros/tf2_msgs` from the vasco_gpu repository (ROS 2 from "
        "PyPI), or source a ROS 2 installation that has tf2_msgs (apt: ros-$ROS_DISTRO-tf2-msgs)")
 
 
-class MissingMessages(ImportError):
+class MissingMessages(Error, ImportError):
     """A message package the node needs is not installed; the text says how to install it."""
 
 

@@ -18,7 +18,8 @@
 
 #include "vasco_gpu/grid.h"
 #include "vasco_gpu/params.h"
-#include "vasco_gpu/pose_file.h"
+#include "vasco_gpu/pipeline/log_scans.h"
+#include "vasco_gpu/pipeline/pose_match.h"
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco {
@@ -33,7 +34,7 @@ struct SessionInput {
 };
 
 // Where the scans' poses come from when not from the inputs themselves: a
-// pose file of a SLAM back end (pose_file.h), matched to the scans of the
+// pose file of a SLAM back end (pose_file.h, pose_match.h), matched to the scans of the
 // whole input before vasco_first_scan / vasco_num_scans select.
 struct PoseSource {
   std::string file;  // empty: the inputs' own laser poses

@@ -1,6 +1,6 @@
 """sensor_msgs/PointCloud2 as a planar scan: the 3-D lidar's points in a height band become
 beams from the sensor's origin, one per angle bin, as pointcloud_to_laserscan makes them. The
-one adapter of bags and the live node (beside read_laser for LaserScans).
+one adapter of bags and the live node (beside :mod:`.laser` for LaserScans).
 
 What a cloud's beam means
 -------------------------
@@ -25,25 +25,12 @@ import math
 import numpy as np
 
 from .header import frame_name
-from .scans import LaserReading, apply_rep117
+from .laser import LaserReading, apply_rep117
+from .scan_options import SCAN_DEFAULTS, ScanSettings
 
-__all__ = ["CLOUD_DEFAULTS", "check_cloud_options", "cloud_mount", "cloud_points_xyz", "read_cloud"]
-
-#: z band (m, in the base frame), angle step (rad), farthest point used (m): the defaults.
-CLOUD_DEFAULTS = {"z_band": (0.2, 1.8), "angle_step": math.radians(0.25), "range_max": 50.0}
+__all__ = ["cloud_mount", "cloud_points_xyz", "read_cloud", "read_point_cloud"]
 
 _FLOAT32, _FLOAT64 = 7, 8  # sensor_msgs/PointField datatypes
-
-
-def check_cloud_options(z_band, angle_step, range_max) -> None:
-    """ValueError naming the option for a band, step or range no cloud could make sense of."""
-    if len(z_band) != 2 or not all(math.isfinite(v) for v in z_band) or not z_band[0] < z_band[1]:
-        raise ValueError(f"z_band (--z-band MIN,MAX) must be two finite heights, MIN < MAX, not {tuple(z_band)!r}")
-    if not (math.isfinite(angle_step) and math.radians(0.01) <= angle_step <= math.radians(10)):
-        raise ValueError(f"cloud_angle_step (--cloud-angle-step) must be between 0.01 and 10 degrees, not "
-                         f"{math.degrees(angle_step):g}")
-    if not (math.isfinite(range_max) and 0 < range_max <= 1000):
-        raise ValueError(f"cloud_range_max (--cloud-range-max) must be above 0 and at most 1000 m, not {range_max!r}")
 
 
 def cloud_mount(tf, base: str, frame: str):
@@ -84,10 +71,10 @@ def cloud_points_xyz(msg, fail) -> np.ndarray:
     return np.column_stack([pts["x"], pts["y"], pts["z"]]).astype(np.float64)
 
 
-def read_cloud(msg, *, no_return: str, counts: dict, fail, z_band=CLOUD_DEFAULTS["z_band"],
-               angle_step: float = CLOUD_DEFAULTS["angle_step"], range_max: float = CLOUD_DEFAULTS["range_max"],
-               mount=None) -> LaserReading:
-    """A PointCloud2 as a LaserReading (module docstring). mount: (t (3,), q (4,)) of the
+def read_cloud(msg, *, no_return: str, counts: dict, fail, z_band=SCAN_DEFAULTS["z_band"],
+               angle_step: float = math.radians(SCAN_DEFAULTS["cloud_angle_step"]),
+               range_max: float = SCAN_DEFAULTS["cloud_range_max"], mount=None) -> LaserReading:
+    """A PointCloud2 as a LaserReading (module docstring); angle_step in radians. mount: (t (3,), q (4,)) of the
     cloud's frame in the base frame (None: the cloud is in the base frame). counts: read_laser's
     COUNT_KEYS, plus ``points`` (in the band and range) and ``bins_empty``."""
     p = cloud_points_xyz(msg, fail)
@@ -111,3 +98,11 @@ def read_cloud(msg, *, no_return: str, counts: dict, fail, z_band=CLOUD_DEFAULTS
     out = apply_rep117(ranges.astype(np.float32), 0.0, float(np.float32(range_max)), no_return, counts)
     counts["messages"] += 1
     return LaserReading(frame_name(msg.header.frame_id), a0, angle_step, float(range_max), out)
+
+
+def read_point_cloud(msg, settings: ScanSettings, counts: dict, fail, mount=None) -> LaserReading:
+    """The message table's reader of a PointCloud2 (table.py); options: no_return, z_band,
+    cloud_angle_step, cloud_range_max."""
+    return read_cloud(msg, no_return=settings.no_return, counts=counts, fail=fail,
+                      z_band=tuple(float(v) for v in settings.z_band), angle_step=settings.angle_step,
+                      range_max=float(settings.cloud_range_max), mount=mount)

@@ -5,13 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import TfError
-from .geometry import compose, inverse, is_identity, slerp, unit_quaternion
-from .header import NS, frame_name, stamp_ns, stamp_seconds, stamp_text
+from .errors import BagError, TfError
+from .geometry import compose, inverse, is_identity, planar, slerp, unit_quaternion
+from .header import NS, did_you_mean, frame_name, stamp_ns, stamp_seconds, stamp_text
 from .series import bracket, first_outside
-from .topics import did_you_mean
 
-__all__ = ["TfBuffer"]
+__all__ = ["TfBuffer", "static_mount"]
 
 # The stamps a tf message can carry: builtin_interfaces/Time's sec is an int32 (ROS 1's time a
 # uint32), its nanosec a uint32. Any two such stamps are less than 2^63 ns apart, so the int64
@@ -374,6 +373,20 @@ class TfBuffer:
         if b is None:
             return np.array(a[0], dtype=np.float64), np.array(a[1], dtype=np.float64)
         return compose(inverse(b), a)
+
+
+def static_mount(path, tf: TfBuffer | None, base: str, frame: str) -> np.ndarray | None:
+    """The laser pose (x, y, yaw) in base from static tf links only; (0, 0, 0) when the frames
+    are equal; None when there is no static chain."""
+    if base == frame:
+        return np.zeros(3)
+    if tf is None or base not in tf.frames() or frame not in tf.frames():
+        return None
+    try:
+        t, q = tf.lookup(base, frame, np.zeros(1, dtype=np.int64), static_only=True)
+    except BagError:  # no chain, or a /tf link on it (TfError)
+        return None
+    return planar(path, t, q, f"the laser frame {frame!r} in {base!r}")[0]
 
 
 def _link_text(parent: str, child: str, ns: int, topic: str) -> str:

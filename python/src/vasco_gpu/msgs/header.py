@@ -1,7 +1,9 @@
-"""A message header's two parts as the reader uses them: the stamp (whole nanoseconds, seconds,
-exact text) and the frame name."""
+"""A message header's two parts as the adapters use them: the stamp (whole nanoseconds, seconds,
+exact text) and the frame name; and the closest of known names to a mistyped one."""
 
 from __future__ import annotations
+
+import difflib
 
 import numpy as np
 
@@ -30,3 +32,9 @@ def stamp_ns(stamp) -> int:
 def frame_name(name: str) -> str:
     """A frame name without ROS 1's leading '/'."""
     return name[1:] if name.startswith("/") else name
+
+
+def did_you_mean(name: str, names) -> str:
+    """': did you mean '/scan'?' for the closest of names to a mistyped one, else ''."""
+    close = difflib.get_close_matches(name, list(names), n=1, cutoff=0.6)
+    return f": did you mean {close[0]!r}?" if close else ""

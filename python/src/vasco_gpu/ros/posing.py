@@ -1,0 +1,207 @@
+"""The node's posing, without rclpy: a received scan read by its type's adapter (the message
+table), kept waiting until tf has its transform map_frame -> its frame (a cloud until its
+mount in base_frame is known), posed by tf lookups (one for all the waiting scans of a frame
+whose stamps tf covers), refused past transform_timeout; and the Path's poses checked. The node
+(node.py) feeds it messages and maps what it gives back.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .._errors import Error
+from ..msgs.cloud import cloud_mount
+from ..msgs.errors import BagError
+from ..msgs.geometry import planar
+from ..msgs.header import frame_name, stamp_ns, stamp_text
+from ..msgs.laser import COUNT_KEYS
+from ..msgs.path import path_poses
+from ..msgs.scan_options import ScanSettings
+from ..msgs.table import MessageType
+from ..msgs.tf import TfBuffer, static_mount
+
+__all__ = ["Pending", "Posing", "Refused", "scan_settings"]
+
+TF_KEEP_S = 60.0  # seconds of stamps each /tf link keeps
+
+
+class Refused(Error):
+    """A message the node does not map; the text names the topic and stamp, cause the kind."""
+
+    code = "bad input"
+
+    def __init__(self, text: str, cause: str = "bad messages"):
+        super().__init__(text)
+        self.cause = cause
+
+
+class Pending:
+    """A scan waiting for its transform until the deadline (monotonic seconds)."""
+
+    __slots__ = ("topic", "ns", "reading", "deadline", "received", "kind", "msg")
+
+    def __init__(self, topic, ns, reading, deadline, received, kind: MessageType, msg=None):
+        self.topic, self.ns, self.reading, self.deadline = topic, ns, reading, deadline
+        self.received = received  # when received, on perf_counter's clock (DDS's time in a batch)
+        self.kind = kind
+        self.msg = msg  # a message waiting for its mount (reading is None until read)
+
+
+def scan_settings(s) -> ScanSettings:
+    """The scan adapters' options from the node's settings."""
+    return ScanSettings(no_return=s.no_return, echo=s.echo, z_band=tuple(float(v) for v in s.z_band),
+                        cloud_angle_step=s.cloud_angle_step, cloud_range_max=float(s.cloud_range_max))
+
+
+class Posing:
+    """The scans waiting for their poses. settings_of(): the node's current settings; name_of(topic):
+    the topic's resolved name (for the texts); refuse(topic, cause, text): counts and logs a
+    message not mapped."""
+
+    def __init__(self, settings_of, name_of, refuse):
+        self.settings_of, self.name_of, self.refuse = settings_of, name_of, refuse
+        self.tf = TfBuffer(stamp_name="scan stamp", keep=TF_KEEP_S)
+        self.pending: list[Pending] = []
+        self.range_counts = dict.fromkeys(COUNT_KEYS, 0)
+        self._mounts: dict[str, np.ndarray | None] = {}
+        self._scan_settings = (None, None)  # (the node's settings, their ScanSettings)
+
+    def _options(self) -> ScanSettings:
+        s = self.settings_of()
+        if self._scan_settings[0] is not s:
+            self._scan_settings = (s, scan_settings(s))
+        return self._scan_settings[1]
+
+    def add_tf(self, msg, static: bool) -> None:
+        """A TFMessage; BagError for transforms refused."""
+        self.tf.add_message(msg, static)
+        if static:
+            self._mounts.clear()
+
+    def add_scan(self, msg, topic: str, kind: MessageType, received: float | None) -> None:
+        """A scan message of kind on topic: read now (a type that needs its mount, once that is
+        known) and kept until its pose is. received: when DDS received it (perf_counter)."""
+        ns = stamp_ns(msg.header.stamp)
+        reading = None
+        if not kind.mount:
+            try:
+                # the scan's name made only for a refusal: per scan it cost more than the reading
+                reading = kind.read(msg, self._options(), self.range_counts,
+                                    lambda what: Refused(f"{self.name_of(topic)}: {kind.noun} at stamp "
+                                                         f"{stamp_text(ns)} {what}"))
+            except Refused as e:
+                self.refuse(topic, f"bad {kind.noun}s", f"{e}; not mapped")  # the first of each topic
+                return
+            msg = None
+        now = time.perf_counter()
+        received = now if received is None else min(received, now)  # a batch's: when DDS received it
+        deadline = time.monotonic() - (now - received) + self.settings_of().transform_timeout
+        self.pending.append(Pending(topic, ns, reading, deadline, received, kind, msg))
+
+    def _where(self, p: Pending) -> str:
+        noun = p.kind.noun if p.msg is not None else "scan"
+        return f"{self.name_of(p.topic)}: {noun} at stamp {stamp_text(p.ns)}"
+
+    def _read_waiting(self, p: Pending) -> bool:
+        """Reads a message that waited for its mount; False while the mount is not known yet.
+        Raises Refused for one that cannot be read."""
+        s, frame = self.settings_of(), frame_name(p.msg.header.frame_id)
+        try:
+            mount = cloud_mount(self.tf, s.base_frame, frame)
+        except BagError as e:
+            if time.monotonic() < p.deadline:
+                return False
+            raise Refused(f"{self._where(p)} not mapped: its height band is in {s.base_frame!r}, and "
+                          f"there is no /tf_static chain {s.base_frame} -> {frame!r} within "
+                          f"transform_timeout: {e.message}", f"{p.kind.noun}s without a mount") from None
+        where = self._where(p)
+        p.reading = p.kind.read(p.msg, self._options(), self.range_counts,
+                                lambda what: Refused(f"{where} {what}; not mapped", f"bad {p.kind.noun}s"), mount)
+        p.msg = None
+        return True
+
+    def mount(self, frame: str):
+        """The laser frame in base_frame from /tf_static (cached until /tf_static changes)."""
+        if frame not in self._mounts:
+            try:
+                self._mounts[frame] = static_mount(None, self.tf, self.settings_of().base_frame, frame)
+            except BagError:
+                self._mounts[frame] = None
+        return self._mounts[frame]
+
+    def take_posed(self) -> list:
+        """[(pending, laser pose)] of every waiting scan whose transform is there, in the order
+        they were taken; drops those past their deadline, keeps the others waiting."""
+        now, keep, ready = time.monotonic(), [], []
+        for p in self.pending:
+            if p.msg is not None:
+                try:
+                    if not self._read_waiting(p):
+                        keep.append(p)
+                        continue
+                except Refused as e:
+                    self.refuse(p.topic, e.cause, str(e))
+                    continue
+            ready.append(p)
+        by_frame: dict[str, list[Pending]] = {}
+        for p in ready:
+            by_frame.setdefault(p.reading.frame, []).append(p)
+        posed = {}  # id(pending) -> laser pose
+        for frame, waiting in by_frame.items():
+            self._pose_frame(frame, waiting, now, keep, posed)
+        self.pending = keep
+        # in the order they were taken: each topic's in the order they came, a batch's topic by
+        # topic (sorted by DDS's reception times, the first scans of a replay came out of order)
+        return [(p, posed[id(p)]) for p in ready if id(p) in posed]
+
+    def _pose_frame(self, frame: str, waiting: list, now: float, keep: list, posed: dict) -> None:
+        """The laser poses of the waiting scans in one frame, by one tf lookup where every stamp
+        has its transform; the others one by one (each kept, or refused past its deadline)."""
+        target = self.settings_of().map_frame
+        ns = np.fromiter((p.ns for p in waiting), dtype=np.int64, count=len(waiting))
+        wait = self.tf.waiting_for(target, frame, ns)  # its /tf not there yet: no lookup until it is
+        try:
+            ok = ~wait & self.tf.covers(target, frame, ns)
+        except BagError:  # no chain to the frame (yet): each scan's own lookup says why
+            ok = np.zeros(len(ns), dtype=bool)
+        if ok.any():
+            try:
+                t, q = self.tf.lookup(target, frame, ns[ok])
+                poses = planar(None, t, q, f"the laser frame {frame!r} in {target!r}")
+                for p, pose in zip((p for p, k in zip(waiting, ok) if k), poses):
+                    posed[id(p)] = pose
+            except BagError:  # one of them refused (upside down): each its own below
+                ok[:] = False
+        for p, k, w in zip(waiting, ok, wait):
+            if k:
+                continue
+            if w and now < p.deadline:
+                keep.append(p)
+                continue
+            pose = self._pose_one(p, now)
+            if pose is not None:
+                posed[id(p)] = pose
+            elif now < p.deadline:
+                keep.append(p)
+
+    def _pose_one(self, p: Pending, now: float):
+        """One scan's laser pose; None while it has none (refused once past its deadline)."""
+        s = self.settings_of()
+        try:
+            t, q = self.tf.lookup(s.map_frame, p.reading.frame, [p.ns])
+            return planar(None, t, q, f"the laser frame {p.reading.frame!r} in {s.map_frame!r}")[0]
+        except BagError as e:
+            if now >= p.deadline:
+                where = f"{self.name_of(p.topic)}: scan at stamp {stamp_text(p.ns)}"
+                self.refuse(p.topic, "scans without a transform",
+                            f"{where} not mapped: no transform within transform_timeout "
+                            f"{s.transform_timeout:g} s: {e.message}")
+            return None
+
+
+def check_path(path, map_frame: str, topic: str):
+    """(stamps, base poses) of a Path read as arrays (path_cdr.PathArrays); Refused naming the
+    topic and stamp for a Path in another frame, a pose in another frame or not a number."""
+    return path_poses(path, map_frame, topic, Refused)

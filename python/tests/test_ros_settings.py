@@ -1,0 +1,213 @@
+"""The node's parameter schema (vasco_gpu/ros/settings.py) without a running node: each row's
+check refuses naming the row, rows of other components' options take those components' values,
+a change says what the node must do, the ROS descriptors, and docs/ros.md's table is the
+schema's."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+import vasco_gpu as vg
+from vasco_gpu.msgs.scan_options import SCAN_OPTIONS, check_cloud_options
+from vasco_gpu.ros.settings import (NODE_PARAMETERS, Effect, Number, Settings, SettingsError, core_option,
+                                    mapper_parameter_names, parameter_descriptor, parameter_table)
+
+ROOT = Path(__file__).resolve().parents[2]
+ROWS = {p.name: p for p in NODE_PARAMETERS}
+
+
+def test_settings_refuse_naming_the_parameter(tmp_path):
+    assert "vasco_resolution" in mapper_parameter_names() and "vasco_p_occ" in mapper_parameter_names()
+    s = Settings.from_values({}, {})
+    assert s.scan_topics == ["scan"] and s.map_mode == "trinary"
+    # resolution 0.05 by default, ROS's cell: CARMEN's 0.025 m evidence grid in blocks of 2
+    assert (s.params.resolution, s.params.downsample, s.params.map_resolution) == (0.025, 2, 0.05)
+    assert s.params == vg.Params(downsample=2)
+    for node, mapper, word in [({"map_mode": "ternary"}, {}, "map_mode"), ({"scan_topics": "scan"}, {}, "scan_topics"),
+                               ({"transform_timeout": -1.0}, {}, "transform_timeout"),
+                               ({"backend": "gpu9"}, {}, "backend"), ({}, {"vasco_p_occ": 1.5}, "vasco_p_occ"),
+                               ({}, {"vasco_resolutoin": 0.1}, "vasco_resolutoin"), ({}, {"p_occ": 0.6}, "p_occ"),
+                               ({"resolution": -0.05}, {}, "resolution"), ({"resolution": 1e-9}, {}, "resolution"),
+                               ({}, {"vasco_resolution": 0.05}, "vasco_resolution and resolution"),
+                               ({"free_thresh": 0.7}, {}, "free_thresh"),
+                               ({"param_file": str(tmp_path / "none.ini")}, {}, "param_file")]:
+        with pytest.raises(SettingsError, match=word):
+            Settings.from_values(node, mapper)
+    assert Settings.from_values({"resolution": 0}, {"vasco_resolution": 0.05}).params.map_resolution == 0.2
+    one = Settings.from_values({"resolution": 0.05}, {"vasco_downsample": 1}).params  # a given block stays
+    assert (one.resolution, one.downsample) == (0.05, 1)
+    ini = tmp_path / "carmen.ini"
+    ini.write_text("[*]\nvasco_resolution 0.1\nvasco_p_occ 0.8\n")
+    s = Settings.from_values({"param_file": str(ini), "resolution": 0}, {"vasco_p_occ": 0.6})
+    assert s.params.resolution == 0.1 and s.params.p_occ == 0.6  # given over the file
+    s = Settings.from_values({"param_file": str(ini)}, {})  # resolution over the file's vasco_resolution
+    assert (s.params.resolution, s.params.downsample, s.params.p_occ) == (0.05, 1, 0.8)  # round(0.05 / 0.1) = 1
+
+
+@pytest.mark.parametrize("p", NODE_PARAMETERS, ids=lambda p: p.name)
+def test_each_row_takes_its_default_and_refuses_by_its_name(p):
+    p.check(p.name, p.default)
+    for bad in (object(), None, True, float("nan")):
+        with pytest.raises(SettingsError, match=rf"^{p.name}: "):
+            p.check(p.name, bad)
+        with pytest.raises(SettingsError, match=rf"^{p.name}: "):
+            Settings.from_values({p.name: bad}, {})
+
+
+def test_the_refusals_words():
+    for name, value, words in [("map_mode", "ternary", "map_mode: 'ternary' is not one of trinary, scale"),
+                               ("transform_timeout", 0, "transform_timeout: 0 must be a finite number > 0"),
+                               ("scan_batch_interval", -0.1, "scan_batch_interval: -0.1 must be a finite number >= 0"),
+                               ("free_thresh", 1.5, "free_thresh: 1.5 must be between 0 and 1"),
+                               ("threads", 1.0, "threads: 1.0 must be a whole number in [0, 1024]"),
+                               ("max_memory", -1, "max_memory: -1 must be a whole number >= 0"),
+                               ("cloud_range_max", 2000.0,
+                                "cloud_range_max: 2000.0 must be a finite number in (0, 1000]"),
+                               ("z_band", [1.0, 0.5], "z_band: [1.0, 0.5] must be two finite heights [min, max], "
+                                                      "min < max"),
+                               ("map_frame", "/", "map_frame: '/' must be a frame name"),
+                               ("save_map_path", [""], "save_map_path: [''] must be a list of file names")]:
+        with pytest.raises(SettingsError) as e:
+            Settings.from_values({name: value}, {})
+        assert str(e.value) == words
+    with pytest.raises(SettingsError, match="^backend: 'gpu9' is not a backend "):
+        Settings.from_values({"backend": "gpu9"}, {})
+    with pytest.raises(SettingsError, match="nothing to map"):
+        Settings.from_values({"scan_topics": []}, {})
+
+
+def test_rows_of_other_components_take_their_values():
+    """The session's, the map output's and the pose source's options come from their C++
+    tables, the scan options from vasco_gpu.msgs: one default, one set of choices."""
+    for row, component, option in [("backend", "session", "backend"), ("cuda_mode", "session", "cuda_mode"),
+                                   ("max_memory", "session", "max_memory"), ("map_mode", "map_output", "mode"),
+                                   ("free_thresh", "map_output", "free_thresh"),
+                                   ("occupied_thresh", "map_output", "occupied_thresh"),
+                                   ("pose_max_gap", "pose_source", "pose_max_gap")]:
+        o = core_option(component, option)
+        assert set(o) >= {"name", "type", "default", "help", "choices", "lo", "hi"}, o
+        if o["choices"]:
+            assert set(ROWS[row].check.names) <= set(o["choices"]), row
+    assert ROWS["max_memory"].default == 2 << 30  # bytes, a ROS integer, whatever unit the table writes
+    assert (ROWS["free_thresh"].default, ROWS["occupied_thresh"].default) == (0.196, 0.65)
+    assert ROWS["map_mode"].check.names == ("trinary", "scale") and ROWS["map_mode"].default == "trinary"
+    assert set(ROWS["cuda_mode"].check.names) == {"float", "exact"} and ROWS["cuda_mode"].default == "float"
+    assert ROWS["backend"].default == "auto" and ROWS["pose_max_gap"].default == 5.0
+    for o in SCAN_OPTIONS:
+        want = list(o.default) if isinstance(o.default, tuple) else o.default
+        assert (ROWS[o.name].default, ROWS[o.name].help) == (want, o.meaning), o.name
+    with pytest.raises(KeyError, match="no 'nothing'"):
+        core_option("session", "nothing")
+
+
+def test_the_cloud_rows_bounds_are_the_adapters():
+    step, top = ROWS["cloud_angle_step"].check, ROWS["cloud_range_max"].check
+    band, angle, range_max = (0.2, 1.8), math.radians(1.0), 50.0
+    for degrees in (step.lo, step.hi, math.nextafter(step.lo, 0), math.nextafter(step.hi, 99)):
+        inside = step.lo <= degrees <= step.hi
+        try:
+            check_cloud_options(band, math.radians(degrees), range_max)
+            assert inside, degrees
+        except ValueError:
+            assert not inside, degrees
+    for metres in (top.hi, math.nextafter(top.hi, 1e9), 1e-9, 0.0):
+        inside = top.lo < metres <= top.hi
+        try:
+            check_cloud_options(band, angle, metres)
+            assert inside, metres
+        except ValueError:
+            assert not inside, metres
+
+
+def test_a_change_says_what_the_node_does():
+    s = Settings.from_values({"scan_batch_interval": 0.1}, {})
+    new, effects = s.changed({"map_update_interval": 0.2, "use_sim_time": True})  # not the node's: passed over
+    assert effects == (Effect.PUBLISH_PERIOD,) and new.map_update_interval == 0.2 and s.map_update_interval == 0.5
+    assert s.changed({"free_thresh": 0.25, "map_mode": "scale"})[1] == (Effect.REPUBLISH,)
+    assert s.changed({"scan_batch_interval": 0.0})[1] == (Effect.BATCH_PERIOD,)
+    assert s.changed({"scan_batch_interval": 0.1})[1] == ()  # the same value: nothing to do
+    assert s.changed({"save_map_path": ["a.pgm"]})[1] == ()  # read when used
+    assert s.changed({"resolution": 0.05})[1] == ()  # the same Params
+    new, effects = s.changed({"vasco_p_occ": 0.6, "map_update_interval": 1.0, "map_mode": "scale"})
+    assert effects == (Effect.REMAP, Effect.PUBLISH_PERIOD, Effect.REPUBLISH) and new.params.p_occ == 0.6
+    assert new.changed({"vasco_p_occ": None})[0].params == s.params  # unset: the default again
+    assert s.changed({"resolution": 0.1})[1] == (Effect.REMAP,)
+    with pytest.raises(SettingsError, match="^scan_topics: read-only while the node runs"):
+        s.changed({"scan_topics": ["other"]})
+    with pytest.raises(SettingsError, match="^vasco_p_occ"):
+        s.changed({"vasco_p_occ": 1.5})
+    with pytest.raises(SettingsError, match="vasco_resolution and resolution"):
+        s.changed({"vasco_resolution": 0.05})
+    with pytest.raises(SettingsError, match="must be below occupied_thresh"):
+        s.changed({"free_thresh": 0.9})  # taken whole or not at all
+
+
+def test_docs_ros_md_has_the_schemas_table():
+    """docs/ros.md's table of the node's own parameters is parameter_table()'s, line for line
+    (python -m vasco_gpu.ros.settings prints it)."""
+    text = (ROOT / "docs" / "ros.md").read_text()
+    table = parameter_table()
+    head = table.splitlines()[0]
+    assert head in text, "docs/ros.md has no table of the node's parameters"
+    start = text.index(head)
+    end = text.index("\n\n", start) + 1
+    assert text[start:end] == table, "docs/ros.md's table differs from the schema: python -m vasco_gpu.ros.settings"
+    assert [line.split("`")[1] for line in table.splitlines()[2:]] == list(ROWS)
+
+
+def test_the_ros_descriptors():
+    msgs = pytest.importorskip("rcl_interfaces.msg")
+    d = parameter_descriptor(ROWS["scan_topics"])
+    assert d.read_only and d.dynamic_typing and d.description == ROWS["scan_topics"].help
+    assert not d.floating_point_range and not d.integer_range
+    d = parameter_descriptor(ROWS["free_thresh"])
+    assert not d.read_only and d.additional_constraints == "between 0 and 1"
+    assert [(r.from_value, r.to_value) for r in d.floating_point_range] == [(0.0, 1.0)]
+    assert [(r.from_value, r.to_value) for r in parameter_descriptor(ROWS["threads"]).integer_range] == [(0, 1024)]
+    d = parameter_descriptor(ROWS["max_memory"])
+    assert [(r.from_value, r.to_value) for r in d.integer_range] == [(0, 2**63 - 1)]
+    d = parameter_descriptor(ROWS["transform_timeout"])  # > 0: ROS's ranges hold both ends
+    assert not d.floating_point_range and d.additional_constraints == "a finite number > 0"
+    assert parameter_descriptor(ROWS["map_mode"]).additional_constraints == "one of: trinary, scale"
+    assert isinstance(d, msgs.ParameterDescriptor)
+    assert Number(lo=0, hi=1, hi_open=True).ros_range() is None
+
+
+def test_declared_on_a_node(monkeypatch):
+    """declare_parameters on an rclpy Node: the rows' defaults, overrides checked in the
+    schema's words (a value outside a descriptor's range too), the mapper keys unset."""
+    import ros_support  # noqa: F401  (the ROS environment, before rclpy starts)
+
+    rclpy = ros_support.import_or_skip("rclpy")
+    from rclpy.context import Context
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+
+    from vasco_gpu.ros.settings import declare_parameters
+
+    context = Context()
+    rclpy.init(context=context)
+    try:
+        def declared(**overrides):
+            node = Node("settings_test", context=context,
+                        parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()])
+            try:
+                return declare_parameters(node), node.describe_parameter("free_thresh")
+            finally:
+                node.destroy_node()
+
+        s, d = declared()
+        assert s.node == {p.name: p.default for p in NODE_PARAMETERS} and s.given == {}
+        assert not d.read_only and d.floating_point_range[0].to_value == 1.0
+        s, _ = declared(free_thresh=0.25, z_band=[0.1, 2.0], vasco_p_occ=0.6, resolution=0)
+        assert (s.free_thresh, list(s.z_band), s.params.p_occ, s.resolution) == (0.25, [0.1, 2.0], 0.6, 0)
+        with pytest.raises(SettingsError) as e:
+            declared(free_thresh=1.5)  # outside the descriptor's range
+        assert str(e.value) == "free_thresh: 1.5 must be between 0 and 1"
+        with pytest.raises(SettingsError, match="^map_mode: 'raw' is not one of trinary, scale"):
+            declared(map_mode="raw")
+    finally:
+        rclpy.shutdown(context=context)
