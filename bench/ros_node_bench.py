@@ -98,7 +98,7 @@ def bench_one(player, log, name, batch, args, stamps, raw_path):
         player.wait_quiet(2.0)  # every scan mapped, the grid settled, the last map out
         lat = path_latencies(player, raw_path, args.paths)
         rc, _ = proc.interrupt(timeout=60)
-        line = next((ln for ln in proc.lines if ln.startswith("vasco_mapper: ") and " scans mapped" in ln), "")
+        line = next((ln for ln in proc.lines if ln.startswith("/vasco_mapper: ") and " scans mapped" in ln), "")
         mapped = line.split("vasco_mapper: ", 1)[1].split(" scans mapped")[0] if line else "?"
         return {"scans": f"{mapped}/{len(log)}", "cpu_idle": cpu_idle, "cpu_live": cpu_live, "cpu_fast": cpu_fast,
                 "scan": summary_value(line, "scan -> grid"), "path_p50": float(np.median(lat)),

@@ -12,8 +12,9 @@ import pytest
 
 import vasco_gpu as vg
 from vasco_gpu.msgs.scan_options import SCAN_OPTIONS, check_cloud_options
-from vasco_gpu.ros.settings import (NODE_PARAMETERS, Effect, Number, Settings, SettingsError, core_option,
-                                    mapper_parameter_names, parameter_descriptor, parameter_table)
+from vasco_gpu.ros.posing import ScanFilter
+from vasco_gpu.ros.settings import (NODE_PARAMETERS, Effect, Number, Settings, SettingsError, core_option, map_files,
+                                    mapper_parameter_names, parameter_descriptor, parameter_table, unknown_parameters)
 
 ROOT = Path(__file__).resolve().parents[2]
 ROWS = {p.name: p for p in NODE_PARAMETERS}
@@ -26,7 +27,7 @@ def test_settings_refuse_naming_the_parameter(tmp_path):
     # resolution 0.05 by default, ROS's cell: CARMEN's 0.025 m evidence grid in blocks of 2
     assert (s.params.resolution, s.params.downsample, s.params.map_resolution) == (0.025, 2, 0.05)
     assert s.params == vg.Params(downsample=2)
-    for node, mapper, word in [({"map_mode": "ternary"}, {}, "map_mode"), ({"scan_topics": "scan"}, {}, "scan_topics"),
+    for node, mapper, word in [({"map_mode": "ternary"}, {}, "map_mode"), ({"scan_topics": ""}, {}, "scan_topics"),
                                ({"transform_timeout": -1.0}, {}, "transform_timeout"),
                                ({"backend": "gpu9"}, {}, "backend"), ({}, {"vasco_p_occ": 1.5}, "vasco_p_occ"),
                                ({}, {"vasco_resolutoin": 0.1}, "vasco_resolutoin"), ({}, {"p_occ": 0.6}, "p_occ"),
@@ -50,7 +51,7 @@ def test_settings_refuse_naming_the_parameter(tmp_path):
 @pytest.mark.parametrize("p", NODE_PARAMETERS, ids=lambda p: p.name)
 def test_each_row_takes_its_default_and_refuses_by_its_name(p):
     p.check(p.name, p.default)
-    for bad in (object(), None, True, float("nan")):
+    for bad in (object(), None, "true" if isinstance(p.default, bool) else True, float("nan")):
         with pytest.raises(SettingsError, match=rf"^{p.name}: "):
             p.check(p.name, bad)
         with pytest.raises(SettingsError, match=rf"^{p.name}: "):
@@ -69,7 +70,7 @@ def test_the_refusals_words():
                                ("z_band", [1.0, 0.5], "z_band: [1.0, 0.5] must be two finite heights [min, max], "
                                                       "min < max"),
                                ("map_frame", "/", "map_frame: '/' must be a frame name"),
-                               ("save_map_path", [""], "save_map_path: [''] must be a list of file names")]:
+                               ("save_map_path", [""], "save_map_path: [''] must be a file name or a list of them")]:
         with pytest.raises(SettingsError) as e:
             Settings.from_values({name: value}, {})
         assert str(e.value) == words
@@ -211,3 +212,54 @@ def test_declared_on_a_node(monkeypatch):
             declared(map_mode="raw")
     finally:
         rclpy.shutdown(context=context)
+
+
+def test_slam_toolboxs_keys():
+    """slam_toolbox's keys with its meanings: one scan topic (scan_topics takes one name too),
+    max_laser_range the mapper's longest range, vasco_range_sure lowered with it (a note)."""
+    s = Settings.from_values({"scan_topic": "/front", "scan_topics": "/front"}, {})
+    assert s.scan_topics == ["/front"] and s.notes == ()
+    assert Settings.from_values({"scan_topics": "/a"}, {}).scan_topics == ["/a"]
+    with pytest.raises(SettingsError, match=r"^scan_topic '/front' and scan_topics \['/b'\] both name"):
+        Settings.from_values({"scan_topic": "/front", "scan_topics": ["/b"]}, {})
+    s = Settings.from_values({"max_laser_range": 8.0}, {})  # above range_sure 5: nothing lowered
+    assert (s.params.range_max, s.params.range_sure, s.notes) == (8.0, 5.0, ())
+    s = Settings.from_values({"max_laser_range": 4.0}, {})
+    assert (s.params.range_max, s.params.range_sure) == (4.0, 4.0)
+    assert s.notes == ("vasco_range_sure lowered from 5 to 4 m: max_laser_range 4 is below it",)
+    s = Settings.from_values({}, {"vasco_range_max": 3})  # lowered alone: range_sure follows
+    assert (s.params.range_max, s.params.range_sure) == (3, 3) and "vasco_range_max 3" in s.notes[0]
+    with pytest.raises(SettingsError, match="range_sure"):  # both given: the mapper's check, naming them
+        Settings.from_values({}, {"vasco_range_max": 3, "vasco_range_sure": 4})
+    with pytest.raises(SettingsError, match="vasco_range_max and max_laser_range 4 both set"):
+        Settings.from_values({"max_laser_range": 4.0}, {"vasco_range_max": 3})
+    s = Settings.from_values({"max_laser_range": 8.0}, {})
+    new, effects = s.changed({"max_laser_range": 4.0})
+    assert effects == (Effect.REMAP,) and new.params.range_sure == 4.0 and new.notes
+    for name, value in [("throttle_scans", 0), ("throttle_scans", 1.0), ("minimum_time_interval", -1.0),
+                        ("max_laser_range", -1.0), ("odom_frame", "")]:
+        with pytest.raises(SettingsError, match=f"^{name}: "):
+            Settings.from_values({name: value}, {})
+    with pytest.raises(SettingsError, match="read-only"):
+        s.changed({"tf_buffer_duration": 10.0})
+
+
+def test_the_scan_filter():
+    """throttle_scans: every Nth scan of a topic; minimum_time_interval: a scan within it of the
+    last one taken is skipped (a stamp far back is not within it)."""
+    f = ScanFilter()
+    got = [f.skip("a", i * 100_000_000, 2, 0.0) for i in range(5)]
+    assert got == [None, "scans skipped by throttle_scans", None, "scans skipped by throttle_scans", None]
+    f = ScanFilter()
+    got = [f.skip("a", i * 100_000_000, 1, 0.25) for i in range(7)]
+    assert [g is None for g in got] == [True, False, False, True, False, False, True]
+    assert f.skip("b", 0, 1, 0.25) is None  # per topic
+    assert f.skip("a", 0, 1, 0.25) is None  # 0.6 s back
+
+
+def test_save_map_path_forms_and_unknown_keys():
+    assert Settings.from_values({"save_map_path": "/maps/site"}, {}).save_map_path == ["/maps/site"]
+    assert map_files(["/maps/site", "a.PGM", "b.map.gz", "c.v2", "d.png"]) == [
+        "/maps/site.pgm", "a.PGM", "b.map.gz", "c.v2.pgm", "d.png"]
+    assert unknown_parameters(["scan_topci", "zzz"], list(ROWS)) == (
+        "unknown parameters (not used): scan_topci: did you mean 'scan_topic'?; zzz")

@@ -22,14 +22,14 @@ from std_srvs.srv import SetBool, Trigger
 
 from .. import _core
 from ..msgs.errors import BagError
-from ..msgs.header import stamp_text
+from ..msgs.header import stamp_ns, stamp_text
 from ..msgs.table import MESSAGE_TYPES, MessageType
 from .batches import Batches
 from .grid import fill_grid
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
-from .posing import Posing, Refused, check_path
-from .settings import Effect, Settings, SettingsError, declare_parameters
+from .posing import Posing, Refused, ScanFilter, check_path
+from .settings import Effect, Settings, SettingsError, declare_parameters, map_files, unknown_parameters
 from .tf_messages import tf_message_type
 from .transport import map_sized_shm_in_use
 
@@ -64,6 +64,9 @@ class MappingNode(Node):
         super().__init__(NODE_NAME, **node_kwargs)
         self.settings = declare_parameters(self)  # settings.py's rows and the mapper's keys, checked
         s = self.settings
+        self._check_unknown_parameters()
+        for note in s.notes:
+            self.get_logger().info(note)
         try:
             self.live = LiveMap(s.params, backend=s.backend, cuda_mode=s.cuda_mode, device=s.device,
                                 threads=s.threads, max_memory=s.max_memory)
@@ -71,6 +74,9 @@ class MappingNode(Node):
             raise SettingsError(f"backend {s.backend!r}: {e}") from None
         self.paused = False
         self.refused: dict[tuple[str, str], int] = {}
+        self.noted: dict[tuple[str, str], int] = {}  # scans mapped with a caveat (no mount)
+        self.scan_filter = ScanFilter()
+        self._path_before_scans = False  # logged once
         self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse)
         self._published = -1
         self._grid_msg = OccupancyGrid()  # /map's message, filled again for each map
@@ -104,10 +110,22 @@ class MappingNode(Node):
         self._arm()
         self.add_on_set_parameters_callback(self._on_parameters)
 
+    def _check_unknown_parameters(self) -> None:
+        """Parameters set for the node (a params file, the command line) that it does not
+        declare: one warning naming each, or with strict_parameters a start-up refusal."""
+        overrides = getattr(self, "_parameter_overrides", {})  # rclpy's: no public accessor
+        unknown = [n for n in overrides if not self.has_parameter(n) and not n.startswith("qos_overrides.")]
+        if not unknown:
+            return
+        text = unknown_parameters(unknown, self.list_parameters([], 0).names)
+        if self.settings.strict_parameters:
+            raise SettingsError(f"{text} (strict_parameters: true)")
+        self.get_logger().warning(f"{text}; strict_parameters:=true refuses them")
+
     def announce_ready(self) -> None:
         """The 'ready' line (tests and launch files wait for it), once the executor spins."""
         s = self.settings
-        topics = [t for kind in SCAN_TYPES for t in getattr(s, kind.topics)]
+        topics = [self.resolve_topic_name(t) for kind in SCAN_TYPES for t in getattr(s, kind.topics)]
         self.get_logger().info(
             f"ready: backend {self.live.backend}, scans on {', '.join(topics)}, poses from tf {s.map_frame} -> "
             f"the scans' frames and from the Path on "
@@ -132,6 +150,8 @@ class MappingNode(Node):
                 self.live.set_params(new.params)  # every stored scan mapped again
         except (SettingsError, LiveMapError, ValueError) as e:
             return SetParametersResult(successful=False, reason=str(e))
+        for note in set(new.notes) - set(self.settings.notes):
+            self.get_logger().info(note)
         for effect in effects:
             self._apply(effect, new)
         self.settings = new
@@ -224,8 +244,18 @@ class MappingNode(Node):
             self.refused[(topic, "paused")] = self.refused.get((topic, "paused"), 0) + 1
         return self.paused
 
+    def _skipped(self, msg, topic: str) -> bool:
+        """throttle_scans and minimum_time_interval (slam_toolbox's): a skipped scan is counted."""
+        s = self.settings
+        if s.throttle_scans == 1 and s.minimum_time_interval == 0:
+            return False
+        cause = self.scan_filter.skip(topic, stamp_ns(msg.header.stamp), s.throttle_scans, s.minimum_time_interval)
+        if cause:
+            self.refused[(topic, cause)] = self.refused.get((topic, cause), 0) + 1
+        return cause is not None
+
     def _on_scan(self, msg, topic: str, kind: MessageType, received: float | None = None) -> None:
-        if self._paused_on(topic):
+        if self._paused_on(topic) or self._skipped(msg, topic):
             return
         self.posing.add_scan(msg, topic, kind, received)
         self._pose_soon()
@@ -259,10 +289,14 @@ class MappingNode(Node):
         done = time.perf_counter()
         for (p, _), mount in zip(posed, mounts):
             self.scan_ms.append((done - p.received) * 1e3)
-            if mount is None:
-                self._refuse(p.topic, "scans without a mount",
-                             f"{self.resolve_topic_name(p.topic)}: no /tf_static chain {self.settings.base_frame} -> "
-                             f"{p.reading.frame}: its scans are mapped at their tf pose, a Path cannot move them")
+            if mount is None:  # mapped all the same: counted apart from the refusals
+                key = (p.topic, "without a mount")
+                self.noted[key] = self.noted.get(key, 0) + 1
+                if self.noted[key] == 1:
+                    self.get_logger().warning(
+                        f"{self.resolve_topic_name(p.topic)}: no /tf_static chain {self.settings.base_frame} -> "
+                        f"{p.reading.frame}: its scans are mapped at their tf pose, a Path cannot move them (further "
+                        f"ones are counted, not logged)")
 
     def _flush(self) -> None:
         """The batch: the scans gathered for it mapped (by the timer, and now before a Path, a
@@ -280,6 +314,11 @@ class MappingNode(Node):
             self._refuse(self.settings.path_topic, e.cause, f"{e}; ignored")
             return
         read = time.perf_counter()
+        if len(self.live) == 0 and not self._path_before_scans:
+            self._path_before_scans = True
+            self.get_logger().info(f"{self.resolve_topic_name(self.settings.path_topic)}: a Path before any scan was "
+                                   f"mapped: nothing to move (scans that come later are posed by tf until the next "
+                                   f"Path; logged once)")
         try:
             counts = self.live.repose(stamps, poses, int(self.settings.pose_max_gap * 1e9))
         except LiveMapError as e:
@@ -335,7 +374,7 @@ class MappingNode(Node):
         return {"finish": t1 - t0, "message": t2 - t1, "publish": time.perf_counter() - t2}
 
     def _save_map(self, request, response):
-        paths = self.settings.save_map_path
+        paths = map_files(self.settings.save_map_path)
         self._flush()
         m = self.live.finish()
         if not paths or m is None:
@@ -356,6 +395,7 @@ class MappingNode(Node):
         self._flush()  # the scans received before the reset are dropped with the others
         n = self.live.reset()
         self.posing.pending.clear()
+        self.scan_filter = ScanFilter()
         response.success, response.message = True, f"dropped {n} scans and the grid"
         self.get_logger().info(response.message)
         return response
@@ -371,7 +411,9 @@ class MappingNode(Node):
     def summary(self) -> str:
         """What the node did: scans mapped, what it refused, and its own latencies."""
         refused = ", ".join(f"{n} {cause} on {topic}" for (topic, cause), n in sorted(self.refused.items()))
-        text = f"{len(self.live)} scans mapped" + (f"; not mapped: {refused}" if refused else "")
+        noted = ", ".join(f"{n} {cause} on {topic}" for (topic, cause), n in sorted(self.noted.items()))
+        text = (f"{len(self.live)} scans mapped" + (f" ({noted}: a Path cannot move them)" if noted else "")
+                + (f"; not mapped: {refused}" if refused else ""))
         for what, ms in (("scan -> grid", self.scan_ms), ("Path -> /map published", self.path_ms)):
             if len(ms):
                 p50, p99 = np.percentile(np.asarray(ms), [50, 99])

@@ -22,9 +22,7 @@ from ..msgs.scan_options import ScanSettings
 from ..msgs.table import MessageType
 from ..msgs.tf import TfBuffer, static_mount
 
-__all__ = ["Pending", "Posing", "Refused", "scan_settings"]
-
-TF_KEEP_S = 60.0  # seconds of stamps each /tf link keeps
+__all__ = ["Pending", "Posing", "Refused", "ScanFilter", "scan_settings"]
 
 
 class Refused(Error):
@@ -55,6 +53,28 @@ def scan_settings(s) -> ScanSettings:
                         cloud_angle_step=s.cloud_angle_step, cloud_range_max=float(s.cloud_range_max))
 
 
+class ScanFilter:
+    """slam_toolbox's throttle_scans and minimum_time_interval, per topic: of the scans of a
+    topic, every Nth is taken (the first too), and of those, one whose stamp is within the
+    interval of the last one taken is skipped."""
+
+    def __init__(self):
+        self.count: dict[str, int] = {}
+        self.last: dict[str, int] = {}  # the stamp (ns) of the last scan taken
+
+    def skip(self, topic: str, ns: int, throttle: int, interval_s: float) -> str | None:
+        """None for a scan to map; else the cause of its skipping, as the summary counts it."""
+        n = self.count.get(topic, 0)
+        self.count[topic] = n + 1
+        if n % throttle:
+            return "scans skipped by throttle_scans"
+        last = self.last.get(topic)
+        if last is not None and abs(ns - last) < interval_s * 1e9:
+            return "scans within minimum_time_interval"
+        self.last[topic] = ns
+        return None
+
+
 class Posing:
     """The scans waiting for their poses. settings_of(): the node's current settings; name_of(topic):
     the topic's resolved name (for the texts); refuse(topic, cause, text): counts and logs a
@@ -62,7 +82,7 @@ class Posing:
 
     def __init__(self, settings_of, name_of, refuse):
         self.settings_of, self.name_of, self.refuse = settings_of, name_of, refuse
-        self.tf = TfBuffer(stamp_name="scan stamp", keep=TF_KEEP_S)
+        self.tf = TfBuffer(stamp_name="scan stamp", keep=settings_of().tf_buffer_duration)
         self.pending: list[Pending] = []
         self.range_counts = dict.fromkeys(COUNT_KEYS, 0)
         self._mounts: dict[str, np.ndarray | None] = {}

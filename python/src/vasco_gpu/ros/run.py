@@ -48,7 +48,8 @@ def main(argv=None) -> int:
         pass
     finally:
         if node is not None:
-            print(f"vasco_mapper: {node.summary()}", file=sys.stderr)
+            # the node's own name: renamed (__node) or in a namespace, it is not vasco_mapper
+            print(f"{node.get_fully_qualified_name()}: {node.summary()}", file=sys.stderr)
             node.destroy_node()
         rclpy.try_shutdown()
     return 0

@@ -25,10 +25,11 @@ from dataclasses import dataclass, field
 
 from .. import _core
 from .._errors import Error
+from ..msgs.header import did_you_mean
 from ..msgs.scan_options import SCAN_OPTIONS
 
 __all__ = ["NODE_PARAMETERS", "Effect", "NodeParameter", "Settings", "SettingsError", "core_option",
-           "declare_parameters", "mapper_parameter_names", "parameter_table"]
+           "declare_parameters", "map_files", "mapper_parameter_names", "parameter_table", "unknown_parameters"]
 
 
 class SettingsError(Error, ValueError):
@@ -127,17 +128,38 @@ class Text:
 
 
 @dataclass(frozen=True)
+class Flag:
+    """true or false (a ROS bool)."""
+
+    def __call__(self, name, v):
+        if not isinstance(v, bool):
+            raise SettingsError(f"{name}: {v!r} must be {self.rule()}")
+
+    def rule(self) -> str:
+        return "true or false"
+
+    def ros_range(self):
+        return None
+
+
+@dataclass(frozen=True)
 class Names:
-    """A list of non-empty strings: topic names or file names."""
+    """A list of non-empty strings: topic names or file names; single: one name alone is taken
+    as a list of it (a params file's ``scan_topics: /scan``)."""
 
     kind: str
+    single: bool = False
 
     def __call__(self, name, v):
         if not isinstance(v, (list, tuple)) or not all(isinstance(t, str) and t for t in v):
             raise SettingsError(f"{name}: {v!r} must be {self.rule()}")
 
     def rule(self) -> str:
-        return f"a list of {self.kind} names"
+        return f"a {self.kind} name or a list of them" if self.single else f"a list of {self.kind} names"
+
+    def as_list(self, v):
+        """v as the check takes it: one name a list of it, where single."""
+        return [v] if self.single and isinstance(v, str) and v else v
 
     def ros_range(self):
         return None
@@ -223,7 +245,9 @@ _SESSION = "session"
 _MAP_OUTPUT = "map_output"
 
 NODE_PARAMETERS = (
-    NodeParameter("scan_topics", ["scan"], Names("topic"), "sensor_msgs/LaserScan topics"),
+    NodeParameter("scan_topics", ["scan"], Names("topic", single=True), "sensor_msgs/LaserScan topics"),
+    NodeParameter("scan_topic", "", Text(), "slam_toolbox's key: the LaserScan topic, in place of scan_topics (both "
+                  "set name the same topic, or the start is refused); '': scan_topics"),
     NodeParameter("multi_echo_topics", [], Names("topic"),
                   "sensor_msgs/MultiEchoLaserScan topics (one echo a beam: echo)"),
     _from_scan("echo"),
@@ -241,11 +265,26 @@ NODE_PARAMETERS = (
                   "the map's cell size (m), /map's info.resolution, as log2map --resolution sets it (vasco_resolution "
                   "= resolution / vasco_downsample; the downsample kept where given, else max(1, round(resolution / "
                   "vasco_resolution))); 0: vasco_resolution x vasco_downsample alone", Effect.REMAP),
+    NodeParameter("max_laser_range", 0.0, Number(lo=0, words="a range in metres >= 0 (0: vasco_range_max)"),
+                  "slam_toolbox's key: the longest range mapped (m), vasco_range_max; vasco_range_sure is lowered to "
+                  "it where above it (logged once); 0: vasco_range_max alone", Effect.REMAP),
+    NodeParameter("minimum_time_interval", 0.0, Number(lo=0),
+                  "slam_toolbox's key: seconds; a scan whose stamp is closer than it to the last scan taken from its "
+                  "topic is skipped (counted, not mapped); 0: none skipped", Effect.READ_WHEN_USED),
+    NodeParameter("throttle_scans", 1, Number(lo=1, whole=True),
+                  "slam_toolbox's key: every Nth scan of a topic is mapped, the others skipped (counted); 1: each",
+                  Effect.READ_WHEN_USED),
     _from_scan("no_return"),
     NodeParameter("map_frame", "map", Text("frame"), "the fixed frame: the map's frame and the poses' frame"),
     NodeParameter("base_frame", "base_link", Text("frame"), "the robot's frame, whose poses the Path carries"),
+    NodeParameter("odom_frame", "odom", Text("frame"),
+                  "slam_toolbox's key, accepted and unused: the node publishes no transform (map -> odom is the "
+                  "localization's, REP 105) and looks scans up from map_frame, through odom where the tree has it"),
     NodeParameter("path_topic", "trajectory", Text(), "nav_msgs/Path of base_frame poses from the optimizer"),
     NodeParameter("transform_timeout", 0.5, _SECONDS, "seconds a scan waits for its transform map_frame -> its frame"),
+    # 60 s: a replay faster than real time still finds the transforms of the scans queued for it
+    NodeParameter("tf_buffer_duration", 60.0, _SECONDS,
+                  "seconds of stamps each /tf link keeps for the scans' lookups (tf2's cache time)"),
     NodeParameter("scan_batch_interval", 0.1, Number(lo=0),
                   "seconds scans gather before they are posed and mapped together (one tf lookup, one insert: less "
                   "CPU a scan); 0: each scan on arrival", Effect.BATCH_PERIOD),
@@ -259,8 +298,9 @@ NODE_PARAMETERS = (
     _from_core(_MAP_OUTPUT, "free_thresh", _bounds(), help="trinary: p below it is free (0)", effect=Effect.REPUBLISH),
     _from_core(_MAP_OUTPUT, "occupied_thresh", _bounds(), help="trinary: p above it is occupied (100)",
                effect=Effect.REPUBLISH),
-    NodeParameter("save_map_path", [], Names("file"),
-                  "the files ~/save_map writes, one transaction (.map.gz, .pgm, .png, ...)", Effect.READ_WHEN_USED),
+    NodeParameter("save_map_path", [], Names("file", single=True),
+                  "the files ~/save_map writes, one transaction (.map.gz, .pgm, .png, ...); a name without a map "
+                  "format's extension writes NAME.pgm + NAME.yaml, as map_saver", Effect.READ_WHEN_USED),
     NodeParameter("param_file", "", Text(), "a carmen.ini with vasco_* keys (as log2map's --param-file)"),
     NodeParameter("robot", "", Text(), "the carmen.ini robot section (as log2map's --robot)"),
     _from_core(_SESSION, "backend", lambda o: Choice(tuple(o["choices"]), "a backend")),
@@ -269,6 +309,9 @@ NODE_PARAMETERS = (
     _from_core(_SESSION, "threads", _bounds()),
     # bytes, a ROS integer (log2map's flag takes MiB)
     _from_core(_SESSION, "max_memory", _bounds(lo=0), help="bytes the session may hold (scans and grid); 0: no limit"),
+    NodeParameter("strict_parameters", False, Flag(),
+                  "a parameter the node does not know (a params file's, the command line's) refuses the start (exit "
+                  "2); false: one warning names them"),
 )
 
 _ROWS = {p.name: p for p in NODE_PARAMETERS}
@@ -290,6 +333,7 @@ class Settings:
     node: dict
     params: _core.Params
     given: dict = field(default_factory=dict)  # the mapper keys set as node parameters
+    notes: tuple = ()  # what the node changed on its own (a range lowered), for the log
 
     def __getattr__(self, name):
         try:
@@ -305,14 +349,21 @@ class Settings:
         node = {}
         for p in NODE_PARAMETERS:
             value = node_values.get(p.name, p.default)
+            value = p.check.as_list(value) if isinstance(p.check, Names) else value
             node[p.name] = value = list(value) if isinstance(value, tuple) else value
             p.check(p.name, value)
+        if node["scan_topic"]:  # slam_toolbox's one topic in place of ours
+            if node["scan_topics"] not in (_ROWS["scan_topics"].default, [node["scan_topic"]]):
+                raise SettingsError(f"scan_topic {node['scan_topic']!r} and scan_topics {node['scan_topics']} both "
+                                    f"name the LaserScan topics: set one")
+            node["scan_topics"] = [node["scan_topic"]]
         if not node["free_thresh"] < node["occupied_thresh"]:
             raise SettingsError(f"free_thresh {node['free_thresh']} must be below occupied_thresh "
                                 f"{node['occupied_thresh']}")
         if not node["scan_topics"] and not node["multi_echo_topics"] and not node["cloud_topics"]:
             raise SettingsError("scan_topics, multi_echo_topics and cloud_topics are all empty: nothing to map")
-        return cls(node, _mapper_params(node, mapper_values), dict(mapper_values))
+        params, notes = _mapper_params(node, mapper_values)
+        return cls(node, params, dict(mapper_values), notes)
 
     def changed(self, values: dict) -> tuple["Settings", tuple[Effect, ...]]:
         """These settings with values (name -> value) over them, validated whole, and what the
@@ -338,9 +389,10 @@ class Settings:
         return new, tuple(e for e in Effect if e in effects and e is not Effect.READ_WHEN_USED)
 
 
-def _mapper_params(node: dict, given: dict) -> _core.Params:
-    """The mapper's Params: given keys over the param_file over the defaults, then resolution
-    (the map's cell) by log2map --resolution's rule."""
+def _mapper_params(node: dict, given: dict) -> tuple[_core.Params, tuple]:
+    """(the mapper's Params, notes): given keys over the param_file over the defaults, then
+    resolution (the map's cell) by log2map --resolution's rule and max_laser_range (the longest
+    range); vasco_range_sure, where not given, lowered to a longest range below it (a note)."""
     unknown = sorted(set(given) - set(mapper_parameter_names()))
     if unknown:
         raise SettingsError(f"{unknown[0]}: not a mapper parameter ({', '.join(mapper_parameter_names())})")
@@ -348,6 +400,23 @@ def _mapper_params(node: dict, given: dict) -> _core.Params:
     if cell and "vasco_resolution" in given:
         raise SettingsError(f"vasco_resolution and resolution {node['resolution']} both set the cell size: set "
                             f"resolution (the map's cell), or resolution 0 to take vasco_resolution x vasco_downsample")
+    given = dict(given)
+    if node["max_laser_range"] > 0:
+        if "vasco_range_max" in given:
+            raise SettingsError(f"vasco_range_max and max_laser_range {node['max_laser_range']:g} both set the longest "
+                                f"range: set one (max_laser_range 0 takes vasco_range_max)")
+        given["vasco_range_max"] = node["max_laser_range"]
+    notes = ()
+    if "vasco_range_max" in given and "vasco_range_sure" not in given:
+        top, key = given["vasco_range_max"], "max_laser_range" if node["max_laser_range"] > 0 else "vasco_range_max"
+        sure = _params(node, {k: v for k, v in given.items() if k != "vasco_range_max"}, cell).range_sure
+        if isinstance(top, (int, float)) and 0 <= top < sure:
+            given["vasco_range_sure"] = top
+            notes = (f"vasco_range_sure lowered from {sure:g} to {top:g} m: {key} {top:g} is below it",)
+    return _params(node, given, cell), notes
+
+
+def _params(node: dict, given: dict, cell: dict) -> _core.Params:
     try:
         if node["param_file"]:
             if not os.path.isfile(node["param_file"]):
@@ -358,6 +427,19 @@ def _mapper_params(node: dict, given: dict) -> _core.Params:
         if isinstance(e, SettingsError):
             raise
         raise SettingsError(str(e)) from None
+
+
+def map_files(paths: list) -> list:
+    """save_map_path's files as the map writers take them: a name without a map format's
+    extension is map_saver's base name, NAME.pgm (its NAME.yaml written beside it)."""
+    known = tuple(f["extension"] for f in _core.map_formats())
+    return [p if p.lower().endswith(known) else p + ".pgm" for p in paths]
+
+
+def unknown_parameters(names, known) -> str:
+    """The text naming each of names (parameters set but not the node's), each with the closest
+    of known: "unknown parameters (not used): scan_topci: did you mean 'scan_topic'?; ..."."""
+    return "unknown parameters (not used): " + "; ".join(f"{n}{did_you_mean(n, known)}" for n in sorted(names))
 
 
 # -- ROS: the declarations ------------------------------------------------------------------------
