@@ -12,7 +12,7 @@ import pytest
 
 import vasco_gpu as vg
 from vasco_gpu.msgs.scan_options import SCAN_OPTIONS, check_cloud_options
-from vasco_gpu.ros.posing import ScanFilter
+from vasco_gpu.ros.posing import TIME_JUMP_S, Posing, ScanFilter, TimeJumps
 from vasco_gpu.ros.settings import (NODE_PARAMETERS, Effect, Number, Settings, SettingsError, core_option, map_files,
                                     mapper_parameter_names, parameter_descriptor, parameter_table, unknown_parameters)
 
@@ -255,6 +255,52 @@ def test_the_scan_filter():
     assert [g is None for g in got] == [True, False, False, True, False, False, True]
     assert f.skip("b", 0, 1, 0.25) is None  # per topic
     assert f.skip("a", 0, 1, 0.25) is None  # 0.6 s back
+
+
+def test_time_going_back_is_told_per_source():
+    """A stamp more than TIME_JUMP_S behind its own source's newest is a jump (not one behind
+    another source's); /clock gone back is one where the stamps seen lie ahead of it."""
+    s = 10**9
+    j = TimeJumps()
+    assert j.back("a", 100 * s) == 0 and j.back("b", 50 * s) == 0  # b behind a: another source
+    assert j.back("a", 99 * s) == 0  # within the bound: jitter, reordering
+    assert j.back("a", 101 * s) == 0 and j.back("a", 90 * s) == 11 * s
+    assert j.newest["a"] == 101 * s  # a jump is not taken as the newest: the node clears
+    assert j.ahead_of(101 * s) == 0 and j.ahead_of(100 * s + s // 2) == 0 and j.ahead_of(10 * s) == 91 * s
+    j.clear()
+    assert j.ahead_of(0) == 0 and j.back("a", 0) == 0
+    assert TIME_JUMP_S == 1.0 and "over 1 s" in ROWS["on_time_jump"].help
+    assert ROWS["on_time_jump"].default == "reset" and ROWS["on_time_jump"].effect is Effect.READ_WHEN_USED
+    with pytest.raises(SettingsError, match="^on_time_jump: 'drop' is not one of reset, keep"):
+        Settings.from_values({"on_time_jump": "drop"}, {})
+
+
+def _tf(parent, child, sec):
+    from types import SimpleNamespace as NS
+    return NS(header=NS(frame_id=parent, stamp=NS(sec=sec, nanosec=0)), child_frame_id=child,
+              transform=NS(translation=NS(x=float(sec), y=0.0, z=0.0), rotation=NS(x=0.0, y=0.0, z=0.0, w=1.0)))
+
+
+def test_a_jump_back_on_tf_clears_the_tf_history_but_not_tf_static():
+    from types import SimpleNamespace as NS
+    settings = Settings.from_values({}, {})
+    jumps = []
+
+    def jumped(where, back_ns):
+        jumps.append((where, back_ns))
+        posing.clear_time()  # what the node does
+
+    posing = Posing(lambda: settings, str, None, jumped)
+    posing.add_tf(NS(transforms=[_tf("base_link", "laser", 0)]), True)
+    for sec in (100, 101, 102):
+        posing.add_tf(NS(transforms=[_tf("map", "base_link", sec)]), False)
+    assert posing.tf.covers("map", "laser", [101 * 10**9]).all() and not jumps
+    posing.add_tf(NS(transforms=[_tf("map", "base_link", 100)]), False)  # a bag played again
+    assert jumps == [("/tf (frame 'base_link')", 2 * 10**9)]
+    assert not posing.tf.covers("map", "laser", [101 * 10**9]).any()  # the old time's samples gone
+    posing.add_tf(NS(transforms=[_tf("map", "base_link", 101)]), False)
+    t, _ = posing.tf.lookup("map", "laser", [100_500_000_000])
+    assert t[0][0] == pytest.approx(100.5) and len(jumps) == 1  # /tf_static kept; the new time goes on
 
 
 def test_save_map_path_forms_and_unknown_keys():

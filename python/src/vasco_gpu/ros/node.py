@@ -13,9 +13,11 @@ from array import array
 
 import numpy as np
 import rclpy
+from builtin_interfaces.msg import Time
 from nav_msgs.msg import MapMetaData, OccupancyGrid, Path
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.clock import Clock, ClockType
+from rclpy.clock import Clock, ClockType, JumpThreshold
+from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from std_srvs.srv import SetBool, Trigger
@@ -28,7 +30,7 @@ from .batches import Batches
 from .grid import fill_grid
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
-from .posing import Posing, Refused, ScanFilter, check_path
+from .posing import TIME_JUMP_S, Posing, Refused, ScanFilter, check_path
 from .settings import Effect, Settings, SettingsError, declare_parameters, map_files, unknown_parameters
 from .tf_messages import tf_message_type
 from .transport import map_sized_shm_in_use
@@ -77,8 +79,9 @@ class MappingNode(Node):
         self.noted: dict[tuple[str, str], int] = {}  # scans mapped with a caveat (no mount)
         self.scan_filter = ScanFilter()
         self._path_before_scans = False  # logged once
-        self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse)
+        self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse, self._time_jumped)
         self._published = -1
+        self._latest_stamp = None  # the newest stamp (ns) of the latest scans mapped: /map's under a silent /clock
         self._grid_msg = OccupancyGrid()  # /map's message, filled again for each map
         self._grid_data = None  # its data array, written again for a map of its size
         self._last_scan = 0.0
@@ -95,7 +98,11 @@ class MappingNode(Node):
         self.create_service(Trigger, "~/save_map", self._save_map)
         self.create_service(Trigger, "~/reset", self._reset)
         self.create_service(SetBool, "~/pause", self._pause)
-        self._timer = self.create_timer(s.map_update_interval, self._publish_if_changed)
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        # On the steady clock, as the batches below: with use_sim_time and no /clock (a bag
+        # paused or over, a simulator not publishing yet) ROS time stands still, and a timer on
+        # it would never publish a map.
+        self._timer = self.create_timer(s.map_update_interval, self._publish_if_changed, clock=steady)
         # Batches: every scan_batch_interval this timer takes what queued on /tf and the scan
         # topics (batches.py: they do not wake the node) and poses and maps those scans together
         # (one tf lookup, one insert: per scan, rclpy's wake-up, the callbacks' Python and the
@@ -104,9 +111,13 @@ class MappingNode(Node):
         # drops the scans past transform_timeout, running only while some wait. On the steady
         # clock: with use_sim_time and a paused (or absent) /clock, batches still come, and /tf
         # does not overflow its queue while it waits.
-        self._retry = self.create_timer(self._retry_period(s), self._flush,
-                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
+        self._retry = self.create_timer(self._retry_period(s), self._flush, clock=steady)
         self._retry.cancel()
+        # /clock going back (a bag played again with --clock): as tf2's buffer does, and as stamps
+        # going back do (posing.py); on_clock_change off: switching use_sim_time is no jump
+        self._clock_jumps = self.get_clock().create_jump_callback(
+            JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-int(TIME_JUMP_S * 1e9)),
+                          on_clock_change=False), post_callback=self._on_clock_jump)
         self._arm()
         self.add_on_set_parameters_callback(self._on_parameters)
 
@@ -255,7 +266,11 @@ class MappingNode(Node):
         return cause is not None
 
     def _on_scan(self, msg, topic: str, kind: MessageType, received: float | None = None) -> None:
-        if self._paused_on(topic) or self._skipped(msg, topic):
+        if self._paused_on(topic):
+            return
+        # before the skipping: after a jump, throttle_scans counts from the new time's first scan
+        self.posing.stamp_seen(("scan", topic), stamp_ns(msg.header.stamp), lambda: self.resolve_topic_name(topic))
+        if self._skipped(msg, topic):
             return
         self.posing.add_scan(msg, topic, kind, received)
         self._pose_soon()
@@ -286,6 +301,7 @@ class MappingNode(Node):
                          f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)} not mapped: {e}")
             return
         self._last_scan = time.monotonic()
+        self._latest_stamp = max(p.ns for p, _ in posed)
         done = time.perf_counter()
         for (p, _), mount in zip(posed, mounts):
             self.scan_ms.append((done - p.received) * 1e3)
@@ -367,11 +383,21 @@ class MappingNode(Node):
             return {}
         t1 = time.perf_counter()
         msg = self._grid_msg  # one message, filled again for each map
-        self._grid_data = fill_grid(msg, *got, frame=s.map_frame, stamp=self.get_clock().now().to_msg())
+        self._grid_data = fill_grid(msg, *got, frame=s.map_frame, stamp=self._map_stamp())
         t2 = time.perf_counter()
         self.map_pub.publish(msg)
         self.meta_pub.publish(msg.info)
         return {"finish": t1 - t0, "message": t2 - t1, "publish": time.perf_counter() - t2}
+
+    def _map_stamp(self) -> Time:
+        """/map's stamp: the node's clock (ROS time: sim time while /clock ticks, the last /clock
+        when it paused); while it reads 0 (use_sim_time before any /clock) the newest stamp of
+        the latest scans mapped, so that a map's stamp is a time of its data, which tf can look
+        up, not 0."""
+        now = self.get_clock().now()
+        if now.nanoseconds == 0 and self._latest_stamp is not None:
+            return Time(sec=self._latest_stamp // 10**9, nanosec=self._latest_stamp % 10**9)
+        return now.to_msg()
 
     def _save_map(self, request, response):
         paths = map_files(self.settings.save_map_path)
@@ -393,12 +419,40 @@ class MappingNode(Node):
 
     def _reset(self, request, response):
         self._flush()  # the scans received before the reset are dropped with the others
-        n = self.live.reset()
-        self.posing.pending.clear()
-        self.scan_filter = ScanFilter()
+        n = self._start_over()
         response.success, response.message = True, f"dropped {n} scans and the grid"
         self.get_logger().info(response.message)
         return response
+
+    def _start_over(self) -> int:
+        """A new map: the stored scans, the waiting ones and the skipping's counts dropped, and
+        the newest stamps forgotten (a replay after a reset is no jump); returns how many scans
+        were dropped."""
+        n = self.live.reset()
+        self.posing.pending.clear()
+        self.posing.jumps.clear()
+        self.scan_filter = ScanFilter()
+        self._latest_stamp = None
+        return n
+
+    def _time_jumped(self, where: str, back_ns: int) -> None:
+        """Stamps (or /clock) went back more than TIME_JUMP_S: tf's history cleared, as tf2 does;
+        on_time_jump reset: a new map (a bag played twice maps one pass), keep: the stored scans
+        stay (the same stamps twice: doubled evidence). One log line."""
+        self.posing.clear_time()
+        self.scan_filter = ScanFilter()
+        if self.settings.on_time_jump == "reset":
+            what = f"a new map ({self._start_over()} scans dropped; on_time_jump: reset)"
+        else:
+            what = f"the map keeps its {len(self.live)} scans (on_time_jump: keep)"
+        self.get_logger().warning(f"time went back {back_ns * 1e-9:.3f} s on {where}: tf's history cleared, {what}")
+
+    def _on_clock_jump(self, jump) -> None:
+        """/clock went back: a jump where the stamps seen lie ahead of the new time (none where
+        the scans or /tf told of it first)."""
+        back = self.posing.jumps.ahead_of(self.get_clock().now().nanoseconds)
+        if back:
+            self._time_jumped("/clock", back)
 
     def _pause(self, request, response):
         self._flush()  # the scans received before the pause are mapped

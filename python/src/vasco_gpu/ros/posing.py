@@ -1,8 +1,8 @@
 """The node's posing, without rclpy: a received scan read by its type's adapter (the message
 table), kept waiting until tf has its transform map_frame -> its frame (a cloud until its
 mount in base_frame is known), posed by tf lookups (one for all the waiting scans of a frame
-whose stamps tf covers), refused past transform_timeout; and the Path's poses checked. The node
-(node.py) feeds it messages and maps what it gives back.
+whose stamps tf covers), refused past transform_timeout; stamps that go back in time (a bag played again) noticed; and
+the Path's poses checked. The node (node.py) feeds it messages and maps what it gives back.
 """
 
 from __future__ import annotations
@@ -22,7 +22,12 @@ from ..msgs.scan_options import ScanSettings
 from ..msgs.table import MessageType
 from ..msgs.tf import TfBuffer, static_mount
 
-__all__ = ["Pending", "Posing", "Refused", "ScanFilter", "scan_settings"]
+__all__ = ["TIME_JUMP_S", "Pending", "Posing", "Refused", "ScanFilter", "TimeJumps", "scan_settings"]
+
+# Seconds a stamp may lie behind the newest one of its source (a scan topic, a /tf link) before
+# time counts as gone back: a driver's jitter or a reordered message stays far below a second,
+# a bag played again or a simulator restarted goes back by its whole run.
+TIME_JUMP_S = 1.0
 
 
 class Refused(Error):
@@ -75,14 +80,47 @@ class ScanFilter:
         return None
 
 
+class TimeJumps:
+    """Stamps going back in time, per source (a scan topic, a /tf link): each source's newest
+    stamp, and how far a new one lies behind it. A source's own stamps are compared (not all
+    sources' together): a link published late, or stamped behind the others, is no jump."""
+
+    def __init__(self, bound_s: float = TIME_JUMP_S):
+        self.bound_ns = int(bound_s * 1e9)
+        self.newest: dict = {}  # source -> its newest stamp (ns)
+
+    def back(self, source, ns: int) -> int:
+        """How far (ns) stamp ns of source lies behind that source's newest, where more than the
+        bound; else 0. Either way ns counts as seen."""
+        last = self.newest.get(source)
+        if last is None or ns >= last:
+            self.newest[source] = ns
+            return 0
+        return last - ns if last - ns > self.bound_ns else 0
+
+    def ahead_of(self, ns: int) -> int:
+        """How far (ns) the newest stamp seen lies ahead of ns (a /clock that went back to ns),
+        where more than the bound; else 0. 0 too where the stamps seen since the last clear are
+        already the new ones (the scans told of the jump before /clock did)."""
+        ahead = max(self.newest.values(), default=ns) - ns
+        return ahead if ahead > self.bound_ns else 0
+
+    def clear(self) -> None:
+        self.newest.clear()
+
+
 class Posing:
     """The scans waiting for their poses. settings_of(): the node's current settings; name_of(topic):
     the topic's resolved name (for the texts); refuse(topic, cause, text): counts and logs a
-    message not mapped."""
+    message not mapped; jumped(where, back_ns): stamps went back by more than TIME_JUMP_S (called
+    before the message that went back is taken)."""
 
-    def __init__(self, settings_of, name_of, refuse):
+    def __init__(self, settings_of, name_of, refuse, jumped=None):
         self.settings_of, self.name_of, self.refuse = settings_of, name_of, refuse
-        self.tf = TfBuffer(stamp_name="scan stamp", keep=settings_of().tf_buffer_duration)
+        self.jumped = jumped or (lambda where, back_ns: None)
+        self.jumps = TimeJumps()
+        self._statics: dict = {}  # child frame -> its latest /tf_static transform: kept over a clear
+        self.tf = self._new_tf()
         self.pending: list[Pending] = []
         self.range_counts = dict.fromkeys(COUNT_KEYS, 0)
         self._mounts: dict[str, np.ndarray | None] = {}
@@ -94,10 +132,36 @@ class Posing:
             self._scan_settings = (s, scan_settings(s))
         return self._scan_settings[1]
 
+    def _new_tf(self) -> TfBuffer:
+        tf = TfBuffer(stamp_name="scan stamp", keep=self.settings_of().tf_buffer_duration)
+        for ts in self._statics.values():
+            tf.add_transform(ts, True)
+        return tf
+
+    def clear_time(self) -> None:
+        """Time went back: tf's history of /tf dropped (its samples belong to the time before),
+        /tf_static kept, as tf2 clears its buffer on a jump back; the newest stamps forgotten."""
+        self.tf = self._new_tf()
+        self.jumps.clear()
+
+    def stamp_seen(self, source, ns: int, where) -> None:
+        """A stamp of source (("scan", topic) or ("tf", child frame)); where() names it for the
+        log. Calls jumped when it lies more than TIME_JUMP_S behind the source's newest."""
+        back = self.jumps.back(source, ns)
+        if back:
+            self.jumped(where(), back)
+            self.jumps.back(source, ns)  # the new time's first stamp
+
     def add_tf(self, msg, static: bool) -> None:
         """A TFMessage; BagError for transforms refused."""
+        if not static:
+            for ts in msg.transforms:
+                child = ts.child_frame_id
+                self.stamp_seen(("tf", child), stamp_ns(ts.header.stamp), lambda c=child: f"/tf (frame {c!r})")
         self.tf.add_message(msg, static)
         if static:
+            for ts in msg.transforms:
+                self._statics[frame_name(ts.child_frame_id)] = ts
             self._mounts.clear()
 
     def add_scan(self, msg, topic: str, kind: MessageType, received: float | None) -> None:

@@ -27,6 +27,7 @@ from .. import _core
 from .._errors import Error
 from ..msgs.header import did_you_mean
 from ..msgs.scan_options import SCAN_OPTIONS
+from .posing import TIME_JUMP_S
 
 __all__ = ["NODE_PARAMETERS", "Effect", "NodeParameter", "Settings", "SettingsError", "core_option",
            "declare_parameters", "map_files", "mapper_parameter_names", "parameter_table", "unknown_parameters"]
@@ -309,6 +310,10 @@ NODE_PARAMETERS = (
     _from_core(_SESSION, "threads", _bounds()),
     # bytes, a ROS integer (log2map's flag takes MiB)
     _from_core(_SESSION, "max_memory", _bounds(lo=0), help="bytes the session may hold (scans and grid); 0: no limit"),
+    NodeParameter("on_time_jump", "reset", Choice(("reset", "keep")),
+                  f"stamps (a scan topic's, a /tf link's) or /clock gone back over {TIME_JUMP_S:g} s (a bag played "
+                  "again): reset starts a new map (as ~/reset), keep maps on over the stored scans; both clear tf's "
+                  "history, as tf2 does", Effect.READ_WHEN_USED),
     NodeParameter("strict_parameters", False, Flag(),
                   "a parameter the node does not know (a params file's, the command line's) refuses the start (exit "
                   "2); false: one warning names them"),
