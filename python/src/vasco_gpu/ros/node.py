@@ -15,6 +15,7 @@ import numpy as np
 import rclpy
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import MapMetaData, OccupancyGrid, Path
+from nav_msgs.srv import GetMap
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType, JumpThreshold
 from rclpy.duration import Duration
@@ -30,7 +31,7 @@ from .batches import Batches
 from .grid import fill_grid
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
-from .posing import TIME_JUMP_S, Posing, Refused, ScanFilter, check_path
+from .posing import TIME_JUMP_S, Posing, Refused, ScanFilter, Unposed, check_path
 from .settings import Effect, Settings, SettingsError, declare_parameters, map_files, unknown_parameters
 from .tf_messages import tf_message_type
 from .transport import map_sized_shm_in_use
@@ -78,9 +79,12 @@ class MappingNode(Node):
         self.refused: dict[tuple[str, str], int] = {}
         self.noted: dict[tuple[str, str], int] = {}  # scans mapped with a caveat (no mount)
         self.scan_filter = ScanFilter()
+        self._kept_topics: set[str] = set()  # a scan of theirs kept for a Path logged
         self._path_before_scans = False  # logged once
-        self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse, self._time_jumped)
+        self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse, self._time_jumped,
+                             Unposed(self._unposed_room, self._unposed_dropped), self._kept)
         self._published = -1
+        self._map_sent = False  # _grid_msg published at least once: ~/dynamic_map serves it
         self._latest_stamp = None  # the newest stamp (ns) of the latest scans mapped: /map's under a silent /clock
         self._grid_msg = OccupancyGrid()  # /map's message, filled again for each map
         self._grid_data = None  # its data array, written again for a map of its size
@@ -95,6 +99,7 @@ class MappingNode(Node):
         self._batches.start(s.scan_batch_interval)
         self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
         self.meta_pub = self.create_publisher(MapMetaData, "map_metadata", LATCHED)
+        self.create_service(GetMap, "~/dynamic_map", self._dynamic_map)
         self.create_service(Trigger, "~/save_map", self._save_map)
         self.create_service(Trigger, "~/reset", self._reset)
         self.create_service(SetBool, "~/pause", self._pause)
@@ -246,7 +251,7 @@ class MappingNode(Node):
         except BagError as e:
             self._refuse(topic, "bad transforms", f"{topic}: {e.message}")
             return
-        if self.posing.pending:
+        if self.posing.pending or len(self.posing.unposed):
             self._pose_soon()
 
     def _paused_on(self, topic: str) -> bool:
@@ -275,15 +280,32 @@ class MappingNode(Node):
         self.posing.add_scan(msg, topic, kind, received)
         self._pose_soon()
 
+    def _unposed_room(self) -> int | None:
+        """Bytes the scans given up as to tf may hold: max_memory less what the map stores."""
+        return max(0, self.live.max_memory - self.live.bytes) if self.live.max_memory else None
+
+    def _kept(self, topic: str, text: str) -> None:
+        """A scan given up as to tf, kept for a Path: the first of each topic logged."""
+        if topic not in self._kept_topics:
+            self._kept_topics.add(topic)
+            self.get_logger().warning(f"{text} (further ones on {topic} are counted, not logged)")
+
+    def _unposed_dropped(self, p) -> None:
+        self._refuse(p.topic, "scans dropped for memory while waiting for a pose",
+                     f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)} dropped: the scans waiting "
+                     f"for a pose (no transform within transform_timeout, no Path yet) reached max_memory "
+                     f"{self.live.max_memory} bytes with the map; the oldest go first")
+
     def _pose_pending(self) -> None:
         """Maps every waiting scan whose transform is there; drops those past their deadline."""
-        if self.posing.pending:
+        if self.posing.pending or len(self.posing.unposed):
             self._insert(self.posing.take_posed())
         self._arm()
 
-    def _insert(self, posed: list) -> None:
+    def _insert(self, posed: list, timed: bool = True) -> None:
         """Maps the posed scans [(pending, laser pose)], in one insert; when that is refused
-        (max_memory), one by one, so that each refusal names its scan."""
+        (max_memory), one by one, so that each refusal names its scan. timed: their latency
+        counts in scan -> grid (not for scans a Path posed after they waited for it)."""
         if not posed:
             return
         mounts = [self.posing.mount(p.reading.frame) for p, _ in posed]
@@ -294,17 +316,19 @@ class MappingNode(Node):
         except LiveMapError as e:
             if len(posed) > 1:
                 for one in posed:
-                    self._insert([one])
+                    self._insert([one], timed)
                 return
             p = posed[0][0]
             self._refuse(p.topic, "scans over max_memory",
                          f"{self.resolve_topic_name(p.topic)}: scan at stamp {stamp_text(p.ns)} not mapped: {e}")
             return
         self._last_scan = time.monotonic()
+        self.posing.unposed.fit()  # the map took memory: the waiting scans' room is less
         self._latest_stamp = max(p.ns for p, _ in posed)
         done = time.perf_counter()
         for (p, _), mount in zip(posed, mounts):
-            self.scan_ms.append((done - p.received) * 1e3)
+            if timed:
+                self.scan_ms.append((done - p.received) * 1e3)
             if mount is None:  # mapped all the same: counted apart from the refusals
                 key = (p.topic, "without a mount")
                 self.noted[key] = self.noted.get(key, 0) + 1
@@ -329,6 +353,8 @@ class MappingNode(Node):
         except Refused as e:
             self._refuse(self.settings.path_topic, e.cause, f"{e}; ignored")
             return
+        # the scans no tf posed that the Path covers: mapped at its poses, then moved with the others
+        self._insert(self.posing.take_on_path(stamps, poses, int(self.settings.pose_max_gap * 1e9)), timed=False)
         read = time.perf_counter()
         if len(self.live) == 0 and not self._path_before_scans:
             self._path_before_scans = True
@@ -387,6 +413,7 @@ class MappingNode(Node):
         t2 = time.perf_counter()
         self.map_pub.publish(msg)
         self.meta_pub.publish(msg.info)
+        self._map_sent = True
         return {"finish": t1 - t0, "message": t2 - t1, "publish": time.perf_counter() - t2}
 
     def _map_stamp(self) -> Time:
@@ -398,6 +425,18 @@ class MappingNode(Node):
         if now.nanoseconds == 0 and self._latest_stamp is not None:
             return Time(sec=self._latest_stamp // 10**9, nanosec=self._latest_stamp % 10**9)
         return now.to_msg()
+
+    def _dynamic_map(self, request, response):
+        """GetMap, as slam_toolbox's dynamic_map: the map as of now, which is also the latest
+        /map (a change not yet published is published first, then that very message served;
+        one executor thread: no map is filled meanwhile). Before any map: an empty grid
+        (info.width 0), logged."""
+        self._publish_if_changed()
+        if self._map_sent:
+            response.map = self._grid_msg
+        else:
+            self.get_logger().info("~/dynamic_map: no map yet (no scan mapped): an empty grid served")
+        return response
 
     def _save_map(self, request, response):
         paths = map_files(self.settings.save_map_path)
@@ -430,6 +469,7 @@ class MappingNode(Node):
         were dropped."""
         n = self.live.reset()
         self.posing.pending.clear()
+        self.posing.unposed.clear()
         self.posing.jumps.clear()
         self.scan_filter = ScanFilter()
         self._latest_stamp = None
@@ -467,7 +507,9 @@ class MappingNode(Node):
         refused = ", ".join(f"{n} {cause} on {topic}" for (topic, cause), n in sorted(self.refused.items()))
         noted = ", ".join(f"{n} {cause} on {topic}" for (topic, cause), n in sorted(self.noted.items()))
         text = (f"{len(self.live)} scans mapped" + (f" ({noted}: a Path cannot move them)" if noted else "")
-                + (f"; not mapped: {refused}" if refused else ""))
+                + (f"; not mapped: {refused}" if refused else "")
+                + (f"; {len(self.posing.unposed)} scans waiting for a pose (no transform, no Path over their stamps)"
+                   if len(self.posing.unposed) else ""))
         for what, ms in (("scan -> grid", self.scan_ms), ("Path -> /map published", self.path_ms)):
             if len(ms):
                 p50, p99 = np.percentile(np.asarray(ms), [50, 99])

@@ -1,8 +1,9 @@
 """The node's posing, without rclpy: a received scan read by its type's adapter (the message
 table), kept waiting until tf has its transform map_frame -> its frame (a cloud until its
 mount in base_frame is known), posed by tf lookups (one for all the waiting scans of a frame
-whose stamps tf covers), refused past transform_timeout; stamps that go back in time (a bag played again) noticed; and
-the Path's poses checked. The node (node.py) feeds it messages and maps what it gives back.
+whose stamps tf covers), refused past transform_timeout (or, with a path_topic, kept for a later
+tf or Path: Unposed); stamps that go back in time (a bag played again) noticed; and the Path's
+poses checked. The node (node.py) feeds it messages and maps what it gives back.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import time
 
 import numpy as np
 
+from .. import _core
 from .._errors import Error
 from ..msgs.cloud import cloud_mount
 from ..msgs.errors import BagError
@@ -22,7 +24,7 @@ from ..msgs.scan_options import ScanSettings
 from ..msgs.table import MessageType
 from ..msgs.tf import TfBuffer, static_mount
 
-__all__ = ["TIME_JUMP_S", "Pending", "Posing", "Refused", "ScanFilter", "TimeJumps", "scan_settings"]
+__all__ = ["TIME_JUMP_S", "Pending", "Posing", "Refused", "ScanFilter", "TimeJumps", "Unposed", "scan_settings"]
 
 # Seconds a stamp may lie behind the newest one of its source (a scan topic, a /tf link) before
 # time counts as gone back: a driver's jitter or a reordered message stays far below a second,
@@ -50,6 +52,65 @@ class Pending:
         self.received = received  # when received, on perf_counter's clock (DDS's time in a batch)
         self.kind = kind
         self.msg = msg  # a message waiting for its mount (reading is None until read)
+
+
+# Bytes a scan waiting for a pose counts besides its ranges (as LiveMap's _SCAN_BYTES: stamp,
+# pose, mount, angles).
+_UNPOSED_BYTES = 8 * 9
+
+
+class Unposed:
+    """Scans that tf gave no pose within transform_timeout, kept (where a Path may still come)
+    until a later /tf or a Path covers their stamps. room(): the bytes they may hold (the
+    session's max_memory less what the map stores; None: no limit); past it the oldest are
+    dropped, each passed to dropped(pending)."""
+
+    def __init__(self, room=lambda: None, dropped=lambda p: None):
+        self.room, self.dropped = room, dropped
+        self.scans: list[Pending] = []  # oldest first
+        self.bytes = 0
+
+    def __len__(self) -> int:
+        return len(self.scans)
+
+    @staticmethod
+    def size(p: Pending) -> int:
+        return p.reading.ranges.nbytes + _UNPOSED_BYTES
+
+    def add(self, p: Pending) -> None:
+        self.scans.append(p)
+        self.bytes += self.size(p)
+        self.fit()
+
+    def fit(self) -> None:
+        """Drops the oldest while they hold more than room() (the newest may go too)."""
+        room = self.room()
+        while self.scans and room is not None and self.bytes > room:
+            self.bytes -= self.size(self.scans[0])
+            self.dropped(self.scans.pop(0))
+
+    def keep_only(self, kept: list) -> None:
+        self.scans = kept
+        self.bytes = sum(self.size(p) for p in kept)
+
+    def clear(self) -> None:
+        self.keep_only([])
+
+
+def laser_poses_on_path(scans: list, path_ns, path_poses, max_gap_ns: int, mount_of) -> list:
+    """The laser pose of each scan (Pending, read) on a Path of base poses: interpolated at its
+    stamp as LiveMap.repose moves a stored scan (_core._repose), composed with its mount
+    (mount_of(frame), None: unknown); None for a scan the Path does not pose (outside its span,
+    in a gap, no mount)."""
+    if not scans or len(path_ns) == 0:
+        return [None] * len(scans)
+    ns = np.fromiter((p.ns for p in scans), dtype=np.int64, count=len(scans))
+    mounts = np.array([(np.nan,) * 3 if m is None else m for m in (mount_of(p.reading.frame) for p in scans)],
+                      dtype=np.float64).reshape(-1, 3)
+    out = np.full((len(scans), 3), np.nan)
+    _core._repose(np.asarray(path_ns, dtype=np.int64), np.ascontiguousarray(path_poses, dtype=np.float64),
+                  ns, mounts, out, int(max_gap_ns))
+    return [row if np.isfinite(row).all() else None for row in out]
 
 
 def scan_settings(s) -> ScanSettings:
@@ -113,11 +174,14 @@ class Posing:
     """The scans waiting for their poses. settings_of(): the node's current settings; name_of(topic):
     the topic's resolved name (for the texts); refuse(topic, cause, text): counts and logs a
     message not mapped; jumped(where, back_ns): stamps went back by more than TIME_JUMP_S (called
-    before the message that went back is taken)."""
+    before the message that went back is taken); unposed: where scans that tf gave no pose in
+    time wait for a Path (with a path_topic; without one they are refused)."""
 
-    def __init__(self, settings_of, name_of, refuse, jumped=None):
+    def __init__(self, settings_of, name_of, refuse, jumped=None, unposed: Unposed | None = None, kept=None):
         self.settings_of, self.name_of, self.refuse = settings_of, name_of, refuse
+        self.kept = kept or (lambda topic, text: None)  # a scan given up as to tf, kept for a Path
         self.jumped = jumped or (lambda where, back_ns: None)
+        self.unposed = unposed if unposed is not None else Unposed()
         self.jumps = TimeJumps()
         self._statics: dict = {}  # child frame -> its latest /tf_static transform: kept over a clear
         self.tf = self._new_tf()
@@ -236,6 +300,7 @@ class Posing:
         for frame, waiting in by_frame.items():
             self._pose_frame(frame, waiting, now, keep, posed)
         self.pending = keep
+        ready += self._unposed_by_tf(posed)
         # in the order they were taken: each topic's in the order they came, a batch's topic by
         # topic (sorted by DDS's reception times, the first scans of a replay came out of order)
         return [(p, posed[id(p)]) for p in ready if id(p) in posed]
@@ -270,6 +335,47 @@ class Posing:
             elif now < p.deadline:
                 keep.append(p)
 
+    def _unposed_by_tf(self, posed: dict) -> list:
+        """The scans given up as to tf whose transform has come since: posed (one lookup a
+        frame, over the stamps tf now covers), taken from Unposed and returned; the others stay."""
+        if not self.unposed.scans:
+            return []
+        target, taken = self.settings_of().map_frame, []
+        by_frame: dict[str, list[Pending]] = {}
+        for p in self.unposed.scans:
+            by_frame.setdefault(p.reading.frame, []).append(p)
+        for frame, waiting in by_frame.items():
+            ns = np.fromiter((p.ns for p in waiting), dtype=np.int64, count=len(waiting))
+            try:
+                ok = ~self.tf.waiting_for(target, frame, ns) & self.tf.covers(target, frame, ns)
+                if not ok.any():
+                    continue
+                t, q = self.tf.lookup(target, frame, ns[ok])
+                poses = planar(None, t, q, f"the laser frame {frame!r} in {target!r}")
+            except BagError:  # no chain yet, or a pose refused: they wait for a Path
+                continue
+            for p, pose in zip((p for p, k in zip(waiting, ok) if k), poses):
+                posed[id(p)] = pose
+                taken.append(p)
+        if taken:
+            gone = {id(p) for p in taken}
+            self.unposed.keep_only([p for p in self.unposed.scans if id(p) not in gone])
+        return taken
+
+    def take_on_path(self, path_ns, path_poses, max_gap_ns: int) -> list:
+        """[(pending, laser pose)] of the scans still without a pose (waiting for tf, or given up
+        as to tf) that a Path poses, taken from both; the others stay as they were."""
+        posed = []
+        for store in (self.pending, self.unposed.scans):
+            read = [p for p in store if p.msg is None]
+            poses = laser_poses_on_path(read, path_ns, path_poses, max_gap_ns, self.mount)
+            posed += [(p, pose) for p, pose in zip(read, poses) if pose is not None]
+        if posed:
+            gone = {id(p) for p, _ in posed}
+            self.pending = [p for p in self.pending if id(p) not in gone]
+            self.unposed.keep_only([p for p in self.unposed.scans if id(p) not in gone])
+        return posed
+
     def _pose_one(self, p: Pending, now: float):
         """One scan's laser pose; None while it has none (refused once past its deadline)."""
         s = self.settings_of()
@@ -279,9 +385,13 @@ class Posing:
         except BagError as e:
             if now >= p.deadline:
                 where = f"{self.name_of(p.topic)}: scan at stamp {stamp_text(p.ns)}"
-                self.refuse(p.topic, "scans without a transform",
-                            f"{where} not mapped: no transform within transform_timeout "
-                            f"{s.transform_timeout:g} s: {e.message}")
+                why = f"no transform within transform_timeout {s.transform_timeout:g} s: {e.message}"
+                if s.path_topic:  # a later /tf or Path may pose it
+                    self.unposed.add(p)
+                    self.kept(p.topic, f"{where}: {why}; it waits for a pose from a later /tf or a Path on "
+                                       f"{self.name_of(s.path_topic)}")
+                else:
+                    self.refuse(p.topic, "scans without a transform", f"{where} not mapped: {why}")
             return None
 
 
