@@ -46,3 +46,27 @@ def cuda_or_skip():
     status = vg.cuda_available()
     if not status:
         pytest.skip(f"CUDA backend not usable here: {status.reason}")
+
+
+# The ROS 2 tests' two shared fixtures (each test file imports ros_support first, so the
+# environment is set before rclpy starts; rclpy and the player are imported here only when a
+# test asks for them, so the other tests run without ROS).
+@pytest.fixture(scope="module")
+def intel():
+    """The intel log at the node's default map cell, ROS's 0.05 m (the log's own keys give 0.1)."""
+    import vasco_gpu as vg
+
+    return vg.load_log(ROOT / "logs" / "intel.gfs.log.gz", map_resolution=0.05)
+
+
+@pytest.fixture(scope="module")
+def ros():
+    """rclpy started in this process for one test file, with the player that drives the node."""
+    import rclpy
+    from ros_player import Player
+
+    rclpy.init()
+    player = Player()
+    yield player
+    player.close()
+    rclpy.try_shutdown()

@@ -19,24 +19,9 @@ ros_support.import_or_skip("tf2_msgs")
 
 import vasco_gpu as vg  # noqa: E402
 from nav_msgs.srv import GetMap  # noqa: E402
-from ros_player import Player  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
-from test_ros_node import INTEL, assert_grid_matches, grid_equals  # noqa: E402
+from test_ros_node import assert_grid_matches, grid_equals  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def intel():
-    return vg.load_log(INTEL, map_resolution=0.05)
-
-
-@pytest.fixture(scope="module")
-def ros():
-    rclpy.init()
-    player = Player()
-    yield player
-    player.close()
-    rclpy.try_shutdown()
 
 
 @pytest.fixture(scope="module")

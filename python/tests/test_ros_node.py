@@ -31,7 +31,7 @@ rclpy = ros_support.import_or_skip("rclpy")
 ros_support.import_or_skip("tf2_msgs")
 
 import vasco_gpu as vg  # noqa: E402
-from ros_player import LATCHED, RELIABLE, Player  # noqa: E402
+from ros_player import LATCHED, RELIABLE  # noqa: E402
 from nav_msgs.msg import OccupancyGrid  # noqa: E402
 from std_srvs.srv import SetBool, Trigger  # noqa: E402
 
@@ -68,21 +68,6 @@ def grid_equals(want):
         got = np.frombuffer(bytes(msg.data), dtype=np.int8)
         return np.array_equal(got == -1, exp == -1) and int((got != exp).sum()) <= ANGLE_BOUND * got.size
     return match
-
-
-@pytest.fixture(scope="module")
-def intel():
-    """The log at the node's default map cell, ROS's 0.05 m (the log's own keys give 0.1)."""
-    return vg.load_log(INTEL, map_resolution=0.05)
-
-
-@pytest.fixture(scope="module")
-def ros():
-    rclpy.init()
-    player = Player()
-    yield player
-    player.close()
-    rclpy.try_shutdown()
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,6 @@ import threading
 import time
 
 import numpy as np
-import pytest
 
 import ros_support  # noqa: F401  (the ROS environment, before rclpy starts)
 from ros_support import ROS_ENV, NodeProcess
@@ -23,10 +22,10 @@ rclpy = ros_support.import_or_skip("rclpy")
 ros_support.import_or_skip("tf2_msgs")
 
 import vasco_gpu as vg  # noqa: E402
-from ros_player import RELIABLE, Player  # noqa: E402
+from ros_player import RELIABLE  # noqa: E402
 from sensor_msgs.msg import LaserScan  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
-from test_ros_node import INTEL, grid_equals  # noqa: E402
+from test_ros_node import grid_equals  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 from vasco_gpu.ros.settings import Settings  # noqa: E402
 
@@ -55,20 +54,6 @@ def slam_toolbox_params(path, out):
     text = "".join(f"    {k}: {v!r}\n" if isinstance(v, str) else f"    {k}: {v}\n" for k, v in keys.items())
     path.write_text("/**:\n  ros__parameters:\n" + text)
     return path
-
-
-@pytest.fixture(scope="module")
-def intel():
-    return vg.load_log(INTEL, map_resolution=0.05)
-
-
-@pytest.fixture(scope="module")
-def ros():
-    rclpy.init()
-    player = Player()
-    yield player
-    player.close()
-    rclpy.try_shutdown()
 
 
 def test_a_slam_toolbox_params_file(ros, intel, tmp_path):

@@ -17,7 +17,7 @@ rclpy = ros_support.import_or_skip("rclpy")
 ros_support.import_or_skip("tf2_msgs")
 
 import vasco_gpu as vg  # noqa: E402
-from ros_player import Player, stamp_of  # noqa: E402
+from ros_player import stamp_of  # noqa: E402
 from rosgraph_msgs.msg import Clock  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 from test_ros_node import INTEL, grid_equals, set_parameter  # noqa: E402
@@ -30,15 +30,6 @@ T0 = 10**12  # the pass's first stamp; its scans 0.1 s apart
 def intel():
     log = vg.load_log(INTEL, map_resolution=0.05)
     return log, log.scans.select(0, SCANS)
-
-
-@pytest.fixture(scope="module")
-def ros():
-    rclpy.init()
-    player = Player()
-    yield player
-    player.close()
-    rclpy.try_shutdown()
 
 
 @pytest.fixture(scope="module")
