@@ -12,25 +12,25 @@ import time
 from array import array
 
 import numpy as np
-import rclpy
 from builtin_interfaces.msg import Time
-from nav_msgs.msg import MapMetaData, OccupancyGrid, Path
+from nav_msgs.msg import Path
 from nav_msgs.srv import GetMap
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType, JumpThreshold
 from rclpy.duration import Duration
-from rclpy.node import Node
+from rclpy.lifecycle import LifecycleNode, TransitionCallbackReturn
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from std_srvs.srv import SetBool, Trigger
 
 from .. import _core
+from .._errors import Error
 from ..msgs.errors import BagError
 from ..msgs.header import stamp_ns, stamp_text
 from ..msgs.table import MESSAGE_TYPES, MessageType
 from .batches import Batches
-from .grid import fill_grid
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
+from .publication import MapPublication
 from .posing import TIME_JUMP_S, Posing, Refused, ScanFilter, Unposed, check_path
 from .settings import Effect, Settings, SettingsError, declare_parameters, map_files, unknown_parameters
 from .tf_messages import tf_message_type
@@ -39,8 +39,6 @@ from .transport import map_sized_shm_in_use
 __all__ = ["MappingNode"]
 
 NODE_NAME = "vasco_mapper"
-LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL,
-                     history=HistoryPolicy.KEEP_LAST)
 REPLAY = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
 # tf's queue and history are deeper than tf2's (100 messages, 10 s): a node busy for a moment, or
 # a replay faster than real time, must find the transforms of the scans still queued for it.
@@ -60,49 +58,64 @@ def message_class(kind: MessageType):
     return getattr(importlib.import_module(f"{kind.package}.msg"), kind.class_name)
 
 
-class MappingNode(Node):
-    """The node; construction raises SettingsError for a bad parameter (nothing started)."""
+class MappingNode(LifecycleNode):
+    """The node, a managed one: construction reads and checks the parameters (SettingsError for a
+    bad one, nothing started); configure makes the mapper, the outputs and the services,
+    activate subscribes and maps, deactivate stops mapping (the subscriptions dropped: scans sent
+    meanwhile are never mapped), cleanup and shutdown release the mapper. autostart (run.py)
+    configures and activates it at once."""
 
     def __init__(self, **node_kwargs):
         super().__init__(NODE_NAME, **node_kwargs)
         self.settings = declare_parameters(self)  # settings.py's rows and the mapper's keys, checked
-        s = self.settings
         self._check_unknown_parameters()
-        for note in s.notes:
+        for note in self.settings.notes:
             self.get_logger().info(note)
-        try:
-            self.live = LiveMap(s.params, backend=s.backend, cuda_mode=s.cuda_mode, device=s.device,
-                                threads=s.threads, max_memory=s.max_memory)
-        except (RuntimeError, ValueError) as e:  # e.g. cuda without a usable GPU
-            raise SettingsError(f"backend {s.backend!r}: {e}") from None
+        self.live: LiveMap | None = None  # configure's, until cleanup
+        self.active = False
+        self.configure_error = ""  # why the last configure failed
         self.paused = False
         self.refused: dict[tuple[str, str], int] = {}
         self.noted: dict[tuple[str, str], int] = {}  # scans mapped with a caveat (no mount)
-        self.scan_filter = ScanFilter()
         self._kept_topics: set[str] = set()  # a scan of theirs kept for a Path logged
         self._path_before_scans = False  # logged once
-        self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse, self._time_jumped,
-                             Unposed(self._unposed_room, self._unposed_dropped), self._kept)
-        self._published = -1
-        self._map_sent = False  # _grid_msg published at least once: ~/dynamic_map serves it
-        self._latest_stamp = None  # the newest stamp (ns) of the latest scans mapped: /map's under a silent /clock
-        self._grid_msg = OccupancyGrid()  # /map's message, filled again for each map
-        self._grid_data = None  # its data array, written again for a map of its size
         self._last_scan = 0.0
         self.scan_ms = array("d")  # callback -> scan in the grid, per scan
         self.path_ms: list[float] = []  # callback -> /map published, per Path
         # ... and its steps, per Path (ms): where a Path's time goes, in the summary
         self.path_steps: dict[str, list[float]] = {
             k: [] for k in ("batch", "read", "repose", "finish", "message", "publish")}
-        self._batches = Batches(self.context)
-        self._subscribe()
-        self._batches.start(s.scan_batch_interval)
-        self.map_pub = self.create_publisher(OccupancyGrid, "map", LATCHED)
-        self.meta_pub = self.create_publisher(MapMetaData, "map_metadata", LATCHED)
-        self.create_service(GetMap, "~/dynamic_map", self._dynamic_map)
-        self.create_service(Trigger, "~/save_map", self._save_map)
-        self.create_service(Trigger, "~/reset", self._reset)
-        self.create_service(SetBool, "~/pause", self._pause)
+        self._inputs: list = []  # activate's subscriptions
+        self._batches: Batches | None = None
+        self.add_on_set_parameters_callback(self._on_parameters)
+
+    # -- lifecycle: configure, activate, deactivate, cleanup, shutdown -----------------------------
+    def on_configure(self, state) -> TransitionCallbackReturn:
+        try:
+            self._configure()
+        except (SettingsError, LiveMapError, Error) as e:
+            self.configure_error = str(e)
+            self.get_logger().error(f"configure failed: {e}")
+            self._release()
+            return TransitionCallbackReturn.FAILURE
+        return TransitionCallbackReturn.SUCCESS
+
+    def _configure(self) -> None:
+        """The mapper (with load_session's scans), the outputs, the services, the timers."""
+        s = self.settings
+        try:
+            self.live = LiveMap(s.params, backend=s.backend, cuda_mode=s.cuda_mode, device=s.device,
+                                threads=s.threads, max_memory=s.max_memory)
+        except (RuntimeError, ValueError) as e:  # e.g. cuda without a usable GPU
+            raise SettingsError(f"backend {s.backend!r}: {e}") from None
+        self.scan_filter = ScanFilter()
+        self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse, self._time_jumped,
+                             Unposed(self._unposed_room, self._unposed_dropped), self._kept)
+        self._latest_stamp = None  # the newest stamp (ns) of the latest scans mapped: /map's under a silent /clock
+        self.out = MapPublication(self)
+        self._node_services = [self.create_service(kind, name, handler) for kind, name, handler in (
+            (GetMap, "~/dynamic_map", self._dynamic_map), (Trigger, "~/save_map", self._save_map),
+            (Trigger, "~/reset", self._reset), (SetBool, "~/pause", self._pause))]
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         # On the steady clock, as the batches below: with use_sim_time and no /clock (a bag
         # paused or over, a simulator not publishing yet) ROS time stands still, and a timer on
@@ -117,14 +130,65 @@ class MappingNode(Node):
         # clock: with use_sim_time and a paused (or absent) /clock, batches still come, and /tf
         # does not overflow its queue while it waits.
         self._retry = self.create_timer(self._retry_period(s), self._flush, clock=steady)
-        self._retry.cancel()
+        for timer in (self._timer, self._retry):
+            timer.cancel()  # activate starts them
         # /clock going back (a bag played again with --clock): as tf2's buffer does, and as stamps
         # going back do (posing.py); on_clock_change off: switching use_sim_time is no jump
         self._clock_jumps = self.get_clock().create_jump_callback(
             JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-int(TIME_JUMP_S * 1e9)),
                           on_clock_change=False), post_callback=self._on_clock_jump)
+
+    def on_activate(self, state) -> TransitionCallbackReturn:
+        self._subscribe()
+        self.active = True
+        self._timer.reset()
+        self._batches.start(self.settings.scan_batch_interval)
         self._arm()
-        self.add_on_set_parameters_callback(self._on_parameters)
+        self.announce_ready()
+        return super().on_activate(state)  # the lifecycle publishers
+
+    def on_deactivate(self, state) -> TransitionCallbackReturn:
+        self._flush()  # the scans received while active are mapped, and published
+        self._publish_if_changed(settle=False)
+        self._unsubscribe()
+        self.active = False
+        self._timer.cancel()
+        self._arm()
+        self.get_logger().info("inactive: scans are not mapped, maps not published until activated")
+        return super().on_deactivate(state)
+
+    def on_cleanup(self, state) -> TransitionCallbackReturn:
+        self._release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_shutdown(self, state) -> TransitionCallbackReturn:
+        if self.active:
+            self.on_deactivate(state)
+        self._release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def _release(self) -> None:
+        """What configure made, dropped: the mapper and its scans, the outputs, the services."""
+        if getattr(self, "_clock_jumps", None) is not None:
+            self._clock_jumps.unregister()
+            self._clock_jumps = None
+        for timer in (getattr(self, "_timer", None), getattr(self, "_retry", None)):
+            if timer is not None:
+                self.destroy_timer(timer)
+        self._timer = self._retry = None
+        for service in getattr(self, "_node_services", ()):
+            self.destroy_service(service)
+        self._node_services = []
+        if getattr(self, "out", None) is not None:
+            self.out.destroy()
+        self.out = None
+        self.live = None
+
+    def start(self) -> bool:
+        """autostart: configure and activate now; False (configure_error says why) if configure failed."""
+        if self.trigger_configure() != TransitionCallbackReturn.SUCCESS:
+            return False
+        return self.trigger_activate() == TransitionCallbackReturn.SUCCESS
 
     def _check_unknown_parameters(self) -> None:
         """Parameters set for the node (a params file, the command line) that it does not
@@ -162,7 +226,7 @@ class MappingNode(Node):
         """A change taken whole or refused whole: settings.py checks it and says what it asks."""
         try:
             new, effects = self.settings.changed({c.name: c.value for c in changed})
-            if Effect.REMAP in effects:
+            if Effect.REMAP in effects and self.live is not None:
                 self.live.set_params(new.params)  # every stored scan mapped again
         except (SettingsError, LiveMapError, ValueError) as e:
             return SetParametersResult(successful=False, reason=str(e))
@@ -174,16 +238,20 @@ class MappingNode(Node):
         return SetParametersResult(successful=True)
 
     def _apply(self, effect: Effect, new: Settings) -> None:
-        """What a parameter change asks of the running node, beside the mapper's (REMAP)."""
+        """What a parameter change asks of the running node, beside the mapper's (REMAP); an
+        unconfigured node reads the new values at configure, an inactive one at activate."""
+        if self.live is None:
+            return
         if effect is Effect.PUBLISH_PERIOD:
             self._timer.timer_period_ns = int(new.map_update_interval * 1e9)
         elif effect is Effect.BATCH_PERIOD:
             self._flush()  # the scans gathered so far, at the old period's settings
             self._retry.timer_period_ns = int(self._retry_period(new) * 1e9)
-            self._batches.start(new.scan_batch_interval)
+            if self.active:
+                self._batches.start(new.scan_batch_interval)
             self._arm()
         elif effect is Effect.REPUBLISH:
-            self._published = -1
+            self.out.again()
 
     # -- inputs -----------------------------------------------------------------------------
     @staticmethod
@@ -199,7 +267,7 @@ class MappingNode(Node):
 
     def _arm(self) -> None:
         """The batch timer runs while batches are taken, or some scan waits; else it sleeps."""
-        need = self._batches.running or bool(self.posing.pending)
+        need = self.active and (self._batches.running or bool(self.posing.pending))
         if need and self._retry.is_canceled():
             self._retry.reset()
         elif not need and not self._retry.is_canceled():
@@ -214,28 +282,39 @@ class MappingNode(Node):
             self._arm()
 
     def _subscribe(self) -> None:
+        """The inputs, made by activate (a batch takes /tf and the scans, batches.py)."""
         s = self.settings
+        self._batches = Batches(self.context)
+        made = self._inputs = []
         qos = SENSOR if s.scan_qos == "sensor_data" else REPLAY
         # tf first: rclpy's executor runs the ready callbacks of one wake-up in the order the
         # subscriptions were made, so a scan and the /tf of its stamp that came together are
         # taken tf first and the scan is mapped at once (a batch takes /tf after the scans)
         tf_type = tf_message_type()
-        self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC)
+        made.append(self.create_subscription(tf_type, "/tf_static", lambda m: self._on_tf(m, True), TF_STATIC))
         inputs = [(tf_type, "/tf", TF, lambda m, received: self._on_tf(m, False))]
         inputs += [(message_class(kind), t, qos, lambda m, received, t=t, k=kind: self._on_scan(m, t, k, received))
                    for kind in SCAN_TYPES if kind.batched for t in getattr(s, kind.topics)]
         for kind, topic, topic_qos, handler in inputs:
-            self._batches.add(self.create_subscription(kind, topic, lambda m, h=handler: self._on_input(h, m),
-                                                       topic_qos, callback_group=self._batches.group), handler)
+            made.append(self.create_subscription(kind, topic, lambda m, h=handler: self._on_input(h, m), topic_qos,
+                                                 callback_group=self._batches.group))
+            self._batches.add(made[-1], handler)
         # clouds (megabytes each) a callback each, as they come: their reading costs far more than
         # a wake-up, and a batch's queue of them would hold hundreds of megabytes
         alone_qos = qos_profile_sensor_data if s.scan_qos == "sensor_data" else REPLAY
         for kind in SCAN_TYPES:
             for topic in getattr(s, kind.topics) if not kind.batched else ():
-                self.create_subscription(message_class(kind), topic,
-                                         lambda m, t=topic, k=kind: self._on_scan(m, t, k), alone_qos)
+                made.append(self.create_subscription(message_class(kind), topic,
+                                                     lambda m, t=topic, k=kind: self._on_scan(m, t, k), alone_qos))
         if s.path_topic:  # as bytes: path_cdr.py reads them far faster than rclpy's objects
-            self.create_subscription(Path, s.path_topic, self._on_path, PATH, raw=True)
+            made.append(self.create_subscription(Path, s.path_topic, self._on_path, PATH, raw=True))
+
+    def _unsubscribe(self) -> None:
+        """Deactivate's: no input left, so nothing queues for the node while it is inactive."""
+        for sub in self._inputs:
+            self.destroy_subscription(sub)
+        self._inputs = []
+        self._batches.start(0)
 
     def _refuse(self, topic: str, cause: str, text: str) -> None:
         """Counts a message not mapped; logs the first of each (topic, cause)."""
@@ -341,7 +420,8 @@ class MappingNode(Node):
     def _flush(self) -> None:
         """The batch: the scans gathered for it mapped (by the timer, and now before a Path, a
         map, a save)."""
-        self._batches.take(self.settings.scan_batch_interval)
+        if self.active:
+            self._batches.take(self.settings.scan_batch_interval)
         self._pose_pending()
 
     def _on_path(self, raw: bytes) -> None:
@@ -397,24 +477,7 @@ class MappingNode(Node):
                 self.live.settle()
             except LiveMapError as e:
                 self.get_logger().warning(f"grid not rendered again after growing: {e}")
-        if self.live.version == self._published:
-            return {}
-        s = self.settings
-        t0 = time.perf_counter()
-        # the data written again into the last map's array where the size is the same (that
-        # message was published, that is serialised, by then)
-        got = self.live.finish_grid(s.map_mode, s.free_thresh, s.occupied_thresh, out=self._grid_data)
-        self._published = self.live.version
-        if got is None:
-            return {}
-        t1 = time.perf_counter()
-        msg = self._grid_msg  # one message, filled again for each map
-        self._grid_data = fill_grid(msg, *got, frame=s.map_frame, stamp=self._map_stamp())
-        t2 = time.perf_counter()
-        self.map_pub.publish(msg)
-        self.meta_pub.publish(msg.info)
-        self._map_sent = True
-        return {"finish": t1 - t0, "message": t2 - t1, "publish": time.perf_counter() - t2}
+        return self.out.publish(self.live, self.settings, self._map_stamp())
 
     def _map_stamp(self) -> Time:
         """/map's stamp: the node's clock (ROS time: sim time while /clock ticks, the last /clock
@@ -432,8 +495,8 @@ class MappingNode(Node):
         one executor thread: no map is filled meanwhile). Before any map: an empty grid
         (info.width 0), logged."""
         self._publish_if_changed()
-        if self._map_sent:
-            response.map = self._grid_msg
+        if self.out.sent:
+            response.map = self.out.grid_msg
         else:
             self.get_logger().info("~/dynamic_map: no map yet (no scan mapped): an empty grid served")
         return response
@@ -506,10 +569,11 @@ class MappingNode(Node):
         """What the node did: scans mapped, what it refused, and its own latencies."""
         refused = ", ".join(f"{n} {cause} on {topic}" for (topic, cause), n in sorted(self.refused.items()))
         noted = ", ".join(f"{n} {cause} on {topic}" for (topic, cause), n in sorted(self.noted.items()))
-        text = (f"{len(self.live)} scans mapped" + (f" ({noted}: a Path cannot move them)" if noted else "")
+        stored = len(self.live) if self.live is not None else 0  # 0 after cleanup
+        text = (f"{stored} scans mapped" + (f" ({noted}: a Path cannot move them)" if noted else "")
                 + (f"; not mapped: {refused}" if refused else "")
                 + (f"; {len(self.posing.unposed)} scans waiting for a pose (no transform, no Path over their stamps)"
-                   if len(self.posing.unposed) else ""))
+                   if self.live is not None and len(self.posing.unposed) else ""))
         for what, ms in (("scan -> grid", self.scan_ms), ("Path -> /map published", self.path_ms)):
             if len(ms):
                 p50, p99 = np.percentile(np.asarray(ms), [50, 99])

@@ -42,7 +42,13 @@ def main(argv=None) -> int:
             return 0
         executor = SingleThreadedExecutor()
         executor.add_node(node)
-        node.announce_ready()  # only now: a signal from here on ends the spin cleanly
+        # only now: a signal from here on ends the spin cleanly; activate logs the ready line
+        if not node.settings.autostart:
+            node.get_logger().info("unconfigured (autostart: false): waiting for a lifecycle manager to configure "
+                                   "and activate the node")
+        elif not node.start():
+            print(f"vasco_mapper: {node.configure_error or 'activation failed'}", file=sys.stderr)
+            return 2
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

@@ -183,6 +183,26 @@ class Band:
         return None
 
 
+@dataclass(frozen=True)
+class Pair:
+    """[] or two finite numbers [a, b]; positive: both > 0. what: the refusal's words for them."""
+
+    what: str
+    positive: bool = False
+
+    def __call__(self, name, v):
+        numbers = isinstance(v, (list, tuple)) and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)
+        if not (numbers and len(v) in (0, 2) and (not self.positive or all(x > 0 for x in v))):
+            raise SettingsError(f"{name}: {v!r} must be {self.rule()}")
+
+    def rule(self) -> str:
+        return f"[] or {self.what}" + (" (both > 0)" if self.positive else "")
+
+    def ros_range(self):
+        return None
+
+
 # -- the rows -------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class NodeParameter:
@@ -190,7 +210,7 @@ class NodeParameter:
 
     name: str
     default: object
-    check: object  # Number, Choice, Text, Names or Band: check(name, value) raises SettingsError
+    check: object  # Number, Choice, Text, Names, Band or Pair: check(name, value) raises SettingsError
     help: str
     effect: Effect | None = None
 
@@ -299,6 +319,12 @@ NODE_PARAMETERS = (
     _from_core(_MAP_OUTPUT, "free_thresh", _bounds(), help="trinary: p below it is free (0)", effect=Effect.REPUBLISH),
     _from_core(_MAP_OUTPUT, "occupied_thresh", _bounds(), help="trinary: p above it is occupied (100)",
                effect=Effect.REPUBLISH),
+    NodeParameter("map_size", [], Pair("[width, height] in metres", positive=True),
+                  "a fixed grid: /map keeps this size, axis-aligned at map_origin (which it needs), while the scans "
+                  "fall inside it (cells beyond it are not mapped, as CARMEN's fixed grids); []: the grid grows with "
+                  "the scans, in large steps (docs/ros.md)"),
+    NodeParameter("map_origin", [], Pair("[x, y] in metres"),
+                  "the fixed grid's lower-left corner in map_frame (with map_size)"),
     NodeParameter("save_map_path", [], Names("file", single=True),
                   "the files ~/save_map writes, one transaction (.map.gz, .pgm, .png, ...); a name without a map "
                   "format's extension writes NAME.pgm + NAME.yaml, as map_saver", Effect.READ_WHEN_USED),
@@ -314,6 +340,15 @@ NODE_PARAMETERS = (
                   f"stamps (a scan topic's, a /tf link's) or /clock gone back over {TIME_JUMP_S:g} s (a bag played "
                   "again): reset starts a new map (as ~/reset), keep maps on over the stored scans; both clear tf's "
                   "history, as tf2 does", Effect.READ_WHEN_USED),
+    NodeParameter("session_path", "", Text(),
+                  "the file ~/save_session writes (stored scans, stamps, mounts, poses and the mapper parameters; one "
+                  "transaction); '': ~/save_session refuses", Effect.READ_WHEN_USED),
+    NodeParameter("load_session", "", Text(),
+                  "a file ~/save_session wrote, restored at configure: the first /map equals the last one before "
+                  "the restart; '': a new map"),
+    NodeParameter("autostart", True, Flag(),
+                  "configure and activate at start, as slam_toolbox; false: unconfigured until a lifecycle manager "
+                  "(nav2's) configures and activates it"),
     NodeParameter("strict_parameters", False, Flag(),
                   "a parameter the node does not know (a params file's, the command line's) refuses the start (exit "
                   "2); false: one warning names them"),
@@ -362,6 +397,9 @@ class Settings:
                 raise SettingsError(f"scan_topic {node['scan_topic']!r} and scan_topics {node['scan_topics']} both "
                                     f"name the LaserScan topics: set one")
             node["scan_topics"] = [node["scan_topic"]]
+        if bool(node["map_size"]) != bool(node["map_origin"]):
+            raise SettingsError(f"map_size {node['map_size']} and map_origin {node['map_origin']} go together: a fixed "
+                                f"grid needs both, a growing one neither")
         if not node["free_thresh"] < node["occupied_thresh"]:
             raise SettingsError(f"free_thresh {node['free_thresh']} must be below occupied_thresh "
                                 f"{node['occupied_thresh']}")
