@@ -1,15 +1,19 @@
 """The ROS 2 tests' and the node benchmark's own node: publishes scans, tf and Paths, records
-/map, calls the node's services. Import ros_support first (the environment)."""
+/map as a subscriber with nav2's subscribe_to_updates has it (each /map, and each map_updates
+message applied to a copy of the map before it), calls the node's services. Import ros_support
+first (the environment)."""
 
 from __future__ import annotations
 
 import math
 import threading
+from array import array
 import time
 
 import numpy as np
 import rclpy
 from builtin_interfaces.msg import Time
+from map_msgs.msg import OccupancyGridUpdate
 from geometry_msgs.msg import PoseStamped, TransformStamped
 from nav_msgs.msg import OccupancyGrid
 from nav_msgs.msg import Path as PathMsg
@@ -20,6 +24,11 @@ from tf2_msgs.msg import TFMessage
 
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 RELIABLE = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+UPDATES = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+
+
+def _ns(stamp) -> int:
+    return stamp.sec * 10**9 + stamp.nanosec
 
 
 def stamp_of(ns: int):
@@ -41,9 +50,13 @@ class Player:
         self.tf_static = n.create_publisher(TFMessage, "/tf_static", LATCHED)
         self.cloud = n.create_publisher(PointCloud2, "points", RELIABLE)
         self.path = n.create_publisher(PathMsg, "trajectory", QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE))
-        self.maps: list[tuple[float, OccupancyGrid]] = []
+        self.maps: list[tuple[float, OccupancyGrid]] = []  # full maps and maps with an update applied
+        self.full_maps = self.updates = 0
+        self.update_bytes = 0
+        self._full_stamp = -1
         self.lock = threading.Lock()
         n.create_subscription(OccupancyGrid, "map", self._on_map, LATCHED)
+        n.create_subscription(OccupancyGridUpdate, "map_updates", self._on_update, UPDATES)
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(n)
         self.thread = threading.Thread(target=self.executor.spin, daemon=True)
@@ -52,6 +65,29 @@ class Player:
     def _on_map(self, msg):
         with self.lock:
             self.maps.append((time.monotonic(), msg))
+            self.full_maps += 1
+            self._full_stamp = _ns(msg.header.stamp)
+
+    def _on_update(self, u):
+        """The latest map with u applied, as a new map (its header u's). An update stamped before
+        the latest full map is one that map already holds (the two topics are not ordered with
+        respect to each other) and is dropped."""
+        now = time.monotonic()
+        with self.lock:
+            if not self.maps or _ns(u.header.stamp) < self._full_stamp:
+                return
+            base = self.maps[-1][1]
+            info = base.info
+            cells = np.frombuffer(bytes(base.data), dtype=np.int8).reshape(info.height, info.width).copy()
+            assert u.x >= 0 and u.y >= 0 and u.x + u.width <= info.width and u.y + u.height <= info.height, \
+                f"update {u.x},{u.y} {u.width}x{u.height} outside the {info.width}x{info.height} map"
+            cells[u.y:u.y + u.height, u.x:u.x + u.width] = np.frombuffer(bytes(u.data), dtype=np.int8).reshape(
+                u.height, u.width)
+            m = OccupancyGrid(header=u.header, info=info)
+            m.data = array("b", cells.tobytes())
+            self.maps.append((now, m))
+            self.updates += 1
+            self.update_bytes += len(u.data)
 
     def map_count(self) -> int:
         with self.lock:

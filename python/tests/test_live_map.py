@@ -175,3 +175,52 @@ def test_without_rclpy_the_node_says_how_to_install_it():
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert r.returncode == 1
     assert "rclpy does not import" in r.stderr and "pip install '.[ros]' ./ros/tf2_msgs" in r.stderr
+
+
+def test_a_fixed_frame_reaches_the_mapper_and_none_is_never_passed(monkeypatch):
+    log = vg.load_log(CASES["intel.gfs__vasco_default_ds4"][0])
+    scans = log.scans.select(0, 60)
+    frame = vg.Frame(900, 700, log.params.resolution)
+    live = LiveMap(log.params, backend="cpu_double", frame=frame)
+    feed(live, scans, np.arange(60))
+    fixed = vg.Mapper(log.params, backend="cpu_double", frame=frame)
+    fixed.insert(scans)
+    m = live.finish()
+    assert (m.size_x, m.size_y) == (fixed.finish().size_x, fixed.finish().size_y)
+    assert m.sha256() == fixed.finish().sha256() and live.mapper.frame.size_x == 900
+    seen = []
+    real = vg._core.Mapper
+
+    def recording(*args, **kwargs):
+        seen.append(sorted(k for k in kwargs if k.startswith("frame")))
+        kwargs.pop("frame_centre", None)  # a Mapper that may not take it yet: what was passed is the test
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(vg._core, "Mapper", recording)
+    LiveMap(log.params, backend="cpu_double")
+    LiveMap(log.params, backend="cpu_double", frame=frame, frame_centre=(1.0, 2.0))
+    assert seen == [[], ["frame", "frame_centre"]]
+
+
+def test_restore_maps_the_saved_scans_with_the_saved_parameters_or_changes_nothing():
+    from vasco_gpu.ros.session_file import SavedSession
+
+    log = vg.load_log(CASES["intel.gfs__vasco_default_ds4"][0])
+    scans = log.scans.select(0, 50)
+    p = vg.Params(resolution=0.05, p_occ=0.7)
+    live = LiveMap(p, backend="cpu_double")
+    feed(live, scans, np.arange(50) * 7, (0.1, 0, 0))
+    saved = SavedSession.of(live)
+    fresh = vg.Mapper(p, backend="cpu_double")
+    fresh.insert(scans)
+    restored = LiveMap(log.params, backend="cpu_double")
+    restored.restore(saved)
+    assert restored.finish().sha256() == fresh.finish().sha256()
+    assert list(restored.stamps) == list(np.arange(50) * 7) and list(restored.mounts[:3]) == [0.1, 0, 0]
+    with pytest.raises(LiveMapError, match="already stores 50 scans"):
+        restored.restore(saved)
+    small = LiveMap(log.params, backend="cpu_double")
+    small.max_memory = 1000  # our own store's bound: far less than 50 scans
+    with pytest.raises(LiveMapError, match="max_memory"):
+        small.restore(saved)
+    assert len(small) == 0 and small.mapper.params.to_dict() == log.params.to_dict()

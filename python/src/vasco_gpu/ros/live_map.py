@@ -38,15 +38,24 @@ class LiveMap:
 
     ``add`` stores one scan at its laser pose (with its mount in the base frame, when known, so a
     Path of base poses can move it); ``repose`` applies a Path; ``set_params`` re-renders every
-    stored scan with new mapper parameters; ``finish`` gives the map to publish."""
+    stored scan with new mapper parameters; ``finish`` gives the map to publish; ``restore`` maps a
+    saved session (session_file) into a new one. ``frame`` (a fixed grid) and ``frame_centre``
+    go to the Mapper only when given."""
 
     def __init__(self, params: _core.Params, *, backend: str = "auto", cuda_mode: str = "float",
-                 device: int = 0, threads: int = 0, max_memory: int = _DEFAULT_MAX_MEMORY):
+                 device: int = 0, threads: int = 0, max_memory: int = _DEFAULT_MAX_MEMORY,
+                 frame: _core.Frame | None = None, frame_centre=None):
         self.max_memory = int(max_memory)
+        # What the session was asked for (a saved session carries it: session_file); max_memory
+        # is read from the attribute, which a caller may lower.
+        self.options = {"backend": backend, "cuda_mode": cuda_mode, "device": int(device), "threads": int(threads)}
+        # A fixed grid: passed only when given, so a Mapper without these keywords still works
+        # for every caller that gives none.
+        fixed = {k: v for k, v in (("frame", frame), ("frame_centre", frame_centre)) if v is not None}
         # cuda_mode and device are ignored by the CPU backends. A live map is a workload without
         # end (expected_renders=0): auto weighs the GPU's start-up against no known amount of work.
         self.mapper = _core.Mapper(params, backend=backend, cuda_mode=cuda_mode, threads=threads, cuda_device=device,
-                                   max_memory_bytes=self.max_memory, expected_renders=0)
+                                   max_memory_bytes=self.max_memory, expected_renders=0, **fixed)
         self.version = 0  # changes whenever the grid does
         self._clear()
 
@@ -101,6 +110,28 @@ class LiveMap:
         self.ranges.extend(ranges)
         self.bytes += more
         self.version += 1
+
+    def restore(self, saved) -> None:
+        """Stores a saved session's scans (session_file.load_session's SavedSession: stamps,
+        laser poses, mounts, angles, ranges) in one insert, mapped with the saved mapper
+        parameters, so that the grid is a fresh map of them: log2map's map of the saved file, and
+        the saved LiveMap's own finish when it was settled (or last rendered) before the save.
+        Only into a LiveMap that stores no scan; LiveMapError (nothing changed) otherwise, or
+        when max_memory or the mapper refuses the scans."""
+        if len(self):
+            raise LiveMapError(f"restore: this session already stores {len(self)} scans; restore into a new one")
+        old = self.mapper.params
+        if saved.params.to_dict() != old.to_dict():
+            self.set_params(saved.params)
+        if len(saved) == 0:
+            return
+        ranges = np.split(saved.ranges, np.cumsum(saved.beam_counts)[:-1])
+        try:
+            self.add_many(saved.stamps, saved.poses, ranges, saved.first_angle, saved.angle_step, saved.mounts)
+        except LiveMapError:
+            if saved.params.to_dict() != old.to_dict():
+                self.set_params(old)
+            raise
 
     def _pose_array(self) -> np.ndarray:
         return np.frombuffer(self.poses, dtype=np.float64).reshape(-1, 3)

@@ -28,6 +28,7 @@ from ..msgs.errors import BagError
 from ..msgs.header import stamp_ns, stamp_text
 from ..msgs.table import MESSAGE_TYPES, MessageType
 from .batches import Batches
+from .canvas import fixed_frame
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
 from .publication import MapPublication
@@ -103,16 +104,17 @@ class MappingNode(LifecycleNode):
     def _configure(self) -> None:
         """The mapper (with load_session's scans), the outputs, the services, the timers."""
         s = self.settings
+        frame, centre = fixed_frame(s.map_size, s.map_origin, s.params)  # (None, None): a grid that grows
         try:
             self.live = LiveMap(s.params, backend=s.backend, cuda_mode=s.cuda_mode, device=s.device,
-                                threads=s.threads, max_memory=s.max_memory)
+                                threads=s.threads, max_memory=s.max_memory, frame=frame, frame_centre=centre)
         except (RuntimeError, ValueError) as e:  # e.g. cuda without a usable GPU
             raise SettingsError(f"backend {s.backend!r}: {e}") from None
         self.scan_filter = ScanFilter()
         self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse, self._time_jumped,
                              Unposed(self._unposed_room, self._unposed_dropped), self._kept)
         self._latest_stamp = None  # the newest stamp (ns) of the latest scans mapped: /map's under a silent /clock
-        self.out = MapPublication(self)
+        self.out = MapPublication(self, fixed=frame is not None)
         self._node_services = [self.create_service(kind, name, handler) for kind, name, handler in (
             (GetMap, "~/dynamic_map", self._dynamic_map), (Trigger, "~/save_map", self._save_map),
             (Trigger, "~/reset", self._reset), (SetBool, "~/pause", self._pause))]
@@ -531,6 +533,7 @@ class MappingNode(LifecycleNode):
         the newest stamps forgotten (a replay after a reset is no jump); returns how many scans
         were dropped."""
         n = self.live.reset()
+        self.out.reset()
         self.posing.pending.clear()
         self.posing.unposed.clear()
         self.posing.jumps.clear()

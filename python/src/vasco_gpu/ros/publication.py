@@ -1,63 +1,114 @@
 """The node's map outputs: /map and /map_metadata (latched), map_updates (the cells changed since
-the last message, as map_msgs/OccupancyGridUpdate) and the message ~/dynamic_map serves. Made by
-the node's configure, published through lifecycle publishers (nothing goes out while the node
-is inactive), dropped by its cleanup."""
+the last message, as map_msgs/OccupancyGridUpdate: nav2's static layer reads it with
+subscribe_to_updates) and the message ~/dynamic_map serves. The geometry /map keeps and the
+updates are the canvas's (canvas.py); this file puts them in messages. Made by the node's
+configure, published through lifecycle publishers (nothing goes out while the node is
+inactive), dropped by its cleanup."""
 
 from __future__ import annotations
 
 import time
+from array import array
 
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import MapMetaData, OccupancyGrid
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
+from .canvas import Canvas, FullMap, fill_update
 from .grid import fill_grid
+from .tf_messages import map_update_type
 
 __all__ = ["MapPublication"]
 
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL,
                      history=HistoryPolicy.KEEP_LAST)
+# What nav2's static layer subscribes map_updates with (rclcpp's default: reliable, volatile,
+# depth 10): an update is relative to the one before, so none may be dropped by the QoS; a
+# subscriber that joins late starts from the latched /map and the updates after it.
+UPDATES = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE,
+                     history=HistoryPolicy.KEEP_LAST)
 
 
 class MapPublication:
-    """/map of a node's LiveMap: ``publish`` sends what changed since the last publication."""
+    """/map and map_updates of a node's LiveMap: ``publish`` sends what changed since the last
+    publication. fixed: the mapper's frame never moves (map_size), so /map keeps its geometry."""
 
-    def __init__(self, node):
+    def __init__(self, node, fixed: bool):
         self._node = node
         self.map_pub = node.create_lifecycle_publisher(OccupancyGrid, "map", LATCHED)
         self.meta_pub = node.create_lifecycle_publisher(MapMetaData, "map_metadata", LATCHED)
+        update_type = map_update_type()
+        self.update_pub = node.create_lifecycle_publisher(update_type, "map_updates", UPDATES)
+        self.canvas = Canvas(fixed=fixed)
         self._published = -1  # the LiveMap version last published
+        self._renders = -1  # the mapper's full renders then: more since is a full /map
         self.sent = False  # grid_msg published at least once: ~/dynamic_map serves it
-        self.grid_msg = OccupancyGrid()  # /map's message, filled again for each map
-        self._grid_data = None  # its data array, written again for a map of its size
+        self.grid_msg = OccupancyGrid()  # /map's message, filled again for each full map
+        self.update_msg = update_type()
+        self.counts = {"maps": 0, "updates": 0, "map_bytes": 0, "update_bytes": 0}
+        self._finished = None  # the finish's buffer, written again for a map of its size
+        self._subscribers = 0  # /map's, at the last publication
+        self._updated = False  # updates sent since the last full map
 
     def destroy(self) -> None:
-        self._node.destroy_lifecycle_publisher(self.map_pub)
-        self._node.destroy_lifecycle_publisher(self.meta_pub)
+        for pub in (self.map_pub, self.meta_pub, self.update_pub):
+            self._node.destroy_lifecycle_publisher(pub)
 
     def again(self) -> None:
-        """The next publish sends the map even where the grid did not change (map_mode)."""
+        """The next publish sends a full map even where the grid did not change (map_mode)."""
+        self._published = -1
+
+    def reset(self) -> None:
+        """A new map (~/reset, a time jump): the next map is a full one of its own size."""
+        self.canvas.reset()
         self._published = -1
 
     def publish(self, live, settings, stamp: Time) -> dict:
-        """Publishes /map and /map_metadata when live's grid changed since the last publication.
-        Returns the seconds of its steps (finish, message, publish); empty when nothing was
-        published."""
-        if live.version == self._published:
+        """Publishes what changed in live's grid since the last publication: a full /map (and
+        /map_metadata) after a render of every scan (a Path, new parameters) or a change of
+        geometry, else the changed rectangle on map_updates. Returns the seconds of its steps
+        (finish, message, publish); empty when nothing was published."""
+        # A subscriber that joined since got the latched /map, without the updates sent after it:
+        # it gets the map as it is now, in one piece (nav2's static layer joining late).
+        subscribers = self.map_pub.get_subscription_count()
+        joined, self._subscribers = subscribers > self._subscribers and self._updated, subscribers
+        if live.version == self._published and not joined:
             return {}
         s = settings
         t0 = time.perf_counter()
-        # the data written again into the last map's array where the size is the same (that
-        # message was published, that is serialised, by then)
-        got = live.finish_grid(s.map_mode, s.free_thresh, s.occupied_thresh, out=self._grid_data)
-        self._published = live.version
+        got = live.finish_grid(s.map_mode, s.free_thresh, s.occupied_thresh, out=self._finished)
+        full = joined or self._published == -1 or live.mapper.renders != self._renders
+        self._published, self._renders = live.version, live.mapper.renders
         if got is None:
             return {}
+        if not isinstance(got[1], array):  # a new size: a buffer of it, written again next time
+            self._finished = array("b", got[1])
+            got = (got[0], self._finished)
+        geometry = self.canvas.geometry
+        if geometry is not None and geometry[2] != got[0][2]:
+            self.canvas.reset()  # a new cell size: a canvas of the map's own size (its margin was in cells)
+        out = self.canvas.publish(got, live.mapper.frame, full=full)
+        if out is None:
+            return {}
         t1 = time.perf_counter()
-        msg = self.grid_msg  # one message, filled again for each map
-        self._grid_data = fill_grid(msg, *got, frame=s.map_frame, stamp=stamp)
-        t2 = time.perf_counter()
-        self.map_pub.publish(msg)
-        self.meta_pub.publish(msg.info)
-        self.sent = True
+        if isinstance(out, FullMap):
+            # the canvas's own array: the message then always holds the last /map with the
+            # updates since applied, which is what ~/dynamic_map serves
+            fill_grid(self.grid_msg, out.geometry, out.data, frame=s.map_frame, stamp=stamp)
+            t2 = time.perf_counter()
+            self.map_pub.publish(self.grid_msg)
+            self.meta_pub.publish(self.grid_msg.info)
+            self.sent, self._updated = True, False
+            self._count("map", len(out.data))
+        else:
+            fill_update(self.update_msg, out, frame=s.map_frame, stamp=stamp)
+            self.grid_msg.header.stamp = stamp  # ~/dynamic_map's: the map as of this update
+            t2 = time.perf_counter()
+            self.update_pub.publish(self.update_msg)
+            self._updated = True
+            self._count("update", len(out.data))
         return {"finish": t1 - t0, "message": t2 - t1, "publish": time.perf_counter() - t2}
+
+    def _count(self, kind: str, cells: int) -> None:
+        self.counts[f"{kind}s"] += 1
+        self.counts[f"{kind}_bytes"] += cells
