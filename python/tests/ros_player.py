@@ -27,10 +27,6 @@ RELIABLE = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 UPDATES = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 
 
-def _ns(stamp) -> int:
-    return stamp.sec * 10**9 + stamp.nanosec
-
-
 def stamp_of(ns: int):
     return Time(sec=ns // 10**9, nanosec=ns % 10**9)
 
@@ -53,7 +49,7 @@ class Player:
         self.maps: list[tuple[float, OccupancyGrid]] = []  # full maps and maps with an update applied
         self.full_maps = self.updates = 0
         self.update_bytes = 0
-        self._full_stamp = -1
+        self._full_sent = -1  # the latest full map's source timestamp
         self.lock = threading.Lock()
         n.create_subscription(OccupancyGrid, "map", self._on_map, LATCHED)
         n.create_subscription(OccupancyGridUpdate, "map_updates", self._on_update, UPDATES)
@@ -62,19 +58,20 @@ class Player:
         self.thread = threading.Thread(target=self.executor.spin, daemon=True)
         self.thread.start()
 
-    def _on_map(self, msg):
+    def _on_map(self, msg, info):
         with self.lock:
             self.maps.append((time.monotonic(), msg))
             self.full_maps += 1
-            self._full_stamp = _ns(msg.header.stamp)
+            self._full_sent = info["source_timestamp"]
 
-    def _on_update(self, u):
-        """The latest map with u applied, as a new map (its header u's). An update stamped before
-        the latest full map is one that map already holds (the two topics are not ordered with
-        respect to each other) and is dropped."""
+    def _on_update(self, u, info):
+        """The latest map with u applied, as a new map (its header u's). An update published
+        before the latest full map (the publisher's source timestamps; the two topics are not
+        ordered with respect to each other, and stamps may go back) is one that map already holds,
+        and is dropped."""
         now = time.monotonic()
         with self.lock:
-            if not self.maps or _ns(u.header.stamp) < self._full_stamp:
+            if not self.maps or info["source_timestamp"] < self._full_sent:
                 return
             base = self.maps[-1][1]
             info = base.info

@@ -22,8 +22,6 @@ from rclpy.lifecycle import LifecycleNode, TransitionCallbackReturn
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from std_srvs.srv import SetBool, Trigger
 
-from .. import _core
-from .._errors import Error
 from ..msgs.errors import BagError
 from ..msgs.header import stamp_ns, stamp_text
 from ..msgs.table import MESSAGE_TYPES, MessageType
@@ -32,8 +30,9 @@ from .canvas import fixed_frame
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
 from .publication import MapPublication
+from .services import NodeServices
 from .posing import TIME_JUMP_S, Posing, Refused, ScanFilter, Unposed, check_path
-from .settings import Effect, Settings, SettingsError, declare_parameters, map_files, unknown_parameters
+from .settings import Effect, Settings, SettingsError, declare_parameters, unknown_parameters
 from .tf_messages import tf_message_type
 from .transport import map_sized_shm_in_use
 
@@ -59,7 +58,7 @@ def message_class(kind: MessageType):
     return getattr(importlib.import_module(f"{kind.package}.msg"), kind.class_name)
 
 
-class MappingNode(LifecycleNode):
+class MappingNode(NodeServices, LifecycleNode):
     """The node, a managed one: construction reads and checks the parameters (SettingsError for a
     bad one, nothing started); configure makes the mapper, the outputs and the services,
     activate subscribes and maps, deactivate stops mapping (the subscriptions dropped: scans sent
@@ -94,7 +93,7 @@ class MappingNode(LifecycleNode):
     def on_configure(self, state) -> TransitionCallbackReturn:
         try:
             self._configure()
-        except (SettingsError, LiveMapError, Error) as e:
+        except Exception as e:  # SettingsError, SessionFileError, LiveMapError; rclpy's when shut down meanwhile
             self.configure_error = str(e)
             self.get_logger().error(f"configure failed: {e}")
             self._release()
@@ -114,10 +113,13 @@ class MappingNode(LifecycleNode):
         self.posing = Posing(lambda: self.settings, self.resolve_topic_name, self._refuse, self._time_jumped,
                              Unposed(self._unposed_room, self._unposed_dropped), self._kept)
         self._latest_stamp = None  # the newest stamp (ns) of the latest scans mapped: /map's under a silent /clock
+        if s.load_session:
+            self._load_session(s.load_session)
         self.out = MapPublication(self, fixed=frame is not None)
         self._node_services = [self.create_service(kind, name, handler) for kind, name, handler in (
             (GetMap, "~/dynamic_map", self._dynamic_map), (Trigger, "~/save_map", self._save_map),
-            (Trigger, "~/reset", self._reset), (SetBool, "~/pause", self._pause))]
+            (Trigger, "~/reset", self._reset), (SetBool, "~/pause", self._pause),
+            (Trigger, "~/save_session", self._save_session))]
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         # On the steady clock, as the batches below: with use_sim_time and no /clock (a bag
         # paused or over, a simulator not publishing yet) ROS time stands still, and a timer on
@@ -491,43 +493,6 @@ class MappingNode(LifecycleNode):
             return Time(sec=self._latest_stamp // 10**9, nanosec=self._latest_stamp % 10**9)
         return now.to_msg()
 
-    def _dynamic_map(self, request, response):
-        """GetMap, as slam_toolbox's dynamic_map: the map as of now, which is also the latest
-        /map (a change not yet published is published first, then that very message served;
-        one executor thread: no map is filled meanwhile). Before any map: an empty grid
-        (info.width 0), logged."""
-        self._publish_if_changed()
-        if self.out.sent:
-            response.map = self.out.grid_msg
-        else:
-            self.get_logger().info("~/dynamic_map: no map yet (no scan mapped): an empty grid served")
-        return response
-
-    def _save_map(self, request, response):
-        paths = map_files(self.settings.save_map_path)
-        self._flush()
-        m = self.live.finish()
-        if not paths or m is None:
-            response.success = False
-            response.message = "save_map_path is empty: set it to the files to write" if not paths else \
-                "no scan mapped yet: nothing to save"
-            return response
-        try:
-            _core._write_maps(paths, m, self.settings.map_mode)
-        except (OSError, ValueError, RuntimeError) as e:
-            response.success, response.message = False, f"not saved: {e}"
-            return response
-        response.success, response.message = True, f"wrote {', '.join(paths)}"
-        self.get_logger().info(response.message)
-        return response
-
-    def _reset(self, request, response):
-        self._flush()  # the scans received before the reset are dropped with the others
-        n = self._start_over()
-        response.success, response.message = True, f"dropped {n} scans and the grid"
-        self.get_logger().info(response.message)
-        return response
-
     def _start_over(self) -> int:
         """A new map: the stored scans, the waiting ones and the skipping's counts dropped, and
         the newest stamps forgotten (a replay after a reset is no jump); returns how many scans
@@ -559,14 +524,6 @@ class MappingNode(LifecycleNode):
         back = self.posing.jumps.ahead_of(self.get_clock().now().nanoseconds)
         if back:
             self._time_jumped("/clock", back)
-
-    def _pause(self, request, response):
-        self._flush()  # the scans received before the pause are mapped
-        self.paused = bool(request.data)
-        response.success = True
-        response.message = "paused: new scans are not mapped" if self.paused else "mapping new scans"
-        self.get_logger().info(response.message)
-        return response
 
     def summary(self) -> str:
         """What the node did: scans mapped, what it refused, and its own latencies."""

@@ -47,6 +47,8 @@ def main(argv=None) -> int:
             node.get_logger().info("unconfigured (autostart: false): waiting for a lifecycle manager to configure "
                                    "and activate the node")
         elif not node.start():
+            if not rclpy.ok():  # a signal shut ROS 2 down while the node configured
+                return 0
             print(f"vasco_mapper: {node.configure_error or 'activation failed'}", file=sys.stderr)
             return 2
         executor.spin()
