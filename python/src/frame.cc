@@ -16,7 +16,8 @@ constexpr const char *kFrameDoc =
     "the first scan's heading (theta_offset) and laser position (x0, y0); the\n"
     "grid is centred on (x0, y0). Pass one to Mapper(frame=...) for a fixed frame\n"
     "(size, resolution and theta_offset are used; x0 and y0 come from the first\n"
-    "scan).";
+    "scan, or from Mapper(frame_centre=(x, y)): then centre_given is True and the\n"
+    "grid's axes are the world's).";
 
 void init_frame(GridGeometry *self, int size_x, int size_y, double resolution, double theta_offset) {
   auto *g = new (self) GridGeometry();
@@ -37,11 +38,14 @@ void bind_frame(nb::module_ &m) {
       .def_rw("theta_offset", &GridGeometry::theta_offset)
       .def_rw("x0", &GridGeometry::x0)
       .def_rw("y0", &GridGeometry::y0)
+      .def_ro("centre_given", &GridGeometry::centre_given,
+              "Whether (x0, y0) is a centre given to Mapper(frame_centre=...), not the first scan's position.")
       .def("world_x", &GridGeometry::world_x, "gx"_a, "World x of the lower-left corner of cell column gx.")
       .def("world_y", &GridGeometry::world_y, "gy"_a, "World y of the lower-left corner of cell row gy.")
       .def("__repr__", [](const GridGeometry &g) {
-        return nb::str("Frame(size_x={}, size_y={}, resolution={}, theta_offset={}, x0={}, y0={})")
-            .format(g.size_x, g.size_y, g.resolution, g.theta_offset, g.x0, g.y0);
+        return nb::str("Frame(size_x={}, size_y={}, resolution={}, theta_offset={}, x0={}, y0={}{})")
+            .format(g.size_x, g.size_y, g.resolution, g.theta_offset, g.x0, g.y0,
+                    g.centre_given ? ", centre_given=True" : "");
       });
 }
 

@@ -15,6 +15,7 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/tuple.h>
 
+#include <cmath>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -138,9 +139,34 @@ std::vector<vasco::Pose> poses_from(nb::handle obj) {
   return p;
 }
 
+// frame_centre=(x, y): the fixed frame's centre, in metres (GridGeometry::centre_given).
+void set_frame_centre(nb::handle centre, std::optional<vasco::GridGeometry> *frame) {
+  if (centre.is_none()) return;
+  if (!*frame)
+    throw nb::type_error("Mapper: frame_centre=(x, y) centres a fixed frame: give frame=Frame(...) with it");
+  const auto not_a_pair = [&] {
+    return nb::type_error(("Mapper: frame_centre must be two numbers (x, y) in metres, not " +
+                           std::string(nb::repr(centre).c_str()))
+                              .c_str());
+  };
+  if (PyUnicode_Check(centre.ptr()) || PyBytes_Check(centre.ptr()) || !PySequence_Check(centre.ptr()) ||
+      nb::len(centre) != 2)
+    throw not_a_pair();
+  double xy[2];
+  for (size_t i = 0; i < 2; ++i)
+    if (!nb::try_cast<double>(centre[i], xy[i])) throw not_a_pair();
+  if (!std::isfinite(xy[0]) || !std::isfinite(xy[1]))
+    throw nb::value_error(
+        ("Mapper: frame_centre must be finite, not " + std::string(nb::repr(centre).c_str())).c_str());
+  (*frame)->x0 = xy[0];
+  (*frame)->y0 = xy[1];
+  (*frame)->centre_given = true;
+}
+
 void init_mapper(Session *self, std::optional<vasco::MapperParams> params, const std::string &backend,
                  std::optional<std::string> cuda_mode, int threads, std::optional<vasco::GridGeometry> frame,
-                 int cuda_device, uint64_t max_memory_bytes, int expected_renders) {
+                 int cuda_device, uint64_t max_memory_bytes, int expected_renders, nb::handle frame_centre) {
+  set_frame_centre(frame_centre, &frame);
   std::string name;
   const vasco::BackendOptions o =
       backend_options(backend, cuda_mode, threads, cuda_device, max_memory_bytes, expected_renders, &name);
@@ -319,18 +345,36 @@ constexpr const char *kMapperInitDoc =
     "A session with ``params`` (vasco's defaults when None) on ``backend``.\n\n"
     "cuda_mode: 'float' (default) or 'exact'. threads: cpu_threads' threads (0: all cores; at\n"
     "most 1024, as log2map's --threads). frame: a fixed Frame (cells outside it are skipped, as\n"
-    "CARMEN does) instead of the PROTOCOL frame, which grows as scans arrive. max_memory_bytes:\n"
+    "CARMEN does) instead of the PROTOCOL frame, which grows as scans arrive; centred on the first\n"
+    "scan, as CARMEN's egrid.c, or on frame_centre=(x, y) (metres, finite; only with frame): then\n"
+    "the grid lies there with the world's axes whatever the scans' poses (its lower-left corner at\n"
+    "x - size_x * resolution / 2, y - size_y * resolution / 2; theta_offset moves nothing), through\n"
+    "inserts, render and start_over. A frame read from a session centred so keeps its centre.\n"
+    "max_memory_bytes:\n"
     "host memory the session may use (0: no limit). expected_renders: what auto weighs the GPU's\n"
     "start-up against (vasco_gpu.auto_choice): 1, the default, chooses at the first insert by its\n"
     "scans, as log2map --backend auto does for a log; more, a session that will render its scans\n"
     "again; 0, a workload without end (a live map): the GPU when one is usable, chosen now.\n"
-    "Raises ValueError for bad parameters or an unknown backend, RuntimeError when the backend\n"
-    "cannot run here (e.g. cuda without a GPU).";
+    "Raises ValueError for bad parameters, an unknown backend or a frame_centre not finite,\n"
+    "TypeError for a frame_centre that is not two numbers or comes without frame, RuntimeError\n"
+    "when the backend cannot run here (e.g. cuda without a GPU).";
+
+// The constructor's signature for the stubs: frame_centre is taken as any
+// object and checked by set_frame_centre, for messages clearer than a cast's.
+const char *mapper_init_signature() {
+  static const std::string sig =
+      "def __init__(self, params: Params | None = None, backend: str = 'cpu_double', cuda_mode: str | None = None, "
+      "threads: int = 0, frame: Frame | None = None, cuda_device: int = 0, max_memory_bytes: int = " +
+      std::to_string(vasco::kDefaultMaxMemoryBytes) +
+      ", expected_renders: int = 1, frame_centre: tuple[float, float] | None = None) -> None";
+  return sig.c_str();
+}
 
 void bind_mapper_constructor(nb::class_<Session> &cls) {
   cls.def("__init__", &init_mapper, "params"_a = nb::none(), "backend"_a = "cpu_double", "cuda_mode"_a = nb::none(),
           "threads"_a = 0, "frame"_a = nb::none(), "cuda_device"_a = 0,
-          "max_memory_bytes"_a = vasco::kDefaultMaxMemoryBytes, "expected_renders"_a = 1, kMapperInitDoc);
+          "max_memory_bytes"_a = vasco::kDefaultMaxMemoryBytes, "expected_renders"_a = 1,
+          "frame_centre"_a = nb::none(), nb::sig(mapper_init_signature()), kMapperInitDoc);
 }
 
 void bind_mapper_mapping(nb::class_<Session> &cls) {
@@ -372,7 +416,8 @@ void bind_mapper_arrays(nb::class_<Session> &cls) {
 void bind_mapper_state(nb::class_<Session> &cls) {
   cls.def("__len__", [](Session &s) { return s.state().num_scans; })
       .def_prop_ro("num_scans", [](Session &s) { return s.state().num_scans; }, "Scans stored.")
-      .def_prop_ro("frame", [](Session &s) { return s.state().frame; }, "The current frame (a copy).")
+      .def_prop_ro("frame", [](Session &s) { return s.state().frame; },
+                   "The current frame (a copy); a fixed frame at frame_centre has centre_given True.")
       .def_prop_ro("params", [](Session &s) { return s.state().params; },
                    "The session's parameters (a copy; start_over replaces them).")
       .def_prop_ro("backend", [](Session &s) { return s.state().backend; },

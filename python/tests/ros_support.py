@@ -31,7 +31,7 @@ def import_or_skip(module: str):
     module fails the test run instead of skipping it."""
     import pytest
 
-    how = "the ROS 2 extra is not installed: pip install '.[ros]' ./ros/tf2_msgs"
+    how = "the ROS 2 extra is not installed: pip install '.[ros]' ./ros (Jazzy: ROS_DISTRO=jazzy pip install '.[ros-jazzy]' ./ros)"
     if os.environ.get("VASCO_REQUIRE_ROS_TESTS") == "1":
         try:
             return __import__(module)

@@ -133,3 +133,23 @@ def test_lifecycle_transitions_gate_mapping(ros, node, intel):
     code, _ = node.interrupt()
     assert code == 0, node.output[-2000:]
     assert "0 scans mapped" in node.output, node.output[-1000:]
+
+
+def test_the_nav2_example_params_file_starts_for_a_lifecycle_manager(ros, tmp_path):
+    """examples/ros/vasco_mapper_nav2.yaml, as docs/ros.md gives it: strict_parameters accepts
+    every key, the node waits unconfigured, and configure + activate bring it up."""
+    from pathlib import Path
+
+    from test_ros_slam_toolbox import ParamsFileNode
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "ros" / "vasco_mapper_nav2.yaml"
+    proc = ParamsFileNode(example, "-p", "backend:=cpu_double", "-p", f"save_map_path:={tmp_path / 'site'}")
+    try:
+        proc.wait_for("waiting for a lifecycle manager")
+        assert "unknown parameters" not in proc.output, proc.output[-2000:]
+        assert transition(ros, Transition.TRANSITION_CONFIGURE)
+        assert transition(ros, Transition.TRANSITION_ACTIVATE)
+        assert state(ros) == State.PRIMARY_STATE_ACTIVE
+        assert "ready" in proc.wait_for("ready")
+    finally:
+        proc.kill()

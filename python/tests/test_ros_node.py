@@ -281,6 +281,7 @@ def test_a_batching_node_sleeps_between_its_batches(ros, node, intel):
     # loaded machine, whose spin would still show as tens of percent of CPU time.
     cpu = node.cpu_share(lambda: ros.replay(intel.scans.select(90, 80), 435 * 10**10 + np.arange(80) * 25_000_000,
                                             rate_hz=40.0))
+    print(f"batching node: {100 * cpu:.0f} % of a core at 40 Hz")
     assert cpu < 0.4, f"{100 * cpu:.0f} % of a core at 40 Hz"
 
 

@@ -401,9 +401,20 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "c: vasco_mapper_params p;": Check("compile", harness=C_HARNESS),
     },
     "docs/ros.md": {
-        'sh: pip install ".[ros]" ./ros/tf2_msgs': Check(
-            "covered-by", files=[(".ci/run", ['pip install ".[dask,ros]"', "pip install ./ros/tf2_msgs",
+        'sh: ROS_DISTRO=kilted pip install ".[ros]" ./ros': Check(
+            "covered-by", files=[(".ci/run", ["ROS_DISTRO=kilted", '"$vasco_wheel[dask,ros]"', "./ros",
                                               "VASCO_REQUIRE_ROS_TESTS=1"])]),
+        'sh: ROS_DISTRO=jazzy pip install ".[ros-jazzy]" ./ros': Check(
+            "covered-by", files=[(".ci/run", ["ROS_DISTRO=jazzy", '"$vasco_wheel[ros-jazzy]"', "./ros",
+                                              "python/tests/test_ros_*.py"])]),
+        "sh: vasco_map_node --ros-args --params-file examples/ros/vasco_m": Check(
+            "covered-by", files=[("python/tests/test_ros_lifecycle.py", ["vasco_mapper_nav2.yaml", "ParamsFileNode"]),
+                                 ("python/tests/test_ros_slam_toolbox.py", ['"--params-file"'])]),
+        'python: node = subprocess.Popen(["vasco_map_node", "--ros-args", "--': Check(
+            "covered-by", files=[("python/tests/test_ros_lifecycle.py", ["vasco_mapper_nav2.yaml"]),
+                                 ("python/tests/test_ros_node.py", ["SIGINT"])]),
+        "yaml: lifecycle_manager_mapping:": Check(
+            "skip", reason="needs nav2 (a system ROS 2): its keys are nav2's lifecycle manager's and static layer's"),
         "sh: export FASTDDS_BUILTIN_TRANSPORTS=SHM ROS_DOMAIN_ID=42": Check(
             "covered-by", files=[("python/tests/test_ros_node.py", ["docs/ros.md", "def test_the_docs_command_runs"])]),
         "sh: ros2 launch examples/ros/vasco_with_slam_toolbox.launch.py b": Check(

@@ -13,12 +13,7 @@ std::vector<oracle::ScanStart> place_scans(const ScanBatch &batch, const GridGeo
                                            size_t last) {
   last = std::min(last, batch.num_scans());
   first = std::min(first, last);
-  oracle::GridFrame frame;
-  frame.size_x = geo.size_x;
-  frame.size_y = geo.size_y;
-  frame.resolution = geo.resolution;
-  frame.theta_offset = geo.theta_offset;
-  if (first > 0) oracle::scan_start(frame, batch.x[0], batch.y[0], batch.theta[0]);
+  oracle::GridFrame frame = start_frame(geo, batch);  // scan 0's pose, or the given centre
   std::vector<oracle::ScanStart> starts(last - first);
   for (size_t s = first; s < last; ++s)
     starts[s - first] = oracle::scan_start(frame, batch.x[s], batch.y[s], batch.theta[s]);

@@ -12,6 +12,7 @@
 
 #include "beam_updates.h"
 #include "host_renderer.h"
+#include "vasco_gpu/grid.h"
 #include "vasco_gpu/internal/oracle.h"
 #include "vasco_gpu/internal/sensor_params.h"
 #include "vasco_gpu/internal/table_cache.h"
@@ -57,13 +58,9 @@ class CpuDoubleRenderer : public HostGridRenderer {
   void apply_to(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
                 const GridGeometry &geo, float *cells, MapStats *stats) override {
     const auto t0 = std::chrono::steady_clock::now();
-    oracle::GridFrame frame;
-    frame.size_x = geo.size_x;
-    frame.size_y = geo.size_y;
-    frame.resolution = geo.resolution;
-    frame.theta_offset = geo.theta_offset;
-    // CARMEN's first update call records the start pose: that is scan 0's.
-    if (first > 0 && batch.num_scans() > 0) oracle::scan_start(frame, batch.x[0], batch.y[0], batch.theta[0]);
+    // CARMEN's first update call records the start pose: that is scan 0's
+    // (or the given centre's).
+    oracle::GridFrame frame = start_frame(geo, batch);
     tables_key_.ensure(params, [&] { tables_.emplace(params); });
     MapStats st;
     beam_updates::BeamUpdates updates(params.table_size());

@@ -36,7 +36,10 @@ oracle::GridFrame start_frame(const GridGeometry &geo, const ScanBatch &batch) {
   frame.size_y = geo.size_y;
   frame.resolution = geo.resolution;
   frame.theta_offset = geo.theta_offset;
-  if (batch.num_scans() > 0) oracle::scan_start(frame, batch.x[0], batch.y[0], batch.theta[0]);
+  if (geo.centre_given)
+    oracle::scan_start(frame, geo.x0, geo.y0, geo.theta_offset);  // records the pose as a first update would
+  else if (batch.num_scans() > 0)
+    oracle::scan_start(frame, batch.x[0], batch.y[0], batch.theta[0]);
   return frame;
 }
 

@@ -34,6 +34,8 @@ void check_fixed_frame(const GridGeometry &frame, const MapperParams &params) {
     throw Error(ErrorCode::Usage, "Mapper: the frame's resolution differs from vasco_resolution");
   if (!std::isfinite(frame.theta_offset))
     throw Error(ErrorCode::Usage, "Mapper: the fixed frame's theta_offset is not finite");
+  if (frame.centre_given && !(std::isfinite(frame.x0) && std::isfinite(frame.y0)))
+    throw Error(ErrorCode::Usage, "Mapper: the fixed frame's given centre (x0, y0) is not finite");
 }
 
 void check_poses(const std::vector<Pose> &poses) {
@@ -157,11 +159,21 @@ Mapper::Mapper(const MapperParams &params, const GridGeometry &frame, const std:
   geo_ = grid_ = frame;
 }
 
+Mapper::Mapper(const MapperParams &params, const GridGeometry &frame, std::unique_ptr<Renderer> renderer,
+               const BackendOptions &options)
+    : Mapper(params, std::move(renderer), options) {
+  check_fixed_frame(frame, params);
+  fixed_frame_ = true;
+  geo_ = grid_ = frame;
+}
+
 GridGeometry Mapper::frame_for(const PoseExtent &extent, const ScanBatch &scans) const {
   if (!fixed_frame_) return size_grid(extent, scans, params_);
   GridGeometry g = geo_;
-  g.x0 = extent.x0;
-  g.y0 = extent.y0;
+  if (!g.centre_given) {  // CARMEN's egrid.c: centred on the first scan
+    g.x0 = extent.x0;
+    g.y0 = extent.y0;
+  }
   return g;
 }
 

@@ -21,11 +21,18 @@ struct GridFrame;  // vasco_gpu/internal/oracle.h
 // Where the evidence grid lies: its size and the first scan's pose, which
 // fixes the frame (theta_offset = the first scan's heading, so the grid axes
 // are the world axes).
+//
+// With centre_given, (x0, y0, theta_offset) is that pose instead of scan 0's
+// of the batch a renderer is given: every renderer places scans as CARMEN
+// does after a first update at (x0, y0, theta_offset), so the grid's axes
+// are the world's and its centre is (x0, y0) whatever the scans' poses (a
+// Mapper's fixed frame at a given centre, mapper.hpp).
 struct GridGeometry {
   int size_x = 0, size_y = 0;
   double resolution = 0;
   double theta_offset = 0;
-  double x0 = 0, y0 = 0;  // world position of the first used scan's laser
+  double x0 = 0, y0 = 0;  // world position of the first used scan's laser, or the given centre
+  bool centre_given = false;
 
   uint64_t num_cells() const { return static_cast<uint64_t>(size_x) * static_cast<uint64_t>(size_y); }
   // World coordinates of the lower-left corner of cell (gx, gy).
@@ -72,9 +79,10 @@ GridGeometry size_grid(const ScanBatch &batch, const MapperParams &params);
 GridGeometry size_grid(const PoseExtent &extent, const ScanBatch &batch, const MapperParams &params);
 
 // The oracle's frame of a grid of `geo` with the start pose recorded from
-// scan 0 of `batch` (when it has one), as CARMEN's first update records it:
-// what every exact backend places scans [first, last) of a batch with, for
-// any first. The one GridGeometry -> oracle::GridFrame conversion.
+// scan 0 of `batch` (when it has one), as CARMEN's first update records it,
+// or from (x0, y0, theta_offset) when geo.centre_given: what every backend
+// places scans [first, last) of a batch with, for any first. The one
+// GridGeometry -> oracle::GridFrame conversion.
 oracle::GridFrame start_frame(const GridGeometry &geo, const ScanBatch &batch);
 
 // The result of finish: a downsampled, cropped grid.

@@ -41,6 +41,13 @@
 // margin, and gives CARMEN's bytes again (mapper/cpu_threads: 27 of 27). A fixed frame
 // (given size, resolution and heading; centred on the first scan, as CARMEN's
 // egrid.c) never changes: cells outside it are skipped, as CARMEN skips them.
+// A fixed frame at a given centre (frame.centre_given: a grid at a place
+// chosen in advance, the ROS node's map_size and map_origin) is centred on
+// (frame.x0, frame.y0) with the world's axes, whatever the scans' poses:
+// its grid is bit for bit the fixed frame's whose first scan lies at
+// (x0, y0) heading theta_offset (theta_offset itself then moves nothing).
+// Inserts, render(), start_over and the restore after a failed call all keep
+// that centre; frame() reports it from construction on.
 //
 // Failures. A failed call (vasco::Error with its code, or std::bad_alloc)
 // leaves the session as it was: scans, poses, frame and grid. Everything that
@@ -89,13 +96,19 @@ class Mapper {
          const BackendOptions &options = {});
   // Fixed frame: `frame.size_x`, `size_y`, `resolution` (must equal
   // params.resolution) and `theta_offset` (finite) are used; x0 and y0 are
-  // taken from the first scan. Error(Usage) for a bad frame, Error(TooLarge)
-  // for a side beyond kMaxGridSide (the memory it needs is checked by the
-  // first insert, against the budget then in force).
+  // taken from the first scan, or, with `frame.centre_given`, are the
+  // frame's centre (finite; see "A fixed frame at a given centre" above).
+  // Error(Usage) for a bad frame, Error(TooLarge) for a side beyond
+  // kMaxGridSide (the memory it needs is checked by the first insert,
+  // against the budget then in force).
   Mapper(const MapperParams &params, const GridGeometry &frame, const std::string &backend,
          const BackendOptions &options = {});
   // PROTOCOL frame on a renderer of the caller's (a backend of its own).
   Mapper(const MapperParams &params, std::unique_ptr<Renderer> renderer, const BackendOptions &options = {});
+  // Fixed frame (as above) on a renderer of the caller's, which places scans
+  // by start_frame (grid.h) to honour frame.centre_given.
+  Mapper(const MapperParams &params, const GridGeometry &frame, std::unique_ptr<Renderer> renderer,
+         const BackendOptions &options = {});
 
   // Stores `scans` (ranges, beam geometry and poses) after those stored and
   // applies them to the current grid. Throws, storing nothing:

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "vasco_gpu/grid.h"
 #include "vasco_gpu/internal/log_odds.h"
 #include "vasco_gpu/internal/oracle.h"
 
@@ -112,14 +113,9 @@ void CudaFloatRenderer::apply_scans(const ScanBatch &scans, size_t first, size_t
 }
 
 // The records of scans [first, last) into pinned staging, placed with scan
-// 0 fixing the start pose.
+// 0 (or the given centre) fixing the start pose.
 void CudaFloatRenderer::stage_scan_records(const ScanBatch &scans, size_t first, size_t last) {
-  oracle::GridFrame frame;
-  frame.size_x = geo().size_x;
-  frame.size_y = geo().size_y;
-  frame.resolution = geo().resolution;
-  frame.theta_offset = geo().theta_offset;
-  oracle::scan_start(frame, scans.x[0], scans.y[0], scans.theta[0]);
+  oracle::GridFrame frame = start_frame(geo(), scans);
   grow_to(staging_scans_, last - first);
   for (size_t s = first; s < last; ++s) {
     const oracle::ScanStart p = oracle::scan_start(frame, scans.x[s], scans.y[s], scans.theta[s]);

@@ -31,7 +31,7 @@ def main(argv=None) -> int:
         if _interrupted(e):  # SIGINT inside an extension's initialisation: pybind11 raises ImportError from it
             return 0
         print(f"vasco_map_node: {e.name or e} does not import: install the ROS 2 extra (pip install "
-              "'.[ros]' ./ros/tf2_msgs from the repository, Python 3.10 or newer) or source a ROS 2 "
+              "'.[ros]' ./ros from the repository, Python 3.10 or newer; Jazzy: '.[ros-jazzy]') or source a ROS 2 "
               "installation (docs/ros.md)", file=sys.stderr)
         return 1
     return run(argv)
