@@ -486,11 +486,11 @@ class MappingNode(NodeServices, LifecycleNode):
         return check_path(path, self.settings.map_frame, topic)
 
     # -- outputs ----------------------------------------------------------------------------
-    def _publish_if_changed(self, settle: bool = True) -> dict:
+    def _publish_if_changed(self, settle: bool = True, now: bool = False) -> dict:
         """Publishes /map and /map_metadata when the grid changed since the last publication. A
         grown grid is rendered once more when the stream has paused for an interval (LiveMap).
         Returns the seconds of its steps (finish, message, publish); empty when nothing was
-        published."""
+        published. now: an update even right after a full map (MapPublication.publish)."""
         self._flush()
         quiet = time.monotonic() - self._last_scan > self.settings.map_update_interval
         if settle and quiet:
@@ -498,7 +498,7 @@ class MappingNode(NodeServices, LifecycleNode):
                 self.live.settle()
             except LiveMapError as e:
                 self.get_logger().warning(f"grid not rendered again after growing: {e}")
-        return self.out.publish(self.live, self.settings, self._map_stamp())
+        return self.out.publish(self.live, self.settings, self._map_stamp(), now=now)
 
     def _map_stamp(self) -> Time:
         """/map's stamp: the node's clock (ROS time: sim time while /clock ticks, the last /clock

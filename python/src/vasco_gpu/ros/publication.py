@@ -49,6 +49,7 @@ class MapPublication:
         self._finished = None  # the finish's buffer, written again for a map of its size
         self._subscribers = 0  # /map's, at the last publication
         self._updated = False  # updates sent since the last full map
+        self._full_at = -1e9  # time.monotonic() of the last full map
 
     def destroy(self) -> None:
         for pub in (self.map_pub, self.meta_pub, self.update_pub):
@@ -63,21 +64,37 @@ class MapPublication:
         self.canvas.reset()
         self._published = -1
 
-    def publish(self, live, settings, stamp: Time) -> dict:
+    def current(self) -> OccupancyGrid:
+        """The last /map message with every update since applied (~/dynamic_map's answer), its
+        stamp the last publication's. Its data is the canvas's: rclpy messages copy an array
+        unless they check their fields, so it is given again here."""
+        self.grid_msg.data = self.canvas.current().data
+        return self.grid_msg
+
+    def publish(self, live, settings, stamp: Time, *, now: bool = False) -> dict:
         """Publishes what changed in live's grid since the last publication: a full /map (and
         /map_metadata) after a render of every scan (a Path, new parameters) or a change of
         geometry, else the changed rectangle on map_updates. Returns the seconds of its steps
-        (finish, message, publish); empty when nothing was published."""
+        (finish, message, publish); empty when nothing was published.
+
+        No update goes out within map_update_interval of a full map (now: even so): /map and
+        map_updates are two topics, and a small update sent right after a map of megabytes can
+        reach a subscriber first, which applies it to the map before and then loses it under
+        the new one. The changes wait for the next publication, which carries them all (the
+        update is the difference from the last canvas sent)."""
         # A subscriber that joined since got the latched /map, without the updates sent after it:
         # it gets the map as it is now, in one piece (nav2's static layer joining late).
         subscribers = self.map_pub.get_subscription_count()
         joined, self._subscribers = subscribers > self._subscribers and self._updated, subscribers
         if live.version == self._published and not joined:
             return {}
+        full_due = joined or self._published == -1 or live.mapper.renders != self._renders
+        if not (full_due or now) and time.monotonic() - self._full_at < settings.map_update_interval:
+            return {}
         s = settings
         t0 = time.perf_counter()
         got = live.finish_grid(s.map_mode, s.free_thresh, s.occupied_thresh, out=self._finished)
-        full = joined or self._published == -1 or live.mapper.renders != self._renders
+        full = full_due
         self._published, self._renders = live.version, live.mapper.renders
         if got is None:
             return {}
@@ -92,13 +109,11 @@ class MapPublication:
             return {}
         t1 = time.perf_counter()
         if isinstance(out, FullMap):
-            # the canvas's own array: the message then always holds the last /map with the
-            # updates since applied, which is what ~/dynamic_map serves
             fill_grid(self.grid_msg, out.geometry, out.data, frame=s.map_frame, stamp=stamp)
             t2 = time.perf_counter()
             self.map_pub.publish(self.grid_msg)
             self.meta_pub.publish(self.grid_msg.info)
-            self.sent, self._updated = True, False
+            self.sent, self._updated, self._full_at = True, False, time.monotonic()
             self._count("map", len(out.data))
         else:
             fill_update(self.update_msg, out, frame=s.map_frame, stamp=stamp)

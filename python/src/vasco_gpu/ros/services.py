@@ -19,12 +19,12 @@ class NodeServices:
 
     def _dynamic_map(self, request, response):
         """GetMap, as slam_toolbox's dynamic_map: the map as of now, which is also the latest
-        /map (a change not yet published is published first, then that very message served;
-        one executor thread: no map is filled meanwhile). Before any map: an empty grid
-        (info.width 0), logged."""
-        self._publish_if_changed()
+        /map with every map_updates message since applied (a change not yet published is
+        published first; one executor thread: no map is filled meanwhile). Before any map: an
+        empty grid (info.width 0), logged."""
+        self._publish_if_changed(now=True)
         if self.out.sent:
-            response.map = self.out.grid_msg
+            response.map = self.out.current()
         else:
             self.get_logger().info("~/dynamic_map: no map yet (no scan mapped): an empty grid served")
         return response
