@@ -163,15 +163,21 @@ class Player:
         return msg
 
     def call(self, srv_type, name, request, timeout=10.0):
+        """The service's answer. A query (GetMap, GetState) is asked again once where no answer
+        came: a client made just now can miss the reply, DDS having matched the server's reply
+        writer to its reader only after the reply went (wait_for_service sees the request side
+        alone); a request that changes something is asked once."""
         client = self.node.create_client(srv_type, name)
         try:
             assert client.wait_for_service(timeout_sec=timeout), f"service {name} not there"
-            future = client.call_async(request)
-            end = time.monotonic() + timeout
-            while not future.done() and time.monotonic() < end:
-                time.sleep(0.01)
-            assert future.done(), f"{name}: no answer within {timeout} s"
-            return future.result()
+            for attempt in range(2 if srv_type.__name__ in ("GetMap", "GetState") else 1):
+                future = client.call_async(request)
+                end = time.monotonic() + (timeout if attempt else timeout / 2)
+                while not future.done() and time.monotonic() < end:
+                    time.sleep(0.01)
+                if future.done():
+                    return future.result()
+            raise AssertionError(f"{name}: no answer within {timeout} s")
         finally:
             self.node.destroy_client(client)
 
