@@ -36,7 +36,7 @@ TEST(MapImagePgm, TrinaryPixelsAndYaml) {
   EXPECT_EQ(yaml.size(), 7u);
   EXPECT_EQ(yaml.at("image"), "tiny.pgm");
   EXPECT_EQ(yaml.at("resolution"), "0.05");
-  EXPECT_EQ(yaml.at("origin"), "[-1.5, 2.25, 0]");
+  EXPECT_EQ(yaml.at("origin"), "[-1.5, 2.25, 0.0]");
   EXPECT_EQ(yaml.at("negate"), "0");
   EXPECT_EQ(yaml.at("occupied_thresh"), "0.65");
   EXPECT_EQ(yaml.at("free_thresh"), "0.196");
@@ -45,9 +45,10 @@ TEST(MapImagePgm, TrinaryPixelsAndYaml) {
 }
 
 // Numbers as people write them (issue: ROS conventions): a resolution
-// computed as 0.03 / 7 * 7 (not 0.03 in double) and origins with 17 digits
-// come out as the shortest text of their nearest float.
-TEST(MapImagePgm, YamlNumbersAreTheShortestTextOfTheirFloat) {
+// computed as 0.03 / 7 * 7 (not 0.03 in double) comes out as the shortest
+// text of its float; the origin keeps its double's digits, since the .map's
+// OFFSET and the tf tree are doubles (a float moves a UTM origin by cells).
+TEST(MapImagePgm, YamlResolutionIsItsFloatAndOriginItsDouble) {
   TempDir dir;
   carmen::GridMap m = tiny_map();
   m.resolution = 0.03 / 7 * 7;
@@ -55,7 +56,7 @@ TEST(MapImagePgm, YamlNumbersAreTheShortestTextOfTheirFloat) {
   carmen::write_pgm_with_yaml(dir.file("n.pgm"), m, carmen::GlobalOffset{-13.499734000000002, 1234.5678901234, 0});
   const auto yaml = read_yaml(dir.file("n.yaml"));
   EXPECT_EQ(yaml.at("resolution"), "0.03");
-  EXPECT_EQ(yaml.at("origin"), "[-13.499734, 1234.5679, 0]");  // 1234.5679f is the float nearest 1234.5678901234
+  EXPECT_EQ(yaml.at("origin"), "[-13.499734000000002, 1234.5678901234, 0.0]");
 }
 
 TEST(MapImagePgm, ScaleAndRawModes) {
@@ -66,7 +67,7 @@ TEST(MapImagePgm, ScaleAndRawModes) {
   carmen::write_pgm_with_yaml(dir.file("r.pgm"), tiny_map(), {}, carmen::PgmMode::Raw);
   EXPECT_EQ(read_pgm(dir.file("r.pgm")).pixels, kRaw);
   EXPECT_EQ(read_yaml(dir.file("r.yaml")).at("mode"), "raw");
-  EXPECT_EQ(read_yaml(dir.file("r.yaml")).at("origin"), "[0, 0, 0]");
+  EXPECT_EQ(read_yaml(dir.file("r.yaml")).at("origin"), "[0.0, 0.0, 0.0]");
 }
 
 TEST(MapImagePgm, ModeNames) {

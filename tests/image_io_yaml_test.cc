@@ -115,7 +115,7 @@ TEST(MapImagePngYaml, ScaleModeHasTransparentUnknown) {
   const auto yaml = read_yaml(dir.file("s.yaml"));
   EXPECT_EQ(yaml.at("image"), "s.png");
   EXPECT_EQ(yaml.at("mode"), "scale");
-  EXPECT_EQ(yaml.at("origin"), "[-1.5, 2.25, 0]");
+  EXPECT_EQ(yaml.at("origin"), "[-1.5, 2.25, 0.0]");
   // Decoded by libpng, not by our reader: grey + alpha.
   png_image image;
   std::memset(&image, 0, sizeof image);

@@ -117,9 +117,28 @@ TEST_F(MapConvert, PgmModeAndOffsetOrigin) {
   ASSERT_EQ(r.status, 0) << r.output;
   const std::string yaml = read_bytes(dir.file("out.yaml"));
   EXPECT_TRUE(contains(yaml, "mode: raw\n")) << yaml;
-  EXPECT_TRUE(contains(yaml, "origin: [-3.5, 1.25, 0]\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "origin: [-3.5, 1.25, 0.0]\n")) << yaml;
   EXPECT_TRUE(contains(yaml, "resolution: 0.25\n")) << yaml;
   EXPECT_EQ(read_bytes(dir.file("out.pgm")), std::string("P5\n2 1\n255\n") + char(50) + char(50));
+}
+
+// A gmapping map (origin [-100, -100, 0], 10 m cells here) through
+// mapconvert, .yaml -> .map -> .yaml: every number comes back as a YAML 1.1
+// float with the same value (was "-1e+02" and "1e+01", strings to PyYAML).
+TEST_F(MapConvert, YamlRoundTripKeepsNumbersAsFloats) {
+  TempDir dir;
+  maptest::write_bytes(dir.file("g.pgm"), std::string("P5\n2 1\n255\n") + char(0) + char(254));
+  maptest::write_bytes(dir.file("g.yaml"), "image: g.pgm\nresolution: 10\norigin: [-100, -100, 0]\n"
+                                           "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n");
+  ToolRun r = mapconvert({dir.file("g.yaml"), dir.file("g.map")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = mapconvert({dir.file("g.map"), dir.file("back.pgm")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string yaml = read_bytes(dir.file("back.yaml"));
+  EXPECT_TRUE(contains(yaml, "\norigin: [-100.0, -100.0, 0.0]\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "\nresolution: 10.0\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "\noccupied_thresh: 0.65\n")) << yaml;
+  EXPECT_TRUE(contains(yaml, "\nfree_thresh: 0.196\n")) << yaml;
 }
 
 TEST_F(MapConvert, BadInputExitsOneNamingTheFile) {
@@ -217,11 +236,11 @@ TEST_F(MapConvert, Log2MapPgmRoundTripsThroughTheYaml) {
   ASSERT_EQ(a.gridmap->size_x, b.gridmap->size_x);
   ASSERT_EQ(a.gridmap->size_y, b.gridmap->size_y);
   EXPECT_FLOAT_EQ(float(a.gridmap->resolution), float(b.gridmap->resolution));
-  // The YAML writes the origin as the shortest text of its nearest float
-  // (ROS's conventions): it reads back as that float, not as the double.
-  EXPECT_EQ(float(a.offset->x), float(b.offset->x));
-  EXPECT_EQ(float(a.offset->y), float(b.offset->y));
-  EXPECT_NE(a.offset->y, b.offset->y) << "intel's origin has more digits than a float: this test would not see them lost";
+  // The YAML writes the origin's double exactly (the .map's OFFSET is a
+  // double), though intel's origin has more digits than a float holds.
+  EXPECT_EQ(a.offset->x, b.offset->x);
+  EXPECT_EQ(a.offset->y, b.offset->y);
+  EXPECT_NE(double(float(a.offset->y)), a.offset->y) << "a float would keep this origin: the test would not see it cut";
   ASSERT_TRUE(b.creator);
   EXPECT_EQ(b.creator->origin, "m.yaml");
   size_t counts[4] = {0, 0, 0, 0};

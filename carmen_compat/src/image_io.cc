@@ -14,6 +14,7 @@
 
 #include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
+#include "carmen_compat/yaml_number.h"
 
 namespace carmen {
 
@@ -78,15 +79,6 @@ std::string number_text(double v) {
     if (is_float ? static_cast<float>(back) == static_cast<float>(v) : back == v) break;
   }
   return buf;
-}
-
-// A YAML's resolution and origin as people write them: the shortest text of
-// the nearest float (0.05, -13.49973, not 0.050000000000000003 or
-// -13.499734000000002). A float says 7 significant digits: an origin 1 km
-// out moves by at most 61 µm, far below any cell; the resolution is a float
-// in a CARMEN map and in ROS's MapMetaData anyway.
-std::string float_number_text(double v) {
-  return number_text(static_cast<double>(static_cast<float>(v)));
 }
 
 std::string file_name_of(const std::string &path) {
@@ -292,12 +284,16 @@ void write_map_server_pair(AtomicOutput &image, AtomicOutput &yaml_out, const Gr
   std::string yaml;
   yaml += "image: " + yaml_quoted(file_name_of(image.final_path())) + "\n";
   yaml += "mode: " + std::string(pgm_mode_name(o.mode)) + "\n";
-  yaml += "resolution: " + float_number_text(map.resolution) + "\n";
-  yaml += "origin: [" + float_number_text(origin_of_cell00.x) + ", " + float_number_text(origin_of_cell00.y) + ", " +
-          float_number_text(origin_of_cell00.theta) + "]\n";
+  // The resolution as the float it is in a CARMEN map and in ROS's
+  // MapMetaData (0.05, not 0.05000000074505806); the origin keeps its
+  // double, as the .map's OFFSET and the tf tree do (a UTM northing of
+  // 5.4e6 m as a float is off by up to 0.25 m).
+  yaml += "resolution: " + yaml_float_text_of_float(map.resolution) + "\n";
+  yaml += "origin: [" + yaml_float_text(origin_of_cell00.x) + ", " + yaml_float_text(origin_of_cell00.y) + ", " +
+          yaml_float_text(origin_of_cell00.theta) + "]\n";
   yaml += std::string("negate: ") + (o.negate ? "1" : "0") + "\n";
-  yaml += "occupied_thresh: " + number_text(o.occupied_thresh) + "\n";
-  yaml += "free_thresh: " + number_text(o.free_thresh) + "\n";
+  yaml += "occupied_thresh: " + yaml_float_text(o.occupied_thresh) + "\n";
+  yaml += "free_thresh: " + yaml_float_text(o.free_thresh) + "\n";
   if (kind == MapImageKind::Pgm) {
     write_all(image, "P5\n" + std::to_string(map.size_x) + " " + std::to_string(map.size_y) + "\n255\n", pixels);
   } else if (o.mode == PgmMode::Scale) {

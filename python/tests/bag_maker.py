@@ -325,3 +325,27 @@ def _build(store, msgtype: str, fields: dict):
     types = dict(store.fielddefs[msgtype][1])
     values = {k: _build(store, types[k][1], v) if isinstance(v, dict) else v for k, v in fields.items()}
     return store.types[msgtype](**values)
+
+
+POINT_CLOUD2 = "sensor_msgs/msg/PointCloud2"
+
+
+def scan_with_angle_max(rec: Recording, topic, t, frame, ranges, angle_min, angle_max, angle_increment,
+                        range_min=0.1, range_max=30.0):
+    """A LaserScan whose angle_max is given, not derived from the count: as a driver publishes
+    one that disagrees with its ranges (velodyne_laserscan's nominal increment)."""
+    msg = rec.messages.laser_scan(t, frame, ranges, angle_min, angle_increment, range_min, range_max)
+    msg.angle_max = float(angle_max)
+    rec.add(t, topic, LASER_SCAN, msg)
+
+
+def point_cloud(rec: Recording, topic, t, frame, points):
+    """A PointCloud2 of (n, 3) points: fields x, y, z as float32, one row, little-endian."""
+    T = rec.messages.T
+    pts = np.ascontiguousarray(points, dtype="<f4")
+    fields = [T["sensor_msgs/msg/PointField"](name=n, offset=4 * k, datatype=7, count=1)
+              for k, n in enumerate("xyz")]
+    msg = T[POINT_CLOUD2](header=rec.messages.header(t, frame), height=1, width=len(pts), fields=fields,
+                          is_bigendian=False, point_step=12, row_step=12 * len(pts),
+                          data=np.frombuffer(pts.tobytes(), dtype=np.uint8), is_dense=True)
+    rec.add(t, topic, POINT_CLOUD2, msg)

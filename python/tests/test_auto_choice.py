@@ -7,6 +7,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -21,8 +22,10 @@ TYPES = {"flag", "whole", "real", "bytes", "choice", "text", "whole_list"}
 
 
 def built_log2map():
-    """log2map of a build of this checkout (VASCO_BIN, build/bin, PATH), or None."""
-    for d in (os.environ.get("VASCO_BIN"), ROOT / "build" / "bin"):
+    """log2map of a build of this checkout (VASCO_BIN, build/bin), else the one `pip install .`
+    put beside this interpreter (a virtual environment's bin/, not on the PATH when its python
+    runs without activating it), else the PATH's, or None."""
+    for d in (os.environ.get("VASCO_BIN"), ROOT / "build" / "bin", Path(sys.executable).parent):
         if d and (Path(d) / "log2map").is_file():
             return Path(d) / "log2map"
     found = shutil.which("log2map")

@@ -141,10 +141,14 @@ def test_frame_with_two_parents(tmp_path):
 
 
 def test_no_tf_and_no_pose_topic(tmp_path):
+    # read_bag speaks the Python API's words, bag2map's reader (wording "cli") the options'
     p = make(tmp_path, "rosbag1")
-    with pytest.raises(vb.BagError, match="--pose-topic") as e:
+    with pytest.raises(vb.BagError, match="pose_topic=TOPIC") as e:
         vb.read_bag(p)
-    assert p.name in str(e.value) and "--poses FILE" in str(e.value)
+    assert p.name in str(e.value) and "poses=FILE" in e.value.message and "--" not in e.value.message
+    with pytest.raises(vb.BagError, match="--pose-topic TOPIC") as e:
+        vb.read_bag(p, wording="cli")
+    assert "--poses FILE" in e.value.message and "_topic" not in e.value.message
 
 
 # ----------------------------------------------------------------------------------------------
@@ -272,7 +276,7 @@ def test_a_robot_that_does_not_move(tmp_path):
     p = make(tmp_path, "mcap", name="still")  # scans only: no tf, no pose topic
     with pytest.raises(vb.BagError) as e:
         vb.read_bag(p)
-    assert "--static-pose X,Y,THETA" in str(e.value) and "--pose-topic" in str(e.value)
+    assert "static_pose=(X, Y, THETA)" in str(e.value) and "pose_topic=TOPIC" in str(e.value)
     b = vb.read_bag(p, static_pose=(1.0, 2.0, 0.5))
     assert b.pose_source == "static" and np.array_equal(b.poses, np.tile([1.0, 2.0, 0.5], (5, 1)))
     b = vb.read_bag(p, static_pose="1,2,0", laser_mount=(0.5, 0.0, 0.25))  # text, and a mount

@@ -518,7 +518,7 @@ def test_bad_laser_clock_and_receive_stamps(tmp_path, intel):
 
 def built_log2map():
     """log2map of a build of this checkout (VASCO_BIN, build/bin, PATH), or None."""
-    for d in (os.environ.get("VASCO_BIN"), ROOT / "build" / "bin"):
+    for d in (os.environ.get("VASCO_BIN"), ROOT / "build" / "bin", Path(sys.executable).parent):
         if d and (Path(d) / "log2map").is_file():
             return Path(d) / "log2map"
     found = shutil.which("log2map")

@@ -58,7 +58,7 @@ def run_script(name, *args, cwd=None):
 
 def tool_bin():
     """The build's directory of log2map and mapdiff (VASCO_BIN, build/bin, PATH), or None."""
-    for d in (os.environ.get("VASCO_BIN"), ROOT / "build" / "bin"):
+    for d in (os.environ.get("VASCO_BIN"), ROOT / "build" / "bin", Path(sys.executable).parent):
         if d and (Path(d) / "log2map").is_file() and (Path(d) / "mapdiff").is_file():
             return Path(d).resolve()
     found = shutil.which("log2map")

@@ -1,7 +1,10 @@
 #include "log2map_options.h"
 
 #include <CLI/CLI.hpp>
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -196,6 +199,22 @@ std::string backend_aliases_help() {
   return text.empty() ? text : "also: " + text + "\n";
 }
 
+// The compiled backends, a line each, for --backend's help. auto's line
+// gives its one rule as this command line applies it, a single log and a
+// batch alike (backend_choice.h: N renders, 1 for a log, 0 for a batch).
+std::string backends_help() {
+  std::string text;
+  for (const vasco::BackendInfo &b : vasco::backend_registry()) {
+    if (!b.compiled) continue;
+    const std::string summary =
+        b.chooses ? "cuda where a GPU is usable and a measured cost model expects it to finish first (in a "
+                    "batch its start-up weighs nothing), else cpu_threads"
+                  : b.summary;
+    text += std::string(b.name) + ": " + summary + "\n";
+  }
+  return text;
+}
+
 void add_backend_options(CLI::App &app, Options &opt) {
   // The registry's names and aliases (one not compiled in says why when
   // run); an unknown one is refused naming the nearest.
@@ -214,7 +233,7 @@ void add_backend_options(CLI::App &app, Options &opt) {
     return vasco::option_row(vasco::session_option_table(), name);
   };
   app.add_option("--backend", opt.backend,
-                 row("backend").help_with_default() + ", one of:\n" + vasco::backend_help() + backend_aliases_help())
+                 row("backend").help_with_default() + ", one of:\n" + backends_help() + backend_aliases_help())
       ->type_name("NAME")
       ->check(known_backend);
   const OptionSpec &threads = row("threads");
@@ -336,6 +355,32 @@ void resolve_backend_alias(const CLI::App &app, Options &opt) {
                                       opt.cuda_mode);
   opt.backend = name;
   opt.cuda_mode = mode;
+}
+
+// Whether `path` names a ROS bag by its form: a ROS 1 .bag, a ROS 2 .mcap or
+// .db3 file, or a ROS 2 bag directory (its metadata.yaml).
+bool looks_like_a_bag(const std::string &path) {
+  std::string lower = path;
+  for (char &c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const char *ext : {".bag", ".mcap", ".db3"}) {
+    const std::string e = ext;
+    if (lower.size() > e.size() && lower.compare(lower.size() - e.size(), e.size(), e) == 0) return true;
+  }
+  struct stat st;
+  return ::stat((path + "/metadata.yaml").c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+// log2map reads CARMEN logs: a bag given to it is a usage error that names
+// the tool that maps bags.
+void check_inputs_are_logs(const ToolSpec &spec, const Options &opt) {
+  if (spec.read) return;  // a tool with its own reader (bag2map) takes its own inputs
+  std::vector<std::string> inputs = opt.out_dir.empty() ? std::vector<std::string>{opt.log} : opt.inputs;
+  for (const auto &more : opt.more) inputs.push_back(more.path);
+  for (const std::string &in : inputs)
+    if (looks_like_a_bag(in))
+      throw Error(ErrorCode::Usage, "'" + carmen::printable(in) + "' is a ROS bag, and " + spec.name +
+                                        " reads CARMEN logs: map it with bag2map (bag2map " +
+                                        carmen::printable(in) + " OUTPUT; the same options)");
 }
 
 // Everything checked after parsing that CLI11 cannot: a usage error.
@@ -491,6 +536,7 @@ int parse_options(int argc, const char *const *argv, const ToolSpec &spec, Optio
     finish_options(app, spec, raw_poses, max_memory, *opt);
     finish_resolution_option(app, raw["resolution"], *opt);
     finish_batch_options(app, raw_batch, *opt);
+    check_inputs_are_logs(spec, *opt);  // a batch's inputs are known from here
     finish_map_server_options(app, raw_map_server, *opt);
   } catch (const carmen::Error &e) {
     std::fprintf(stderr, "%s: %s\n", spec.name.c_str(), carmen::printable(e.what()).c_str());

@@ -157,8 +157,22 @@ vasco::LogInput read_input_once(const Options &opt, const std::string &log, cons
   return vasco::log_input_from_scans(std::move(scans), in);
 }
 
-// Why a log's scans updated no cell, for the error that says so (there is
-// no map to write: finish crops to the known cells).
+// A map cell so large that CARMEN's finish, which keeps only whole blocks
+// of downsample x downsample grid cells counted from the grid's corner,
+// keeps none of the cells the beams updated: the parameters' fault, not the
+// log's (a usage error naming the options and the map it would give).
+void check_blocks_keep_a_cell(const RunResult &r) {
+  const int ds = r.input.params.downsample;
+  if (r.known > 0 || r.stats.cell_updates == 0 || ds <= 1) return;
+  const vasco::GridGeometry &g = r.input.geo;
+  std::ostringstream m;
+  m << "a map cell of " << r.input.params.map_resolution() << " m (vasco_downsample " << ds << " x vasco_resolution "
+    << r.input.params.resolution << " m) leaves no mapped cell: the finish keeps whole blocks of " << ds << " x " << ds
+    << " grid cells from the corner of the " << g.size_x << " x " << g.size_y << "-cell grid, a map of "
+    << g.size_x / ds << " x " << g.size_y / ds << " cells, and none of them holds a cell a beam updated; "
+    << "give a smaller --resolution or --vasco_downsample";
+  throw carmen::Error(carmen::ErrorCode::Usage, m.str());
+}
 }  // namespace
 
 void map_input(vasco::Mapper &mapper, const std::string &log, RunResult &r) {
@@ -187,6 +201,7 @@ void map_input(vasco::Mapper &mapper, const std::string &log, RunResult &r) {
   r.map = mapper.finish();
   r.finish_s = cli::seconds_since(t);
   r.known = vasco::pipeline::known_cells(r.map.cells);
+  check_blocks_keep_a_cell(r);
   vasco::pipeline::check_mapped(r.map.cells, mapper.scans(), log);
   r.origin = vasco::world_origin(r.map, r.input.geo);
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 #include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/internal/parallel.h"
@@ -55,12 +56,22 @@ std::string workload_note(const AutoChoice &c, const CostModel &m, const std::st
   return text;
 }
 
+// Whether CUDA_VISIBLE_DEVICES hides every GPU: set empty, or its first
+// entry an invalid index such as -1 (CUDA shows only the devices before the
+// first invalid entry).
+bool every_gpu_hidden() {
+  const char *visible = std::getenv("CUDA_VISIBLE_DEVICES");
+  return visible != nullptr && (visible[0] == '\0' || visible[0] == '-');
+}
+
 // Whether this process surely has no GPU, known without starting CUDA: a
-// build without the cuda backend, or a host where NVIDIA's kernel driver is
-// not loaded (then asking fails at once, without a context).
+// build without the cuda backend, a host where NVIDIA's kernel driver is
+// not loaded, or every GPU hidden from it (then asking fails at once,
+// without a context, and the note gives no GPU time).
 bool no_gpu_at_no_cost() {
   const BackendInfo *cuda = find_backend("cuda");
-  return cuda == nullptr || !cuda->compiled || ::access("/proc/driver/nvidia/version", F_OK) != 0;
+  return cuda == nullptr || !cuda->compiled || ::access("/proc/driver/nvidia/version", F_OK) != 0 ||
+         every_gpu_hidden();
 }
 
 }  // namespace

@@ -79,6 +79,7 @@ from ._core import (
 from . import _core
 from ._cuda import CudaStatus, cuda_available
 from .bags.load import load_bag
+from .bags.info import bag_info
 from ._batch import BatchError, LogResult, map_logs
 
 __version__: str = _core.__version__
@@ -110,6 +111,7 @@ __all__ = [
     "backend_names",
     "backend_registry",
     "backends",
+    "bag_info",
     "compare",
     "cuda_available",
     "estimated_cell_updates",

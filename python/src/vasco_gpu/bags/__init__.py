@@ -22,7 +22,8 @@ The parts, one job each: :mod:`.errors` (BagError, TfError, BagWarning), :mod:`.
 (which topics to read), :mod:`.storage` (opening a bag with rosbags), :mod:`.scans` (a
 topic's scans through the message table, BagScans), :mod:`.poses` (the laser pose at each
 scan), :mod:`.reader` (read_bag), :mod:`.carmen_writer` (write_carmen_log), :mod:`.load`
-(load_bag), :mod:`.bag_writer` (a CARMEN log as a bag), and the console tools :mod:`.cli`
+(load_bag), :mod:`.info` (bag_info: what a bag holds and the command that maps it),
+:mod:`.bag_writer` (a CARMEN log as a bag), and the console tools :mod:`.cli`
 (bag2map, bag2carmen) and :mod:`.carmen2bag` (carmen2bag).
 """
 

@@ -38,6 +38,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--period", metavar="S", type=float, help=(
         "stamps S, 2S, 3S, ... seconds instead of the log's (for a log whose scans share stamps or have none)"))
     p.add_argument("-q", "--quiet", action="store_true", help="no summary line")
+    p.add_argument("--version", action="version", version=f"carmen2bag (vasco_gpu) {_core.__version__}")
     return p
 
 

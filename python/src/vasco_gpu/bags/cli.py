@@ -45,7 +45,8 @@ BAG_OPTIONS = (
               "(default: the only one); repeat it (or separate names by commas) to map several lasers together, each "
               "at its own mount, their scans in stamp order", "TOPIC"),
     BagOption("fixed-frame", "fixed_frame", "the frame the map is in: the root of the tf chain to each scan "
-              "(default: map), or the frame of --pose-topic's poses", "FRAME"),
+              "(default: map; in a bag without a map frame, the one root of tf that every scan reaches, e.g. odom, with a "
+              "warning), or the frame of --pose-topic's poses", "FRAME"),
     BagOption("base-frame", "base_frame", "the robot's frame for --pose-topic and a point cloud's height band "
               "(default: the odometry's child frame, else base_link)", "FRAME"),
     BagOption("pose-topic", "pose_topic", "the robot's poses from a nav_msgs/Odometry, geometry_msgs/PoseStamped "
@@ -140,15 +141,58 @@ def _bag2map_summary() -> str:
     extensions = ", ".join(f["extension"] for f in _core.map_formats())  # the engine's format table
     return ("bag2map: builds a CARMEN evidence-grid map (vasco/egrid.c) from a ROS bag's laser scans.\n"
             "Inputs: ROS 1 .bag, ROS 2 bag directories (sqlite3, MCAP) and .mcap files. Outputs by extension:\n"
-            f"{extensions}. Every other option is log2map's.")
+            f"{extensions}. Every other option is log2map's.\n"
+            "bag2map --info BAG prints what the bag holds (topics, tf tree, scans, poses) and the command "
+            "that maps it.")
+
+
+def _info_main(args: list[str]) -> int:
+    """bag2map --info BAG...: each bag's report (bags/info.py) on stdout. Exit 0, 1 when a
+    BAG is not a bag (named on stderr, as bag2map's own errors are), 2 for other arguments."""
+    end = args.index("--") if "--" in args else len(args)  # after '--' a name may start with '-'
+    bags = [a for a in args[:end] if a != "--info"] + args[end + 1:]
+    if not bags or any(a.startswith("-") for a in args[:end] if a != "--info"):
+        print("bag2map: --info takes bags only: bag2map --info BAG [BAG...]", file=sys.stderr)
+        return 2
+    reader_module()  # without rosbags: the ImportError that says to install it
+    from .info import bag_info
+
+    status, printed = 0, False
+    for bag in bags:
+        try:
+            text = bag_info(bag).text()
+        except BagError as e:
+            print(f"bag2map: {e}", file=sys.stderr)
+            status = 1
+            continue
+        print(("\n" if printed else "") + text, end="", flush=True)  # a blank line between reports
+        printed = True
+    return status
 
 
 def bag2map_main(argv: list[str] | None = None) -> int:
-    """The console script bag2map: log2map's command line with ROS bags as inputs."""
-    args = _join_repeated(list(sys.argv[1:] if argv is None else argv), "scan-topic")
+    """The console script bag2map: log2map's command line with ROS bags as inputs; with --info,
+    what each bag holds and the command that maps it (:func:`vasco_gpu.bag_info`)."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    if "--info" in args[:args.index("--") if "--" in args else len(args)]:
+        return _info_main(args)
+    args = _join_repeated(args, "scan-topic")
+    # the names before the first option (an option's value, e.g. --poses robot.log, may be a log)
+    leading = args[:next((i for i, a in enumerate(args) if a.startswith("-")), len(args))]
+    logs = [a for a in leading if _is_carmen_log(a)]
+    if logs:
+        print(f"bag2map: '{logs[0]}' is a CARMEN log, and bag2map reads ROS bags: map it with log2map (log2map "
+              f"{logs[0]} OUTPUT; the same options)", file=sys.stderr)
+        return 2
     return _core._run_tool(["bag2map", *args], "bag2map", _bag2map_summary(), "BAG",
                            "ROS 1 .bag, ROS 2 bag directory (sqlite3 or MCAP) or .mcap file",
                            [(o.flag, o.help, o.metavar) for o in BAG_OPTIONS], _tool_reader)
+
+
+def _is_carmen_log(name: str) -> bool:
+    """A name with a CARMEN log's extension (.log, .clf; gzipped or not)."""
+    plain = name[:-3] if name.lower().endswith(".gz") else name
+    return plain.lower().endswith(tuple(_core.carmen_log_extensions()))
 
 
 def _carmen_log_names() -> str:
@@ -168,6 +212,7 @@ def _bag2carmen_parser() -> argparse.ArgumentParser:
         p.add_argument("--" + o.flag, dest=o.keyword, help=o.help, metavar=o.metavar, **repeated)
     p.add_argument("--laser-mount", metavar="X,Y,THETA", help="the laser in the robot's frame (for --pose-topic)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress")
+    p.add_argument("--version", action="version", version=f"bag2carmen (vasco_gpu) {_core.__version__}")
     return p
 
 

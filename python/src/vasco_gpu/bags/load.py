@@ -41,15 +41,20 @@ def edge_warning(b) -> str | None:
 def read_for_engine(path, *, scan_topic=None, fixed_frame=None, base_frame=None, pose_topic=None, laser_mount=None,
                     no_return=SCAN_DEFAULTS["no_return"], need_poses=True, skip_unposed=False, progress=None,
                     echo=SCAN_DEFAULTS["echo"],
-                    stamp="header", z_band=None, cloud_angle_step=None, cloud_range_max=None, static_pose=None):
+                    stamp="header", z_band=None, cloud_angle_step=None, cloud_range_max=None, static_pose=None,
+                    wording="cli"):
     """The bag's scans as the engine takes them: {'scans', 'stamps', 'mounts', 'unposed', 'edges',
     'warnings', 'bag'}. The scans before the first and after the last pose of their chain are
     left out and counted ('unposed', and 'edges': before, after), with one warning; a scan in a
-    gap of the poses is an error, unless skip_unposed leaves out every scan without a pose."""
+    gap of the poses is an error, unless skip_unposed leaves out every scan without a pose.
+    Without fixed_frame and pose_topic the poses are tf's in 'map', or, in a bag without a 'map'
+    frame, in the one root of tf the scans reach (with a warning). wording: errors and warnings
+    name options as bag2map does ("cli") or as load_bag does ("python")."""
     reader = reader_module()
     outside = ("skip" if skip_unposed else "edges") if need_poses else "error"
     b = reader.read_bag(os.fspath(path), scan_topic=scan_topic,
                         fixed_frame=fixed_frame if fixed_frame is not None else ("map" if pose_topic is None else None),
+                        root_if_no_map=fixed_frame is None and pose_topic is None, wording=wording,
                         base_frame=base_frame, pose_topic=pose_topic, laser_mount=laser_mount,
                         pose_source="auto" if need_poses else "none", no_return=no_return, progress=progress,
                         outside_span=outside, echo=echo, stamp=stamp, z_band=z_band,
@@ -65,7 +70,7 @@ def read_for_engine(path, *, scan_topic=None, fixed_frame=None, base_frame=None,
     warning = edge_warning(b) if need_poses else None
     edges = {k: (b.edges or {}).get(k, 0) for k in ("before", "after")}
     return {"scans": scans, "stamps": b.stamps[keep], "mounts": mounts, "unposed": int((~keep).sum()), "bag": b,
-            "edges": edges, "warnings": [warning] if warning else []}
+            "edges": edges, "warnings": list(b.warnings) + ([warning] if warning else [])}
 
 
 def _none_posed_text(b, n: int, stamp: str) -> str:
@@ -100,7 +105,8 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     stamped by their header (``stamp='receive'``: by the time the bag received them), ranges mapped to CARMEN's semantics by REP 117 (see docs/bags-and-poses.md, "REP 117 ranges, in CARMEN's terms";
     ``no_return='free'`` makes +inf clear free space). The laser pose at each scan's stamp comes
     from ``/tf`` + ``/tf_static`` (the chain from ``fixed_frame``, default ``map``, to the scan's
-    frame, interpolated in time), or from ``pose_topic`` (Odometry, PoseStamped,
+    frame, interpolated in time; a bag without a ``map`` frame is mapped in the one root of tf
+    that the scans reach, such as ``odom``, with a :class:`BagWarning`), or from ``pose_topic`` (Odometry, PoseStamped,
     PoseWithCovarianceStamped, or a Path: its last message) and the mount (``/tf_static`` or
     ``laser_mount``), or ``static_pose`` (x, y, yaw of a robot that does not move, with the mount),
     or from a pose file: ``poses=FILE`` and the other pose keywords of :func:`load_log`, matched by stamp.
@@ -124,7 +130,7 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
                    laser_mount=laser_mount, no_return=no_return, need_poses=need_poses,
                    skip_unposed=bool(pose_keywords.pop("skip_unposed", False)) if need_poses else False,
                    progress=progress, echo=echo, stamp=stamp, z_band=z_band, cloud_angle_step=cloud_angle_step,
-                   cloud_range_max=cloud_range_max, static_pose=static_pose)
+                   cloud_range_max=cloud_range_max, static_pose=static_pose, wording="python")
     if len(sessions) > 1 and pose_keywords.get("poses") is not None:
         raise _core_usage_error("poses= applies to one input: write each session's poses into it first")
     d = None

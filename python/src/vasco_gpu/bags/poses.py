@@ -13,6 +13,7 @@ from ..msgs.geometry import planar, planar_compose, unit_quaternion, wrap_angle,
 from ..msgs.header import frame_name, stamp_ns, stamp_seconds, stamp_text
 from ..msgs.series import bracket, first_outside, sorted_samples
 from ..msgs.tf import TfBuffer, static_mount
+from .errors import words
 
 
 class PoseSeries:
@@ -206,3 +207,49 @@ def _tf_poses(path, tf: TfBuffer, fixed_frame: str | None, frame: str, ns: np.nd
         fixed_frame = tf.root(frame)
     t, q = tf.lookup(fixed_frame, frame, ns)
     return planar(path, t, q, f"the laser frame {frame!r} in {fixed_frame!r}")
+
+
+def choose_fixed_frame(path, tf: TfBuffer, frames, wording: str) -> tuple[str, str | None]:
+    """(fixed frame, warning or None) for tf poses when none was asked for: 'map' when tf has it;
+    else the root that every scan frame reaches through a /tf link (a bag recorded without
+    localisation: odom), with a warning; else a BagError naming the roots (or, where no /tf link
+    moves the scans, saying where poses come from)."""
+    known = set(tf.frames())
+    reach = {f: tf.up(f) if f in known else [f] for f in frames}
+    roots = sorted({chain[-1] for chain in reach.values()})
+    if "map" in known:
+        if all("map" in chain for chain in reach.values()):
+            return "map", None
+        raise BagError(path, _no_root_text(tf, reach, "'map' is in tf, but not every scan frame reaches it",
+                                           wording))
+    parented = all(len(chain) > 1 for chain in reach.values())
+    if len(roots) != 1 or not parented:
+        raise BagError(path, _no_root_text(tf, reach, "tf has no 'map' frame and the scans' frames reach no one "
+                                                      "root", wording))
+    root = roots[0]
+    if all(tf.span(root, f) is None for f in frames):  # static links only: nothing moves the scans
+        from .topics import no_poses_text
+        chains = ", ".join(" -> ".join(reversed(c)) for c in reach.values())
+        raise BagError(path, no_poses_text(f"tf links the scans to {root!r} on /tf_static only ({chains}), "
+                                           "so it holds no robot motion, and there is no 'map' frame", wording))
+    fixed = words(wording, "--fixed-frame FRAME", "fixed_frame=FRAME")
+    poses = words(wording, "--poses FILE", "poses=FILE")
+    via = "; ".join(_reach_text(f, chain) for f, chain in reach.items())
+    return root, (f"the bag has no 'map' frame: the map is made in {root!r}, the root of tf that the "
+                  f"scans reach ({via}); {fixed} chooses another. {root!r} follows the robot's odometry, "
+                  f"which drifts: for a SLAM-corrected map give the corrected poses with {poses}")
+
+
+def _reach_text(frame: str, chain: list[str]) -> str:
+    via = f" via {', '.join(chain[1:-1])}" if len(chain) > 2 else ""
+    return f"{frame!r}{via}"
+
+
+def _no_root_text(tf: TfBuffer, reach: dict, why: str, wording: str) -> str:
+    """Why no fixed frame is clear: which root each scan frame reaches, tf's roots, and the option."""
+    parents = {f for f in tf.frames() if len(tf.up(f)) == 1}
+    each = "; ".join(f"{f!r} is not in tf" if len(c) == 1 and f not in parents else
+                     f"{f!r} reaches {c[-1]!r}" for f, c in reach.items())
+    fixed = words(wording, "--fixed-frame FRAME", "fixed_frame=FRAME")
+    return (f"{why} ({each}; the roots in tf: {', '.join(sorted(parents)) or 'none'}): pass {fixed} with the "
+            "frame the map is to be in, one that every scan frame reaches")

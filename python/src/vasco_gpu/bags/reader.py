@@ -23,7 +23,7 @@ from ..msgs.header import stamp_seconds, stamp_text
 from ..msgs.scan_options import SCAN_DEFAULTS, ScanSettings, check_choice, check_cloud_options
 from ..msgs.table import message_type
 from ..msgs.tf import TfBuffer
-from .poses import PoseSeries, poses_for
+from .poses import PoseSeries, choose_fixed_frame, poses_for
 from .scans import STAMP_MODES, BagScans, ScanAccumulator
 from .storage import open_bag, read_messages
 from .topics import check_pose_topic, choose_pose_source, pick_scan_topics, tf_topics
@@ -79,7 +79,7 @@ def _check_arguments(pose_source, no_return, pose_topic, outside_span, echo, sta
 def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_topic=None,
              laser_mount=None, pose_source="auto", no_return=SCAN_DEFAULTS["no_return"], progress=None,
              outside_span="error", echo=SCAN_DEFAULTS["echo"], stamp="header", z_band=None, cloud_angle_step=None,
-             cloud_range_max=None, static_pose=None) -> BagScans:
+             cloud_range_max=None, static_pose=None, root_if_no_map=False, wording="python") -> BagScans:
     """The scans of the bag's laser scan topics at path, with the laser pose at each stamp.
 
     scan_topic: the sensor_msgs/LaserScan or MultiEchoLaserScan topic; None takes the only one;
@@ -107,6 +107,11 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     frame, cloud_angle_step in degrees (default 0.25), cloud_range_max in metres (default 50); each
     may be given as text too (bag2map's options: "0.2,1.8").
 
+    root_if_no_map: with fixed_frame "map" and tf poses, a bag whose tf has no 'map' frame is
+    mapped in the root that every scan frame reaches through a /tf link (odom, for a recording
+    without localisation), with a warning in the result's ``warnings``. wording: the errors and
+    warnings name options as the Python API ("python", the default) or bag2map ("cli") does.
+
     Raises BagError for anything about the bag, ValueError for arguments that are wrong in
     themselves.
     """
@@ -130,7 +135,7 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
         for name in names:
             if topics[name].msgcount == 0:
                 raise BagError(path, f"scan topic {name!r} has no messages", topic=name)
-        source = choose_pose_source(path, topics, pose_source, pose_topic)
+        source = choose_pose_source(path, topics, pose_source, pose_topic, wording)
         tf = None
         if tf_topics(topics):
             tf = TfBuffer(path, stamp_name="scan stamp", max_gap=TF_MAX_GAP, refuse_repeats=True,
@@ -154,10 +159,12 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
         ticker = Progress(progress, total)
         read_messages(reader, path, handlers, ticker)
         ticker.end()
+    notes = _checked_topics(path, accs, settings, base_frame, wording)
+    if source == "tf" and root_if_no_map and fixed_frame == "map":
+        fixed_frame, chosen = choose_fixed_frame(path, tf, [acc.frame_id for acc in accs], wording)
+        notes.insert(0, chosen)
     parts = []
     for acc in accs:
-        if not acc.ns:
-            raise BagError(path, f"scan topic {acc.topic!r} has no messages", topic=acc.topic)
         ns = np.frombuffer(acc.ns, dtype=np.int64).copy()
         try:
             parts.append((acc, ns) + poses_for(path, source, acc, ns, tf, series, fixed_frame, base_frame,
@@ -167,7 +174,23 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
                 e.message += f" (scans of {acc.topic!r})"
                 e.args = (e.args[0] + f" (scans of {acc.topic!r})",)
             raise
-    return _merge(path, parts)
+    merged = _merge(path, parts)
+    merged.warnings = tuple(f"{path}: {n}" for n in notes if n)
+    return merged
+
+
+def _checked_topics(path, accs, settings, base_frame, wording) -> list:
+    """What to warn of for each topic read (or None), after the checks of what it holds: a topic
+    without messages, clouds with no point in the height band."""
+    notes = []
+    for acc in accs:
+        if not acc.ns:
+            raise BagError(path, f"scan topic {acc.topic!r} has no messages", topic=acc.topic)
+        band = acc.band_error(settings.z_band, base_frame or "base_link", wording)
+        if band is not None:
+            raise band
+        notes.append(acc.angles_warning())
+    return notes
 
 
 def _numbers(value, what: str) -> list[float]:
@@ -230,7 +253,11 @@ def _merge(path, parts) -> BagScans:
     total = {}
     for p in parts:
         for key, value in p[0].counts.items():
-            total[key] = total.get(key, 0) + value
+            pick = {"z_min": min, "z_max": max}.get(key)  # the heights seen: their range, not a sum
+            if key not in total:
+                total[key] = value
+            else:
+                total[key] = pick(total[key], value) if pick else total[key] + value
     edges = None
     known = [p[5] for p in parts if p[5] is not None]
     if known:

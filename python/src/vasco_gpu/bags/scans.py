@@ -5,6 +5,7 @@ CARMEN's semantics) is :mod:`vasco_gpu.msgs.laser`'s."""
 
 from __future__ import annotations
 
+import math
 from array import array
 from dataclasses import dataclass
 
@@ -12,9 +13,10 @@ import numpy as np
 
 from ..msgs.errors import BagError
 from ..msgs.header import frame_name, stamp_ns, stamp_seconds, stamp_text
-from ..msgs.laser import COUNT_KEYS
+from ..msgs.laser import ANGLES_OFF, COUNT_KEYS
 from ..msgs.scan_options import ScanSettings
 from ..msgs.table import MessageType
+from .errors import words
 
 __all__ = ["BagScans", "STAMP_MODES", "ScanAccumulator"]
 
@@ -35,7 +37,9 @@ class BagScans:
     order; ``topic_index[s]`` is scan s's topic in ``topics``, ``topic`` and ``frame_id`` are
     the first's. ``edges``: the scans before the first and after the last pose of their topic's
     chain, left out (``outside_span="edges"``): {"before", "after", "first", "last"} (counts,
-    and the first and last stamp with a pose, in seconds) or None.
+    and the first and last stamp with a pose, in seconds) or None. ``warnings``: lines to warn
+    of (a fixed frame chosen for a bag without 'map'; scans whose angle_max disagrees with their
+    ranges by rounding, once a topic).
     """
 
     path: str
@@ -55,6 +59,7 @@ class BagScans:
     topic_index: np.ndarray | None = None
     frame_ids: tuple = ()
     edges: dict | None = None
+    warnings: tuple = ()  # what the caller should warn of, one line each (BagWarning's)
 
 
 class ScanAccumulator:
@@ -77,6 +82,7 @@ class ScanAccumulator:
         self.beam_counts = array("q")
         self.ranges: list[np.ndarray] = []
         self.counts = dict.fromkeys(COUNT_KEYS, 0)
+        self.angles_note: str | None = None  # the first scan taken although its angles disagree
 
     def _error(self, ns: int, what: str) -> BagError:
         """A BagError about the scan at stamp ns."""
@@ -95,9 +101,48 @@ class ScanAccumulator:
         if self.kind.mount and not self.ns:  # the first scan: its frame's mount, for the height band
             self._mount = self.mount_of(frame, ns)
         scan = self.kind.read(msg, self.settings, self.counts, lambda what: self._error(ns, what), self._mount)
+        if self.angles_note is None and self.counts.get(ANGLES_OFF):
+            self.angles_note = _angles_text(msg, ns)
         self.ns.append(ns)
         self.first_angle.append(scan.first_angle)
         self.angle_step.append(scan.angle_step)
         self.range_max.append(scan.range_max)
         self.beam_counts.append(len(scan.ranges))
         self.ranges.append(scan.ranges)
+
+    def angles_warning(self) -> str | None:
+        """The one line about the scans taken although angle_max disagrees with their ranges."""
+        off = self.counts.get(ANGLES_OFF, 0)
+        if not off:
+            return None
+        return (f"{off} of the {len(self.ns)} scans on {self.topic!r} have angles that disagree with their "
+                f"ranges by rounding (the first, {self.angles_note}): beam i is taken at angle_min + i * "
+                "angle_increment, as RViz and laser_geometry take it")
+
+    def band_error(self, band, base: str, wording: str) -> BagError | None:
+        """The error for point clouds whose height band kept no point of the finite ones seen."""
+        seen = self.counts.get("points_seen", 0)
+        if not self.kind.mount or not seen or self.counts.get("points_in_band", 0):
+            return None
+        lo, hi = self.counts["z_min"], self.counts["z_max"]
+        flag = words(wording, f"--z-band {band[0]:g},{band[1]:g}", f"z_band=({band[0]:g}, {band[1]:g})")
+        fix = words(wording, "--z-band MIN,MAX", "z_band=(MIN, MAX)")
+        text = (f"every one of the {seen} points of the {len(self.ns)} clouds on {self.topic!r} lies outside "
+                f"the height band {flag} (metres in the base frame {base!r}): their heights run from {lo:.3f} to "
+                f"{hi:.3f} m; pass {fix} with the band of the obstacles' heights")
+        if hi - lo < 0.5:  # a cloud already flattened (as a 2-D lidar's, at its mount's height)
+            text += f" (these points: {_band_around(lo, hi, wording)})"
+        return BagError(self.path, text, topic=self.topic)
+
+
+def _band_around(lo: float, hi: float, wording: str) -> str:
+    """The option that keeps heights lo to hi, with 5 cm either side, in whole centimetres."""
+    a, b = math.floor((lo - 0.05) * 100) / 100, math.ceil((hi + 0.05) * 100) / 100
+    return words(wording, f"--z-band {a:g},{b:g}", f"z_band=({a:g}, {b:g})")
+
+
+def _angles_text(msg, ns: int) -> str:
+    """What is off in a LaserScan taken although its angle_max disagrees with its ranges."""
+    n, a0, a1, da = len(msg.ranges), float(msg.angle_min), float(msg.angle_max), float(msg.angle_increment)
+    return (f"stamp {stamp_text(ns)}, has {n} ranges, but angle_min {a0:.9g} to angle_max {a1:.9g} by "
+            f"{da:.9g} makes {(a1 - a0) / da + 1:.1f} beams; its last beam is at {a0 + (n - 1) * da:.9g}")

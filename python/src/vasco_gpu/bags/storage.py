@@ -69,20 +69,60 @@ def _storage_target(path) -> Path:
     return p
 
 
+def _storage_kind(target: Path) -> str:
+    """".bag", ".mcap" or ".db3": the storage of the path handed to rosbags (a ROS 2 bag
+    directory's by the storage files in it)."""
+    if target.is_dir():
+        suffixes = {x.suffix for x in target.iterdir() if x.is_file()}
+        return ".mcap" if ".mcap" in suffixes else ".db3" if ".db3" in suffixes else ""
+    return target.suffix
+
+
 def _repair_hint(target: Path, err: BaseException) -> str:
-    """A hint for the usual damage: a recording cut short loses what is written at the end."""
+    """What is wrong with the file, as far as rosbags' failure tells, and the tool that repairs
+    it or reads it otherwise: a recording cut short loses what is written at the end (a ROS 1
+    bag's index, an MCAP file's footer, an SQLite database's last pages)."""
     text = str(err).lower()
-    if target.suffix == ".bag" and ("index" in text or "header" in text):
-        return " (a ROS 1 bag cut short loses its index; 'rosbag reindex' may restore it)"
-    if target.suffix == ".mcap" and ("end magic" in text or "footer" in text or "summary" in text):
-        return " (an MCAP file cut short has no footer; 'mcap recover' may repair it)"
+    kind = _storage_kind(target)
+    checked = isinstance(err, AssertionError) or "assert" in text
+    if kind == ".bag" and (checked or "index" in text or "header" in text or "chunk" in text or "record" in text):
+        return ("; the bag's index or record headers are damaged (a recording cut short loses its index) or "
+                "laid out otherwise than rosbags reads them: ROS 1's 'rosbag reindex BAG' rebuilds the index, "
+                "'rosbag filter BAG OUT.bag True' rewrites every record; then read the result")
+    if kind == ".mcap" and (checked or any(w in text for w in ("magic", "footer", "summary", "record", "chunk"))):
+        return ("; an MCAP file cut short has no footer and no summary: 'mcap recover FILE -o OUT.mcap' (the "
+                "mcap command line tool) writes what can be read into OUT.mcap; then read that file")
+    if kind == ".db3" and ("malformed" in text or "not a database" in text or "corrupt" in text or checked):
+        return ("; the SQLite database is damaged (a recording cut short): \"sqlite3 FILE.db3 '.recover' | "
+                "sqlite3 OUT.db3\" copies what can be read into OUT.db3; then read that file")
+    if checked:
+        return "; the file is damaged, or written otherwise than rosbags reads it"
     return ""
 
 
 def reason(err: BaseException) -> str:
-    """One line saying what an exception from rosbags says."""
-    text = str(err).strip() or type(err).__name__
-    return text.splitlines()[0]
+    """One line saying what an exception from rosbags says; for a failed check without a message
+    (an AssertionError), the check and where rosbags makes it."""
+    text = str(err).strip()
+    if not text and isinstance(err, AssertionError):
+        return _failed_check(err)
+    return (text or type(err).__name__).splitlines()[0]
+
+
+def _failed_check(err: AssertionError) -> str:
+    """'rosbags' check `assert size == 47` (rosbag1/reader.py, line 643) failed' from the
+    traceback's innermost frame."""
+    import linecache
+    import traceback
+
+    frames = traceback.extract_tb(err.__traceback__)
+    if not frames:
+        return "a check of rosbags' reader failed"
+    last = frames[-1]
+    source = (last.line or linecache.getline(last.filename, last.lineno)).strip()
+    where = Path(last.filename)
+    name = "/".join(where.parts[-2:])
+    return f"a check of rosbags' reader failed: `{source}` ({name}, line {last.lineno})"
 
 
 @contextmanager
@@ -94,8 +134,7 @@ def open_bag(path):
         reader = AnyReader([target], default_typestore=default)
         reader.open()
     except Exception as err:  # rosbags raises many kinds (ReaderError, KeyError, sqlite3, zstd, ...)
-        why = f"{reason(err)}{_repair_hint(target, err)}"
-        raise BagError(path, f"cannot be read as a ROS bag: {why}") from err
+        raise BagError(path, f"cannot be read as a ROS bag: {reason(err)}{_repair_hint(target, err)}") from err
     try:
         _ensure_types(reader, default)
         yield reader
@@ -128,7 +167,8 @@ def read_messages(reader, path, handlers: dict, progress) -> None:
         try:
             item = next(stream, None)
         except Exception as err:
-            raise BagError(path, f"reading failed after {progress.done} messages: {reason(err)}") from err
+            hint = _repair_hint(Path(path), err)
+            raise BagError(path, f"reading failed after {progress.done} messages: {reason(err)}{hint}") from err
         if item is None:
             break
         connection, t_ns, raw = item

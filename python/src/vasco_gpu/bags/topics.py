@@ -7,6 +7,7 @@ from __future__ import annotations
 from ..msgs.errors import BagError
 from ..msgs.header import did_you_mean
 from ..msgs.table import POSE_TYPES, SCAN_TYPES, TF_TYPES, UNSUPPORTED_SENSORS, norm_type, short_type
+from .errors import words
 
 TF_TOPICS = ("/tf", "/tf_static")
 
@@ -105,7 +106,7 @@ def tf_topics(topics) -> list[str]:
     return found
 
 
-def choose_pose_source(path, topics, pose_source: str, pose_topic: str | None) -> str:
+def choose_pose_source(path, topics, pose_source: str, pose_topic: str | None, wording: str = "python") -> str:
     """"tf", "topic" or "none" from the pose_source argument and what the bag has."""
     if pose_source == "auto":
         if pose_topic is not None:
@@ -113,14 +114,27 @@ def choose_pose_source(path, topics, pose_source: str, pose_topic: str | None) -
         if tf_topics(topics):
             return "tf"
         candidates = topics_of_type(topics, POSE_TYPES)
-        found = f"; its pose topics: {', '.join(repr(t) for t in candidates)}" if candidates else ""
-        raise BagError(path, "no /tf and no pose topic to take the laser poses from: pass pose_topic "
-                             "(--pose-topic TOPIC) for a topic of robot poses, a pose file (--poses FILE), or "
-                             f"static_pose (--static-pose X,Y,THETA) for a sensor that does not move{found}")
+        raise BagError(path, no_poses_text("the bag has no /tf and no pose topic", wording, candidates))
     if pose_source == "tf" and not tf_topics(topics):
         raise BagError(path, f"pose_source 'tf' but the bag has no /tf or /tf_static messages (topics: "
                              f"{topic_listing(topics)})")
     return pose_source
+
+
+def no_poses_text(why: str, wording: str, pose_topics=()) -> str:
+    """Why a bag gives the scans no poses, and where a moving sensor's poses come from, in the
+    words of the command line or of the Python API (wording: errors.WORDINGS)."""
+    say = lambda cli, python: words(wording, cli, python)
+    text = f"no poses for the scans: {why}."
+    if pose_topics:
+        listed = ", ".join(repr(t) for t in pose_topics)
+        text += f" Its pose topics ({listed}) give them with {say('--pose-topic TOPIC', 'pose_topic=TOPIC')}."
+    return text + (
+        " A moving sensor's poses must come from SLAM or odometry: run a SLAM system over the bag offline "
+        "(slam_toolbox or Cartographer, playing the bag) and give its trajectory with "
+        f"{say('--poses FILE', 'poses=FILE')} (TUM, g2o or a CARMEN log), or record the robot's odometry (an "
+        f"Odometry topic, {say('--pose-topic TOPIC', 'pose_topic=TOPIC')}) or its /tf with the scans. A sensor "
+        f"that does not move: {say('--static-pose X,Y,THETA', 'static_pose=(X, Y, THETA)')}")
 
 
 def check_pose_topic(path, topics, pose_topic: str) -> tuple[str, str]:

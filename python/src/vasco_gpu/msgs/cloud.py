@@ -76,7 +76,8 @@ def read_cloud(msg, *, no_return: str, counts: dict, fail, z_band=SCAN_DEFAULTS[
                range_max: float = SCAN_DEFAULTS["cloud_range_max"], mount=None) -> LaserReading:
     """A PointCloud2 as a LaserReading (module docstring); angle_step in radians. mount: (t (3,), q (4,)) of the
     cloud's frame in the base frame (None: the cloud is in the base frame). counts: read_laser's
-    COUNT_KEYS, plus ``points`` (in the band and range) and ``bins_empty``."""
+    COUNT_KEYS, plus ``points`` (in the band and range), ``bins_empty`` and the heights seen
+    (:func:`_count_heights`)."""
     p = cloud_points_xyz(msg, fail)
     finite = np.isfinite(p).all(axis=1)
     z = p[:, 2]
@@ -87,7 +88,9 @@ def read_cloud(msg, *, no_return: str, counts: dict, fail, z_band=SCAN_DEFAULTS[
         z = (2 * (q[0] * q[2] - w * q[1])) * p[:, 0] + (2 * (q[1] * q[2] + w * q[0])) * p[:, 1] + \
             (1 - 2 * (x * x + y * y)) * p[:, 2] + t[2]
     r = np.hypot(p[:, 0], p[:, 1])
-    keep = finite & (z >= z_band[0]) & (z <= z_band[1]) & (r > 0) & (r <= range_max)
+    in_band = finite & (z >= z_band[0]) & (z <= z_band[1])
+    _count_heights(counts, z[finite], int(in_band.sum()))
+    keep = in_band & (r > 0) & (r <= range_max)
     n = int(round(2 * math.pi / angle_step))
     a0 = -math.pi
     k = np.floor((np.arctan2(p[keep, 1], p[keep, 0]) - a0) / angle_step + 0.5).astype(np.int64) % n
@@ -98,6 +101,16 @@ def read_cloud(msg, *, no_return: str, counts: dict, fail, z_band=SCAN_DEFAULTS[
     out = apply_rep117(ranges.astype(np.float32), 0.0, float(np.float32(range_max)), no_return, counts)
     counts["messages"] += 1
     return LaserReading(frame_name(msg.header.frame_id), a0, angle_step, float(range_max), out)
+
+
+def _count_heights(counts: dict, z: np.ndarray, in_band: int) -> None:
+    """The heights seen, for the error of a band that keeps no point: counts' ``points_seen``
+    (finite points), ``points_in_band``, ``z_min`` and ``z_max`` (in the base frame)."""
+    counts["points_seen"] = counts.get("points_seen", 0) + len(z)
+    counts["points_in_band"] = counts.get("points_in_band", 0) + in_band
+    if len(z):
+        counts["z_min"] = min(counts.get("z_min", math.inf), float(z.min()))
+        counts["z_max"] = max(counts.get("z_max", -math.inf), float(z.max()))
 
 
 def read_point_cloud(msg, settings: ScanSettings, counts: dict, fail, mount=None) -> LaserReading:

@@ -39,8 +39,8 @@ import numpy as np
 from .header import frame_name
 from .scan_options import ScanSettings
 
-__all__ = ["COUNT_KEYS", "LaserReading", "NO_RETURN_FREE", "apply_rep117", "read_laser", "read_laser_scan",
-           "read_multi_echo"]
+__all__ = ["ANGLES_OFF", "COUNT_KEYS", "LaserReading", "NO_RETURN_FREE", "angle_check", "apply_rep117", "read_laser",
+           "read_laser_scan", "read_multi_echo"]
 
 #: The range stored for a +inf reading with ``no_return="free"``: the largest float32 below 50.
 NO_RETURN_FREE = np.nextafter(np.float32(50.0), np.float32(0.0))
@@ -123,12 +123,46 @@ class LaserReading:
 # writes a line that log2map refuses.
 MAX_BEAMS = 100_000
 
-# How far len(ranges) may be from what angle_min, angle_max and angle_increment imply, in
-# beams: drivers compute angle_max as angle_min + (n - 1) * increment in float32 or from the
-# device's nominal field of view, so the quotient is a whole number give or take rounding, and
-# some drivers count one beam more or less at an edge. Two beams off is a message whose ranges
-# are not those angles' (a truncated or mis-assembled scan).
+# How far len(ranges) may be from the beam count that angle_min, angle_max and angle_increment
+# imply, (angle_max - angle_min) / angle_increment + 1, before the message is refused. Drivers
+# compute angle_max in float32, from the device's nominal field of view, or count one beam more
+# or less at an edge; and some give a nominal increment rounded to a few digits, whose error
+# grows with the count: velodyne_laserscan publishes 897 ranges with angle_min -3.14159274,
+# angle_max 3.14159274 and increment 0.00700000022 (2 pi / 897 is 0.0070048), 898.6 beams by
+# the angles. Such a scan is what RViz and laser_geometry draw, beam i at angle_min + i *
+# angle_increment, and so is it taken here (with a warning, once a topic: the ANGLES_OFF count).
+# The bound is BEAM_COUNT_SLACK beams or BEAM_COUNT_FRACTION of the count, whichever is more:
+# 2 % holds a nominal increment given to three digits (0.07 % off for the velodyne scan, 1.6
+# beams) many times over, while a scan whose ranges are not those angles' (truncated, or of
+# another configuration: 180 ranges for 201 beams is 10 % off) is well beyond it.
 BEAM_COUNT_SLACK = 1.5
+BEAM_COUNT_FRACTION = 0.02
+# Within this many beams the count is the angles' own, give or take float32 rounding: no warning.
+BEAM_COUNT_EXACT = 0.5
+#: The counts key of the scans taken although angle_max disagrees with len(ranges).
+ANGLES_OFF = "angles_off"
+
+
+def angle_check(n: int, a0: float, a1: float, da: float) -> str | None:
+    """None for a scan whose n ranges fit its angles; "off" for one that fits within the bounds
+    above (taken, with a warning); else why it cannot be a scan (a refusal naming the numbers)."""
+    if da == 0 or not math.isfinite(a1) or n == 0:
+        return None
+    implied = (a1 - a0) / da + 1
+    numbers = f"angle_min {a0:.9g} to angle_max {a1:.9g} by {da:.9g} makes {implied:.1f} beams"
+    # One turn and one step: a full circle's scan may repeat its first angle at the end, no more.
+    turn = 2 * math.pi + abs(da)
+    if (n - 1) * abs(da) > turn or abs(a1 - a0) > turn:
+        return (f"has {n} ranges, but angle_min {a0:.9g} by {da:.9g} spans {(n - 1) * abs(da):.4f} rad for them "
+                f"and angle_max {a1:.9g} {abs(a1 - a0):.4f} rad, more than a turn and a step "
+                f"({turn:.4f} rad): not one scan")
+    off = abs(implied - n)
+    if off <= BEAM_COUNT_EXACT:
+        return None
+    if off > max(BEAM_COUNT_SLACK, BEAM_COUNT_FRACTION * n):
+        return (f"has {n} ranges, but {numbers} ({100 * off / n:.1f} % off, more than the "
+                f"{100 * BEAM_COUNT_FRACTION:g} % or {BEAM_COUNT_SLACK:g} beams that rounding explains)")
+    return "off"
 
 
 def read_laser(msg, *, no_return: str, counts: dict, fail, echo: str | None = None) -> LaserReading:
@@ -146,9 +180,11 @@ def read_laser(msg, *, no_return: str, counts: dict, fail, echo: str | None = No
         raise fail(f"has {n} beams, more than the {MAX_BEAMS} a CARMEN log line and the mapper take")
     raw = msg.ranges if echo is None else pick_echoes(msg, echo, fail)
     a1 = float(getattr(msg, "angle_max", math.nan))
-    if da != 0 and math.isfinite(a1) and n > 0 and abs((a1 - a0) / da + 1 - n) > BEAM_COUNT_SLACK:
-        raise fail(f"has {n} ranges, but angle_min {a0:.9g} to angle_max {a1:.9g} by {da:.9g} makes "
-                   f"{(a1 - a0) / da + 1:.1f} beams")
+    why = angle_check(n, a0, a1, da)
+    if why == "off":  # beam i at a0 + i * da, as RViz and laser_geometry take it
+        counts[ANGLES_OFF] = counts.get(ANGLES_OFF, 0) + 1
+    elif why is not None:
+        raise fail(why)
     r = apply_rep117(raw, rmin, rmax, no_return, counts)
     counts["messages"] += 1
     return LaserReading(frame_name(msg.header.frame_id), a0, da, rmax, r)

@@ -14,6 +14,11 @@ def main(argv=None) -> int:
     ROS 2 is not there."""
     import sys
 
+    if _asks_version(sys.argv if argv is None else argv):  # answered before rclpy (slow, maybe missing) loads
+        from .. import __version__
+
+        print(f"vasco_map_node (vasco_gpu) {__version__}")
+        return 0
     # A SIGINT while rclpy loads can land inside importlib's lock callbacks, where Python prints
     # it as an ignored exception: not printed (the node exits 0, as for any SIGINT while starting)
     hook = sys.unraisablehook
@@ -35,6 +40,13 @@ def main(argv=None) -> int:
               "installation (docs/ros.md)", file=sys.stderr)
         return 1
     return run(argv)
+
+
+def _asks_version(argv) -> bool:
+    """Whether the command line (argv[0] the program) has --version before any --ros-args, where
+    everything after belongs to ROS 2."""
+    args = list(argv[1:])
+    return "--version" in (args[:args.index("--ros-args")] if "--ros-args" in args else args)
 
 
 def _interrupted(e: BaseException) -> bool:
