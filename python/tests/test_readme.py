@@ -2,13 +2,14 @@
 package's console scripts (bag2map, bag2carmen, python -c), run here with the installed
 package; the rest of the documents is tests/docs/readme_test.py's (ctest
 ReadmeCommandsWork). Both read the documents through tests/docs/readme_blocks.py and take
-each block's check from tests/docs/readme_checks.py, where the fixtures and the
-substitutions used here are stated.
+each block's check from tests/docs/readme_checks.py, where the fixtures used here are
+stated.
 
-Substitutions and fixtures: bags made here from intel (bag_maker.py) where a block names
-run.mcap, run.bag, run/ and pose files; backend="cuda" becomes cpu_threads without a usable
-GPU; optimizer.poses() (a SLAM back end the block assumes) becomes mapper.poses; where no
-log2map binary is found (VASCO_BIN, build/bin, PATH) a stand-in maps the log through the
+Every block runs as written, in a scratch directory: a Python block as a script would
+(__name__ is "__main__"), a shell block's commands with bash. Fixtures: logs/ (the bundled
+logs, as the repository root has them); bags made here from intel (bag_maker.py) where a
+block names run.mcap, run.bag, run/ and pose files. Where no log2map binary is found
+(VASCO_BIN, build/bin, beside this interpreter, PATH) a stand-in maps the log through the
 package (load_log, Mapper, write_map).
 """
 
@@ -26,7 +27,6 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "tests" / "docs"
 LOGS = ROOT / "logs"
-GOLDEN_FR079 = ROOT / "tests" / "data" / "golden" / "maps" / "fr079-complete.gfs__vasco_default_ds4.map.gz"
 
 
 def _load(name):
@@ -151,30 +151,12 @@ def fixture_bags(d, intel):
     make_bags(d, intel)
 
 
-def fixture_loop_closure(d, intel):
-    (d / "logs").symlink_to(LOGS, target_is_directory=True)
-    shutil.copy(GOLDEN_FR079, d / "carmen.map.gz")
-
-
-def fixture_dask_logs(d, intel):
-    """logs: two CARMEN logs, a (intel) and b (its first N_SCANS scans)."""
-    import gzip
-
-    shutil.copy(LOGS / "intel.gfs.log.gz", d / "a.log.gz")
-    with gzip.open(LOGS / "intel.gfs.log.gz", "rt") as f:
-        lines = [ln for ln in f if ln.startswith("FLASER ")][:N_SCANS]
-    with gzip.open(d / "b.log.gz", "wt") as f:
-        f.writelines(lines)
-    return {"logs": [str(d / "a.log.gz"), str(d / "b.log.gz")]}
-
-
 def fixture_logs(d, intel):
     """logs/: the bundled logs, as the repository root has them."""
     (d / "logs").symlink_to(LOGS, target_is_directory=True)
 
 
-FIXTURES = {"bags": fixture_bags, "loop_closure": fixture_loop_closure, "dask_logs": fixture_dask_logs,
-            "logs": fixture_logs}
+FIXTURES = {"bags": fixture_bags, "logs": fixture_logs}
 
 
 # --- tools on PATH --------------------------------------------------------------------------
@@ -193,15 +175,21 @@ for out in args[1:]:
 
 
 def find_log2map():
-    for d in (os.environ.get("VASCO_BIN"), ROOT / "build" / "bin"):
+    for d in (os.environ.get("VASCO_BIN"), ROOT / "build" / "bin", Path(sys.executable).parent):
         if d and (Path(d) / "log2map").is_file():
             return Path(d) / "log2map"
     found = shutil.which("log2map")
     return Path(found) if found else None
 
 
+# The console scripts the blocks use, as pyproject.toml's [project.scripts] names them.
+CONSOLE_SCRIPTS = {"bag2map": ("vasco_gpu.bags.cli", "bag2map_main"),
+                   "bag2carmen": ("vasco_gpu.bags.cli", "bag2carmen_main"),
+                   "carmen2bag": ("vasco_gpu.bags.carmen2bag", "main")}
+
+
 def tool_dir(d: Path) -> Path:
-    """python, python3, bag2map, bag2carmen and log2map for the blocks' commands: this
+    """python, python3, bag2map, bag2carmen, carmen2bag and log2map for the blocks' commands: this
     interpreter, the console scripts beside it (else their entry points under it), the
     build's log2map (else a stand-in through the package)."""
     tools = d / ".tools"
@@ -210,14 +198,14 @@ def tool_dir(d: Path) -> Path:
         # A script, not a link: a link to a virtual environment's python starts outside it.
         (tools / name).write_text(f"#!/bin/sh\nexec '{sys.executable}' \"$@\"\n")
         (tools / name).chmod(0o755)
-    for name, entry in (("bag2map", "bag2map_main"), ("bag2carmen", "bag2carmen_main")):
+    for name, (module, entry) in CONSOLE_SCRIPTS.items():
         exe = Path(sys.executable).parent / name
         script = tools / name
         if exe.exists():
             script.symlink_to(exe)
         else:
             script.write_text(f"#!/bin/sh\nexec '{sys.executable}' -c "
-                              f"'import sys; from vasco_gpu.bags.cli import {entry}; sys.exit({entry}())' \"$@\"\n")
+                              f"'import sys; from {module} import {entry}; sys.exit({entry}())' \"$@\"\n")
             script.chmod(0o755)
     log2map = find_log2map()
     if log2map is not None:
@@ -229,18 +217,12 @@ def tool_dir(d: Path) -> Path:
     return tools
 
 
-def substituted(text, subs):
-    for old, new in subs:
-        assert old in text, f"the substitution {old!r} of readme_checks.py no longer matches the block"
-        text = text.replace(old, new)
-    return text
-
-
 @pytest.mark.parametrize("doc,block,check", python_blocks())
 def test_readme_block(doc, block, check, tmp_path, monkeypatch, intel):
     for module in check.needs:
         pytest.importorskip(module)
-    made = FIXTURES[check.fixture](tmp_path, intel) if check.fixture else None
+    if check.fixture:
+        FIXTURES[check.fixture](tmp_path, intel)
     # The package as this process imports it, for the blocks' processes too (a PYTHONPATH
     # relative to the repository would not survive the chdir).
     package_root = str(Path(vg.__file__).resolve().parents[1])
@@ -254,15 +236,14 @@ def test_readme_block(doc, block, check, tmp_path, monkeypatch, intel):
             if any(cmd.startswith(p) for p in check.skip):
                 continue
             want = next((s for p, s in check.status.items() if cmd.startswith(p)), 0)
-            r = subprocess.run(["bash", "-c", substituted(cmd, check.subs)], cwd=tmp_path, env=env,
+            r = subprocess.run(["bash", "-c", cmd], cwd=tmp_path, env=env,
                                capture_output=True, text=True, timeout=300)
             assert r.returncode == want, (f"{doc}:{block.content_line(offset)}: `{cmd}` exits "
                                           f"{r.returncode}, not {want}:\n{r.stderr}{r.stdout}")
     else:
-        code = substituted(block.text, check.subs)
-        namespace = {"__name__": "__readme__", "BACKEND": "cuda" if vg.cuda_available() else "cpu_threads"}
-        namespace.update(made or {})
-        exec(compile(code, f"{doc}:{block.line + 1}", "exec"), namespace)
+        # "__main__": a block that starts worker processes guards them as a script must.
+        namespace = {"__name__": "__main__"}
+        exec(compile(block.text, f"{doc}:{block.line + 1}", "exec"), namespace)
         results = namespace.get("results")
         if results is not None:
             assert all(r.ok for r in results), [r.error for r in results if not r.ok]

@@ -29,8 +29,8 @@ Kinds of check:
                command's stderr must match the block's line with numbers and the
                alternatives of `alternatives` generalised.
   layout       the Layout tree: every directory and file it names must exist.
-  python       a Python block: python/tests/test_readme.py runs it (fixture, substitutions
-               `subs` stated here, `outputs` must exist afterwards); skipped by the docs test.
+  python       a Python block: python/tests/test_readme.py runs it as written, as a script
+               would (fixture first, `outputs` must exist afterwards); skipped by the docs test.
   quoted       a benchmark's output quoted from a results file: the block's lines must be a
                run of consecutive lines of `quote_of` (a file of bench/results/, made by one
                bench/run_all.sh run under a header naming its date, machine and commit), or
@@ -70,7 +70,6 @@ class Check:
     command: str = ""
     output_file: str = ""
     alternatives: Sequence[Tuple[str, str]] = ()
-    subs: Sequence[Tuple[str, str]] = ()
     needs: Sequence[str] = ()  # Python modules a python check needs (skipped without them)
     quote_of: str = ""  # quoted: the results file the block comes from
     picked: bool = False  # quoted: lines of it in its order, not one run of them
@@ -267,6 +266,9 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         # The tour.
         "sh: log2map logs/intel.gfs.log.gz intel.map.gz intel.pgm intel.p": Check(
             "run", fixture="logs", outputs=["intel.map.gz", "intel.pgm", "intel.yaml", "intel.png", "fine.map.gz"]),
+        # The sample bag: the walkthrough's first command, then bag2map on it.
+        "sh: carmen2bag logs/intel.gfs.log.gz intel.mcap": Check(
+            "run", python=True, fixture="logs", outputs=["intel.mcap", "bag.pgm", "bag.yaml", "bag.map.gz"]),
         'python: log = vg.load_log("logs/intel.gfs.log.gz")': Check(
             "python", fixture="logs", outputs=["intel.png"]),
     },
@@ -390,11 +392,11 @@ CHECKS: Dict[str, Dict[str, Check]] = {
                    ("python/CMakeLists.txt", ["add_custom_target(vasco_gpu_python"]),
                    ("python/tests/conftest.py", ["ROOT"])]),
         'python: log = vg.load_log("logs/fr079-complete.gfs.log.gz")': Check(
-            "python", fixture="loop_closure", outputs=["after.png"],
-            subs=[('backend="cuda"', 'backend=BACKEND'), ("optimizer.poses()", "mapper.poses")]),
-        "python: with LocalCluster(n_workers=4, threads_per_worker=1) as clus": Check(
-            "python", fixture="dask_logs", outputs=["maps/a.map.gz", "maps/a.png", "maps/b.map.gz"],
-            subs=[("n_workers=4", "n_workers=2")], needs=["dask.distributed"]),
+            "python", fixture="logs", outputs=["before.png", "after.png"]),
+        'python: if __name__ == "__main__":': Check(
+            "python", fixture="logs", needs=["dask.distributed"],
+            outputs=["maps/intel.gfs.map.gz", "maps/intel.gfs.png", "maps/fr101.carmen.map.gz",
+                     "maps/fr101.carmen.png"]),
     },
     "docs/sessions.md": {
         "cpp: vasco::MapperParams params;": Check("compile", harness=CXX_HARNESS),

@@ -24,6 +24,7 @@ from std_srvs.srv import SetBool, Trigger
 
 from ..msgs.errors import BagError
 from ..msgs.header import stamp_ns, stamp_text
+from ..msgs.laser import ANGLES_OFF
 from ..msgs.table import MESSAGE_TYPES, MessageType
 from .batches import Batches
 from .canvas import fixed_frame
@@ -78,6 +79,7 @@ class MappingNode(NodeServices, LifecycleNode):
         self.refused: dict[tuple[str, str], int] = {}
         self.noted: dict[tuple[str, str], int] = {}  # scans mapped with a caveat (no mount)
         self._kept_topics: set[str] = set()  # a scan of theirs kept for a Path logged
+        self._angles_off: set[str] = set()  # a scan of theirs with angles off by rounding logged
         self._path_before_scans = False  # logged once
         self._last_scan = 0.0
         self.scan_ms = array("d")  # callback -> scan in the grid, per scan
@@ -361,7 +363,14 @@ class MappingNode(NodeServices, LifecycleNode):
         self.posing.stamp_seen(("scan", topic), stamp_ns(msg.header.stamp), lambda: self.resolve_topic_name(topic))
         if self._skipped(msg, topic):
             return
+        off = self.posing.range_counts.get(ANGLES_OFF, 0)
         self.posing.add_scan(msg, topic, kind, received)
+        if self.posing.range_counts.get(ANGLES_OFF, 0) > off and topic not in self._angles_off:
+            self._angles_off.add(topic)
+            self.get_logger().warning(
+                f"{self.resolve_topic_name(topic)}: a scan's angle_max disagrees with its number of ranges by "
+                f"rounding (as velodyne_laserscan publishes): each range mapped at angle_min + i * angle_increment "
+                f"(logged once a topic)")
         self._pose_soon()
 
     def _unposed_room(self) -> int | None:
