@@ -38,7 +38,7 @@ lies in it, so its geometry never changes and inserts give only updates.
 
 What is published. After scans were inserted, the update is the bounding box of the cells
 whose value differs from the last published canvas, row-major int8 (or nothing when none
-does). After a re-render (a Path, new parameters, a settle) a full /map is sent: every stored
+does). After a re-render (a Path, new parameters) a full /map is sent: every stored
 scan may have moved, so the box is usually the whole map anyway, and a full /map is what a
 subscriber that missed an update or joined late (the latched /map) can start from again. A
 geometry change is always a full /map.
@@ -175,7 +175,7 @@ class Canvas:
     def publish(self, finished, frame, *, full: bool = False) -> FullMap | MapUpdate | None:
         """What to publish for `finished` (LiveMap.finish_grid's ((size_x, size_y, resolution,
         origin), data)), a map of `frame` (the mapper's frame: x0, y0, resolution, size_x,
-        size_y). full: the map was rendered again (a Path, new parameters, a settle), a full map
+        size_y). full: every scan was rendered again (a Path, new parameters), a full map
         is due. A full map also when the canvas changes; else the changed rectangle, or None."""
         lattice, window = _locate(finished, frame)
         (size_x, size_y, _, _), data = finished

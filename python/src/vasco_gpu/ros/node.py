@@ -235,6 +235,7 @@ class MappingNode(NodeServices, LifecycleNode):
             new, effects = self.settings.changed({c.name: c.value for c in changed})
             if Effect.REMAP in effects and self.live is not None:
                 self.live.set_params(new.params)  # every stored scan mapped again
+                self.out.again()
         except (SettingsError, LiveMapError, ValueError) as e:
             return SetParametersResult(successful=False, reason=str(e))
         for note in set(new.notes) - set(self.settings.notes):
@@ -473,6 +474,8 @@ class MappingNode(NodeServices, LifecycleNode):
                                    f"Path; logged once)")
         try:
             counts = self.live.repose(stamps, poses, int(self.settings.pose_max_gap * 1e9))
+            if counts["moved"] or counts["in_gap"]:
+                self.out.again()  # every scan may have moved: a whole /map
         except LiveMapError as e:
             self._refuse(self.settings.path_topic, "paths not rendered", f"Path not rendered: {e}")
             return

@@ -41,7 +41,6 @@ class MapPublication:
         self.update_pub = node.create_lifecycle_publisher(update_type, "map_updates", UPDATES)
         self.canvas = Canvas(fixed=fixed)
         self._published = -1  # the LiveMap version last published
-        self._renders = -1  # the mapper's full renders then: more since is a full /map
         self.sent = False  # grid_msg published at least once: ~/dynamic_map serves it
         self.grid_msg = OccupancyGrid()  # /map's message, filled again for each full map
         self.update_msg = update_type()
@@ -56,7 +55,10 @@ class MapPublication:
             self._node.destroy_lifecycle_publisher(pub)
 
     def again(self) -> None:
-        """The next publish sends a full map even where the grid did not change (map_mode)."""
+        """The next publish sends a full map, even where the grid did not change: after a render
+        of every scan at new poses or with new parameters (a Path, a parameter change), or a new
+        map_mode. A render the mapper makes for itself (a grid grown, a settle) moves no scan:
+        what it changes goes out as an update, as any change does."""
         self._published = -1
 
     def reset(self) -> None:
@@ -88,14 +90,14 @@ class MapPublication:
         joined, self._subscribers = subscribers > self._subscribers and self._updated, subscribers
         if live.version == self._published and not joined:
             return {}
-        full_due = joined or self._published == -1 or live.mapper.renders != self._renders
+        full_due = joined or self._published == -1
         if not (full_due or now) and time.monotonic() - self._full_at < settings.map_update_interval:
             return {}
         s = settings
         t0 = time.perf_counter()
         got = live.finish_grid(s.map_mode, s.free_thresh, s.occupied_thresh, out=self._finished)
         full = full_due
-        self._published, self._renders = live.version, live.mapper.renders
+        self._published = live.version
         if got is None:
             return {}
         if not isinstance(got[1], array):  # a new size: a buffer of it, written again next time
