@@ -96,7 +96,6 @@ class MapPublication:
         s = settings
         t0 = time.perf_counter()
         got = live.finish_grid(s.map_mode, s.free_thresh, s.occupied_thresh, out=self._finished)
-        full = full_due
         self._published = live.version
         if got is None:
             return {}
@@ -106,7 +105,7 @@ class MapPublication:
         geometry = self.canvas.geometry
         if geometry is not None and geometry[2] != got[0][2]:
             self.canvas.reset()  # a new cell size: a canvas of the map's own size (its margin was in cells)
-        out = self.canvas.publish(got, live.mapper.frame, full=full)
+        out = self.canvas.publish(got, live.mapper.frame, full=full_due)
         if out is None:
             return {}
         t1 = time.perf_counter()
