@@ -368,6 +368,29 @@ def test_a_signal_while_starting_is_a_clean_exit_too(after):
     assert "Traceback" not in early.output, early.output
 
 
+def test_a_signal_inside_the_exit_still_destroys_the_node_and_shuts_ros_down(monkeypatch):
+    # rclpy's handler passes a SIGINT on to Python's, so a KeyboardInterrupt can arise inside
+    # the exit's own steps (Jazzy shuts the context down at once, while the node still closes)
+    from vasco_gpu.ros import run
+
+    done = []
+
+    class Closing:
+        def get_fully_qualified_name(self):
+            return "/n"
+
+        def summary(self):
+            raise KeyboardInterrupt
+
+        def destroy_node(self):
+            done.append("destroyed")
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(run.rclpy, "try_shutdown", lambda: done.append("shut down"))
+    run._close(Closing())
+    assert done == ["destroyed", "shut down"]
+
+
 def test_the_node_under_test_exits_cleanly_too(node):
     rc, took = node.interrupt()
     assert rc == 0 and took < 1.0, (rc, took, node.output[-2000:])

@@ -39,7 +39,10 @@ def main(argv=None) -> int:
               "'.[ros]' ./ros from the repository, Python 3.10 or newer; Jazzy: '.[ros-jazzy]') or source a ROS 2 "
               "installation (docs/ros.md)", file=sys.stderr)
         return 1
-    return run(argv)
+    try:
+        return run(argv)
+    except KeyboardInterrupt:  # a SIGINT passed on by rclpy's handler, landing between run's own guards
+        return 0
 
 
 def _asks_version(argv) -> bool:

@@ -55,9 +55,22 @@ def main(argv=None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        if node is not None:
-            # the node's own name: renamed (__node) or in a namespace, it is not vasco_mapper
-            print(f"{node.get_fully_qualified_name()}: {node.summary()}", file=sys.stderr)
-            node.destroy_node()
-        rclpy.try_shutdown()
+        _close(node)
     return 0
+
+
+def _close(node) -> None:
+    """The exit summary, the node destroyed, ROS 2 shut down: each step runs even when a SIGINT
+    lands inside an earlier one. rclpy's signal handler passes the signal on to Python's own, so
+    a KeyboardInterrupt can arise at any line, also here (on Jazzy, where rclpy shuts the context
+    down at once, the node may be closing already when it comes)."""
+    steps = [rclpy.try_shutdown]
+    if node is not None:
+        # the node's own name: renamed (__node) or in a namespace, it is not vasco_mapper
+        steps[:0] = [lambda: print(f"{node.get_fully_qualified_name()}: {node.summary()}", file=sys.stderr),
+                     node.destroy_node]
+    for step in steps:
+        try:
+            step()
+        except KeyboardInterrupt:
+            pass
