@@ -15,6 +15,11 @@ for each backend. Printed as a table, ratios in the same run:
               entry) -> the scan in the grid (ms): a batch waits up to its interval
   Path->/map  publish() of the serialized Path -> the new /map in this process's subscriber
               (ms, median and best of --paths), the whole loop a SLAM back end sees
+  floor       what no node can go below: ROS 2's own cost for the Path and a map of this size
+              (ros_floor_relay.py in the node's place: it maps nothing and answers each Path with
+              a /map made beforehand, taking and publishing as the node does; p50) plus the
+              node's render (its repose and finish steps, p50); a line after the table gives its
+              parts and how far Path->/map is above it
   node        of that, the node's own: its Path callback's entry -> /map published (p50 ms:
               reading the Path, the render, the finish, the OccupancyGrid); the rest is DDS
               carrying the Path and the map, and the callbacks' wake-ups; its steps (batch: map
@@ -194,6 +199,7 @@ def bench_one(player, log, name, batch, args, stamps, raw_path):
         player.wait_quiet(2.0)  # every scan mapped, the grid settled, the last map out
         traffic = map_traffic(player.events[first_event:], live_span, (live_span[0], time.monotonic()))
         lat = path_latencies(player, raw_path, args.paths)
+        last = player.latest().info
         rc, _ = proc.interrupt(timeout=60)
         line = next((ln for ln in proc.lines if ln.startswith("/vasco_mapper: ") and " scans mapped" in ln), "")
         mapped = line.split("vasco_mapper: ", 1)[1].split(" scans mapped")[0] if line else "?"
@@ -203,9 +209,34 @@ def bench_one(player, log, name, batch, args, stamps, raw_path):
                 "node": summary_value(line, "Path -> /map published").split("/")[0],
                 "steps": line.split("Path steps p50 ms: ", 1)[1].split(";")[0] if "Path steps" in line else "-",
                 "path_min": float(min(lat)), "rc": rc, "upd": update_latency(upd_node, traffic["wire"]),
-                "upd_node": upd_node, "published": published_counts(line), **traffic}
+                "upd_node": upd_node, "published": published_counts(line), "size": (last.width, last.height),
+                "relay": relay_latencies(player, raw_path, args.paths, last.width, last.height), **traffic}
     finally:
         proc.kill()
+
+
+def relay_latencies(player, raw_path: bytes, paths: int, width: int, height: int) -> list[float]:
+    """Path -> /map through ros_floor_relay.py in the node's place (the node stopped): ROS 2's
+    own cost for a Path and a map of the node's last size."""
+    relay = NodeProcess({}, command=[sys.executable, str(ROOT / "bench" / "ros_floor_relay.py"), str(width), str(height)])
+    try:
+        relay.wait_for("ready", timeout=60)
+        time.sleep(1.0)  # past discovery; its first (latched) /map arrives meanwhile
+        return path_latencies(player, raw_path, paths)
+    finally:
+        relay.interrupt(timeout=30)
+        relay.kill()
+
+
+def step_ms(steps: str, name: str) -> float:
+    """One step's p50 (ms) from the node's "batch 0.01, read 0.45, repose 1.28, ..."."""
+    hit = re.search(rf"\b{name} ([\d.]+)", steps)
+    return float(hit.group(1)) if hit else float("nan")
+
+
+def floor_ms(r: dict) -> float:
+    """ROS 2's own cost (the relay's p50) plus the node's render: what no node can go below."""
+    return float(np.median(r["relay"])) + step_ms(r["steps"], "repose") + step_ms(r["steps"], "finish")
 
 
 def print_rows(path: str, rows: dict, first_batch: float) -> None:
@@ -215,10 +246,18 @@ def print_rows(path: str, rows: dict, first_batch: float) -> None:
         traffic = f"{r['rate'] / 1e3:.1f} kB {r['ratio']:.1f}x" if r["rate"] else "-"
         print(f"{Path(path).name:<24} {name:<12} {b:>5g} {r['scans']:>11} {100 * r['cpu_idle']:>7.1f}% "
               f"{100 * r['cpu_live']:>8.1f}% "
-              f"{100 * r['cpu_fast']:>7.1f}% {r['scan']:>16} {r['path_p50']:>13.1f} {r['path_min']:>7.1f} {r['node']:>7} "
+              f"{100 * r['cpu_fast']:>7.1f}% {r['scan']:>16} {r['path_p50']:>13.1f} {r['path_min']:>7.1f} {floor_ms(r):>7.1f} "
+              f"{r['node']:>7} "
               f"{ratio:>13} {r['upd']:>15} {traffic:>16}", flush=True)
     for (name, b), r in rows.items():
         print(f"#   {Path(path).name} {name}, batch {b:g} s: the node's Path steps, p50 ms: {r['steps']}", flush=True)
+    for (name, b), r in rows.items():
+        relay, floor = float(np.median(r["relay"])), floor_ms(r)
+        print(f"#   {Path(path).name} {name}, batch {b:g} s: floor {floor:.2f} ms = ROS 2 alone {relay:.2f} (a relay "
+              f"answering each Path with a ready {r['size'][0]} x {r['size'][1]} /map, p50, best "
+              f"{min(r['relay']):.2f}) + the node's repose {step_ms(r['steps'], 'repose'):.2f} and finish "
+              f"{step_ms(r['steps'], 'finish'):.2f}; Path->/map {r['path_p50']:.2f} ms is "
+              f"{100 * (r['path_p50'] / floor - 1):.0f} % above it", flush=True)
     for (name, b), r in rows.items():
         wire, live = (f"{w[0]:.2f}/{w[1]:.2f} ({w[2]})" if w else "-" for w in (r["wire"], r["wire_live"]))
         u = r["updates_only"]
@@ -251,7 +290,7 @@ def main() -> int:
         print(f"# map cell {args.resolution:g} m (evidence grid {args.resolution / args.downsample:g} m); {args.live_scans} scans at {args.rate:g} Hz, "
               f"the rest at {args.fast_rate:g} Hz; Path -> /map over {args.paths} Paths")
         print(f"{'log':<24} {'backend':<12} {'batch':>5} {'scans':>11} {'CPU idle':>8} {'CPU 40 Hz':>9} {'CPU fast':>8} "
-              f"{'scan p50/p99 ms':>16} {'Path->/map ms':>13} {'best':>7} {'node':>7} {'vs cpu_double':>13} "
+              f"{'scan p50/p99 ms':>16} {'Path->/map ms':>13} {'best':>7} {'floor':>7} {'node':>7} {'vs cpu_double':>13} "
               f"{'upd p50/p99 ms':>15} {'bytes/s 40 Hz':>16}")
         for path in args.logs:
             log = vg.load_log(ROOT / path)

@@ -43,8 +43,9 @@ def import_or_skip(module: str):
 class NodeProcess:
     """``python -m vasco_gpu.ros`` with ROS parameters; its output collected line by line."""
 
-    def __init__(self, params: dict, cwd=None, env=None):
-        args = [sys.executable, "-m", "vasco_gpu.ros", "--ros-args"]
+    def __init__(self, params: dict, cwd=None, env=None, command=None):
+        """command: another program to run the same way (a benchmark's stand-in for the node)."""
+        args = command or [sys.executable, "-m", "vasco_gpu.ros", "--ros-args"]
         for k, v in params.items():
             args += ["-p", f"{k}:={_ros_value(v)}"]
         self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,

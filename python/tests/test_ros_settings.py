@@ -60,8 +60,8 @@ def test_each_row_takes_its_default_and_refuses_by_its_name(p):
 
 def test_the_refusals_words():
     for name, value, words in [("map_mode", "ternary", "map_mode: 'ternary' is not one of trinary, scale"),
-                               ("transform_timeout", 0, "transform_timeout: 0 must be a finite number > 0"),
-                               ("scan_batch_interval", -0.1, "scan_batch_interval: -0.1 must be a finite number >= 0"),
+                               ("transform_timeout", 0, "transform_timeout: 0 must be a finite number in (0, 86400]"),
+                               ("scan_batch_interval", -0.1, "scan_batch_interval: -0.1 must be between 0 and 86400"),
                                ("free_thresh", 1.5, "free_thresh: 1.5 must be between 0 and 1"),
                                ("threads", 1.0, "threads: 1.0 must be a whole number in [0, 1024]"),
                                ("max_memory", -1, "max_memory: -1 must be a whole number >= 0"),
@@ -171,7 +171,7 @@ def test_the_ros_descriptors():
     d = parameter_descriptor(ROWS["max_memory"])
     assert [(r.from_value, r.to_value) for r in d.integer_range] == [(0, 2**63 - 1)]
     d = parameter_descriptor(ROWS["transform_timeout"])  # > 0: ROS's ranges hold both ends
-    assert not d.floating_point_range and d.additional_constraints == "a finite number > 0"
+    assert not d.floating_point_range and d.additional_constraints == "a finite number in (0, 86400]"
     assert parameter_descriptor(ROWS["map_mode"]).additional_constraints == "one of: trinary, scale"
     assert isinstance(d, msgs.ParameterDescriptor)
     assert Number(lo=0, hi=1, hi_open=True).ros_range() is None

@@ -8,6 +8,7 @@ import numpy as np
 
 from .geometry import QUAT_TOL, yaw
 from .header import frame_name, stamp_text
+from .tf import MAX_TRANSLATION
 
 __all__ = ["path_poses"]
 
@@ -35,9 +36,29 @@ def path_poses(path, want: str, topic: str, fail):
         k = int(np.argmax(~np.isfinite(pos).all(axis=1) | ~np.isfinite(norm) | (norm < 1e-6)))
         raise fail(f"{topic}: pose {k} (stamp {stamp_text(int(path.stamps[k]))}) has position "
                    f"{tuple(pos[k].tolist())}, orientation {tuple(q[k].tolist())}", "paths with a bad pose")
+    # the tf tree's bound: beyond it a double's cell lattice is coarser than the map's cells,
+    # and a map's origin can overflow to inf in the files written
+    if np.abs(pos[:, :2]).max(initial=0.0) > MAX_TRANSLATION:
+        k = int(np.argmax(np.abs(pos[:, :2]).max(axis=1) > MAX_TRANSLATION))
+        raise fail(f"{topic}: pose {k} (stamp {stamp_text(int(path.stamps[k]))}) has position "
+                   f"{tuple(pos[k].tolist())}, beyond {MAX_TRANSLATION:g} m", "paths with a bad pose")
+    _distinct_stamps(path.stamps, topic, fail)
     off = np.abs(norm - 1.0) > QUAT_TOL
     if off.any():
         q = np.where(off[:, None], q / norm[:, None], q)
     poses = np.empty((len(q), 3))
     poses[:, :2], poses[:, 2] = pos[:, :2], yaw(q)
     return path.stamps, poses
+
+
+def _distinct_stamps(stamps: np.ndarray, topic: str, fail) -> None:
+    """Refuses a Path with two poses at one stamp: which one a scan at that stamp takes would be
+    a guess (the Path's order is not a time order)."""
+    if len(stamps) < 2 or (np.diff(stamps) > 0).all():  # a Path in time order: nothing to sort
+        return
+    order = np.argsort(stamps, kind="stable")
+    same = np.flatnonzero(np.diff(stamps[order]) == 0)
+    if len(same):
+        a, b = sorted((int(order[same[0]]), int(order[same[0] + 1])))
+        raise fail(f"{topic}: poses {a} and {b} of the Path have one stamp, {stamp_text(int(stamps[a]))}: which "
+                   f"one a scan there takes would be a guess", "paths with a repeated stamp")

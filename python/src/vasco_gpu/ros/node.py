@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import importlib
 import time
-from array import array
 
 import numpy as np
 from builtin_interfaces.msg import Time
@@ -28,6 +27,7 @@ from ..msgs.laser import ANGLES_OFF
 from ..msgs.table import MESSAGE_TYPES, MessageType
 from .batches import Batches
 from .canvas import fixed_frame
+from .latency import Reservoir
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
 from .publication import MapPublication
@@ -82,12 +82,13 @@ class MappingNode(NodeServices, LifecycleNode):
         self._angles_off: set[str] = set()  # a scan of theirs with angles off by rounding logged
         self._path_before_scans = False  # logged once
         self._last_scan = 0.0
-        self.scan_ms = array("d")  # callback -> scan in the grid, per scan
-        self.path_ms: list[float] = []  # callback -> /map published, per Path
-        self.batch_ms = array("d")  # batch timer -> map_updates published, per batch that sent one
+        # bounded samples (latency.py): a node runs for days
+        self.scan_ms = Reservoir()  # callback -> scan in the grid, per scan
+        self.path_ms = Reservoir()  # callback -> /map published, per Path
+        self.batch_ms = Reservoir()  # batch timer -> map_updates published, per batch that sent one
         # ... and its steps, per Path (ms): where a Path's time goes, in the summary
-        self.path_steps: dict[str, list[float]] = {
-            k: [] for k in ("batch", "read", "repose", "finish", "message", "publish")}
+        self.path_steps: dict[str, Reservoir] = {
+            k: Reservoir() for k in ("batch", "read", "repose", "finish", "message", "publish")}
         self._inputs: list = []  # activate's subscriptions
         self._batches: Batches | None = None
         self.add_on_set_parameters_callback(self._on_parameters)
@@ -465,7 +466,7 @@ class MappingNode(NodeServices, LifecycleNode):
             self._refuse(self.settings.path_topic, e.cause, f"{e}; ignored")
             return
         # the scans no tf posed that the Path covers: mapped at its poses, then moved with the others
-        self._insert(self.posing.take_on_path(stamps, poses, int(self.settings.pose_max_gap * 1e9)), timed=False)
+        self._insert(self.posing.take_on_path(stamps, poses, self.settings.max_gap_ns), timed=False)
         read = time.perf_counter()
         if len(self.live) == 0 and not self._path_before_scans:
             self._path_before_scans = True
@@ -473,7 +474,7 @@ class MappingNode(NodeServices, LifecycleNode):
                                    f"mapped: nothing to move (scans that come later are posed by tf until the next "
                                    f"Path; logged once)")
         try:
-            counts = self.live.repose(stamps, poses, int(self.settings.pose_max_gap * 1e9))
+            counts = self.live.repose(stamps, poses, self.settings.max_gap_ns)
             if counts["moved"] or counts["in_gap"]:
                 self.out.again()  # every scan may have moved: a whole /map
         except LiveMapError as e:
@@ -485,7 +486,7 @@ class MappingNode(NodeServices, LifecycleNode):
         steps = {"batch": flushed - start, "read": read - flushed, "repose": rendered - read, **published}
         for k, v in steps.items():
             self.path_steps[k].append(v * 1e3)
-        self.get_logger().debug(f"Path of {len(stamps)} poses: {counts}, published in {self.path_ms[-1]:.1f} ms")
+        self.get_logger().debug(f"Path of {len(stamps)} poses: {counts}, published in {(time.perf_counter() - start) * 1e3:.1f} ms")
 
     def _path_poses(self, raw: bytes):
         """(stamps (k,) int64 ns, base poses (k, 3)) of a serialized nav_msgs/Path; Refused
@@ -527,7 +528,10 @@ class MappingNode(NodeServices, LifecycleNode):
         the newest stamps forgotten (a replay after a reset is no jump); returns how many scans
         were dropped."""
         n = self.live.reset()
-        self.out.reset()
+        if self.active:  # the map of the dropped scans replaced at once by an empty one
+            self.out.reset(self.settings.map_frame, self._map_stamp())
+        else:
+            self.out.reset()
         self.posing.pending.clear()
         self.posing.unposed.clear()
         self.posing.jumps.clear()
@@ -567,7 +571,7 @@ class MappingNode(NodeServices, LifecycleNode):
             text += _percentiles(what, ms)
         if self.path_ms:
             text += "; Path steps p50 ms: " + ", ".join(
-                f"{k} {np.percentile(np.asarray(v), 50):.2f}" for k, v in self.path_steps.items() if v)
+                f"{k} {np.percentile(v.values(), 50):.2f}" for k, v in self.path_steps.items() if len(v))
         text += _percentiles("batch -> map_updates published", self.batch_ms)
         c = self.out.counts if getattr(self, "out", None) is not None else None
         if c and c["maps"]:
@@ -580,5 +584,5 @@ def _percentiles(what: str, ms) -> str:
     """"; what: p50 X ms, p99 Y ms (n)" of a list of milliseconds; "" for none."""
     if not len(ms):
         return ""
-    p50, p99 = np.percentile(np.asarray(ms), [50, 99])
+    p50, p99 = np.percentile(ms.values(), [50, 99])
     return f"; {what}: p50 {p50:.2f} ms, p99 {p99:.2f} ms ({len(ms)})"

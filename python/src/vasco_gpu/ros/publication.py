@@ -61,10 +61,20 @@ class MapPublication:
         what it changes goes out as an update, as any change does."""
         self._published = -1
 
-    def reset(self) -> None:
-        """A new map (~/reset, a time jump): the next map is a full one of its own size."""
+    def reset(self, frame: str | None = None, stamp: Time | None = None) -> None:
+        """A new map (~/reset, a time jump): the next map is a full one of its own size. With
+        frame (the node active), the map sent so far is replaced at once by one of its geometry
+        with every cell unknown: /map is latched, and a subscriber joining later (map_server,
+        nav2, RViz) must not get the map of the scans just dropped."""
+        sent = self.canvas.current() if frame is not None and self.sent else None
         self.canvas.reset()
         self._published = -1
+        if sent is not None:
+            fill_grid(self.grid_msg, sent.geometry, array("b", b"\xff") * len(sent.data), frame=frame, stamp=stamp)
+            self.map_pub.publish(self.grid_msg)
+            self.meta_pub.publish(self.grid_msg.info)
+            self._updated, self._full_at = False, time.monotonic()
+            self._count("map", len(sent.data))
 
     def current(self) -> OccupancyGrid:
         """The last /map message with every update since applied (~/dynamic_map's answer), its

@@ -261,7 +261,11 @@ def _from_scan(name: str, check=None) -> NodeParameter:
     return NodeParameter(name, default, check or Choice(o.choices), o.meaning)
 
 
-_SECONDS = Number(lo=0, lo_open=True)  # a finite number > 0
+# Seconds the node turns into a timer's period or a wait: rclpy keeps a period as int64
+# nanoseconds (1e12 s overflows inside create_timer), so they are bounded, at a day: no
+# interval or timeout of a live mapper is longer.
+LONGEST_S = 86400.0
+_SECONDS = Number(lo=0, lo_open=True, hi=LONGEST_S)  # a finite number in (0, a day]
 _SESSION = "session"
 _MAP_OUTPUT = "map_output"
 
@@ -306,12 +310,14 @@ NODE_PARAMETERS = (
     # 60 s: a replay faster than real time still finds the transforms of the scans queued for it
     NodeParameter("tf_buffer_duration", 60.0, _SECONDS,
                   "seconds of stamps each /tf link keeps for the scans' lookups (tf2's cache time)"),
-    NodeParameter("scan_batch_interval", 0.1, Number(lo=0),
+    NodeParameter("scan_batch_interval", 0.1, Number(lo=0, hi=LONGEST_S),
                   "seconds scans gather before they are posed and mapped together (one tf lookup, one insert: less "
                   "CPU a scan); 0: each scan on arrival", Effect.BATCH_PERIOD),
-    # nanoseconds in the node: finite and > 0, where a pose file also takes 0 and inf
+    # nanoseconds in the node: finite and > 0, where a pose file also takes 0 and inf; beyond
+    # ROS time's span (292 years) it is no limit (max_gap_ns)
     _from_core("pose_source", "pose_max_gap", _bounds(lo=0, hi=None, lo_open=True, hi_open=False),
-               help="seconds: a scan between two Path poses further apart keeps its pose"),
+               help="seconds: a scan between two Path poses further apart keeps its pose (over 292 years, the span "
+                    "of ROS time: no limit)"),
     NodeParameter("map_update_interval", 0.5, _SECONDS, "seconds between two map publications at most",
                   Effect.PUBLISH_PERIOD),
     _from_core(_MAP_OUTPUT, "map_mode", _choices, effect=Effect.REPUBLISH),
@@ -380,6 +386,12 @@ class Settings:
             return self.__dict__["node"][name]
         except KeyError:
             raise AttributeError(name) from None
+
+    @property
+    def max_gap_ns(self) -> int:
+        """pose_max_gap in nanoseconds, at most ROS time's span (longer: no limit)."""
+        ns = self.node["pose_max_gap"] * 1e9
+        return 2**63 - 1 if ns >= 2**63 - 1 else int(ns)
 
     @classmethod
     def from_values(cls, node_values: dict, mapper_values: dict) -> "Settings":
