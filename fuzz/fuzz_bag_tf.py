@@ -19,6 +19,9 @@ Invariants, each a violation when broken:
   * each call returns within --call-limit seconds (default 1);
   * a live buffer (keep=) holds no more samples a link than it may: those within keep of the
     link's newest stamp at some time, plus the 256 appended between two prunings, plus two.
+  * the tree stays a tree: no link from a frame to itself, no loop (a self transform is
+    ignored and a link that would close a loop refused as it arrives), so no lookup finds a
+    cycle.
 
 It loads the msgs subpackage by file path (no compiled extension, no rosbags needed).
 Prints one summary line; exits 0 when no invariant broke, 1 on a violation (after printing
@@ -377,6 +380,7 @@ class Violation(Exception):
 
 # What an error is about, for the summary.
 ERROR_KINDS = (
+    ("links a frame to itself", "self link"), ("would close a cycle", "closes a cycle"),
     ("two parents", "two parents"), ("on both /tf and /tf_static", "static and moving"),
     ("invalid rotation", "bad rotation"), ("has translation", "bad translation"), ("cycle", "cycle"),
     ("no transform chain", "no chain"), ("outside the time span", "outside the span"),
@@ -431,6 +435,8 @@ class Runner:
                 raise Violation("bad shape", f"covers gave {result.shape} for {len(op[3])} stamps", index)
             if op[0] == "add" and keep_ns is not None and not op[1] and len(op[3]) == 1 and result is not None:
                 self._check_memory(tf, op[3][0], keep_ns, added, most, index)
+            if op[0] == "add":
+                self._check_tree(tf, index)
             if self.verbose:
                 print(f"  [{index}] {op[0]}: {'error' if result is None else 'ok'} ({took * 1e3:.1f} ms)")
 
@@ -458,6 +464,8 @@ class Runner:
         text = str(e)
         self.errors[error_kind(text)] += 1
         self.examples[error_kind(text)] = e
+        if error_kind(text) == "cycle":  # a walk found a loop: the tree took a link it must refuse
+            raise Violation("cycle stored", text[:300], index)
         if len(text) > MAX_ERROR_TEXT + QUOTED_NAMES * longest_name:
             raise Violation("long error", f"{len(text)} characters: {text[:300]}...", index)
         if e.file != keywords.get("file"):
@@ -474,6 +482,22 @@ class Runner:
         norm = np.linalg.norm(q, axis=1)
         if n and not (np.abs(norm - 1.0) < 1e-6).all():
             raise Violation("not a unit quaternion", f"norms {norm.min()} to {norm.max()}", index)
+
+    @staticmethod
+    def _check_tree(tf, index: int) -> None:
+        """No self link and no loop among the stored links (the one other look inside): each
+        frame's walk up ends at a root, each frame walked once."""
+        parent = {child: edge.parent for child, edge in tf._edges.items()}
+        done: set = set()
+        for start in parent:
+            path, seen, f = [], set(), start
+            while f in parent and f not in done:
+                if f in seen:
+                    raise Violation("cycle stored", f"tf holds a loop through {f!r}", index)
+                seen.add(f)
+                path.append(f)
+                f = parent[f]
+            done.update(path)
 
     @staticmethod
     def _check_memory(tf, link, keep_ns: int, added: dict, most: dict, index: int) -> None:

@@ -171,12 +171,13 @@ TEST_F(EgridApi, FinishDownsamplesAndCrops) {
 // A run that mapped nothing (an empty or scan-less log): CARMEN's finish
 // sizes the map max - min = 4 border + 1 - n blocks, negative for a grid of
 // more blocks, and dies "Out of memory" before its caller writes a map. Ours
-// stops there too, saying why, so that no half-written map file follows.
+// stops there too, saying why, so that no half-written map file follows,
+// with carmen_die's status: exit(-1), 255 to the shell that checks it.
 TEST_F(EgridApi, FinishingAGridThatMappedNothingStopsAsCarmenDoes) {
   EXPECT_EQ(vasco_egrid_finish_would_stop(&g, 1, 2), 1);
   EXPECT_EQ(vasco_egrid_finish_would_stop(&g, 1, 5), 0);  // 20 blocks <= 4 x 5 + 1: CARMEN finishes it
   EXPECT_EQ(vasco_egrid_finish_would_stop(nullptr, 1, 2), 0);
-  EXPECT_EXIT(carmen_mapper_finish_evidence_grid(&g, 1, 2), ::testing::ExitedWithCode(EXIT_FAILURE),
+  EXPECT_EXIT(carmen_mapper_finish_evidence_grid(&g, 1, 2), ::testing::ExitedWithCode(255),
               "no cell of the 20 x 20 grid was updated");
 }
 

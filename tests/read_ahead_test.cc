@@ -5,7 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <set>
+#include <string>
 #include <vector>
+
+#include "map_test_support.h"
 
 namespace {
 
@@ -76,6 +82,112 @@ TEST(ReadAhead, FailedReadsHoldNothingAndStopEndsIt) {
   ra.stop();
   ra.taken(2);
   EXPECT_EQ(ra.admit(), Inputs{});
+}
+
+// A batch run in steps against `ra`, each read taking `actual[i]` bytes:
+// what is let through starts, the oldest read ends, a mapper takes the next
+// input once it is read and releases it once mapped. Returns the most bytes
+// held at once, the reads under way counted at their full size (as if each
+// had read all of it at once).
+uint64_t peak_bytes(cli::ReadAhead &ra, const std::vector<uint64_t> &actual) {
+  std::set<size_t> reading;
+  std::vector<bool> done(actual.size(), false);
+  uint64_t peak = 0;
+  size_t next_taken = 0;
+  auto account = [&] {
+    uint64_t bytes = ra.held_bytes();
+    for (size_t i : reading) bytes += actual[i];
+    peak = std::max(peak, bytes);
+  };
+  while (next_taken < actual.size()) {
+    for (size_t i : ra.admit()) reading.insert(i);
+    account();
+    if (!reading.empty()) {
+      const size_t oldest = *reading.begin();
+      reading.erase(reading.begin());
+      ra.read(oldest, actual[oldest]);
+      done[oldest] = true;
+    }
+    if (done[next_taken]) {
+      ra.taken(next_taken);
+      for (size_t i : ra.admit()) reading.insert(i);
+      account();
+      ra.released(next_taken++);
+    }
+  }
+  return peak;
+}
+
+// Six inputs that each parse to 289 MB, three pool threads (six reads at
+// once), a 1 GiB budget: counted at their estimates from the start, the
+// reads let through never pass the budget, where counted at the mean size
+// read so far (none, at the start) all six ran at once.
+TEST(ReadAhead, ReadsUnderWayCountAtTheirEstimatesBeforeAnySizeIsKnown) {
+  const uint64_t mb = 1000 * 1000, budget = uint64_t{1} << 30;
+  const std::vector<uint64_t> actual(6, 289 * mb);
+  cli::ReadAhead blind(6, 6, 24, budget);
+  EXPECT_EQ(blind.admit().size(), 6u);  // no estimates: nothing is known before the first read ends
+  cli::ReadAhead counted(6, 6, 24, budget, std::vector<uint64_t>(6, 300 * mb));
+  EXPECT_EQ(counted.admit(), (Inputs{0, 1, 2}));  // 4 x 300 MB would pass 1 GiB
+  EXPECT_EQ(counted.reserved_bytes(), 900 * mb);
+  cli::ReadAhead run(6, 6, 24, budget, std::vector<uint64_t>(6, 300 * mb));
+  EXPECT_LE(peak_bytes(run, actual), budget);
+  EXPECT_EQ(run.held_bytes(), 0u);
+  EXPECT_EQ(run.reserved_bytes(), 0u);
+}
+
+// The mean read so far counts where it is more than an input's estimate.
+TEST(ReadAhead, AReadUnderWayCountsAtTheMeanWhereThatIsMore) {
+  cli::ReadAhead ra(10, 2, 10, 1000, std::vector<uint64_t>(10, 10));
+  EXPECT_EQ(ra.admit(), (Inputs{0, 1}));
+  EXPECT_EQ(ra.reserved_bytes(), 20u);
+  ra.read(0, 400);
+  ra.read(1, 400);
+  EXPECT_EQ(ra.reserved_bytes(), 0u);
+  EXPECT_EQ(ra.admit(), Inputs{});  // 800 + 400 does not fit (at its estimate, 800 + 10 would)
+  ra.taken(0);
+  ra.released(0);
+  EXPECT_EQ(ra.admit(), (Inputs{2}));  // 400 + 400 fits
+  EXPECT_EQ(ra.reserved_bytes(), 400u);
+}
+
+// An estimate larger than the budget: only the next input taken runs.
+TEST(ReadAhead, AnEstimateOverTheBudgetRunsOnlyOneAhead) {
+  cli::ReadAhead ra(3, 4, 4, 100, std::vector<uint64_t>(3, UINT64_MAX));
+  EXPECT_EQ(ra.admit(), Inputs{0});
+  ra.read(0, 50);
+  EXPECT_EQ(ra.admit(), Inputs{});
+  ra.taken(0);
+  EXPECT_EQ(ra.admit(), Inputs{1});
+}
+
+// The estimate from a file: its text's size (a gzip file's from its
+// trailer) times kParsedPerTextByte, at most the cap.
+TEST(ReadAheadEstimate, FromAPlainOrAGzipFilesTextSize) {
+  maptest::TempDir dir;
+  const std::string text(100000, '0');
+  maptest::write_bytes(dir.file("a.log"), text);
+  maptest::gzip_to_file(dir.file("a.log.gz"), text);
+  ASSERT_LT(maptest::read_bytes(dir.file("a.log.gz")).size(), 1000u);  // what made the read-ahead blind
+  EXPECT_EQ(cli::parsed_bytes_estimate(dir.file("a.log"), 0), 100000 * cli::kParsedPerTextByte);
+  EXPECT_EQ(cli::parsed_bytes_estimate(dir.file("a.log.gz"), 0), 100000 * cli::kParsedPerTextByte);
+  EXPECT_EQ(cli::parsed_bytes_estimate(dir.file("a.log.gz"), 12345), 12345u);
+  EXPECT_EQ(cli::parsed_bytes_estimate(dir.file("none.log"), 0), 0u);
+}
+
+// A gzip file far larger than its trailer's size (several members, or 4 GiB
+// of text or more): the largest text deflate could make of it.
+TEST(ReadAheadEstimate, AGzipTrailerThatCannotBeTheTextsSize) {
+  maptest::TempDir dir;
+  maptest::gzip_to_file(dir.file("one.gz"), std::string(100000, '0'));
+  const std::string member = maptest::read_bytes(dir.file("one.gz"));
+  std::string many;
+  for (int i = 0; i < 100; ++i) many += member;
+  maptest::gzip_to_file(dir.file("tiny.gz"), "0");
+  many += maptest::read_bytes(dir.file("tiny.gz"));  // the trailer says 1 byte
+  maptest::write_bytes(dir.file("many.gz"), many);
+  EXPECT_EQ(cli::parsed_bytes_estimate(dir.file("many.gz"), 0),
+            many.size() * cli::kMaxDeflateRatio * cli::kParsedPerTextByte);
 }
 
 }  // namespace

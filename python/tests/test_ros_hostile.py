@@ -75,6 +75,22 @@ def test_paths_beyond_the_bound_or_with_a_repeated_stamp_are_refused(ros, node, 
     assert node.proc.poll() is None
 
 
+def test_a_self_link_and_a_reversed_link_are_left_out_and_mapping_goes_on(ros, node, intel):
+    from tf2_msgs.msg import TFMessage
+
+    later = 10**12 + 10**10 + np.arange(60, 120, dtype=np.int64) * 100_000_000  # no jump back
+    ros.tf.publish(TFMessage(transforms=[ros.transform("map", "map", int(later[0]), (0, 0, 0))]))
+    assert "self link" in node.wait_for("/tf: ") or "self link" in node.output
+    ros.tf.publish(TFMessage(transforms=[ros.transform("map", "base_link", int(later[0]), (0, 0, 0)),
+                                         ros.transform("base_link", "map", int(later[0]), (0, 0, 0))]))
+    node.wait_for("cycle")
+    ros.wait_quiet(0.6)
+    before = ros.map_count()
+    ros.replay(intel.scans.select(60, 60), later)
+    assert ros.wait_map(before, timeout=30) is not None, node.output[-2000:]
+    assert "tf has a cycle" not in node.output, node.output[-2000:]
+
+
 def test_reset_replaces_the_latched_map_by_an_empty_one_at_once(ros, node, intel):
     ros.wait_quiet(0.6)
     last = ros.latest()

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <cerrno>
 #include <condition_variable>
 #include <cstdint>
@@ -115,12 +116,21 @@ class Slots {
   size_t free_;
 };
 
-// A batch knob from the environment (batch_bench's A/Bs): `name`'s integer
-// clamped to [lo, hi], or `fallback` when it is unset or empty.
+// A batch knob from the environment (batch_bench's A/Bs): `name`'s whole
+// number in [lo, hi], or `fallback` when it is unset or empty. Anything else
+// is a usage error naming the variable, its value and the range: a typo must
+// not run the batch with a setting nobody asked for.
 int env_knob(const char *name, int lo, int hi, int fallback) {
   const char *v = std::getenv(name);
-  if (v != nullptr && *v != '\0') return std::clamp(std::atoi(v), lo, hi);
-  return fallback;
+  if (v == nullptr || *v == '\0') return fallback;
+  const std::string text = v;
+  int value = 0;
+  const char *end = text.data() + text.size();
+  const auto [stop, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc() || stop != end || value < lo || value > hi)
+    throw Error(ErrorCode::Usage, std::string(name) + "=" + carmen::printable(text) + ": not a whole number from " +
+                                      std::to_string(lo) + " to " + std::to_string(hi));
+  return value;
 }
 
 // How much nicer the pool's threads (reads, writes) run than the mappers:
@@ -149,6 +159,12 @@ uint64_t usable_memory() {
   return bytes;
 }
 
+// The environment's batch knobs, read (and checked) before any work.
+struct BatchKnobs {
+  size_t ahead_per_thread = read_ahead_per_thread();
+  int nice = pool_nice();
+};
+
 // The bytes parsed inputs read ahead may hold (those being mapped
 // included): 1 GiB (some 140 fr079-size logs), at most an eighth of the
 // memory. What a finished map holds until it is written is bounded apart
@@ -164,14 +180,27 @@ uint64_t bytes_held(const vasco::LogInput &in) {
          of(b.range) + of(in.stamps) + of(in.load.stamps) + of(in.load.robot_poses);
 }
 
+// What each input's read may come to hold, from its file, before it is
+// read: the read-ahead counts a read at this from the start, so that reads
+// let through together (2 per pool thread) cannot pass the budget before
+// any of their sizes is known. At most what the reader lets an input's
+// scans take (--max-memory).
+std::vector<uint64_t> read_estimates(const Options &opt) {
+  std::vector<uint64_t> bytes;
+  bytes.reserve(opt.inputs.size());
+  for (const std::string &input : opt.inputs)
+    bytes.push_back(cli::parsed_bytes_estimate(cli::input_path(input), opt.max_memory_bytes));
+  return bytes;
+}
+
 // One batch: inputs read on the pool, mapped here in order, written on the pool.
 class BatchRun {
  public:
-  BatchRun(const Options &opt, const ToolSpec &spec, BatchReport &report, int jobs)
+  BatchRun(const Options &opt, const ToolSpec &spec, BatchReport &report, int jobs, const BatchKnobs &knobs)
       : opt_(opt), spec_(spec), report_(report), writes_(2 * static_cast<size_t>(jobs)),
-        ahead_(opt.inputs.size(), 2 * static_cast<size_t>(jobs), read_ahead_per_thread() * static_cast<size_t>(jobs),
-               read_ahead_budget()),
-        read_(opt.inputs.size()), pool_(jobs, pool_nice()) {}
+        ahead_(opt.inputs.size(), 2 * static_cast<size_t>(jobs), knobs.ahead_per_thread * static_cast<size_t>(jobs),
+               read_ahead_budget(), read_estimates(opt)),
+        read_(opt.inputs.size()), pool_(jobs, knobs.nice) {}
 
   ~BatchRun() { stop_reads(); }  // queued reads return at once; the pool drains
 
@@ -424,6 +453,7 @@ std::thread map_on_other_devices(BatchRun &run, const Options &opt, std::vector<
 
 int run_batch(const Options &opt, const ToolSpec &spec) {
   const auto t_start = cli::Clock::now();
+  const BatchKnobs knobs;  // a bad one is a usage error before anything is made
   carmen::remove_temporaries_on_signals();
   std::vector<BatchEntry> entries = plan_entries(opt);
   std::vector<std::string> inputs = opt.inputs, files;
@@ -438,7 +468,7 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
   double start_s = 0, mapped_s = 0;
   {
     const int jobs = opt.jobs > 0 ? opt.jobs : all_cores();
-    BatchRun run(opt, spec, report, jobs);
+    BatchRun run(opt, spec, report, jobs, knobs);
     run.start_reads();  // while the backend starts
     const std::vector<int> devices = batch_devices(opt);
     // One mapper for every input (per GPU): its backend (a GPU's context

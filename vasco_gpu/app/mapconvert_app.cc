@@ -20,6 +20,7 @@
 #include <tuple>
 #include <vector>
 
+#include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
 #include "carmen_compat/image_io.h"
 #include "carmen_compat/map_file.h"
@@ -297,6 +298,9 @@ void convert_grid(const std::string &in, const std::string &out, const carmen::M
 // (a map_server pair's two files) are checked before the map is read: they
 // must be replaceable and must not be an input.
 void run(const Args &a, MapFormatKind kind) {
+  // As every tool: a termination signal removes the temporaries (the
+  // output's, and the staged map of '-') before the process ends.
+  carmen::remove_temporaries_on_signals();
   if (!a.info && a.files[1] != cli::kStdio) {
     const std::vector<std::string> inputs =
         a.files[0] == cli::kStdio ? std::vector<std::string>{a.files[0]} : carmen::map_input_files(a.files[0]);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "carmen_compat/atomic_file.h"
 #include "carmen_compat/error.h"
 #include "carmen_compat/map_compare.h"
 #include "carmen_compat/map_format.h"
@@ -105,6 +106,7 @@ std::vector<std::string> input_files(const std::string &arg) {
 }
 
 int run(const Options &o) {
+  carmen::remove_temporaries_on_signals();  // as every tool: a signal leaves no picture's temporary
   // The picture's file is checked, and both maps read, before anything is
   // written: a bad input or target leaves no picture.
   if (o.png_given) {

@@ -1,22 +1,38 @@
 #include "read_ahead.h"
 
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <utility>
+
 namespace cli {
 
-ReadAhead::ReadAhead(size_t inputs, size_t in_flight, size_t most, uint64_t budget)
+ReadAhead::ReadAhead(size_t inputs, size_t in_flight, size_t most, uint64_t budget, std::vector<uint64_t> estimates)
     : in_flight_max_(in_flight < 1 ? 1 : in_flight), most_(most < 1 ? 1 : most), budget_(budget),
-      bytes_(inputs, 0) {}
+      estimates_(std::move(estimates)), bytes_(inputs, 0), reserved_for_(inputs, 0) {
+  estimates_.resize(inputs, 0);
+}
+
+// What input i's read is counted at while it is under way: its estimate,
+// or the mean read so far where that is more.
+uint64_t ReadAhead::reservation(size_t i) const {
+  const uint64_t mean = reads_ > 0 ? read_bytes_ / reads_ : 0;
+  return estimates_[i] > mean ? estimates_[i] : mean;
+}
 
 bool ReadAhead::may_admit(size_t i) const {
   if (stopped_ || i >= bytes_.size()) return false;
   if (i <= taken_) return true;  // a mapper waits for it (or will next)
   if (in_flight_ >= in_flight_max_ || i - taken_ >= most_) return false;
-  const uint64_t mean = reads_ > 0 ? read_bytes_ / reads_ : 0;
-  return held_ + (in_flight_ + 1) * mean <= budget_;
+  const uint64_t more = reservation(i);
+  return more <= budget_ && held_ + reserved_ <= budget_ - more;  // no overflow for huge estimates
 }
 
 std::vector<size_t> ReadAhead::admit() {
   std::vector<size_t> now;
   while (may_admit(next_)) {
+    reserved_for_[next_] = reservation(next_);
+    reserved_ += reserved_for_[next_];
     now.push_back(next_++);
     ++in_flight_;
   }
@@ -30,6 +46,8 @@ void ReadAhead::taken(size_t i) {
 void ReadAhead::read(size_t i, uint64_t bytes) {
   if (i >= bytes_.size()) return;
   if (in_flight_ > 0) --in_flight_;
+  reserved_ -= reserved_for_[i];
+  reserved_for_[i] = 0;
   bytes_[i] = bytes;
   held_ += bytes;
   if (bytes > 0) {
@@ -42,6 +60,39 @@ void ReadAhead::released(size_t i) {
   if (i >= bytes_.size()) return;
   held_ -= bytes_[i];
   bytes_[i] = 0;
+}
+
+namespace {
+
+uint64_t saturating_product(uint64_t a, uint64_t b) { return b != 0 && a > UINT64_MAX / b ? UINT64_MAX : a * b; }
+
+// The text's size of a gzip file of `compressed` bytes whose trailer gives
+// `isize` (the size mod 2^32 of its last member's text): that size, unless
+// the file is much larger than it (several members, or a text of 4 GiB or
+// more): then the largest text deflate could have made of the file.
+uint64_t gzip_text_bytes(uint64_t compressed, uint64_t isize) {
+  // Deflate's stored blocks add 5 bytes per 64 KiB; the header and trailer some more.
+  if (isize + isize / 8 + 4096 < compressed) return saturating_product(compressed, kMaxDeflateRatio);
+  return isize > compressed ? isize : compressed;
+}
+
+}  // namespace
+
+uint64_t parsed_bytes_estimate(const std::string &path, uint64_t cap) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return 0;  // a pipe or device: not known, 0
+  uint64_t text = static_cast<uint64_t>(st.st_size);
+  if (FILE *f = std::fopen(path.c_str(), "rb")) {
+    unsigned char magic[2] = {0, 0}, trailer[4] = {0, 0, 0, 0};
+    const bool gzip = std::fread(magic, 1, 2, f) == 2 && magic[0] == 0x1f && magic[1] == 0x8b;
+    if (gzip && st.st_size >= 18 && std::fseek(f, -4, SEEK_END) == 0 && std::fread(trailer, 1, 4, f) == 4) {
+      const uint64_t isize = trailer[0] | trailer[1] << 8 | trailer[2] << 16 | uint64_t{trailer[3]} << 24;
+      text = gzip_text_bytes(text, isize);
+    }
+    std::fclose(f);
+  }
+  const uint64_t parsed = saturating_product(text, kParsedPerTextByte);
+  return cap > 0 && parsed > cap ? cap : parsed;
 }
 
 }  // namespace cli

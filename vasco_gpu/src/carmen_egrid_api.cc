@@ -371,7 +371,7 @@ void carmen_mapper_finish_evidence_grid(evidence_grid *grid, int downsample, int
                  "scan-less log?): there is no map to finish. CARMEN stops here (\"Out of memory\"); so does "
                  "this library, before a map file is begun\n",
                  grid->size_x, grid->size_y);
-    std::exit(EXIT_FAILURE);
+    std::exit(-1);  // carmen_die's status (255): scripts around CARMEN's programs check it
   }
   vasco::FinishedMap m;
   try {

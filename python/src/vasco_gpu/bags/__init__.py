@@ -19,8 +19,9 @@ the rest returns plain NumPy data. What a message means (LaserScan, MultiEchoLas
 PointCloud2, tf) is :mod:`vasco_gpu.msgs`'s, which the ROS 2 node shares.
 
 The parts, one job each: :mod:`.errors` (BagError, TfError, BagWarning), :mod:`.topics`
-(which topics to read), :mod:`.storage` (opening a bag with rosbags), :mod:`.scans` (a
-topic's scans through the message table, BagScans), :mod:`.poses` (the laser pose at each
+(which topics to read), :mod:`.options` (the bag options' values, checked before a bag is
+read), :mod:`.storage` (opening a bag with rosbags), :mod:`.scans` (a topic's scans through
+the message table, BagScans), :mod:`.poses` (the laser pose at each
 scan), :mod:`.reader` (read_bag), :mod:`.carmen_writer` (write_carmen_log), :mod:`.load`
 (load_bag), :mod:`.info` (bag_info: what a bag holds and the command that maps it),
 :mod:`.bag_writer` (a CARMEN log as a bag), and the console tools :mod:`.cli`

@@ -21,6 +21,7 @@ from ..msgs.scan_options import SCAN_DEFAULTS
 from .carmen_writer import write_carmen_log
 from .errors import BagError
 from .load import reader_module, read_for_engine
+from .options import checked_pose, option_error
 
 
 @dataclass(frozen=True)
@@ -110,6 +111,37 @@ def _warn(texts, tool: str = "bag2map") -> None:
         print(f"{lead}{tool}: warning: {text}", file=sys.stderr, flush=True)
 
 
+def _given_values(args: list[str], flags) -> dict:
+    """{flag: text} of the options among flags given as --FLAG VALUE or --FLAG=VALUE, before any
+    '--' (the last one where one is repeated); a flag without a value is left to the parser."""
+    values, k = {}, 0
+    while k < len(args) and args[k] != "--":
+        a = args[k]
+        name = a[2:].split("=", 1)[0] if a.startswith("--") else None
+        if name in flags and "=" in a:
+            values[name] = a.split("=", 1)[1]
+        elif name in flags and k + 1 < len(args):
+            values[name] = args[k + 1]
+            k += 1
+        k += 1
+    return values
+
+
+def _usage_error(values: dict, tool: str) -> str | None:
+    """'TOOL: --static-pose 'nan': ...' for a bag option no bag could make valid (a usage error,
+    exit 2, said before any bag is read), else None. --laser-mount's form is log2map's to check
+    (bag2map): here only the bound on its position."""
+    mount = values.pop("laser-mount", None)
+    why = option_error(values)
+    if why is None and mount is not None:
+        try:
+            checked_pose(mount, "laser_mount (--laser-mount X,Y,THETA)")
+        except ValueError as e:
+            bounded = "within" in str(e)  # three finite numbers, too far out
+            why = f"--laser-mount {mount!r}: {e}" if bounded or tool == "bag2carmen" else None
+    return None if why is None else f"{tool}: {why}"
+
+
 def _join_repeated(args: list[str], flag: str) -> list[str]:
     """--FLAG given more than once (the command line takes each option once) as one --FLAG with
     the values joined by commas, where the first was; arguments after '--' are left alone."""
@@ -177,6 +209,10 @@ def bag2map_main(argv: list[str] | None = None) -> int:
     if "--info" in args[:args.index("--") if "--" in args else len(args)]:
         return _info_main(args)
     args = _join_repeated(args, "scan-topic")
+    usage = _usage_error(_given_values(args, {o.flag for o in BAG_OPTIONS} | {"laser-mount"}), "bag2map")
+    if usage:
+        print(usage, file=sys.stderr)
+        return 2
     # the names before the first option (an option's value, e.g. --poses robot.log, may be a log)
     leading = args[:next((i for i, a in enumerate(args) if a.startswith("-")), len(args))]
     logs = [a for a in leading if _is_carmen_log(a)]
@@ -228,6 +264,11 @@ def bag2carmen_main(argv: list[str] | None = None) -> int:
         mount = _mount_of(a.laser_mount)
     except ValueError:
         print(f"bag2carmen: --laser-mount '{a.laser_mount}': expected X,Y,THETA", file=sys.stderr)
+        return 2
+    given = {o.flag: getattr(a, o.keyword) for o in BAG_OPTIONS if getattr(a, o.keyword) is not None}
+    usage = _usage_error({**given, "laser-mount": a.laser_mount} if a.laser_mount else given, "bag2carmen")
+    if usage:
+        print(usage, file=sys.stderr)
         return 2
     if os.path.exists(a.out) and os.path.exists(a.bag) and os.path.samefile(a.out, a.bag):
         print(f"bag2carmen: {a.out}: the output is the input", file=sys.stderr)

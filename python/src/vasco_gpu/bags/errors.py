@@ -18,7 +18,8 @@ class BagWarning(UserWarning):
     """What load_bag warns of and reads on: scans before the first or after the last pose of the
     chain, left out and counted (a localisation stack's tf starts after the laser and its
     odometry may end before it); the tf root taken as the fixed frame of a bag without 'map';
-    LaserScans whose angle_max disagrees with their ranges by rounding."""
+    LaserScans whose angle_max disagrees with their ranges by rounding; tf links left out (a
+    self transform, a link that would close a cycle), one warning of each kind."""
 
 
 def words(wording: str, cli: str, python: str) -> str:

@@ -3,7 +3,6 @@ pose topic's base poses (PoseSeries) and the laser mount, or none (a pose file f
 
 from __future__ import annotations
 
-import math
 from array import array
 
 import numpy as np
@@ -12,7 +11,7 @@ from ..msgs.errors import BagError
 from ..msgs.geometry import planar, planar_compose, unit_quaternion, wrap_angle, yaw
 from ..msgs.header import frame_name, stamp_ns, stamp_seconds, stamp_text
 from ..msgs.series import bracket, first_outside, sorted_samples
-from ..msgs.tf import TfBuffer, static_mount
+from ..msgs.tf import MAX_TRANSLATION, TfBuffer, static_mount
 from .errors import words
 
 
@@ -43,9 +42,11 @@ class PoseSeries:
         self.values.extend((float(pose.position.x), float(pose.position.y), float(yaw(q))))
 
     def _check_position(self, p, what: str, ns: int) -> None:
-        if not all(math.isfinite(float(v)) for v in (p.x, p.y, p.z)):
-            raise BagError(self.path, f"{what} has position ({p.x}, {p.y}, {p.z})", topic=self.topic,
-                           stamp=stamp_seconds(ns))
+        """A position within tf's bound on a translation, as a tf link's must be: NaN, inf and
+        1e300 m would give the map an origin no map file can hold."""
+        if not all(abs(float(v)) <= MAX_TRANSLATION for v in (p.x, p.y, p.z)):  # NaN too
+            raise BagError(self.path, f"{what} has position ({p.x}, {p.y}, {p.z}): not a finite number of metres "
+                                      f"up to {MAX_TRANSLATION:g}", topic=self.topic, stamp=stamp_seconds(ns))
 
     def _fixed(self, msg, ns: int, what: str) -> str:
         """The message's frame, which must be the fixed frame (the first message's when None)."""

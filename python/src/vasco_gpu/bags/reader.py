@@ -12,17 +12,18 @@ Importing this module raises ImportError when rosbags is not installed.
 from __future__ import annotations
 
 import os
+from collections import Counter
 from typing import Callable
 
 import numpy as np
 
 from ..msgs.cloud import cloud_mount
 from ..msgs.errors import BagError
-from ..msgs.geometry import check_mount
 from ..msgs.header import stamp_seconds, stamp_text
-from ..msgs.scan_options import SCAN_DEFAULTS, ScanSettings, check_choice, check_cloud_options
+from ..msgs.scan_options import SCAN_DEFAULTS, check_choice
 from ..msgs.table import message_type
-from ..msgs.tf import TfBuffer
+from ..msgs.tf import TfBuffer, TfLinkIgnored
+from .options import STATIC_POSE, checked_pose, scan_settings
 from .poses import PoseSeries, choose_fixed_frame, poses_for
 from .scans import STAMP_MODES, BagScans, ScanAccumulator
 from .storage import open_bag, read_messages
@@ -54,6 +55,29 @@ class Progress:
     def end(self) -> None:
         if self.callback is not None and self.reported != self.done:
             self._report()
+
+
+class LeftOutLinks:
+    """Feeds a bag's TFMessages to the tree, going on past the links it leaves out (a self
+    transform, one that would close a cycle: TfLinkIgnored), as the node does: one warning per
+    kind, the first such link's text and how many more. Every other TfError stops the reading."""
+
+    def __init__(self, tf: TfBuffer):
+        self.tf = tf
+        self.first: dict[str, str] = {}
+        self.count: Counter = Counter()
+
+    def add(self, msg, static: bool, topic: str) -> None:
+        for ts in msg.transforms:
+            try:
+                self.tf.add_transform(ts, static, topic)
+            except TfLinkIgnored as e:
+                self.first.setdefault(e.kind, e.message)
+                self.count[e.kind] += 1
+
+    def warnings(self) -> list[str]:
+        return [text + (f" ({self.count[kind] - 1} more {kind}s left out)" if self.count[kind] > 1 else "")
+                for kind, text in self.first.items()]
 
 
 #: A /tf link's samples further apart than this leave the stamps between them without a
@@ -91,7 +115,8 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     nav_msgs/Odometry, geometry_msgs/PoseStamped or PoseWithCovarianceStamped topic of base
     poses, or a nav_msgs/Path topic (its last message: the final trajectory of a LIO or SLAM
     back end). static_pose: (x, y, yaw) of a robot that does not move, every scan at it (with
-    the mount; text "X,Y,THETA" too); pose_source "static" then, the bag needs no poses. laser_mount: (x, y, yaw) of the laser in the base frame, instead of /tf_static (one
+    the mount; text "X,Y,THETA" too; x and y within tf's bound, 1e12 m, as laser_mount's);
+    pose_source "static" then, the bag needs no poses. laser_mount: (x, y, yaw) of the laser in the base frame, instead of /tf_static (one
     topic only). pose_source: "auto" (pose_topic if given, else tf), "tf", "topic" or "none"
     (NaN poses; the caller brings them). no_return: "skip" or "free" (see
     :mod:`vasco_gpu.msgs.laser`). progress: progress(done_messages, total_messages).
@@ -116,16 +141,14 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
     themselves.
     """
     if static_pose is not None:
-        if isinstance(static_pose, str):
-            static_pose = _numbers(static_pose, "static_pose (--static-pose X,Y,THETA)")
-        static_pose = check_mount(static_pose, "static_pose (--static-pose X,Y,THETA)")
+        static_pose = checked_pose(static_pose, STATIC_POSE)
         if pose_source == "none":
             raise ValueError("static_pose (--static-pose) and a pose file (--poses) both pose the scans: pass one")
         if pose_source not in ("auto", "static") or pose_topic is not None:
             raise ValueError("static_pose (--static-pose) poses every scan: it takes neither pose_topic nor tf")
         pose_source = "static"
     _check_arguments(pose_source, no_return, pose_topic, outside_span, echo, stamp)
-    mount_arg = check_mount(laser_mount)
+    mount_arg = checked_pose(laser_mount, "laser_mount")
     with open_bag(path) as reader:
         topics = reader.topics
         names = pick_scan_topics(path, topics, scan_topic)
@@ -145,11 +168,12 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
         accs = [ScanAccumulator(path, name, message_type(topics[name].msgtype), settings, stamp, mount_of)
                 for name in names]
         handlers = {acc.topic: acc.add for acc in accs}
+        left_out = LeftOutLinks(tf)
         if tf is not None:
             for name in tf_topics(topics):
                 static = name.rstrip("/").endswith("tf_static")
                 if static or source == "tf":  # /tf only when it gives the poses
-                    handlers[name] = (lambda m, t, s=static, n=name: tf.add_message(m, s, n))
+                    handlers[name] = (lambda m, t, s=static, n=name: left_out.add(m, s, n))
         series = None
         if source == "topic":
             name, msgtype = check_pose_topic(path, topics, pose_topic)
@@ -159,7 +183,7 @@ def read_bag(path, scan_topic=None, fixed_frame="map", base_frame=None, pose_top
         ticker = Progress(progress, total)
         read_messages(reader, path, handlers, ticker)
         ticker.end()
-    notes = _checked_topics(path, accs, settings, base_frame, wording)
+    notes = _checked_topics(path, accs, settings, base_frame, wording) + left_out.warnings()
     if source == "tf" and root_if_no_map and fixed_frame == "map":
         fixed_frame, chosen = choose_fixed_frame(path, tf, [acc.frame_id for acc in accs], wording)
         notes.insert(0, chosen)
@@ -191,30 +215,6 @@ def _checked_topics(path, accs, settings, base_frame, wording) -> list:
             raise band
         notes.append(acc.angles_warning())
     return notes
-
-
-def _numbers(value, what: str) -> list[float]:
-    """A number, or text of numbers separated by commas, as floats; ValueError naming what."""
-    try:
-        return [float(v) for v in value.split(",")] if isinstance(value, str) else [float(value)]
-    except ValueError:
-        raise ValueError(f"{what}: {value!r} is not a number") from None
-
-
-def scan_settings(no_return, echo, z_band, angle_step, range_max) -> ScanSettings:
-    """The scan adapters' options from read_bag's keywords: the cloud options as numbers, or as
-    text (bag2map's options: "0.2,1.8"); None takes the default."""
-    if isinstance(z_band, str):
-        z_band = _numbers(z_band, "z_band (--z-band MIN,MAX)")
-    settings = ScanSettings(
-        no_return=no_return, echo=echo,
-        z_band=tuple(float(v) for v in (SCAN_DEFAULTS["z_band"] if z_band is None else z_band)),
-        cloud_angle_step=SCAN_DEFAULTS["cloud_angle_step"] if angle_step is None else
-        _numbers(angle_step, "cloud_angle_step (--cloud-angle-step DEGREES)")[0],
-        cloud_range_max=SCAN_DEFAULTS["cloud_range_max"] if range_max is None else
-        _numbers(range_max, "cloud_range_max (--cloud-range-max M)")[0])
-    check_cloud_options(settings.z_band, settings.angle_step, settings.cloud_range_max)
-    return settings
 
 
 def cloud_mount_of(path, tf, base_frame):

@@ -10,7 +10,7 @@ from .geometry import compose, inverse, is_identity, planar, slerp, unit_quatern
 from .header import NS, did_you_mean, frame_name, stamp_ns, stamp_seconds, stamp_text
 from .series import bracket, first_outside
 
-__all__ = ["TfBuffer", "static_mount"]
+__all__ = ["TfBuffer", "TfLinkIgnored", "static_mount"]
 
 # The stamps a tf message can carry: builtin_interfaces/Time's sec is an int32 (ROS 1's time a
 # uint32), its nanosec a uint32. Any two such stamps are less than 2^63 ns apart, so the int64
@@ -31,6 +31,25 @@ LISTED_FRAMES = 20
 # every frame (half a second for 20,000 alike names), in a lookup a live node repeats while it
 # waits for a transform.
 CLOSE_MATCH_FRAMES = 2000
+
+
+class TfLinkIgnored(TfError):
+    """A link the tree leaves out while it keeps every other: a self transform (parent and child
+    the same frame, which tf2 drops too) or a link that would close a cycle (a reversed
+    ``base_link -> map`` while ``map -> base_link`` is there). Nothing of it is stored, so the
+    links already there go on answering; a reader that goes on (the node, bag2map) reports it
+    once per ``kind``: "self link" or "cycle"."""
+
+    def __init__(self, file, message: str, *, kind: str, topic: str | None = None, stamp: float | None = None):
+        super().__init__(file, message, topic=topic, stamp=stamp)
+        self.kind = kind
+
+    def __reduce__(self):
+        return (_make_ignored, (self.file, self.message, self.kind, self.topic, self.stamp))
+
+
+def _make_ignored(file, message, kind, topic, stamp):
+    return TfLinkIgnored(file, message, kind=kind, topic=topic, stamp=stamp)
 
 
 class _Edge:
@@ -165,6 +184,7 @@ class TfBuffer:
         self.outside_hint = outside_hint
         self.max_gap_ns = _duration_ns(max_gap, "max_gap")
         self._edges: dict[str, _Edge] = {}  # by child: each child has one parent
+        self._parents: set[str] = set()  # frames with a child: only such a frame can close a cycle
 
     def __len__(self) -> int:
         """The number of parent -> child links."""
@@ -172,9 +192,17 @@ class TfBuffer:
 
     def add_message(self, msg, static: bool = False, topic: str | None = None) -> None:
         """Adds the transforms of one TFMessage; static: it came on /tf_static. topic (default
-        /tf or /tf_static) is named by the errors."""
+        /tf or /tf_static) is named by the errors. A link left out (TfLinkIgnored) does not stop
+        the others, as tf2 takes each transform of a message on its own: the first one left out
+        is raised once the rest are in. Any other TfError stops the message where it is."""
+        ignored = None
         for ts in msg.transforms:
-            self.add_transform(ts, static, topic)
+            try:
+                self.add_transform(ts, static, topic)
+            except TfLinkIgnored as e:
+                ignored = ignored or e
+        if ignored is not None:
+            raise ignored
 
     def add_transform(self, ts, static: bool = False, topic: str | None = None) -> None:
         """Adds one TransformStamped (or anything shaped like one)."""
@@ -182,6 +210,10 @@ class TfBuffer:
             topic = "/tf_static" if static else "/tf"
         parent, child = frame_name(ts.header.frame_id), frame_name(ts.child_frame_id)
         ns = stamp_ns(ts.header.stamp)
+        if parent == child:  # tf2's TF_SELF_TRANSFORM: dropped whatever its numbers
+            raise TfLinkIgnored(self.file, f"{_link_text(parent, child, ns, topic)} links a frame to itself: "
+                                           "ignored, as tf2 does", kind="self link", topic=topic,
+                                stamp=_seconds_or_none(ns))
         if not MIN_STAMP_NS <= ns <= MAX_STAMP_NS:  # checked first: no edge is made for it
             raise TfError(self.file, f"{_link_text(parent, child, ns, topic)}: the stamp is not a ROS time (sec "
                                      f"{ts.header.stamp.sec}, nanosec {ts.header.stamp.nanosec})", topic=topic)
@@ -196,8 +228,11 @@ class TfBuffer:
                             TfError)
         edge = self._edges.get(child)
         if edge is None:
+            if child in self._parents:  # a frame without children is no one's ancestor: no walk
+                self._check_no_cycle(parent, child, ns, topic)
             edge = self._edges[child] = _Edge(parent, child, static, self.keep_ns, self.file,
                                               self.refuse_repeats)
+            self._parents.add(parent)
         elif edge.parent != parent:
             was = f"{edge.parent!r} on {'/tf_static' if edge.static else '/tf'}"
             raise TfError(self.file, f"frame {child!r} has two parents in tf: {was} and {parent!r} on "
@@ -208,6 +243,18 @@ class TfBuffer:
                                      f"{stamp_text(ns)} on {topic}); a link is either static or not",
                           topic=topic, stamp=stamp_seconds(ns))
         edge.add(ns, t, q)
+
+    def _check_no_cycle(self, parent: str, child: str, ns: int, topic: str) -> None:
+        """TfLinkIgnored when child is already above parent: the new link would close a loop,
+        and every lookup through it would fail. Refused as it arrives, as a second parent is,
+        so the tree stays a tree."""
+        chain = self.up(parent)
+        if child in chain:
+            down = chain[chain.index(child)::-1]  # child down to parent, as the links there run
+            raise TfLinkIgnored(self.file, f"{_link_text(parent, child, ns, topic)} would close a cycle: "
+                                           f"{_chain_text(down)} is already in tf; "
+                                           "refused (tf must be a tree), the links there are kept",
+                                kind="cycle", topic=topic, stamp=stamp_seconds(ns))
 
     def frames(self) -> list[str]:
         """Every frame named by a link, sorted."""
@@ -391,6 +438,19 @@ def static_mount(path, tf: TfBuffer | None, base: str, frame: str) -> np.ndarray
 
 def _link_text(parent: str, child: str, ns: int, topic: str) -> str:
     return f"tf {parent} -> {child} at stamp {stamp_text(ns)} on {topic}"
+
+
+def _seconds_or_none(ns: int) -> float | None:
+    """The stamp in seconds; None for one that is no ROS time (beyond int64's arithmetic)."""
+    return stamp_seconds(ns) if MIN_STAMP_NS <= ns <= MAX_STAMP_NS else None
+
+
+def _chain_text(frames: list[str]) -> str:
+    """'map -> base_link -> laser', the middle of a long chain left out."""
+    if len(frames) > LISTED_FRAMES:
+        half = LISTED_FRAMES // 2
+        frames = frames[:half] + [f"... ({len(frames) - 2 * half} more)"] + frames[-half:]
+    return " -> ".join(frames)
 
 
 def _duration_ns(seconds: float | None, what: str) -> int | None:

@@ -25,6 +25,7 @@ from ..msgs.errors import BagError
 from ..msgs.header import stamp_ns, stamp_text
 from ..msgs.laser import ANGLES_OFF
 from ..msgs.table import MESSAGE_TYPES, MessageType
+from ..msgs.tf import TfLinkIgnored
 from .batches import Batches
 from .canvas import fixed_frame
 from .latency import Reservoir
@@ -336,6 +337,8 @@ class MappingNode(NodeServices, LifecycleNode):
         topic = "/tf_static" if static else "/tf"
         try:
             self.posing.add_tf(msg, static)
+        except TfLinkIgnored as e:  # left out, the message's other links kept: logged once a kind
+            self._refuse(topic, f"{e.kind}s left out", f"{topic}: {e.message}")
         except BagError as e:
             self._refuse(topic, "bad transforms", f"{topic}: {e.message}")
             return

@@ -222,11 +222,21 @@ class Posing:
             for ts in msg.transforms:
                 child = ts.child_frame_id
                 self.stamp_seen(("tf", child), stamp_ns(ts.header.stamp), lambda c=child: f"/tf (frame {c!r})")
-        self.tf.add_message(msg, static)
-        if static:
-            for ts in msg.transforms:
-                self._statics[frame_name(ts.child_frame_id)] = ts
-            self._mounts.clear()
+        try:
+            self.tf.add_message(msg, static)
+        finally:  # a link left out (TfLinkIgnored) leaves the message's other links stored
+            if static:
+                self._keep_statics(msg)
+
+    def _keep_statics(self, msg) -> None:
+        """The static links of msg the tree now holds, for its rebuild after a time jump (a link
+        it left out, a self link or a cycle, must not come back then)."""
+        for ts in msg.transforms:
+            child = frame_name(ts.child_frame_id)
+            edge = self.tf._edges.get(child)
+            if edge is not None and edge.parent == frame_name(ts.header.frame_id):
+                self._statics[child] = ts
+        self._mounts.clear()
 
     def add_scan(self, msg, topic: str, kind: MessageType, received: float | None) -> None:
         """A scan message of kind on topic: read now (a type that needs its mount, once that is
