@@ -73,14 +73,27 @@ fuzz: deps
 	done
 	@$(MAKE) --no-print-directory fuzz-python
 
-# The Python fuzzer of the bag reader's and the node's tf tree (fuzz/fuzz_bag_tf.py): NumPy only, run
+# The Python fuzzers. That of the bag reader's and the node's tf tree (fuzz/fuzz_bag_tf.py): NumPy only, run
 # by FUZZ_PYTHON (default python3; CI gives its venv's). Without NumPy there it says so and stops.
 FUZZ_PYTHON ?= python3
+# Then the node's fuzzer (fuzz/fuzz_node.py: the ROS 2 node in-process), run by FUZZ_ROS_PYTHON (default
+# FUZZ_PYTHON), a Python with rclpy, the node's messages and vasco_gpu; without them it is skipped, said
+# so, unless VASCO_REQUIRE_ROS_TESTS=1, where that fails.
+FUZZ_ROS_PYTHON ?= $(FUZZ_PYTHON)
 fuzz-python:
 	@$(FUZZ_PYTHON) -c "import numpy" 2>/dev/null || { echo "fuzz-python: $(FUZZ_PYTHON) has no NumPy: give FUZZ_PYTHON=a Python with NumPy"; exit 1; }
 	@mkdir -p build-fuzz
 	@echo "== fuzz_bag_tf ($(FUZZ_SECONDS) s)"
 	$(FUZZ_PYTHON) fuzz/fuzz_bag_tf.py --seconds $(FUZZ_SECONDS) --artifact-dir build-fuzz
+	@if $(FUZZ_ROS_PYTHON) -c "import rclpy, tf2_msgs, vasco_gpu.ros.node" 2>/dev/null; then \
+	  echo "== fuzz_node ($(FUZZ_SECONDS) s)"; \
+	  echo "$(FUZZ_ROS_PYTHON) fuzz/fuzz_node.py --seconds $(FUZZ_SECONDS) --artifact-dir build-fuzz"; \
+	  $(FUZZ_ROS_PYTHON) fuzz/fuzz_node.py --seconds $(FUZZ_SECONDS) --artifact-dir build-fuzz; \
+	elif [ "$$VASCO_REQUIRE_ROS_TESTS" = 1 ]; then \
+	  echo "fuzz-python: VASCO_REQUIRE_ROS_TESTS=1 and $(FUZZ_ROS_PYTHON) has no rclpy, tf2_msgs or vasco_gpu.ros: give FUZZ_ROS_PYTHON=a Python with the ROS 2 extra"; exit 1; \
+	else \
+	  echo "fuzz-python: fuzz_node skipped: $(FUZZ_ROS_PYTHON) has no rclpy, tf2_msgs or vasco_gpu.ros (give FUZZ_ROS_PYTHON=a Python with the ROS 2 extra)"; \
+	fi
 
 fuzz-smoke:
 	$(MAKE) fuzz FUZZ_SECONDS=20

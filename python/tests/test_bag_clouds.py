@@ -170,3 +170,12 @@ def test_errors_name_the_bag_once_and_guess_a_mistyped_name(tmp_path, cloud_bag)
     r = run_script("bag2map", "--fixed-frame", "mapp", str(cloud_bag), str(tmp_path / "x.map"))
     assert r.returncode == 1 and "did you mean 'map'?" in r.stderr, r.stderr
     assert r.stderr.count(str(cloud_bag)) == 1, r.stderr
+
+
+def test_a_cloud_without_points_is_empty_whatever_its_layout_claims():
+    # (the node fuzzer's finding) a point_step past NumPy's int limit once raised ValueError
+    # from np.dtype even with no point to read
+    fields = [SimpleNamespace(name=n, offset=o, datatype=7, count=1) for n, o in (("x", 0), ("y", 4), ("z", 8))]
+    msg = SimpleNamespace(fields=fields, is_bigendian=False, width=0, height=1, point_step=2**32 - 1, row_step=0,
+                          data=b"")
+    assert vc.cloud_points_xyz(msg, lambda what: BagError("t", what)).shape == (0, 3)

@@ -101,6 +101,9 @@ def test_reset_replaces_the_latched_map_by_an_empty_one_at_once(ros, node, intel
     assert got is not None, node.output[-2000:]
     assert (got.info.width, got.info.height) == (last.info.width, last.info.height)  # no resize for nav2
     assert (np.frombuffer(bytes(got.data), np.int8) == -1).all()
+    from nav_msgs.srv import GetMap
+    served = ros.call(GetMap, "/vasco_mapper/dynamic_map", GetMap.Request()).map  # once crashed after a reset
+    assert served.info == got.info and bytes(served.data) == bytes(got.data)
     # a subscriber that joins now gets the empty map, not the dropped scans' map
     from nav_msgs.msg import OccupancyGrid
     from ros_player import LATCHED

@@ -309,3 +309,19 @@ def test_save_map_path_forms_and_unknown_keys():
         "/maps/site.pgm", "a.PGM", "b.map.gz", "c.v2.pgm", "d.png"]
     assert unknown_parameters(["scan_topci", "zzz"], list(ROWS)) == (
         "unknown parameters (not used): scan_topci: did you mean 'scan_topic'?; zzz")
+
+
+def test_a_refused_static_link_is_not_added_again_when_time_jumps():
+    # (the node fuzzer's finding) a /tf_static transform the tree refused must not be kept for
+    # the rebuild after a jump back, where it was refused again out of a scan's callback
+    from types import SimpleNamespace as NS
+    from vasco_gpu.msgs.errors import BagError
+    settings = Settings.from_values({}, {})
+    posing = Posing(lambda: settings, str, None, lambda where, back: posing.clear_time())
+    posing.add_tf(NS(transforms=[_tf("base_link", "laser", 0)]), True)
+    bad = _tf("base_link", "laser", 0)
+    bad.transform.translation.x = -1e300
+    with pytest.raises(BagError, match="translation"):
+        posing.add_tf(NS(transforms=[bad]), True)
+    posing.clear_time()  # the rebuild: the good static link again, not the refused one
+    assert posing.tf.covers("base_link", "laser", [5 * 10**9]).all()

@@ -61,6 +61,8 @@ def cloud_points_xyz(msg, fail) -> np.ndarray:
     data = bytes(msg.data) if not isinstance(msg.data, (bytes, np.ndarray)) else msg.data
     data = np.frombuffer(data, dtype=np.uint8) if not isinstance(data, np.ndarray) else data.view(np.uint8)
     size = max(int(fields[n].offset) + int(formats[i][2]) for i, n in enumerate("xyz"))
+    if width * height == 0:  # no point: no layout to read (a point_step past NumPy's int limit included)
+        return np.empty((0, 3))
     if step < size or row < width * step or len(data) < height * row:
         raise fail(f"has {len(data)} bytes for {height} rows of {row} bytes, {width} points of {step} "
                    f"bytes (x, y, z need {size})")

@@ -22,7 +22,7 @@ from ..msgs.laser import COUNT_KEYS
 from ..msgs.path import path_poses
 from ..msgs.scan_options import ScanSettings
 from ..msgs.table import MessageType
-from ..msgs.tf import TfBuffer, static_mount
+from ..msgs.tf import TfBuffer, TfLinkIgnored, static_mount
 
 __all__ = ["TIME_JUMP_S", "Pending", "Posing", "Refused", "ScanFilter", "TimeJumps", "Unposed", "scan_settings"]
 
@@ -222,21 +222,22 @@ class Posing:
             for ts in msg.transforms:
                 child = ts.child_frame_id
                 self.stamp_seen(("tf", child), stamp_ns(ts.header.stamp), lambda c=child: f"/tf (frame {c!r})")
+            self.tf.add_message(msg, False)
+            return
+        # one by one, as add_message goes: only the links the tree took are kept for its rebuild
+        # after a time jump (a refused one would be refused again there, out of a scan's callback)
+        ignored = None
         try:
-            self.tf.add_message(msg, static)
-        finally:  # a link left out (TfLinkIgnored) leaves the message's other links stored
-            if static:
-                self._keep_statics(msg)
-
-    def _keep_statics(self, msg) -> None:
-        """The static links of msg the tree now holds, for its rebuild after a time jump (a link
-        it left out, a self link or a cycle, must not come back then)."""
-        for ts in msg.transforms:
-            child = frame_name(ts.child_frame_id)
-            edge = self.tf._edges.get(child)
-            if edge is not None and edge.parent == frame_name(ts.header.frame_id):
-                self._statics[child] = ts
-        self._mounts.clear()
+            for ts in msg.transforms:
+                try:
+                    self.tf.add_transform(ts, True)
+                    self._statics[frame_name(ts.child_frame_id)] = ts
+                except TfLinkIgnored as e:  # left out; the message's other links still taken
+                    ignored = ignored or e
+        finally:
+            self._mounts.clear()
+        if ignored is not None:
+            raise ignored
 
     def add_scan(self, msg, topic: str, kind: MessageType, received: float | None) -> None:
         """A scan message of kind on topic: read now (a type that needs its mount, once that is

@@ -69,6 +69,7 @@ class MapPublication:
         sent = self.canvas.current() if frame is not None and self.sent else None
         self.canvas.reset()
         self._published = -1
+        self.sent = sent is not None  # inactive: ~/dynamic_map has no map until the next one
         if sent is not None:
             fill_grid(self.grid_msg, sent.geometry, array("b", b"\xff") * len(sent.data), frame=frame, stamp=stamp)
             self.map_pub.publish(self.grid_msg)
@@ -79,8 +80,11 @@ class MapPublication:
     def current(self) -> OccupancyGrid:
         """The last /map message with every update since applied (~/dynamic_map's answer), its
         stamp the last publication's. Its data is the canvas's: rclpy messages copy an array
-        unless they check their fields, so it is given again here."""
-        self.grid_msg.data = self.canvas.current().data
+        unless they check their fields, so it is given again here. After a reset, until the
+        next map: the empty map the reset published (its data in the message itself)."""
+        canvas = self.canvas.current()
+        if canvas is not None:
+            self.grid_msg.data = canvas.data
         return self.grid_msg
 
     def publish(self, live, settings, stamp: Time, *, now: bool = False) -> dict:
