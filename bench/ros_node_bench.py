@@ -221,7 +221,10 @@ def relay_latencies(player, raw_path: bytes, paths: int, width: int, height: int
     relay = NodeProcess({}, command=[sys.executable, str(ROOT / "bench" / "ros_floor_relay.py"), str(width), str(height)])
     try:
         relay.wait_for("ready", timeout=60)
-        time.sleep(1.0)  # past discovery; its first (latched) /map arrives meanwhile
+        end = time.monotonic() + 30
+        while player.path.get_subscription_count() == 0 and time.monotonic() < end:
+            time.sleep(0.05)  # discovery: a Path published before the relay subscribed is lost
+        time.sleep(1.0)  # its first (latched) /map arrives meanwhile
         return path_latencies(player, raw_path, paths)
     finally:
         relay.interrupt(timeout=30)

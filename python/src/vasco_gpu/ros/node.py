@@ -446,7 +446,8 @@ class MappingNode(NodeServices, LifecycleNode):
         time from the timer to an update's publish() is the summary's batch -> map_updates."""
         start, version, updates = time.perf_counter(), self.live.version, self.out.counts["updates"]
         self._flush()
-        if self.live.version != version and self.live.backend == "cuda" and \
+        # the session's backend is its renderer's name: cuda_float or cuda_exact
+        if self.live.version != version and self.live.backend.startswith("cuda") and \
                 self.out.update_pub.get_subscription_count():
             self.out.publish(self.live, self.settings, self._map_stamp())
             if self.out.counts["updates"] != updates:
