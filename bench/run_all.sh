@@ -5,7 +5,7 @@
 # tables are quoted from such a file (docs/performance.md names it), never
 # copied by hand.
 #   bench/run_all.sh BUILD_DIR [STEP...]   (BUILD_DIR absolute or from the repository root;
-#                                          steps: parse oracle mapping large scaling session batch;
+#                                          steps: parse oracle mapping large scaling session batch align;
 #                                          ros, the ROS 2 node, only when named: it needs the [ros] extra;
 #                                          livemap, the node's Path steps without ROS (PYTHON's vasco_gpu),
 #                                          only when named; transport, a map over Fast DDS's shared memory
@@ -16,11 +16,11 @@
 # (vasco_gpu/src/backend_cost_model.txt is such a file); BATCH_ARGS: more of
 # batch_bench's options; BENCH_COMMIT: the commit to name where the tree is
 # a copy without its git history; PYTHON: the interpreter of the ros step (one with vasco_gpu,
-# rclpy and tf2_msgs), ROS_BENCH_ARGS: more of ros_node_bench.py's options; LIVEMAP_ARGS: live_map_steps.py's; PEER_ARGS: peer_bench's.
+# rclpy and tf2_msgs), ROS_BENCH_ARGS: more of ros_node_bench.py's options; LIVEMAP_ARGS: live_map_steps.py's; PEER_ARGS: peer_bench's; ALIGN_ARGS: align_bench's.
 set -euo pipefail
 build=${1:?usage: bench/run_all.sh BUILD_DIR [STEP...]}
 shift
-steps=${*:-parse oracle mapping large scaling session batch}
+steps=${*:-parse oracle mapping large scaling session batch align}
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"  # the steps' paths are the repository's
 out=${BENCH_OUT:-$root/bench/results/bench-$(date -u +%Y-%m-%d).txt}
@@ -52,6 +52,7 @@ for step in $steps; do
     large) run "$build/bin/mapping_bench" --large ;;
     scaling) run "$build/bin/mapping_bench" --thread-scaling ;;
     session) run "$build/bin/session_bench" ;;
+    align) run "$build/bin/align_bench" ${ALIGN_ARGS:-} ;;
     batch) run python3 bench/batch_bench.py --bin "$build/bin" ${BATCH_ARGS:-} \
              ${COST_MODEL_OUT:+--cost-model-out "$COST_MODEL_OUT"} ;;
     ros) run_as "python3 bench/ros_node_bench.py ${ROS_BENCH_ARGS:-}" \

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "test_seed.h"
+#include "align_test_support.h"
 #include "test_support.h"
 #include "vasco_gpu/align.h"
 #include "vasco_gpu/internal/se2.h"
@@ -27,23 +28,9 @@ using vasco::Pose2;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kCell = 0.1;
 
-// Maps at 0.1 m directly (downsample 1): the cell the alignment matches at,
-// and quick enough to map a session per seed.
-vasco::MapperParams params_at_cell() {
-  vasco::MapperParams p;
-  p.resolution = kCell;
-  p.downsample = 1;
-  p.border = 5;
-  return p;
-}
+vasco::MapperParams params_at_cell() { return vasco::testing_support::params_at_align_cell(); }
 
-AlignMap map_of(const vasco::ScanBatch &scans) {
-  vasco::BackendOptions options;
-  options.threads = 2;
-  vasco::Mapper m(params_at_cell(), "cpu_threads", options);
-  m.insert(scans);
-  return vasco::align_map_of(m.finish(), m.frame());
-}
+AlignMap map_of(const vasco::ScanBatch &scans) { return vasco::testing_support::align_map_of_scans(scans); }
 
 struct Sessions {
   vasco::ScanBatch first, second;

@@ -29,6 +29,7 @@ void bind_compare(nb::module_ &m);  // Comparison, compare
 void bind_mapper(nb::module_ &m);   // Mapper
 void bind_pose_series(nb::module_ &m);  // _repose (pose_series.h)
 void bind_path_cdr(nb::module_ &m);     // _path_from_cdr (the node's Path bytes)
+void bind_align(nb::module_ &m);       // _align_maps (align.h)
 
 // A caller's writable buffer of bytes (array('b'), bytearray), exported while it lives, so
 // that C++ may write into it without the GIL and it cannot be resized meanwhile. TypeError

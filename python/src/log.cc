@@ -78,6 +78,25 @@ std::string pose_keywords_doc() {
   return text;
 }
 
+// Log.added_sessions: log2map --json's "added_sessions", as dicts.
+nb::list added_sessions_list(const std::vector<vasco::AddedSession> &added) {
+  nb::list out;
+  for (const vasco::AddedSession &a : added) {
+    nb::dict d;
+    const vasco::AlignResult &r = a.result;
+    d["input"] = a.input;
+    d["transform"] = nb::make_tuple(a.transform.x, a.transform.y, a.transform.theta);
+    d["aligned"] = a.aligned ? "auto" : "given";
+    d["score"] = a.aligned ? nb::object(nb::float_(r.best.score)) : nb::none();
+    d["second_score"] = a.aligned && r.has_second ? nb::object(nb::float_(r.second.score)) : nb::none();
+    d["second_transform"] = a.aligned && r.has_second ? nb::object(nb::make_tuple(r.second.x, r.second.y, r.second.theta))
+                                                      : nb::none();
+    d["overlap"] = a.aligned ? nb::object(nb::float_(r.overlap)) : nb::none();
+    out.append(d);
+  }
+  return out;
+}
+
 // The docs name the scan messages from the pipeline's list (vasco_gpu/pipeline/log_scans.h).
 const char *load_log_doc() {
   static const std::string doc =
@@ -91,7 +110,10 @@ const char *load_log_doc() {
     "Poses from a SLAM back end (log2map --poses), the other pose keywords only with ``poses``\n"
     "(None: the default; a pose keyword without ``poses`` is a UsageError):" + pose_keywords_doc() + "\n\n"
     "Several sessions into one grid: ``transform`` (x, y, theta) of this log into the shared\n"
-    "frame, ``add`` further logs, each a path or (path, (x, y, theta)).\n\n"
+    "frame, ``add`` further logs, each a path or (path, (x, y, theta)), or (path, \"auto\") to find its\n"
+    "transform by aligning the log to those before it (log2map --add LOG@auto; (path, (\"auto\", (x, y,\n"
+    "theta, radius_m, radius_rad))) searches near a guess). A log the alignment refuses raises FileError\n"
+    "naming it. ``Log.added_sessions`` says what each added log was mapped at.\n\n"
     "``map_resolution``: the written map's cell in metres (log2map --resolution; ROS's resolution), set over\n"
     "the keys by Params.map_resolution's rule (vasco_downsample kept where the ini, the log or overrides set\n"
     "it). None: CARMEN's keys alone (0.025 x 4 = 0.1 m).";
@@ -133,6 +155,11 @@ void bind_log(nb::module_ &m) {
       .def_ro("unposed_skipped", &LogInput::unposed_skipped, "Scans left out for want of a pose (``skip_unposed``).")
       .def_ro("warnings", &LogInput::warnings, "Unknown vasco_* keys and the like.")
       .def_prop_ro(
+          "added_sessions", [](const LogInput &in) { return added_sessions_list(in.added_sessions); },
+          "One dict per ``add`` log, in order: ``input``, ``transform`` (x, y, theta) it was mapped at,\n"
+          "``aligned`` (\"auto\" or \"given\"), and for \"auto\" the alignment's ``score``, ``second_score``,\n"
+          "``second_transform`` (None without a second candidate) and ``overlap`` (None where given).")
+      .def_prop_ro(
           "stats", [](const LogInput &in) { return load_stats_dict(in.load); },
           "What the reader counted: lines, messages by type, bad lines by class (lenient mode), odd\n"
           "ranges, scans used.")
@@ -150,7 +177,7 @@ void bind_log(nb::module_ &m) {
                 "skip_unposed: bool | None = None, pose_frame: str | None = None, "
                 "laser_mount: tuple[float, float, float] | None = None, "
                 "transform: tuple[float, float, float] | None = None, "
-                "add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float]]] | None = None, "
+                "add: list[str | os.PathLike | tuple[str | os.PathLike, tuple[float, float, float] | str | tuple]] | None = None, "
                 "map_resolution: float | None = None) -> Log"),
         load_log_doc());
 }

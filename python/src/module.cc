@@ -111,4 +111,5 @@ NB_MODULE(_core, m) {
   vasco_py::bind_mapper(m);
   vasco_py::bind_pose_series(m);
   vasco_py::bind_path_cdr(m);
+  vasco_py::bind_align(m);
 }

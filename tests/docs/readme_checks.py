@@ -331,6 +331,18 @@ CHECKS: Dict[str, Dict[str, Check]] = {
                       "test -f a.yaml && test -f d/intel.map.gz && test -f d/intel.png"]),
         "sh: log2map monday.log.gz --add tuesday.log.gz@12.5,-3.0,1.5708": Check(
             "run", fixture="sessions", outputs=["both.map.gz"]),
+        "sh: log2map -q --json first.log --add second.log@auto both.map": Check(
+            "covered-by", files=[("tests/log2map_auto_test.cc", [
+                "FindsTheTransformAndMapsAsIfItWereGiven", "\"@auto\"", "added_sessions",
+                "aligned\\\":\\\"auto"])]),
+        "text: log2map: second.log: aligned (@auto): transform 3.5014552772": Check(
+            "covered-by", files=[("tests/log2map_auto_test.cc", ["second.log: aligned (@auto): transform "])]),
+        "sh: log2map first.log --add fr079.log@auto both.map": Check(
+            "covered-by", files=[("tests/log2map_auto_test.cc", [
+                "AnotherBuildingIsRefusedAndNothingWritten", "EXPECT_EQ(r.status, 1)", "out.entries().empty()"])]),
+        "text: log2map: fr079.log: not placed by alignment (\"@auto\"): no_ov": Check(
+            "covered-by", files=[("tests/log2map_auto_test.cc", ["fr079.log\") + \": not placed by alignment\"",
+                                                                 "best ("])]),
         "text: log2map: --backend auto: 3.4e+08 cell updates: about 0.302 s": Check(
             "output", fixture="intel", command="log2map --backend auto intel.log.gz auto.map.gz",
             # with a GPU that may be usable, its time; else why none is (backend_choice.h)
@@ -397,6 +409,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "python", fixture="logs", needs=["dask.distributed"],
             outputs=["maps/intel.gfs.map.gz", "maps/intel.gfs.png", "maps/fr101.carmen.map.gz",
                      "maps/fr101.carmen.png"]),
+        'python: log = vg.load_log("logs/intel.gfs.log.gz")': Check("python", fixture="logs", outputs=["merged.png"]),
     },
     "docs/sessions.md": {
         "cpp: vasco::MapperParams params;": Check("compile", harness=CXX_HARNESS),

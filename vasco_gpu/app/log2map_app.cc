@@ -116,6 +116,41 @@ void print_summary(const Options &opt, const RunResult &r) {
                r.write_s, r.total_s);
 }
 
+// A number of the JSON at full precision (a transform given back maps the
+// same bytes), null where not finite.
+std::string json_exact(double v) {
+  if (!std::isfinite(v)) return "null";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", v);
+  return text;
+}
+
+std::string json_triple(double x, double y, double theta) {
+  return "[" + json_exact(x) + "," + json_exact(y) + "," + json_exact(theta) + "]";
+}
+
+// "added_sessions": each --add's transform as mapped, and for an "@auto"
+// one what the alignment found (the scores to judge it by).
+std::string added_sessions_json(const std::vector<vasco::AddedSession> &added) {
+  std::string j = "[";
+  for (size_t i = 0; i < added.size(); ++i) {
+    const vasco::AddedSession &a = added[i];
+    const vasco::AlignResult &r = a.result;
+    j += std::string(i ? "," : "") + "{\"input\":" + cli::json_string(a.input) +
+         ",\"transform\":" + json_triple(a.transform.x, a.transform.y, a.transform.theta) +
+         ",\"aligned\":" + (a.aligned ? "\"auto\"" : "\"given\"");
+    if (!a.aligned) {
+      j += ",\"score\":null,\"second_score\":null,\"second_transform\":null,\"overlap\":null}";
+      continue;
+    }
+    j += ",\"score\":" + json_exact(r.best.score) + ",\"second_score\":" +
+         (r.has_second ? json_exact(r.second.score) : "null") + ",\"second_transform\":" +
+         (r.has_second ? json_triple(r.second.x, r.second.y, r.second.theta) : "null") +
+         ",\"overlap\":" + json_exact(r.overlap) + ",\"seconds\":" + json_exact(a.seconds) + "}";
+  }
+  return j + "]";
+}
+
 void print_json(const Options &opt, const RunResult &r) {
   const auto &ls = r.input.load.log;
   const vasco::MapStats &ms = r.stats;
@@ -128,6 +163,7 @@ void print_json(const Options &opt, const RunResult &r) {
     << ",\"cell_updates\":" << ms.cell_updates << ",\"nan_ranges\":" << ls.nan_ranges
     << ",\"inf_ranges\":" << ls.inf_ranges << ",\"negative_ranges\":" << ls.negative_ranges
     << ",\"bad_lines\":" << ls.total_bad_lines() << ",\"sessions\":" << opt.more.size() + 1
+    << ",\"added_sessions\":" << added_sessions_json(r.input.added_sessions)
     << ",\"posed_from_file\":" << r.input.posed_from_file << ",\"unposed_skipped\":" << r.input.unposed_skipped << ",\"grid\":[" << geo.size_x << "," << geo.size_y
     << "],\"map\":[" << r.map.size_x << "," << r.map.size_y << "],\"map_resolution\":" << r.map.resolution
     << ",\"known_cells\":" << r.known << ",\"origin\":[" << r.origin.x << "," << r.origin.y << "]"

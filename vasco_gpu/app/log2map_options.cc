@@ -273,8 +273,11 @@ void add_pose_options(CLI::App &app, Options &opt, PoseText &raw) {
   app.add_option("--transform", raw.transform, "the input into the shared frame of several sessions (default: identity)")
       ->type_name("X,Y,THETA");
   // One value an occurrence: what follows it is OUT (or the next input).
-  app.add_option("--add", raw.adds, "a further session mapped into the same grid, its transform after an '@' (repeatable)")
-      ->type_name("INPUT[@X,Y,THETA]")
+  app.add_option("--add", raw.adds,
+                 "a further session mapped into the same grid, its transform after an '@', or '@auto' to find it "
+                 "by aligning the session to those before it ('@auto:X,Y,THETA+-R[,RTHETA]': near a guess) "
+                 "(repeatable)")
+      ->type_name("INPUT[@X,Y,THETA|@auto[:HINT]]")
       ->allow_extra_args(false);
 }
 
@@ -480,13 +483,47 @@ vasco::Pose2 parse_pose_triple(const std::string &text, const std::string &optio
   return vasco::Pose2{v[0], v[1], v[2]};
 }
 
+namespace {
+
+// "X,Y,THETA[±R[,RTHETA]]" ("+-" for "±"): a guess of an "@auto"
+// session's transform, searched within R metres in x and y and RTHETA
+// radians (AlignHint's defaults where not given).
+vasco::AlignHint parse_auto_hint(const std::string &text, const std::string &option) {
+  vasco::AlignHint hint;
+  size_t pm = text.find("\xC2\xB1");  // "±" in UTF-8
+  const size_t pm_len = 2;  // "±" and "+-" alike
+  if (pm == std::string::npos) pm = text.find("+-");
+  const vasco::Pose2 guess = parse_pose_triple(text.substr(0, pm), option);
+  hint.x = guess.x;
+  hint.y = guess.y;
+  hint.theta = guess.theta;
+  if (pm == std::string::npos) return hint;
+  const std::string radii = text.substr(pm + pm_len);
+  const size_t comma = radii.find(',');
+  const auto radius = [&](const std::string &v, double *out) {
+    if (!parse_double(v, out) || !std::isfinite(*out) || *out < 0)
+      throw Error(ErrorCode::Usage, option + ": expected auto:X,Y,THETA+-R[,RTHETA] (R metres and RTHETA radians: "
+                                             "finite, 0 or more), not '" + v + "' after the +-");
+  };
+  radius(radii.substr(0, comma), &hint.radius_m);
+  if (comma != std::string::npos) radius(radii.substr(comma + 1), &hint.radius_rad);
+  return hint;
+}
+
+}  // namespace
+
 vasco::SessionInput parse_session(const std::string &text) {
   vasco::SessionInput s;
   s.path = text;
   const size_t at = text.rfind('@');
-  if (at != std::string::npos && std::count(text.begin() + static_cast<std::ptrdiff_t>(at), text.end(), ',') == 2) {
+  const std::string after = at == std::string::npos ? std::string() : text.substr(at + 1);
+  if (after == "auto" || after.rfind("auto:", 0) == 0) {
     s.path = text.substr(0, at);
-    s.transform = parse_pose_triple(text.substr(at + 1), "--add " + text);
+    s.auto_transform = true;
+    if (after != "auto") s.hint = parse_auto_hint(after.substr(5), "--add " + text);
+  } else if (at != std::string::npos && std::count(after.begin(), after.end(), ',') == 2) {
+    s.path = text.substr(0, at);
+    s.transform = parse_pose_triple(after, "--add " + text);
   }
   if (s.path.empty()) throw Error(ErrorCode::Usage, "--add '" + text + "': no input named");
   return s;

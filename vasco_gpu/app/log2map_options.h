@@ -43,7 +43,7 @@ struct Options {
   std::map<std::string, std::string> overrides;  // --vasco_KEY VALUE
   std::optional<double> map_resolution;          // --resolution M: the written map's cell
   vasco::Pose2 transform;                        // --transform: the first input into the shared frame
-  std::vector<vasco::SessionInput> more;         // --add INPUT[@X,Y,THETA]
+  std::vector<vasco::SessionInput> more;         // --add INPUT[@X,Y,THETA | @auto[:HINT]]
   vasco::PoseSource poses;                       // --poses FILE and its options
   std::string laser_mount_text;                  // --laser-mount as given
   std::map<std::string, std::string> extra;      // the tool's own options, as given
@@ -64,6 +64,9 @@ vasco::Pose2 parse_pose_triple(const std::string &text, const std::string &optio
 
 // "--add PATH[@X,Y,THETA]": the path, and the transform when one follows the
 // last '@' (a path may hold an '@' of its own when no transform follows).
+// "PATH@auto": the transform found by alignment; "PATH@auto:X,Y,THETA",
+// "...±R" or "...±R,RTHETA" ("+-" as well as "±"): searched near that
+// guess, within R m in x and y and RTHETA rad (defaults 1 m and 0.1 rad).
 vasco::SessionInput parse_session(const std::string &text);
 
 }  // namespace log2map

@@ -100,6 +100,16 @@ namespace {
 
 vasco::LogInput read_input_once(const Options &opt, const std::string &log, const ToolSpec &spec, ProgressBar *bar);
 
+// The line an "@auto" session's alignment prints (the transform at full
+// precision: given back with --add INPUT@X,Y,THETA it maps the same bytes).
+void print_aligned(const Options &opt, const vasco::AddedSession &a) {
+  const vasco::AlignResult &r = a.result;
+  std::fprintf(stderr, "%s: %s: aligned (@auto): transform %.17g,%.17g,%.17g score %.3f", opt.tool.c_str(),
+               carmen::printable(a.input).c_str(), a.transform.x, a.transform.y, a.transform.theta, r.best.score);
+  if (r.has_second) std::fprintf(stderr, " (second %.3f)", r.second.score);
+  std::fprintf(stderr, ", overlap %.2f, %.2f s\n", r.overlap, a.seconds);
+}
+
 }  // namespace
 
 // --lenient skips bad lines, and only them: a file that cannot be read on (a
@@ -134,10 +144,14 @@ vasco::LogInput read_input_once(const Options &opt, const std::string &log, cons
   in.memory_budget = opt.max_memory_bytes;  // the scans alone may not pass what the map may use
   in.budget_option = "--max-memory";
   if (bar != nullptr) in.progress = [bar](uint64_t done, uint64_t total) { bar->update(done, total); };
-  if (!spec.read) {
-    in.more_logs = opt.more;
-    return vasco::load_log_input(in);
-  }
+  in.more_logs = opt.more;
+  in.align.threads = opt.threads;
+  if (!opt.quiet)
+    in.align.aligned = [&opt, bar](const vasco::AddedSession &a) {
+      if (bar != nullptr) bar->done();
+      print_aligned(opt, a);
+    };
+  if (!spec.read) return vasco::load_log_input(in);
   // Another kind of input: the tool's reader makes the scans, the sessions
   // are appended here, the rest is a log's. The reader learns of --poses
   // (its inputs' poses are then not needed), --laser-mount (the mount of a
@@ -149,12 +163,13 @@ vasco::LogInput read_input_once(const Options &opt, const std::string &log, cons
   const auto no_progress = [](uint64_t, uint64_t) {};
   const std::function<void(uint64_t, uint64_t)> progress = in.progress ? in.progress : no_progress;
   vasco::StampedScans scans = spec.read(log, values, progress);
+  std::vector<vasco::StampedScans> more_scans;
   for (const vasco::SessionInput &more : opt.more) {
     if (bar != nullptr) bar->done();
-    scans.append(spec.read(more.path, values, progress), more.transform);
+    more_scans.push_back(spec.read(more.path, values, progress));
   }
   if (bar != nullptr) bar->done();
-  return vasco::log_input_from_scans(std::move(scans), in);
+  return vasco::log_input_from_sessions(std::move(scans), std::move(more_scans), in);
 }
 
 // A map cell so large that CARMEN's finish, which keeps only whole blocks

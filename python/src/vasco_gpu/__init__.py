@@ -81,6 +81,7 @@ from ._cuda import CudaStatus, cuda_available
 from .bags.load import load_bag
 from .bags.info import bag_info
 from ._batch import BatchError, LogResult, map_logs
+from .align import align_sessions
 
 __version__: str = _core.__version__
 
@@ -107,6 +108,7 @@ __all__ = [
     "TooLargeError",
     "UsageError",
     "__version__",
+    "align_sessions",
     "auto_choice",
     "backend_names",
     "backend_registry",

@@ -11,8 +11,9 @@
 //
 // The search (src/align/): every rotation and every translation where the
 // maps can overlap, by branch and bound over max-pooled likelihood grids at
-// four times the matching cell, then at the matching cell near the best
-// few candidates, then a local refinement to a fraction of a cell. It refuses rather than guesses: a best candidate
+// four times the matching cell (on the GPU: every candidate scored, the
+// same candidates found), then at the matching cell near the best few
+// candidates, then a local refinement to a fraction of a cell. It refuses rather than guesses: a best candidate
 // scoring below min_score is "no overlap", and a distinct second candidate
 // nearly as good is "ambiguous".
 #ifndef VASCO_GPU_ALIGN_H
@@ -67,6 +68,16 @@ struct AlignOptions {
   // best candidate: no overlap.
   int min_matched = 40;
   int threads = 0;  // 0: every usable core
+  // Where the global search runs (the finer passes and the verdict run on
+  // the CPU either way). Auto, the default, takes the GPU where one is
+  // usable: it scores every candidate where the CPU bounds them, and its
+  // candidates are the CPU's (the same sums to the bit), so the choice
+  // changes the time, not the answer; a GPU that fails (no memory, no
+  // device after all) leaves Auto to the CPU. Gpu throws Error(NoGpu) where
+  // none is usable.
+  enum class Backend { Auto, Cpu, Gpu };
+  Backend backend = Backend::Auto;
+  int cuda_device = 0;  // the device Auto and Gpu use
 };
 
 enum class AlignVerdict { Aligned, NoOverlap, Ambiguous };
@@ -99,15 +110,17 @@ struct AlignResult {
   int matched = 0;
   int moving_points = 0;  // occupied moving cells at match_resolution
   int rotations = 0;      // rotations searched
+  bool gpu = false;       // the global search ran on the GPU
 };
 
 // Aligns `moving` to `reference`. Never throws for empty or degenerate maps
 // (no occupied cell, no overlap): verdict NoOverlap with a reason. Throws
 // vasco::Error(Usage) for bad options (match_resolution not finite and > 0,
-// a negative or non-finite hint radius, threads < 0) and Error(BadInput)
+// a negative or non-finite hint radius, threads < 0, cuda_device < 0) and Error(BadInput)
 // for a map whose cells do not number size_x * size_y or whose resolution
 // or origin is not finite; Error(TooLarge) for a map beyond 2^20 cells a
-// side or 2^26 cells at the matching cell.
+// side or 2^26 cells at the matching cell; Error(NoGpu) for backend Gpu
+// without a usable GPU.
 AlignResult align_maps(const AlignMap &reference, const AlignMap &moving, const AlignOptions &options = {});
 
 }  // namespace vasco

@@ -1,6 +1,7 @@
 #include "vasco_gpu/pipeline/log_input.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -194,6 +195,49 @@ void check_sessions(const LogInputOptions &options) {
     if (!finite(s.transform)) throw carmen::Error(carmen::ErrorCode::Usage, s.path + ": the transform is not finite");
 }
 
+// Finds an "@auto" session's transform: its map aligned to the map of
+// `scans`, the sessions before it. A refusal throws, naming the session.
+AddedSession align_added(const StampedScans &scans, const StampedScans &session, const SessionInput &s,
+                         const MapperParams &p, const SessionAlignOptions &align) {
+  AddedSession a{s.path, s.transform, true, {}, 0};
+  if (scans.batch.num_scans() == 0 || session.batch.num_scans() == 0)
+    throw carmen::FileError(s.path, "no scans to align this session by (\"@auto\")");
+  const auto t0 = std::chrono::steady_clock::now();
+  a.result = align_session(scans.batch, session.batch, p, s.hint, align.threads);
+  a.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (a.result.verdict != AlignVerdict::Aligned)
+    throw carmen::FileError(s.path, std::string("not placed by alignment (\"@auto\"): ") +
+                                        align_verdict_name(a.result.verdict) + ": " + align_candidates_text(a.result) +
+                                        "; give its transform (@X,Y,THETA) or a hint (@auto:X,Y,THETA+-R)");
+  a.transform = Pose2{a.result.best.x, a.result.best.y, a.result.best.theta};
+  if (align.aligned) align.aligned(a);
+  return a;
+}
+
+// Appends every further session to `scans` (the first input's, in the
+// shared frame), in order: "@auto" ones at the transform that aligns each
+// to all the sessions before it. The maps for the alignment take the run's
+// parameters (`params`: the command line's, the ini's and every log's).
+std::vector<AddedSession> append_sessions(StampedScans &scans, std::vector<StampedScans> more,
+                                          const LogInputOptions &options, const carmen::ParamFile &params) {
+  std::vector<AddedSession> added;
+  MapperParams p;
+  const bool any_auto = std::any_of(options.more_logs.begin(), options.more_logs.end(),
+                                    [](const SessionInput &s) { return s.auto_transform; });
+  if (any_auto) {
+    p = MapperParams::from_params(params, nullptr);
+    apply_map_resolution(p, options, params);
+  }
+  for (size_t i = 0; i < more.size(); ++i) {
+    const SessionInput &s = options.more_logs[i];
+    AddedSession a = s.auto_transform ? align_added(scans, more[i], s, p, options.align)
+                                      : AddedSession{s.path, s.transform, false, {}, 0};
+    scans.append(std::move(more[i]), a.transform);
+    added.push_back(std::move(a));
+  }
+  return added;
+}
+
 }  // namespace
 
 void StampedScans::append(StampedScans &&more, const Pose2 &transform) {
@@ -261,18 +305,22 @@ LogInput load_log_input(const LogInputOptions &options) {
       params.add_fallback(load.params[i].first, load.params[i].second, path, load.param_lines[i]);
   };
   add_params(in.load, options.log);
+  std::vector<StampedScans> more_scans;
   for (const SessionInput &more : options.more_logs) {
     // The budget is for all sessions together: each log gets what is left.
     LogInputOptions rest = options;
     if (rest.memory_budget > 0)
       rest.memory_budget = rest.memory_budget > in.load.log.kept_bytes ? rest.memory_budget - in.load.log.kept_bytes : 1;
     LogLoadStats load;
-    StampedScans next = read_stamped_scans(more.path, rest, &load);
+    more_scans.push_back(read_stamped_scans(more.path, rest, &load));
     add_params(load, more.path);
     add_counts(in.load, load);
-    scans.append(std::move(next), more.transform);
   }
-  return finish_input(std::move(scans), params, options, std::move(in), scan_message_names() + " scans");
+  // Every log's PARAM lines are known: the maps an "@auto" session is aligned on take them.
+  std::vector<AddedSession> added = append_sessions(scans, std::move(more_scans), options, params);
+  LogInput out = finish_input(std::move(scans), params, options, std::move(in), scan_message_names() + " scans");
+  out.added_sessions = std::move(added);
+  return out;
 }
 
 LogInput log_input_from_scans(StampedScans scans, const LogInputOptions &options) {
@@ -286,6 +334,24 @@ LogInput log_input_from_scans(StampedScans scans, const LogInputOptions &options
   in.unposed_skipped = scans.unposed;
   scans.batch.transform(options.transform.x, options.transform.y, options.transform.theta);
   return finish_input(std::move(scans), params, options, std::move(in), "scans");
+}
+
+LogInput log_input_from_sessions(StampedScans first, std::vector<StampedScans> more, const LogInputOptions &options) {
+  if (more.size() != options.more_logs.size())
+    throw carmen::Error(carmen::ErrorCode::Usage, "log_input_from_sessions: one set of scans per further session");
+  check_sessions(options);
+  std::vector<std::string> warnings;  // said by log_input_from_scans below
+  const carmen::ParamFile params = command_line_params(options, &warnings);
+  // --transform moves the first input alone, as load_log_input's: the
+  // others come with their own.
+  first.batch.transform(options.transform.x, options.transform.y, options.transform.theta);
+  std::vector<AddedSession> added = append_sessions(first, std::move(more), options, params);
+  LogInputOptions merged = options;
+  merged.more_logs.clear();
+  merged.transform = Pose2{};
+  LogInput in = log_input_from_scans(std::move(first), merged);
+  in.added_sessions = std::move(added);
+  return in;
 }
 
 }  // namespace vasco

@@ -5,12 +5,19 @@
 #include "vasco_gpu/align.h"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
+#include <utility>
 
+#include "align_gpu.h"
 #include "align_grids.h"
 #include "align_refine.h"
 #include "align_search.h"
+#include "vasco_gpu/backend.h"
 #include "vasco_gpu/error.h"
 #include "vasco_gpu/internal/parallel.h"
 #include "vasco_gpu/map_output.h"
@@ -59,6 +66,7 @@ void check_options(const AlignOptions &o) {
   if (!(std::isfinite(o.match_resolution) && o.match_resolution > 0))
     throw Error(ErrorCode::Usage, "align_maps: match_resolution must be finite and positive");
   if (o.threads < 0) throw Error(ErrorCode::Usage, "align_maps: threads must be 0 (every core) or more");
+  if (o.cuda_device < 0) throw Error(ErrorCode::Usage, "align_maps: cuda_device must be 0 or more");
   if (o.hint) {
     const AlignHint &h = *o.hint;
     const bool ok = std::isfinite(h.x) && std::isfinite(h.y) && std::isfinite(h.theta) && std::isfinite(h.radius_m) &&
@@ -225,9 +233,55 @@ Found refined(const Leaf &leaf, const SearchSpace &s, const Prepared &p, const R
   return f;
 }
 
+// With VASCO_ALIGN_PROFILE set, each stage's time to stderr: where an
+// alignment's time goes (for tuning; the benchmark times whole calls).
+class StageClock {
+ public:
+  StageClock() : on_(std::getenv("VASCO_ALIGN_PROFILE") != nullptr), last_(std::chrono::steady_clock::now()) {}
+  void mark(const char *stage) {
+    if (!on_) return;
+    const auto now = std::chrono::steady_clock::now();
+    std::fprintf(stderr, "  [align] %-14s %9.3f ms\n", stage,
+                 std::chrono::duration<double, std::milli>(now - last_).count());
+    last_ = now;
+  }
+
+ private:
+  bool on_;
+  std::chrono::steady_clock::time_point last_;
+};
+
+// Whether the global search runs on the GPU (AlignOptions::backend).
+bool gpu_chosen(const AlignOptions &o) {
+  if (o.backend == AlignOptions::Backend::Cpu) return false;
+  std::string why;
+  const bool usable = gpu_search_compiled() && gpu_usable(o.cuda_device, &why);
+  if (o.backend == AlignOptions::Backend::Gpu && !usable)
+    throw Error(ErrorCode::NoGpu, "align_maps: backend gpu, but " +
+                                      (gpu_search_compiled() ? why : std::string("this build has no CUDA")));
+  return usable;
+}
+
+// The coarse search's best distinct leaves, on the GPU when *on_gpu (which
+// a GPU without the memory, or gone, clears where the backend is Auto).
+std::vector<Leaf> coarse_leaves(const SearchSpace &coarse, const Distinctness &distinct, const AlignOptions &o,
+                                int threads, bool *on_gpu) {
+  if (*on_gpu) {
+    try {
+      return gpu_search(coarse, 0.0f, kCoarseCandidates, distinct, threads, o.cuda_device);
+    } catch (const Error &e) {
+      const bool gpu_gone = e.code() == ErrorCode::NoGpu || e.code() == ErrorCode::OutOfMemory;
+      if (o.backend != AlignOptions::Backend::Auto || !gpu_gone) throw;
+      *on_gpu = false;
+    }
+  }
+  return branch_and_bound(coarse, 0.0f, kCoarseCandidates, distinct, threads);
+}
+
 // The global coarse search, then the fine one near each coarse candidate:
 // the refined candidates, best first.
-std::vector<Found> search(const Prepared &p, const AlignOptions &o, int threads, int *rotations) {
+std::vector<Found> search(const Prepared &p, const AlignOptions &o, int threads, int *rotations, bool *on_gpu) {
+  StageClock clock;
   SearchSpace coarse = space_of(p.coarse, p);
   set_rotations(coarse, p, o);
   set_translations(coarse, p.coarse.reference, p, o);
@@ -235,18 +289,30 @@ std::vector<Found> search(const Prepared &p, const AlignOptions &o, int threads,
   const std::vector<PooledGrid> coarse_levels = pool_levels(p.coarse.field, level_count(coarse));
   coarse.levels = &coarse_levels;
   const Distinctness coarse_distinct{p.r_rms / coarse.h, std::max(kCoarseDistinct, kDistinctCells / kCoarse)};
-  const std::vector<Leaf> leaves = branch_and_bound(coarse, 0.0f, kCoarseCandidates, coarse_distinct, threads);
+  clock.mark("coarse levels");
+  const std::vector<Leaf> leaves = coarse_leaves(coarse, coarse_distinct, o, threads, on_gpu);
+  clock.mark(*on_gpu ? "coarse (gpu)" : "coarse (cpu)");
   const RefineInput in{&p.fine.field, p.fine.h, &p.fine.points, p.c_x, p.c_y};
   std::vector<PooledGrid> fine_levels;
-  std::vector<Found> found;
+  std::vector<std::pair<Leaf, SearchSpace>> fine_best;
   for (const Leaf &leaf : leaves) {
     SearchSpace fine = fine_space_near(leaf, coarse, p);
     if (fine_levels.size() < static_cast<size_t>(level_count(fine)))
       fine_levels = pool_levels(p.fine.field, level_count(fine));
     fine.levels = &fine_levels;
     const std::vector<Leaf> best = branch_and_bound(fine, -1e30f, 1, {}, threads);
-    if (!best.empty()) found.push_back(refined(best[0], fine, p, in));
+    if (!best.empty()) fine_best.emplace_back(best[0], fine);
   }
+  clock.mark("fine");
+  // Each refinement climbs alone, one candidate a thread (the search's
+  // threads split rotations instead).
+  std::vector<Found> found(fine_best.size());
+  std::atomic<size_t> next{0};
+  run_on_threads(std::max(1, std::min(threads, static_cast<int>(found.size()))), [&](int) {
+    for (size_t i; (i = next.fetch_add(1)) < found.size();)
+      found[i] = refined(fine_best[i].first, fine_best[i].second, p, in);
+  });
+  clock.mark("refine");
   std::stable_sort(found.begin(), found.end(),
                    [](const Found &a, const Found &b) { return a.candidate.score > b.candidate.score; });
   return found;
@@ -320,6 +386,7 @@ AlignResult align_maps(const AlignMap &reference, const AlignMap &moving, const 
   check_map(moving, "moving");
   const double h = options.match_resolution;
   AlignResult r;
+  bool gpu = gpu_chosen(options);  // before any refusal: backend Gpu without a GPU throws whatever the maps
   if (too_large(reference, h) || too_large(moving, h)) {
     std::ostringstream msg;
     msg << "align_maps: a map at the matching cell of " << h << " m would pass " << kMaxSide << " cells a side or "
@@ -327,12 +394,15 @@ AlignResult align_maps(const AlignMap &reference, const AlignMap &moving, const 
     throw Error(ErrorCode::TooLarge, msg.str());
   }
   if (!(reference.resolution > 0) || !(moving.resolution > 0)) return refused(r, "a map has no positive resolution");
+  StageClock clock;
   const Prepared p = prepare(reference, moving, h);
+  clock.mark("prepare");
   r.moving_points = static_cast<int>(p.fine.points.size());
   if (p.fine.points.empty()) return refused(r, "the moving map has no wall cell (p > 0.65)");
   if (p.fine.reference_walls == 0) return refused(r, "the reference map has no wall cell (p > 0.65)");
   const int threads = options.threads > 0 ? options.threads : hardware_threads();
-  const std::vector<Found> found = search(p, options, threads, &r.rotations);
+  const std::vector<Found> found = search(p, options, threads, &r.rotations, &gpu);
+  r.gpu = gpu;
   if (found.empty()) return refused(r, "no candidate scores above 0");
   r.best = found[0].candidate;
   const RefineInput in{&p.fine.field, h, &p.fine.points, p.c_x, p.c_y};

@@ -113,7 +113,10 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
     The scans before the first and after the last pose of the chain are left out and counted
     (``Log.unposed_skipped``) with one :class:`BagWarning`; a scan in a gap of the poses is an
     error, unless ``skip_unposed=True`` (without a pose file) leaves out every scan without one. ``add=[bag, (bag,
-    (x, y, theta))]`` and ``transform=`` put several sessions into one grid, as in load_log.
+    (x, y, theta))]`` and ``transform=`` put several sessions into one grid, as in load_log; ``(bag, 'auto')``
+    finds the transform by aligning the bag's map to those before it, as
+    :func:`vasco_gpu.align_sessions` does (``align={...}``: its keywords: backend, match_resolution, hints, ...),
+    and raises BadInputError naming the bag where it cannot.
     The parameters come from ``param_file`` and ``overrides`` (a bag has no PARAM lines); the map's
     cell is ROS's 0.05 m (``vasco_gpu.ROS_MAP_RESOLUTION``, bag2map's default too) unless
     ``map_resolution=M`` or a vasco_resolution in them says otherwise (see load_log). Errors
@@ -133,7 +136,8 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
                    cloud_range_max=cloud_range_max, static_pose=static_pose, wording="python")
     if len(sessions) > 1 and pose_keywords.get("poses") is not None:
         raise _core_usage_error("poses= applies to one input: write each session's poses into it first")
-    d = None
+    align = pose_keywords.pop("align", None) or {}
+    read = []
     for p, t in sessions:
         try:
             one = read_for_engine(p, **options)
@@ -141,8 +145,39 @@ def load_bag(path: str | os.PathLike, scan_topic: str | None = None, fixed_frame
             raise FileError(str(e), file=os.fspath(p), line=None, message=str(e)) from e
         for text in one.pop("warnings", []):
             warnings.warn(BagWarning(text), stacklevel=2)
+        read.append((p, one, t))
+    if any(isinstance(t, str) for _, _, t in read):
+        read = _place_auto(read, _session_params(param_file, robot, overrides), align)
+    d = None
+    for _, one, t in read:
         d = _append_session(d, one, t)
     return _core._log_from_scans(d, os.fspath(path), param_file, robot, overrides, **pose_keywords)
+
+
+def _session_params(param_file, robot: str, overrides) -> _core.Params:
+    """The parameters the bags are mapped with (a bag has no PARAM lines): what the alignment maps."""
+    if param_file is not None:
+        return _core.Params.from_ini(os.fspath(param_file), robot, **(overrides or {}))
+    return _core.Params(**(overrides or {}))
+
+
+def _place_auto(read: list, params: _core.Params, align: dict) -> list:
+    """The sessions read, each "auto" one aligned (vasco_gpu.align_sessions' way) to those before it;
+    every session's scans are then in the shared frame (its transform None)."""
+    from ..align import _Session, _transform_of, place_sessions
+
+    sessions = []
+    for i, (p, one, t) in enumerate(read):
+        transform = (0.0, 0.0, 0.0) if t is None else _transform_of(t, os.fspath(p))
+        if i == 0 and transform == "auto":
+            raise _core_usage_error(f"{os.fspath(p)}: the first bag is the shared frame: its transform is given or none")
+        sessions.append(_Session(os.fspath(p), one["scans"], params, transform))
+    options = dict(align)
+    cell = options.pop("resolution", None)
+    place_sessions(sessions, backend=options.pop("backend", "auto"), threads=options.pop("threads", 0),
+                   cell=options.get("match_resolution", 0.1) if cell is None else float(cell),
+                   refuse=True, hints=options.pop("hints", None), align_options=options)
+    return [(p, one, None) for p, one, _ in read]
 
 
 def _core_usage_error(message: str):

@@ -20,6 +20,7 @@
 #include "vasco_gpu/params.h"
 #include "vasco_gpu/pipeline/log_scans.h"
 #include "vasco_gpu/pipeline/pose_match.h"
+#include "vasco_gpu/pipeline/session_align.h"
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco {
@@ -27,10 +28,14 @@ namespace vasco {
 // One more input of a map made from several sessions (several robots or
 // days in one place): its scans follow the first log's, each pose taken into
 // the shared frame by `transform` (the identity when the sessions already
-// share one).
+// share one), or with auto_transform by aligning the session's map to the
+// map of the sessions before it (session_align.h; `hint`: search only near
+// a guess).
 struct SessionInput {
   std::string path;
   Pose2 transform;
+  bool auto_transform = false;
+  std::optional<AlignHint> hint;
 };
 
 // Where the scans' poses come from when not from the inputs themselves: a
@@ -74,6 +79,7 @@ struct LogInputOptions {
   std::string log;                               // .log, .clf, gzipped if .gz
   Pose2 transform;                               // of `log` into the shared frame (identity: as read)
   std::vector<SessionInput> more_logs;           // further sessions mapped into the same grid
+  SessionAlignOptions align;                     // how "@auto" sessions are aligned
   PoseSource poses;
   std::string param_file;                        // carmen.ini; empty: none
   std::string robot;                             // robot section of the ini
@@ -106,6 +112,7 @@ struct LogInput {
                                       // frame a Mapper's first insert of `batch` takes (use the
                                       // Mapper's frame() once it has mapped them)
   std::vector<std::string> warnings;  // unknown vasco_* keys and the like
+  std::vector<AddedSession> added_sessions;  // one per more_logs, in order: the transforms mapped
 };
 
 // Reads the parameters and the log. Throws carmen::FileError naming the file
@@ -114,7 +121,9 @@ struct LogInput {
 // With more_logs, every input is read in turn; their PARAM lines apply in
 // that order, as if the logs were one file, and the frame is that of the
 // combined scans: on an exact backend the map equals that of one log holding
-// every scan in that order.
+// every scan in that order. Sessions with auto_transform are aligned once
+// every log is read (session_align.h), in order; one the alignment refuses
+// throws a carmen::FileError naming it.
 LogInput load_log_input(const LogInputOptions &options);
 
 // The same from scans read elsewhere (a ROS bag): the parameters come from
@@ -122,6 +131,12 @@ LogInput load_log_input(const LogInputOptions &options);
 // applies, options.log names the source in errors and options.more_logs
 // must be empty (the caller appends further sessions to `scans` itself).
 LogInput log_input_from_scans(StampedScans scans, const LogInputOptions &options);
+
+// The same for several sessions read elsewhere: more[i] holds the scans of
+// options.more_logs[i] in that session's own frame; each is appended at its
+// transform, given or found by the alignment ("@auto") as load_log_input
+// does.
+LogInput log_input_from_sessions(StampedScans first, std::vector<StampedScans> more, const LogInputOptions &options);
 
 // Reads a CARMEN log's scans with their stamps and mounts (every laser
 // message; no selection), counting into *stats.
