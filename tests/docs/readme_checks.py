@@ -331,6 +331,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
                       "test -f a.yaml && test -f d/intel.map.gz && test -f d/intel.png"]),
         "sh: log2map monday.log.gz --add tuesday.log.gz@12.5,-3.0,1.5708": Check(
             "run", fixture="sessions", outputs=["both.map.gz"]),
+        "text: # date: 2026-12-06 22:21 UTC": picked("bench/results/align-2026-12-06-2core.txt"),
         "sh: log2map -q --json first.log --add second.log@auto both.map": Check(
             "covered-by", files=[("tests/log2map_auto_test.cc", [
                 "FindsTheTransformAndMapsAsIfItWereGiven", "\"@auto\"", "added_sessions",
