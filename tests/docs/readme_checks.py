@@ -437,7 +437,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "skip", reason="needs ros2 launch and slam_toolbox (a system ROS 2); python/tests/test_live_map.py "
                            "compiles the launch file and checks the node parameters it sets"),
         "text: # date: 2026-12-05 15:09 UTC": picked("bench/results/bench-ros-2026-12-05-h100-d.txt"),
-        "text: # date: 2026-12-06 19:04 UTC": picked("bench/results/bench-ros-2026-12-06-h100-kilted.txt"),
+        "text: # date: 2026-12-06 21:54 UTC": picked("bench/results/bench-ros-2026-12-06b-h100-kilted.txt"),
         "text: # date: 2026-12-05 14:58 UTC": picked("bench/results/bench-ros-2026-12-05-h100-c.txt"),
         "text: # date: 2026-12-05 15:13 UTC": picked("bench/results/bench-ros-2026-12-05-2core-e.txt"),
         "text: ## python3 bench/ros_map_transport.py":
