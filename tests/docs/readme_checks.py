@@ -332,6 +332,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "sh: log2map monday.log.gz --add tuesday.log.gz@12.5,-3.0,1.5708": Check(
             "run", fixture="sessions", outputs=["both.map.gz"]),
         "text: # date: 2026-12-06 22:21 UTC": picked("bench/results/align-2026-12-06-2core.txt"),
+        "text: # date: 2026-12-06 22:46 UTC": picked("bench/results/align-2026-12-06-h100.txt"),
         "sh: log2map -q --json first.log --add second.log@auto both.map": Check(
             "covered-by", files=[("tests/log2map_auto_test.cc", [
                 "FindsTheTransformAndMapsAsIfItWereGiven", "\"@auto\"", "added_sessions",
