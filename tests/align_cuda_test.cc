@@ -23,6 +23,9 @@
 
 namespace {
 
+using vasco::testing_support::distance_to;
+using vasco::testing_support::Segment;
+
 using vasco::AlignMap;
 using vasco::AlignOptions;
 using vasco::AlignResult;
@@ -73,17 +76,6 @@ void expect_truth(const AlignResult &r, const Pose2 &truth) {
 }
 
 // ---- a drawn floor plan -------------------------------------------------
-
-struct Segment {
-  double x0, y0, x1, y1;
-};
-
-double distance_to(const Segment &s, double x, double y) {
-  const double dx = s.x1 - s.x0, dy = s.y1 - s.y0;
-  const double len2 = dx * dx + dy * dy;
-  const double u = len2 > 0 ? std::clamp(((x - s.x0) * dx + (y - s.y0) * dy) / len2, 0.0, 1.0) : 0.0;
-  return std::hypot(x - (s.x0 + u * dx), y - (s.y0 + u * dy));
-}
 
 // A 24 x 14 m floor with rooms of different sizes and doors: no symmetry.
 const std::vector<Segment> &plan_walls() {

@@ -13,10 +13,14 @@
 #include <vector>
 
 #include "test_seed.h"
+#include "align_test_support.h"
 #include "vasco_gpu/align.h"
 #include "vasco_gpu/error.h"
 
 namespace {
+
+using vasco::testing_support::distance_to;
+using vasco::testing_support::Segment;
 
 using vasco::AlignMap;
 using vasco::AlignOptions;
@@ -25,23 +29,12 @@ using vasco::AlignVerdict;
 
 constexpr double kPi = 3.14159265358979323846;
 
-struct Segment {
-  double x0, y0, x1, y1;
-};
-
 // A floor plan: wall segments, and the rectangle inside which a robot saw
 // free space (outside it nothing is known).
 struct Plan {
   std::vector<Segment> walls;
   double x0, y0, x1, y1;
 };
-
-double distance_to(const Segment &s, double x, double y) {
-  const double dx = s.x1 - s.x0, dy = s.y1 - s.y0;
-  const double len2 = dx * dx + dy * dy;
-  const double u = len2 > 0 ? std::clamp(((x - s.x0) * dx + (y - s.y0) * dy) / len2, 0.0, 1.0) : 0.0;
-  return std::hypot(x - (s.x0 + u * dx), y - (s.y0 + u * dy));
-}
 
 // What the plan says at world (x, y): a wall 0.1 m thick, free inside, unknown outside.
 float plan_at(const Plan &plan, double x, double y) {
