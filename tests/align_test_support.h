@@ -13,8 +13,6 @@ namespace vasco::testing_support {
 
 constexpr double kAlignCell = 0.1;
 
-// Maps at 0.1 m directly (downsample 1): the cell the alignment matches at,
-// and quick enough to map a session per seed.
 // A wall of a drawn floor plan, and a point's distance to it.
 struct Segment {
   double x0, y0, x1, y1;
@@ -27,6 +25,8 @@ inline double distance_to(const Segment &s, double x, double y) {
   return std::hypot(x - (s.x0 + u * dx), y - (s.y0 + u * dy));
 }
 
+// Maps at 0.1 m directly (downsample 1): the cell the alignment matches at,
+// and quick enough to map a session per seed.
 inline MapperParams params_at_align_cell() {
   MapperParams p;
   p.resolution = kAlignCell;
