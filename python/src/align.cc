@@ -6,6 +6,7 @@
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
 
+#include <cmath>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -20,6 +21,41 @@
 namespace vasco_py {
 
 using namespace nb::literals;
+
+nb::dict align_result_dict(const vasco::AlignResult &r) {
+  const auto transform_of = [](const vasco::AlignCandidate &c) { return nb::make_tuple(c.x, c.y, c.theta); };
+  nb::dict d;
+  d["verdict"] = vasco::align_verdict_name(r.verdict);
+  d["reason"] = r.reason;
+  d["transform"] = transform_of(r.best);
+  d["score"] = r.best.score;
+  d["second_transform"] = r.has_second ? nb::object(transform_of(r.second)) : nb::none();
+  d["second_score"] = r.has_second ? nb::object(nb::float_(r.second.score)) : nb::none();
+  d["overlap"] = r.overlap;
+  d["matched"] = r.matched;
+  d["moving_points"] = r.moving_points;
+  d["rotations"] = r.rotations;
+  d["gpu"] = r.gpu;
+  return d;
+}
+
+vasco::AlignHint align_hint_of(nb::handle h, const std::string &what) {
+  std::vector<double> v;
+  if (!nb::try_cast(h, v) || (v.size() != 3 && v.size() != 5) || !std::isfinite(v[0]) || !std::isfinite(v[1]) ||
+      !std::isfinite(v[2]) || (v.size() == 5 && !(std::isfinite(v[3]) && v[3] >= 0 && std::isfinite(v[4]) && v[4] >= 0)))
+    throw carmen::Error(carmen::ErrorCode::Usage,
+                        what + ": a hint is (x, y, theta) or (x, y, theta, radius_m, radius_rad): finite numbers, "
+                               "the radii 0 or more, not " + std::string(nb::repr(h).c_str()));
+  vasco::AlignHint hint;
+  hint.x = v[0];
+  hint.y = v[1];
+  hint.theta = v[2];
+  if (v.size() == 5) {  // else AlignHint's radii
+    hint.radius_m = v[3];
+    hint.radius_rad = v[4];
+  }
+  return hint;
+}
 
 namespace {
 
@@ -37,24 +73,6 @@ vasco::AlignMap align_map_from(const Map &m) {
   return a;
 }
 
-// (x, y, theta) or (x, y, theta, radius_m, radius_rad); the radii default
-// to AlignHint's.
-vasco::AlignHint hint_from(const std::vector<double> &h) {
-  if (h.size() != 3 && h.size() != 5)
-    throw carmen::Error(carmen::ErrorCode::Usage,
-                        "_align_maps: hint is (x, y, theta) or (x, y, theta, radius_m, radius_rad), got " +
-                            std::to_string(h.size()) + " numbers");
-  vasco::AlignHint hint;
-  hint.x = h[0];
-  hint.y = h[1];
-  hint.theta = h[2];
-  if (h.size() == 5) {
-    hint.radius_m = h[3];
-    hint.radius_rad = h[4];
-  }
-  return hint;
-}
-
 // Where the global search runs: "auto" (the GPU where one is usable), "cpu" or "gpu".
 vasco::AlignOptions::Backend search_backend(const std::string &name) {
   if (name == "auto") return vasco::AlignOptions::Backend::Auto;
@@ -63,32 +81,14 @@ vasco::AlignOptions::Backend search_backend(const std::string &name) {
   throw carmen::Error(carmen::ErrorCode::Usage, "_align_maps: search is 'auto', 'cpu' or 'gpu', not '" + name + "'");
 }
 
-nb::tuple transform_of(const vasco::AlignCandidate &c) { return nb::make_tuple(c.x, c.y, c.theta); }
-
-nb::dict result_dict(const vasco::AlignResult &r) {
-  nb::dict d;
-  d["verdict"] = vasco::align_verdict_name(r.verdict);
-  d["reason"] = r.reason;
-  d["transform"] = transform_of(r.best);
-  d["score"] = r.best.score;
-  d["second_transform"] = r.has_second ? nb::object(transform_of(r.second)) : nb::none();
-  d["second_score"] = r.has_second ? nb::object(nb::float_(r.second.score)) : nb::none();
-  d["overlap"] = r.overlap;
-  d["matched"] = r.matched;
-  d["moving_points"] = r.moving_points;
-  d["rotations"] = r.rotations;
-  d["gpu"] = r.gpu;
-  return d;
-}
-
 nb::dict align(const Map &reference, const Map &moving, double match_resolution,
-               std::optional<std::vector<double>> hint, double min_score, double ambiguity, int min_matched,
+               nb::handle hint, double min_score, double ambiguity, int min_matched,
                int threads, const std::string &search, int cuda_device) {
   vasco::AlignOptions o;
   o.backend = search_backend(search);
   o.cuda_device = cuda_device;
   o.match_resolution = match_resolution;
-  if (hint) o.hint = hint_from(*hint);
+  if (!hint.is_none()) o.hint = align_hint_of(hint, "_align_maps: hint");
   o.min_score = min_score;
   o.ambiguity = ambiguity;
   o.min_matched = min_matched;
@@ -99,7 +99,7 @@ nb::dict align(const Map &reference, const Map &moving, double match_resolution,
     nb::gil_scoped_release release;
     r = vasco::align_maps(ref, mov, o);
   }
-  return result_dict(r);
+  return align_result_dict(r);
 }
 
 constexpr const char *kAlignDoc =

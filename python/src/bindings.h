@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 
+#include "vasco_gpu/align.h"
 #include "vasco_gpu/scan_batch.h"
 
 namespace vasco_py {
@@ -61,6 +62,14 @@ class WritableBytes {
 
 // The batch's poses as a new (n, 3) float64 array of (x, y, theta).
 nb::ndarray<nb::numpy, double> poses_of(const vasco::ScanBatch &b);
+
+// What the alignment's callers share (align.cc): _align_maps, load_log's and
+// load_bag's ("auto", hint) sessions, Mapper.insert(transform=...).
+// A hint (x, y, theta) or (x, y, theta, radius_m, radius_rad), its radii
+// AlignHint's where not given; UsageError naming `what` for anything else.
+vasco::AlignHint align_hint_of(nb::handle h, const std::string &what);
+// The result as a dict: verdict, reason, transform, score, second_*, overlap, counts.
+nb::dict align_result_dict(const vasco::AlignResult &r);
 
 }  // namespace vasco_py
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "arrays.h"
+#include "bindings.h"
 #include "carmen_compat/error.h"
 #include "log2map_app.h"
 #include "param_keys.h"
@@ -100,28 +101,9 @@ void set_pose_options(vasco::PoseSource &p, const std::string &key, nb::handle v
   }
 }
 
-// ("auto", (x, y, theta[, radius_m, radius_rad])): a guess the alignment
-// searches near (log2map's @auto:X,Y,THETA+-R,RTHETA).
-vasco::AlignHint hint_of(nb::handle h) {
-  std::vector<double> v;
-  if (!nb::try_cast(h, v) || (v.size() != 3 && v.size() != 5) || !std::isfinite(v[0]) || !std::isfinite(v[1]) ||
-      !std::isfinite(v[2]) || (v.size() == 5 && !(std::isfinite(v[3]) && v[3] >= 0 && std::isfinite(v[4]) && v[4] >= 0)))
-    throw Error(ErrorCode::Usage, "add: expected (path, (\"auto\", (x, y, theta[, radius_m, radius_rad]))): finite "
-                                  "numbers, the radii 0 or more");
-  vasco::AlignHint hint;
-  hint.x = v[0];
-  hint.y = v[1];
-  hint.theta = v[2];
-  if (v.size() == 5) {
-    hint.radius_m = v[3];
-    hint.radius_rad = v[4];
-  }
-  return hint;
-}
+}  // namespace
 
-// The second element of (path, WHAT): "auto" or ("auto", hint) sets
-// auto_transform; anything else is the transform.
-void session_transform_of(nb::handle what, vasco::SessionInput &s) {
+void session_transform_of(nb::handle what, vasco::SessionInput &s, const std::string &name) {
   const bool is_str = nb::isinstance<nb::str>(what);
   if (is_str && nb::cast<std::string>(what) == "auto") {
     s.auto_transform = true;
@@ -129,13 +111,15 @@ void session_transform_of(nb::handle what, vasco::SessionInput &s) {
   }
   if (nb::isinstance<nb::tuple>(what) && nb::len(what) == 2 && nb::isinstance<nb::str>(what[0]) &&
       nb::cast<std::string>(what[0]) == "auto") {
-    s.auto_transform = true;
-    s.hint = hint_of(what[1]);
+    s.auto_transform = true;  // with a guess the alignment searches near (log2map's @auto:X,Y,THETA+-R,RTHETA)
+    s.hint = align_hint_of(what[1], name + ": (\"auto\", hint)");
     return;
   }
-  if (is_str) throw Error(ErrorCode::Usage, "add: a session's transform is (x, y, theta) or \"auto\"");
-  s.transform = pose_triple(what, "add: transform");
+  if (is_str) throw Error(ErrorCode::Usage, name + ": a session's transform is (x, y, theta) or \"auto\"");
+  s.transform = pose_triple(what, (name + ": transform").c_str());
 }
+
+namespace {
 
 // add=[path, (path, (x, y, theta)), (path, "auto"), (path, ("auto", hint)), ...]
 std::vector<vasco::SessionInput> sessions_of(nb::handle add) {
@@ -144,7 +128,7 @@ std::vector<vasco::SessionInput> sessions_of(nb::handle add) {
     vasco::SessionInput s;
     if (nb::isinstance<nb::tuple>(item) && nb::len(item) == 2) {
       s.path = as_path(item[0]);
-      session_transform_of(item[1], s);
+      session_transform_of(item[1], s, "add");
     } else {
       s.path = as_path(item);
     }

@@ -24,6 +24,11 @@ void fill_input_options(vasco::LogInputOptions &o, const std::string &path,
                         std::optional<std::filesystem::path> param_file, const std::string &robot,
                         std::optional<nb::dict> overrides, nb::kwargs kwargs);
 
+// A session's placement: the second element of load_log's (path, WHAT) and
+// Mapper.insert's transform=. "auto" or ("auto", hint) sets auto_transform
+// (and hint); (x, y, theta) the transform. UsageError naming `name` else.
+void session_transform_of(nb::handle what, vasco::SessionInput &s, const std::string &name);
+
 }  // namespace vasco_py
 
 #endif  // VASCO_PY_INPUTS_H

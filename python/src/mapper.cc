@@ -27,6 +27,7 @@
 #include "arrays.h"
 #include "bindings.h"
 #include "carmen_compat/error.h"
+#include "inputs.h"
 #include "interruptible.h"
 #include "map_files.h"
 #include "vasco_gpu/backend.h"
@@ -34,6 +35,7 @@
 #include "vasco_gpu/map_output.h"
 #include "vasco_gpu/mapper.hpp"
 #include "vasco_gpu/option_schema.h"
+#include "vasco_gpu/pipeline/session_align.h"
 #include "vasco_gpu/pipeline/mapped.h"
 
 namespace vasco_py {
@@ -182,8 +184,50 @@ void init_mapper(Session *self, std::optional<vasco::MapperParams> params, const
   s->publish();
 }
 
-void insert(Session &s, const vasco::ScanBatch &scans) {
-  run_interruptible([&] { s.locked([&](vasco::Mapper &m) { m.insert(scans); }); });
+// Where insert(scans, transform="auto") puts the scans: aligned to the grid
+// the session holds (its finish()), as log2map's --add B@auto aligns B to
+// the sessions before it. A refusal throws before anything is stored.
+vasco::Pose2 aligned_placement(vasco::Mapper &m, const vasco::ScanBatch &scans, const vasco::SessionInput &how,
+                               vasco::AlignResult *found) {
+  if (m.num_scans() == 0)
+    throw Error(ErrorCode::State,
+                "Mapper.insert(transform=\"auto\"): the session holds no scans to align to; the first scans set "
+                "the shared frame (insert them without a transform)");
+  *found = vasco::align_session_to(vasco::align_map_of(m.finish(), m.frame()), scans, m.params(), how.hint, 0);
+  if (found->verdict != vasco::AlignVerdict::Aligned)
+    throw Error(ErrorCode::BadInput, "Mapper.insert(transform=\"auto\"): the scans are not aligned to the session's " +
+                                         std::to_string(m.num_scans()) + " scans: " +
+                                         vasco::align_candidates_text(*found) +
+                                         "; give transform=(x, y, theta), or (\"auto\", (x, y, theta)) near it");
+  return {found->best.x, found->best.y, found->best.theta};
+}
+
+// insert(scans, transform): None stores the scans as they are; (x, y,
+// theta), "auto" or ("auto", hint) store them taken into the session's
+// frame (Scans.transform's convention), the caller's Scans unchanged.
+// Returns the alignment's dict for "auto", else None.
+nb::object insert(Session &s, const vasco::ScanBatch &scans, nb::handle transform) {
+  if (transform.is_none()) {
+    run_interruptible([&] { s.locked([&](vasco::Mapper &m) { m.insert(scans); }); });
+    return nb::none();
+  }
+  vasco::SessionInput how;
+  session_transform_of(transform, how, "Mapper.insert");
+  std::optional<vasco::AlignResult> found;
+  run_interruptible([&] {
+    s.locked([&](vasco::Mapper &m) {
+      vasco::AlignResult r;
+      const vasco::Pose2 t = how.auto_transform ? aligned_placement(m, scans, how, &r) : how.transform;
+      vasco::ScanBatch moved = scans;
+      moved.transform(t.x, t.y, t.theta);
+      m.insert(std::move(moved));
+      if (how.auto_transform) found = std::move(r);
+    });
+  });
+  if (!found) return nb::none();
+  nb::dict d = align_result_dict(*found);
+  d["aligned"] = "auto";
+  return d;
 }
 
 void render(Session &s, nb::handle poses) {
@@ -378,11 +422,22 @@ void bind_mapper_constructor(nb::class_<Session> &cls) {
 }
 
 void bind_mapper_mapping(nb::class_<Session> &cls) {
-  cls.def("insert", &insert, "scans"_a,
+  cls.def("insert", &insert, "scans"_a, "transform"_a = nb::none(),
+          nb::sig("def insert(self, scans: Scans, transform: tuple[float, float, float] | str | "
+                  "tuple[str, typing.Sequence[float]] | None = None) -> dict[str, typing.Any] | None"),
           "Stores ``scans`` after those stored and applies them to the grid (exact backends: the bytes\n"
           "of mapping everything at once). Raises BadInputError (a ValueError) for a batch whose\n"
           "arrays disagree, RuntimeError when the frame would be too large or the session would\n"
-          "exceed max_memory_bytes (nothing is stored then).")
+          "exceed max_memory_bytes (nothing is stored then).\n\n"
+          "``transform`` places a session recorded in another frame (another run, another robot):\n"
+          "(x, y, theta) takes its poses into this session's frame first (as Scans.transform; the\n"
+          "caller's Scans unchanged); ``\"auto\"`` finds that transform by aligning the scans' map to\n"
+          "the session's grid (as log2map's ``--add B@auto``: mapped on the CPU, matched at 0.1 m or\n"
+          "the map cell where coarser), ``(\"auto\", (x, y, theta[, radius_m, radius_rad]))`` searches\n"
+          "near a guess. With \"auto\" it returns the alignment's dict (as align_sessions': 'transform',\n"
+          "'score', 'second_transform', ...); a session holding no scans yet raises StateError, scans\n"
+          "that do not overlap the grid or fit two places raise BadInputError naming the best\n"
+          "candidates, and nothing is stored.")
       .def("render", &render, "poses"_a, nb::sig("def render(self, poses: numpy.typing.ArrayLike) -> None"),
            "New poses for every stored scan, an (n, 3) float64 array of (x, y, theta), and the grid\n"
            "recomputed from scratch with them (only the poses travel to the GPU).")

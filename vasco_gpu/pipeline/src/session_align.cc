@@ -37,13 +37,17 @@ double session_match_resolution(const MapperParams &params) { return std::max(0.
 
 AlignResult align_session(const ScanBatch &reference, const ScanBatch &moving, const MapperParams &params,
                           const std::optional<AlignHint> &hint, int threads) {
-  const AlignMap ref = cpu_map_of(reference, params, threads);
+  return align_session_to(cpu_map_of(reference, params, threads), moving, params, hint, threads);
+}
+
+AlignResult align_session_to(const AlignMap &reference, const ScanBatch &moving, const MapperParams &params,
+                             const std::optional<AlignHint> &hint, int threads) {
   const AlignMap mov = cpu_map_of(moving, params, threads);
   AlignOptions options;
   options.match_resolution = session_match_resolution(params);
   options.hint = hint;
   options.threads = threads;
-  return align_maps(ref, mov, options);
+  return align_maps(reference, mov, options);
 }
 
 std::string align_candidates_text(const AlignResult &r) {

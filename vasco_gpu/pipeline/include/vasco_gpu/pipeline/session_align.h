@@ -49,6 +49,12 @@ double session_match_resolution(const MapperParams &params);
 AlignResult align_session(const ScanBatch &reference, const ScanBatch &moving, const MapperParams &params,
                           const std::optional<AlignHint> &hint, int threads);
 
+// As align_session, the reference already a map (a session's finish(), as
+// align_map_of gives it): Mapper.insert(scans, transform="auto") aligns to
+// the grid it holds rather than mapping its scans again.
+AlignResult align_session_to(const AlignMap &reference, const ScanBatch &moving, const MapperParams &params,
+                             const std::optional<AlignHint> &hint, int threads);
+
 // "reason; best (x, y, theta) score s, second (x, y, theta) score s": what a
 // refusal says of the candidates.
 std::string align_candidates_text(const AlignResult &r);
