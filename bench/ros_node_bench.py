@@ -208,6 +208,8 @@ def bench_one(player, log, name, batch, args, stamps, raw_path):
                 "scan": summary_value(line, "scan -> grid"), "path_p50": float(np.median(lat)),
                 "node": summary_value(line, "Path -> /map published").split("/")[0],
                 "steps": line.split("Path steps p50 ms: ", 1)[1].split(";")[0] if "Path steps" in line else "-",
+                "batch_steps": line.split("batch steps p50/p99 ms: ", 1)[1].split(";")[0]
+                if "batch steps" in line else "-",
                 "path_min": float(min(lat)), "rc": rc, "upd": update_latency(upd_node, traffic["wire"]),
                 "upd_node": upd_node, "published": published_counts(line), "size": (last.width, last.height),
                 "relay": relay_latencies(player, raw_path, args.paths, last.width, last.height), **traffic}
@@ -268,6 +270,9 @@ def print_rows(path: str, rows: dict, first_batch: float) -> None:
               f"{r['upd_node']}, published -> subscriber {wire}, at 40 Hz only {live}; at 40 Hz {u[2]} map_updates "
               f"({u[0] / 1e3:.1f} kB/s, whole maps {u[1]:.1f}x) and {r['live_maps']} full /maps; the node published "
               f"{r['published']}", flush=True)
+    for (name, b), r in rows.items():
+        print(f"#   {Path(path).name} {name}, batch {b:g} s: the node's batch steps, p50/p99 ms: {r['batch_steps']}",
+              flush=True)
 
 
 def main() -> int:

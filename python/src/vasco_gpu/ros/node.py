@@ -90,6 +90,8 @@ class MappingNode(NodeServices, LifecycleNode):
         # ... and its steps, per Path (ms): where a Path's time goes, in the summary
         self.path_steps: dict[str, Reservoir] = {
             k: Reservoir() for k in ("batch", "read", "repose", "finish", "message", "publish")}
+        # ... and per batch that sent a map_update (map: the batch's scans into the grid)
+        self.batch_steps: dict[str, Reservoir] = {k: Reservoir() for k in ("map", "finish", "message", "publish")}
         self._inputs: list = []  # activate's subscriptions
         self._batches: Batches | None = None
         self.add_on_set_parameters_callback(self._on_parameters)
@@ -446,12 +448,15 @@ class MappingNode(NodeServices, LifecycleNode):
         time from the timer to an update's publish() is the summary's batch -> map_updates."""
         start, version, updates = time.perf_counter(), self.live.version, self.out.counts["updates"]
         self._flush()
+        mapped = time.perf_counter()
         # the session's backend is its renderer's name: cuda_float or cuda_exact
         if self.live.version != version and self.live.backend.startswith("cuda") and \
                 self.out.update_pub.get_subscription_count():
-            self.out.publish(self.live, self.settings, self._map_stamp())
+            steps = self.out.publish(self.live, self.settings, self._map_stamp())
             if self.out.counts["updates"] != updates:
                 self.batch_ms.append((time.perf_counter() - start) * 1e3)
+                for k, v in {"map": mapped - start, **steps}.items():
+                    self.batch_steps[k].append(v * 1e3)
 
     def _flush(self) -> None:
         """The batch: the scans gathered for it mapped (by the timer, and now before a Path, a
@@ -577,6 +582,10 @@ class MappingNode(NodeServices, LifecycleNode):
             text += "; Path steps p50 ms: " + ", ".join(
                 f"{k} {np.percentile(v.values(), 50):.2f}" for k, v in self.path_steps.items() if len(v))
         text += _percentiles("batch -> map_updates published", self.batch_ms)
+        if self.batch_ms:
+            text += "; batch steps p50/p99 ms: " + ", ".join(
+                f"{k} {np.percentile(v.values(), 50):.2f}/{np.percentile(v.values(), 99):.2f}"
+                for k, v in self.batch_steps.items() if len(v))
         c = self.out.counts if getattr(self, "out", None) is not None else None
         if c and c["maps"]:
             text += (f"; published {c['maps']} maps ({c['map_bytes'] / 1e6:.2f} MB) and {c['updates']} map_updates "
