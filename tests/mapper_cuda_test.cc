@@ -178,9 +178,29 @@ TEST_F(MapperCuda, FinishOnTheDeviceEqualsCarmensFinishOfTheGrid) {
   }
 }
 
+// A grown grid (the frame a window of it) is finished on the device from a
+// copy of the window: CARMEN's finish of the frame's cells as read() gives
+// them, finished on the host, in either mode and at every downsample.
+TEST_F(MapperCuda, GrownGridFinishesTheFramesWindowAsTheHostDoes) {
+  for (CudaMode md : {CudaMode::Float, CudaMode::Exact}) {
+    Mapper grown(params_, "cuda", mode(md));
+    for (size_t a = 0; a < scans_.num_scans(); a += 70) grown.insert(scans_.select(static_cast<long>(a), 70));
+    ASSERT_NE(grown.grid_frame().size_x, grown.frame().size_x) << "the grid did not grow: the case is not tested";
+    const GridGeometry geo = grown.frame();
+    const std::vector<float> cells = grown.read();
+    for (int ds : {1, 3, 4}) {
+      const FinishedMap host = finish_grid(cells.data(), geo.size_x, geo.size_y, geo.resolution, ds, 20);
+      const FinishedMap dev = grown.finish(ds, 20);
+      EXPECT_EQ(dev.min_x, host.min_x);
+      EXPECT_EQ(dev.min_y, host.min_y);
+      EXPECT_EQ(golden::digest(dev), golden::digest(host)) << grown.backend_name() << " grown, downsample " << ds;
+    }
+  }
+}
+
 // finish as OccupancyGrid data, converted on the device: the host's
 // conversion of the finish, in either mode; in a grown grid (finished on the
-// host in strips) too.
+// device from a copy of the frame's window) too.
 TEST_F(MapperCuda, FinishOccupancyOnTheDeviceIsTheHostsConversion) {
   for (CudaMode md : {CudaMode::Float, CudaMode::Exact}) {
     Mapper m(params_, "cuda", mode(md));

@@ -112,10 +112,6 @@ double session_memory_need(const GridGeometry &geo, uint64_t beams, const Render
   return per_cell * static_cast<double>(geo.num_cells()) + 68.0 * static_cast<double>(beams);
 }
 
-// Cells a strip of a grown grid's finish reads at a time (finish_grid_by_columns):
-// 64 MiB of floats, or one block column when that is more.
-constexpr uint64_t kFinishStripCells = uint64_t(16) << 20;
-
 }  // namespace
 
 Mapper::Mapper(const MapperParams &params, const std::string &backend, const BackendOptions &options)
@@ -414,31 +410,26 @@ bool Mapper::finishes_whole_grid(const char *what, int downsample, int border) c
 
 FinishedMap Mapper::finish(int downsample, int border) const {
   if (finishes_whole_grid("Mapper::finish", downsample, border)) return renderer_->finish(downsample, border);
-  // A grown grid: CARMEN's finish of the frame()'s window of it, read a strip
-  // of columns at a time (no copy of the whole window in host memory).
-  const int dx = (grid_.size_x - geo_.size_x) / 2, dy = (grid_.size_y - geo_.size_y) / 2;
-  std::vector<float> strip;
-  const ColumnStrip columns = [&](int x0, int width) {
-    strip = renderer_->read(GridWindow{x0 + dx, dy, width, geo_.size_y});
-    return strip.data();
-  };
-  return finish_grid_by_columns(columns, geo_.size_x, geo_.size_y, geo_.resolution, downsample, border,
-                                kFinishStripCells);
+  return renderer_->finish_window(frame_window(), geo_.resolution, downsample, border);  // a grown grid
+}
+
+GridWindow Mapper::frame_window() const {
+  // frame() lies centred in the grid: the same first scan, whole cells of margin.
+  return GridWindow{(grid_.size_x - geo_.size_x) / 2, (grid_.size_y - geo_.size_y) / 2, geo_.size_x, geo_.size_y};
 }
 
 FinishedMap Mapper::finish_occupancy(const carmen::OccupancyValues &values, const OccupancyOut &out,
                                      int downsample, int border) const {
   if (finishes_whole_grid("Mapper::finish_occupancy", downsample, border))
     return renderer_->finish_occupancy(downsample, border, values, out);
-  return occupancy_of(finish(downsample, border), values, out);  // a grown grid: finished in strips on the host
+  return renderer_->finish_occupancy_window(frame_window(), geo_.resolution, downsample, border, values, out);
 }
 
 std::vector<float> Mapper::read(const GridWindow &window) const {
   check_grid_usable("Mapper::read");
   check_window(window, geo_);
-  // frame() lies centred in the grid: the same first scan, whole cells of margin.
-  const int dx = (grid_.size_x - geo_.size_x) / 2, dy = (grid_.size_y - geo_.size_y) / 2;
-  return renderer_->read(GridWindow{window.x0 + dx, window.y0 + dy, window.width, window.height});
+  const GridWindow frame = frame_window();
+  return renderer_->read(GridWindow{window.x0 + frame.x0, window.y0 + frame.y0, window.width, window.height});
 }
 
 std::vector<float> Mapper::read() const { return read(GridWindow{0, 0, geo_.size_x, geo_.size_y}); }

@@ -1,16 +1,42 @@
-// renderer.h's free functions and the Renderer's default finish_occupancy.
+// renderer.h's free functions and the Renderer's default finishes (of the
+// grid as occupancy data, of a window of it).
 #include "vasco_gpu/renderer.h"
 
 #include <utility>
 
 #include "carmen_compat/occupancy_grid.h"
 #include "vasco_gpu/error.h"
+#include "vasco_gpu/grid.h"
 
 namespace vasco {
 
 FinishedMap Renderer::finish_occupancy(int downsample, int border, const carmen::OccupancyValues &values,
                                        const OccupancyOut &out) {
   return occupancy_of(finish(downsample, border), values, out);
+}
+
+namespace {
+
+// Cells a strip of a window's finish reads at a time (finish_grid_by_columns):
+// 64 MiB of floats, or one block column when that is more.
+constexpr uint64_t kFinishStripCells = uint64_t(16) << 20;
+
+}  // namespace
+
+FinishedMap Renderer::finish_window(const GridWindow &window, double resolution, int downsample, int border) {
+  std::vector<float> strip;
+  const ColumnStrip columns = [&](int x0, int width) {
+    strip = read(GridWindow{window.x0 + x0, window.y0, width, window.height});
+    return strip.data();
+  };
+  return finish_grid_by_columns(columns, window.width, window.height, resolution, downsample, border,
+                                kFinishStripCells);
+}
+
+FinishedMap Renderer::finish_occupancy_window(const GridWindow &window, double resolution, int downsample,
+                                              int border, const carmen::OccupancyValues &values,
+                                              const OccupancyOut &out) {
+  return occupancy_of(finish_window(window, resolution, downsample, border), values, out);
 }
 
 FinishedMap occupancy_of(FinishedMap map, const carmen::OccupancyValues &values, const OccupancyOut &out) {

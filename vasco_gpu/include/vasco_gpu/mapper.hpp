@@ -211,6 +211,7 @@ class Mapper {
   // finish's and finish_occupancy's checks, naming `what`; whether the
   // renderer's grid is frame() itself (not grown with a margin around it).
   bool finishes_whole_grid(const char *what, int downsample, int border) const;
+  GridWindow frame_window() const;  // frame()'s cells in the renderer's grid
   InsertPlan plan_insert(const ScanBatch &scans) const;
   void apply_insert(const InsertPlan &plan, size_t before);
   Saved save() const { return Saved{scans_.num_scans(), geo_, grid_, extent_, stats_, shift_invariant_}; }

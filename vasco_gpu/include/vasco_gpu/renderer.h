@@ -69,6 +69,16 @@ class Renderer {
   // device and send one byte a cell instead of a float.
   virtual FinishedMap finish_occupancy(int downsample, int border, const carmen::OccupancyValues &values,
                                        const OccupancyOut &out);
+  // finish and finish_occupancy of a window of the grid (inside it), as if
+  // the window were the whole grid of cells `resolution` metres: a Mapper
+  // whose grid grew past its frame finishes the frame's cells. By default
+  // the window is read a strip of columns at a time and finished on the
+  // host; the CUDA renderers finish it on the device, where a live map's
+  // publication would otherwise bring the whole window's floats across.
+  virtual FinishedMap finish_window(const GridWindow &window, double resolution, int downsample, int border);
+  virtual FinishedMap finish_occupancy_window(const GridWindow &window, double resolution, int downsample,
+                                              int border, const carmen::OccupancyValues &values,
+                                              const OccupancyOut &out);
   // A window of the full-resolution grid, x-major (cells[x * height + y]);
   // the window must lie inside the grid.
   virtual std::vector<float> read(const GridWindow &window) = 0;

@@ -110,7 +110,53 @@ FinishedMap CudaRenderer::finish_occupancy(int downsample, int border, const car
                                            const OccupancyOut &out) {
   finish::Crop crop;
   FinishedMap m = finish_frame(downsample, border, &crop);
-  const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, downsample);
+  download_occupancy(finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, downsample), crop, values, out);
+  return m;
+}
+
+finish::KnownBox CudaRenderer::finish_blocks(int downsample) {
+  require_grid("finish");
+  select_device();
+  const finish::KnownBox known = block_means(cells(), grid_geo_.size_x, grid_geo_.size_y, downsample);
+  blocks_ds_ = downsample;
+  return known;
+}
+
+finish::KnownBox CudaRenderer::block_means(cuda::GridCells grid, int size_x, int size_y, int downsample) {
+  const finish::Blocks blocks = finish::blocks_of(size_x, size_y, downsample);
+  cuda_host::grow_to_checked(blocks_, std::max<size_t>(static_cast<size_t>(blocks.count()), 1),
+                             "the finish's block means");
+  blocks_ds_ = 0;  // until the caller says whose means they are
+  grow_to(known_, 1);
+  grow_to(staging_known_, 1);
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
+  staging_known_[0] = finish::KnownBox{};
+  VG_CUDA_CHECK(cudaMemcpyAsync(known_.get(), staging_known_.get(), sizeof(finish::KnownBox),
+                                cudaMemcpyHostToDevice, stream_));
+  cuda::launch_finish_blocks(grid, size_x, size_y, downsample, blocks_.get(), known_.get(), stream_);
+  VG_CUDA_CHECK(cudaMemcpyAsync(staging_known_.get(), known_.get(), sizeof(finish::KnownBox),
+                                cudaMemcpyDeviceToHost, stream_));
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
+  return staging_known_[0];
+}
+
+std::vector<float> CudaRenderer::read_blocks(const finish::Crop &crop) {
+  require_grid("finish");
+  if (blocks_ds_ < 1) throw Error(ErrorCode::Internal, "read_blocks before finish_blocks (a bug)");
+  select_device();
+  return download_crop(finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, blocks_ds_), crop);
+}
+
+std::vector<float> CudaRenderer::download_crop(const finish::Blocks &blocks, const finish::Crop &crop) {
+  const size_t n = static_cast<size_t>(crop.count());
+  cuda_host::grow_to_checked(finished_, std::max<size_t>(n, 1), "the finished map");
+  cuda::launch_crop(blocks_.get(), blocks, crop, finished_.get(), stream_);
+  const cuda::PinnedBuffer<float> &out = download(finished_.get(), n);
+  return std::vector<float>(out.get(), out.get() + n);
+}
+
+void CudaRenderer::download_occupancy(const finish::Blocks &blocks, const finish::Crop &crop,
+                                      const carmen::OccupancyValues &values, const OccupancyOut &out) {
   const size_t n = static_cast<size_t>(crop.count());
   cuda_host::grow_to_checked(occupancy_, std::max<size_t>(n, 1), "the finished map's OccupancyGrid data");
   grow_to(staging_occupancy_, std::max<size_t>(n, 1));
@@ -119,40 +165,54 @@ FinishedMap CudaRenderer::finish_occupancy(int downsample, int border, const car
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
   int8_t *data = out(n);
   if (n > 0) std::memcpy(data, staging_occupancy_.get(), n);
+}
+
+// The window's probabilities are the floats read() gives (launch_read_window:
+// the expressions finish uses), so the block means of the copy are the host
+// path's, bit for bit (MapperCuda tests of a grown grid).
+bool CudaRenderer::window_frame(const GridWindow &w, int downsample, int border, FinishedMap *frame,
+                                finish::Crop *crop) {
+  finish::check_arguments(downsample, border);
+  require_grid("finish");
+  if (w.x0 < 0 || w.y0 < 0 || w.width < 1 || w.height < 1 || w.width > grid_geo_.size_x - w.x0 ||
+      w.height > grid_geo_.size_y - w.y0)
+    throw Error(ErrorCode::Internal, "a finish window outside the grid (a bug)");
+  select_device();
+  const size_t n = static_cast<size_t>(w.width) * static_cast<size_t>(w.height);
+  try {
+    cuda_host::grow_to_checked(window_, n, "the frame's window of the grid");
+  } catch (const Error &e) {
+    if (e.code() == ErrorCode::OutOfMemory) return false;
+    throw;
+  }
+  VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
+  cuda::launch_read_window(cells(), grid_geo_.size_y, w.x0, w.y0, w.width, w.height, window_.get(), stream_);
+  cuda::GridCells copy;
+  copy.probs = window_.get();
+  const finish::KnownBox known = block_means(copy, w.width, w.height, downsample);
+  *crop = finish::crop_of(known, finish::blocks_of(w.width, w.height, downsample), border);
+  *frame = finish::finished_frame(*crop, grid_geo_.resolution, downsample);
+  return true;
+}
+
+FinishedMap CudaRenderer::finish_window(const GridWindow &window, double resolution, int downsample, int border) {
+  FinishedMap m;
+  finish::Crop crop;
+  if (!window_frame(window, downsample, border, &m, &crop))
+    return Renderer::finish_window(window, resolution, downsample, border);
+  m.cells = download_crop(finish::blocks_of(window.width, window.height, downsample), crop);
   return m;
 }
 
-finish::KnownBox CudaRenderer::finish_blocks(int downsample) {
-  require_grid("finish");
-  select_device();
-  const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, downsample);
-  cuda_host::grow_to_checked(blocks_, std::max<size_t>(static_cast<size_t>(blocks.count()), 1),
-                             "the finish's block means");
-  grow_to(known_, 1);
-  grow_to(staging_known_, 1);
-  VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
-  staging_known_[0] = finish::KnownBox{};
-  VG_CUDA_CHECK(cudaMemcpyAsync(known_.get(), staging_known_.get(), sizeof(finish::KnownBox),
-                                cudaMemcpyHostToDevice, stream_));
-  cuda::launch_finish_blocks(cells(), grid_geo_.size_x, grid_geo_.size_y, downsample, blocks_.get(), known_.get(),
-                             stream_);
-  VG_CUDA_CHECK(cudaMemcpyAsync(staging_known_.get(), known_.get(), sizeof(finish::KnownBox),
-                                cudaMemcpyDeviceToHost, stream_));
-  VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
-  blocks_ds_ = downsample;
-  return staging_known_[0];
-}
-
-std::vector<float> CudaRenderer::read_blocks(const finish::Crop &crop) {
-  require_grid("finish");
-  if (blocks_ds_ < 1) throw Error(ErrorCode::Internal, "read_blocks before finish_blocks (a bug)");
-  select_device();
-  const finish::Blocks blocks = finish::blocks_of(grid_geo_.size_x, grid_geo_.size_y, blocks_ds_);
-  const size_t n = static_cast<size_t>(crop.count());
-  cuda_host::grow_to_checked(finished_, std::max<size_t>(n, 1), "the finished map");
-  cuda::launch_crop(blocks_.get(), blocks, crop, finished_.get(), stream_);
-  const cuda::PinnedBuffer<float> &out = download(finished_.get(), n);
-  return std::vector<float>(out.get(), out.get() + n);
+FinishedMap CudaRenderer::finish_occupancy_window(const GridWindow &window, double resolution, int downsample,
+                                                  int border, const carmen::OccupancyValues &values,
+                                                  const OccupancyOut &out) {
+  FinishedMap m;
+  finish::Crop crop;
+  if (!window_frame(window, downsample, border, &m, &crop))
+    return Renderer::finish_occupancy_window(window, resolution, downsample, border, values, out);
+  download_occupancy(finish::blocks_of(window.width, window.height, downsample), crop, values, out);
+  return m;
 }
 
 std::vector<float> CudaRenderer::read(const GridWindow &w) {

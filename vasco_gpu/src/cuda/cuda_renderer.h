@@ -69,6 +69,12 @@ class CudaRenderer : public Renderer {
   // cell comes back instead of a float.
   FinishedMap finish_occupancy(int downsample, int border, const carmen::OccupancyValues &values,
                                const OccupancyOut &out) final;
+  // The window copied on the device as probabilities (the floats read
+  // gives), then finished there as a grid of its own: only the finished map
+  // crosses the bus. Where the device cannot hold the copy, the host's way.
+  FinishedMap finish_window(const GridWindow &window, double resolution, int downsample, int border) final;
+  FinishedMap finish_occupancy_window(const GridWindow &window, double resolution, int downsample, int border,
+                                      const carmen::OccupancyValues &values, const OccupancyOut &out) final;
   std::vector<float> read(const GridWindow &window) final;
 
  protected:
@@ -133,6 +139,17 @@ class CudaRenderer : public Renderer {
   void require_grid(const char *call) const;
   cuda::PinnedBuffer<float> &download(const float *device, size_t n);
   FinishedMap finish_frame(int downsample, int border, finish::Crop *crop);
+  // The block means of `grid` (size_x x size_y cells) into blocks_, and the
+  // known blocks' box.
+  finish::KnownBox block_means(cuda::GridCells grid, int size_x, int size_y, int downsample);
+  // finish_frame of a window, copied into window_ first; false (nothing
+  // changed but scratch) where the device cannot hold the copy.
+  bool window_frame(const GridWindow &window, int downsample, int border, FinishedMap *frame, finish::Crop *crop);
+  // The crop of blocks_ (the block grid `blocks`): as floats, and as
+  // OccupancyGrid data into out.
+  std::vector<float> download_crop(const finish::Blocks &blocks, const finish::Crop &crop);
+  void download_occupancy(const finish::Blocks &blocks, const finish::Crop &crop,
+                          const carmen::OccupancyValues &values, const OccupancyOut &out);
 
   BackendOptions options_;
   bool exact_;

@@ -10,7 +10,7 @@ import random
 
 import numpy as np
 
-__all__ = ["CAPACITY", "Reservoir"]
+__all__ = ["CAPACITY", "Reservoir", "percentiles_text", "steps_text"]
 
 CAPACITY = 4096  # values kept: 32 KiB a statistic
 
@@ -39,3 +39,18 @@ class Reservoir:
     def values(self) -> np.ndarray:
         """The sample: every value while at most capacity were seen."""
         return self._kept[:min(self._seen, self.capacity)]
+
+
+def percentiles_text(what: str, ms: Reservoir) -> str:
+    """"; what: p50 X ms, p99 Y ms (n)" of a reservoir of milliseconds; "" for none."""
+    if not len(ms):
+        return ""
+    p50, p99 = np.percentile(ms.values(), [50, 99])
+    return f"; {what}: p50 {p50:.2f} ms, p99 {p99:.2f} ms ({len(ms)})"
+
+
+def steps_text(steps: dict, ranks: tuple) -> str:
+    """"name P/P, ..." of named reservoirs (a Path's or a batch's steps) at the percentile ranks,
+    those without a value left out."""
+    return ", ".join(f"{k} " + "/".join(f"{np.percentile(v.values(), r):.2f}" for r in ranks)
+                     for k, v in steps.items() if len(v))

@@ -10,7 +10,6 @@ from __future__ import annotations
 import importlib
 import time
 
-import numpy as np
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import Path
 from nav_msgs.srv import GetMap
@@ -28,7 +27,7 @@ from ..msgs.table import MESSAGE_TYPES, MessageType
 from ..msgs.tf import TfLinkIgnored
 from .batches import Batches
 from .canvas import fixed_frame
-from .latency import Reservoir
+from .latency import Reservoir, percentiles_text, steps_text
 from .live_map import LiveMap, LiveMapError
 from .path_cdr import read_path
 from .publication import MapPublication
@@ -577,25 +576,14 @@ class MappingNode(NodeServices, LifecycleNode):
                 + (f"; {len(self.posing.unposed)} scans waiting for a pose (no transform, no Path over their stamps)"
                    if self.live is not None and len(self.posing.unposed) else ""))
         for what, ms in (("scan -> grid", self.scan_ms), ("Path -> /map published", self.path_ms)):
-            text += _percentiles(what, ms)
+            text += percentiles_text(what, ms)
         if self.path_ms:
-            text += "; Path steps p50 ms: " + ", ".join(
-                f"{k} {np.percentile(v.values(), 50):.2f}" for k, v in self.path_steps.items() if len(v))
-        text += _percentiles("batch -> map_updates published", self.batch_ms)
+            text += "; Path steps p50 ms: " + steps_text(self.path_steps, (50,))
+        text += percentiles_text("batch -> map_updates published", self.batch_ms)
         if self.batch_ms:
-            text += "; batch steps p50/p99 ms: " + ", ".join(
-                f"{k} {np.percentile(v.values(), 50):.2f}/{np.percentile(v.values(), 99):.2f}"
-                for k, v in self.batch_steps.items() if len(v))
+            text += "; batch steps p50/p99 ms: " + steps_text(self.batch_steps, (50, 99))
         c = self.out.counts if getattr(self, "out", None) is not None else None
         if c and c["maps"]:
             text += (f"; published {c['maps']} maps ({c['map_bytes'] / 1e6:.2f} MB) and {c['updates']} map_updates "
                      f"({c['update_bytes'] / 1e6:.2f} MB)")
         return text
-
-
-def _percentiles(what: str, ms) -> str:
-    """"; what: p50 X ms, p99 Y ms (n)" of a list of milliseconds; "" for none."""
-    if not len(ms):
-        return ""
-    p50, p99 = np.percentile(ms.values(), [50, 99])
-    return f"; {what}: p50 {p50:.2f} ms, p99 {p99:.2f} ms ({len(ms)})"
