@@ -5,6 +5,7 @@ bit, a fixed frame gives only updates, reset starts again."""
 
 from __future__ import annotations
 
+import copy
 from array import array
 from types import SimpleNamespace as NS
 
@@ -51,10 +52,13 @@ def expected_canvas(geometry, finished) -> np.ndarray:
     return want
 
 
-def publish_and_check(canvas, sub, finished, frame, full=False):
+def publish_and_check(canvas, sub, finished, frame, full=False, live=None):
     """Publishes, applies to the subscriber, and checks the subscriber against the map placed
-    independently in the canvas's geometry."""
-    got = canvas.publish(finished, frame, full=full)
+    independently in the canvas's geometry. With `live`, only the cells in its reach are
+    compared (as the node publishes), and the reach cleared after."""
+    got = canvas.publish(finished, frame, full=full, reach=None if live is None else live.reach)
+    if live is not None:
+        live.clear_reach()
     sub.take(got)
     assert sub.geometry == canvas.geometry
     np.testing.assert_array_equal(sub.cells, expected_canvas(sub.geometry, finished))
@@ -66,30 +70,36 @@ def add_scans(live, scans, order, stamps):
                   scans.first_angle[order], scans.angle_step[order], [(0.0, 0.0, 0.0)] * len(order))
 
 
-@pytest.mark.parametrize("seed", [1, 2])
-def test_updates_applied_to_a_full_map_give_the_next_full_map(intel, seed):
+@pytest.mark.parametrize("seed, backend, downsample, reach", [
+    (1, "cpu_double", 2, False), (2, "cpu_double", 2, False),
+    (3, "cpu_double", 2, True), (4, "cpu_float", 1, True), (5, "cpu_threads", 3, True)])
+def test_updates_applied_to_a_full_map_give_the_next_full_map(intel, seed, backend, downsample, reach):
     # intel (conftest) at the node's map cell: 0.025 m cells, downsample 2, so the blocks
-    # move whenever the frame grows by an odd number of cells a side (a new lattice)
+    # move whenever the frame grows by an odd number of cells a side (a new lattice). With
+    # reach, only the cells the scans since the last publication can reach are compared: a
+    # reach too small leaves the subscriber's map short of cells the independent one has.
     assert intel.params.downsample == 2
+    params = copy.copy(intel.params)
+    params.downsample = downsample
     rng = np.random.default_rng(seed)
     scans = intel.scans.select(0, 260)
     stamps = 10**9 + np.arange(260, dtype=np.int64) * 10**8
     order = rng.permutation(260)  # random order: the map grows in jumps, and back
-    live = LiveMap(intel.params, backend="cpu_double")
+    live = LiveMap(params, backend=backend)
     canvas, sub, kinds = Canvas(), Subscriber(), []
-    at = 0
+    at, given = 0, live if reach else None
     while at < len(order):
         k = int(rng.integers(1, 12))
         add_scans(live, scans, order[at:at + k], stamps)
         at += k
-        kinds.append(type(publish_and_check(canvas, sub, live.finish_grid(*MODE), live.mapper.frame)))
+        kinds.append(type(publish_and_check(canvas, sub, live.finish_grid(*MODE), live.mapper.frame, live=given)))
         if at >= 130 and "path" not in kinds:  # a Path: every scan moved, a full map due
             base = scans.poses + rng.normal(0, [0.03, 0.03, 0.005], (260, 3))
             assert live.repose(stamps, base, max_gap_ns=10**9)["moved"] == len(live)
-            got = publish_and_check(canvas, sub, live.finish_grid(*MODE), live.mapper.frame, full=True)
+            got = publish_and_check(canvas, sub, live.finish_grid(*MODE), live.mapper.frame, full=True, live=given)
             assert isinstance(got, FullMap)
             kinds.append("path")
-    assert kinds.count(MapUpdate) > 10 and canvas.growths >= 1
+    assert kinds.count(MapUpdate) > 10 and canvas.growths + canvas.lattices >= 2  # the canvas changed at least once
 
 
 def test_a_canvas_the_size_of_the_map_is_todays_map_bit_for_bit(intel):

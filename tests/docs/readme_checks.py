@@ -411,6 +411,10 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "python", fixture="logs", needs=["dask.distributed"],
             outputs=["maps/intel.gfs.map.gz", "maps/intel.gfs.png", "maps/fr101.carmen.map.gz",
                      "maps/fr101.carmen.png"]),
+        "python: ray.init()": Check(
+            "python", fixture="logs", needs=["ray"],
+            outputs=["maps/intel.gfs.map.gz", "maps/intel.gfs.png", "maps/fr101.carmen.map.gz",
+                     "maps/fr101.carmen.png"]),
         'python: log = vg.load_log("logs/intel.gfs.log.gz")': Check("python", fixture="logs", outputs=["merged.png"]),
     },
     "docs/sessions.md": {
@@ -419,7 +423,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
     },
     "docs/ros.md": {
         'sh: ROS_DISTRO=kilted pip install ".[ros]" ./ros': Check(
-            "covered-by", files=[(".ci/run", ["ROS_DISTRO=kilted", '"$vasco_wheel[dask,ros]"', "./ros",
+            "covered-by", files=[(".ci/run", ["ROS_DISTRO=kilted", '"$vasco_wheel[dask,ray,ros]"', "./ros",
                                               "VASCO_REQUIRE_ROS_TESTS=1"])]),
         'sh: ROS_DISTRO=jazzy pip install ".[ros-jazzy]" ./ros': Check(
             "covered-by", files=[(".ci/run", ["ROS_DISTRO=jazzy", '"$vasco_wheel[ros-jazzy]"', "./ros",

@@ -21,8 +21,8 @@ ROS bags (ROS 1 ``.bag``, ROS 2 sqlite3 and MCAP, read with ``rosbags``) give th
 ``vg.load_bag("run.mcap")``; poses from a SLAM back end: ``vg.load_log(path, poses="opt.g2o")``.
 
 Many logs to files, as log2map's batch mode, here or on the workers of any
-``concurrent.futures.Executor`` (a Dask cluster, a process pool), each worker keeping one
-mapper for all its logs::
+``concurrent.futures.Executor`` (a Dask cluster, a process pool, Ray actors through
+:class:`RayExecutor`), each worker keeping one mapper for all its logs::
 
     results = vg.map_logs(["a.log.gz", "b.clf"], "maps", formats=("map.gz", "png"),
                           executor=client.get_executor())     # maps/a.map.gz, maps/a.png, ...
@@ -103,6 +103,7 @@ __all__ = [
     "OutOfMemoryError",
     "Params",
     "ROS_MAP_RESOLUTION",
+    "RayExecutor",
     "Scans",
     "StateError",
     "TooLargeError",
@@ -128,6 +129,15 @@ __all__ = [
     "read_map",
     "write_map",
 ]
+
+
+def __getattr__(name: str):
+    # RayExecutor imports Ray only when asked for: ``import vasco_gpu`` works without it.
+    if name == "RayExecutor":
+        from .ray_executor import RayExecutor
+
+        return RayExecutor
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def read_map(path: str | os.PathLike) -> Map:

@@ -4,7 +4,8 @@
 Python: each log is read, mapped and written to ``DIR/STEM.FORMAT`` for each format, its
 outputs as one transaction, and a failed log is reported, not raised. With an ``executor``
 (any :class:`concurrent.futures.Executor`: a ``ProcessPoolExecutor``, a Dask ``Client``'s
-``get_executor()``, dask-cuda's cluster through its client, ...) one task is submitted per log
+``get_executor()``, dask-cuda's cluster through its client, Ray actors through
+:class:`vasco_gpu.RayExecutor`, ...) one task is submitted per log
 and the logs are mapped where the executor runs them; each worker process keeps one
 :class:`Mapper` per backend configuration for all the logs it maps, so it pays the backend's
 start-up (a CUDA context, device memory) once.
@@ -281,8 +282,14 @@ def map_logs(paths: Sequence[PathLike], out_dir: PathLike, formats: Union[str, S
         with LocalCluster(n_workers=4, threads_per_worker=1) as cluster, Client(cluster) as client:
             results = vg.map_logs(logs, "maps", executor=client.get_executor())
 
-    (dask-cuda's ``LocalCUDACluster`` gives each worker its own GPU the same way), or
-    ``ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"))`` (spawn or
+    (dask-cuda's ``LocalCUDACluster`` gives each worker its own GPU the same way), a Ray
+    cluster through :class:`vasco_gpu.RayExecutor` (Ray ships no Executor; this one runs
+    the tasks on long-lived actors, one mapper each, ``num_gpus=1/3`` three to a GPU)::
+
+        with vg.RayExecutor(num_gpus=1 / 3) as ex:
+            results = vg.map_logs(logs, "maps", executor=ex)
+
+    or ``ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"))`` (spawn or
     forkserver: a process that has used CUDA must not fork). Each process keeps one Mapper,
     and so one backend and CUDA context, for all the logs it maps (``Mapper.start_over``
     between them); threads of one process take turns on it. The paths travel to the workers

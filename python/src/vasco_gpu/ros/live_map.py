@@ -12,6 +12,7 @@ last full render, so that a quiet stream ends in the fresh map's bytes (log2map'
 
 from __future__ import annotations
 
+import math
 from array import array
 
 import numpy as np
@@ -24,6 +25,10 @@ __all__ = ["LiveMap", "LiveMapError"]
 
 # Bytes stored here per scan besides its ranges: stamp, pose (3), mount (3), first angle, step.
 _SCAN_BYTES = 8 * 9
+
+# LiveMap.reach's boxes: every cell may have changed (a render), and none has.
+EVERYWHERE = (-math.inf, -math.inf, math.inf, math.inf)
+NOWHERE = (math.inf, math.inf, -math.inf, -math.inf)
 
 # The session's host-memory budget by default, in bytes (vasco_gpu/option_schema.h).
 _DEFAULT_MAX_MEMORY = next(row["default"] for row in _core.option_schema("session") if row["name"] == "max_memory")
@@ -40,7 +45,9 @@ class LiveMap:
     Path of base poses can move it); ``repose`` applies a Path; ``set_params`` re-renders every
     stored scan with new mapper parameters; ``finish`` gives the map to publish; ``restore`` maps a
     saved session (session_file) into a new one. ``frame`` (a fixed grid) and ``frame_centre``
-    go to the Mapper only when given."""
+    go to the Mapper only when given. ``reach``: a world box (x0, y0, x1, y1) that holds every
+    cell changed since ``clear_reach`` (EVERYWHERE after a render): the publication compares
+    only those cells with the map it sent."""
 
     def __init__(self, params: _core.Params, *, backend: str = "auto", cuda_mode: str = "float",
                  device: int = 0, threads: int = 0, max_memory: int = _DEFAULT_MAX_MEMORY,
@@ -69,6 +76,7 @@ class LiveMap:
         self.ranges: list[np.ndarray] = []
         self.bytes = 0
         self._renders_settled = self.mapper.renders
+        self.reach = EVERYWHERE
 
     def __len__(self) -> int:
         return len(self.stamps)
@@ -96,10 +104,12 @@ class LiveMap:
         counts = [len(r) for r in ranges]
         scans = _core.Scans(poses, ranges[0] if len(ranges) == 1 else np.concatenate(ranges), counts,
                             np.asarray(first_angles, dtype=np.float64), np.asarray(angle_steps, dtype=np.float64))
+        renders = self.mapper.renders
         try:
             self.mapper.insert(scans)
         except (RuntimeError, MemoryError) as e:
             raise LiveMapError(str(e)) from None
+        self._reached(poses if self.mapper.renders == renders else None)
         self.stamps.extend(int(ns) for ns in stamps_ns)
         self.poses.frombytes(poses.tobytes())
         for m in mounts:
@@ -110,6 +120,24 @@ class LiveMap:
         self.ranges.extend(ranges)
         self.bytes += more
         self.version += 1
+
+    def _reached(self, poses) -> None:
+        """Widens ``reach`` by the cells scans at laser poses (k, 3) can change: those within
+        range_max of a laser's cell (egrid_math.h's sensor model stops a beam there), two fine
+        cells of margin; poses None: a render, every cell."""
+        if poses is None:
+            self.reach = EVERYWHERE
+            return
+        p = self.mapper.params
+        r = p.range_max + 2 * p.resolution
+        x, y = poses[:, 0], poses[:, 1]
+        b = self.reach
+        self.reach = (min(b[0], float(x.min()) - r), min(b[1], float(y.min()) - r),
+                      max(b[2], float(x.max()) + r), max(b[3], float(y.max()) + r))
+
+    def clear_reach(self) -> None:
+        """The grid as it is now was published: ``reach`` starts again from no cell."""
+        self.reach = NOWHERE
 
     def restore(self, saved) -> None:
         """Stores a saved session's scans (session_file.load_session's SavedSession: stamps,
@@ -165,6 +193,7 @@ class LiveMap:
         self.poses = array("d")
         self.poses.frombytes(np.ascontiguousarray(poses, dtype=np.float64).tobytes())
         self._renders_settled = self.mapper.renders
+        self.reach = EVERYWHERE
         self.version += 1
 
     def settle(self) -> bool:
@@ -180,6 +209,7 @@ class LiveMap:
         refusal changes nothing)."""
         params.validate()
         old = self.mapper.params
+        self.reach = EVERYWHERE
         self.mapper.start_over(params)
         if len(self) == 0:
             self.version += 1

@@ -119,7 +119,8 @@ class MapPublication:
         geometry = self.canvas.geometry
         if geometry is not None and geometry[2] != got[0][2]:
             self.canvas.reset()  # a new cell size: a canvas of the map's own size (its margin was in cells)
-        out = self.canvas.publish(got, live.mapper.frame, full=full_due)
+        out = self.canvas.publish(got, live.mapper.frame, full=full_due, reach=live.reach)
+        live.clear_reach()
         if out is None:
             return {}
         t1 = time.perf_counter()
