@@ -130,3 +130,27 @@ def type_description_file(name):
     found = next((p for p in paths if os.path.isfile(p)), None)
     assert found, f"no type description of {name} in {prefixes}"
     return found
+
+
+def test_the_published_messages_keep_the_canvas_array_where_rclpy_can():
+    """/map's and map_updates' messages hold the canvas's array itself (no map-sized copy a
+    /map); a distribution whose messages take no check_fields (Humble) gets plain ones."""
+    from array import array
+
+    from nav_msgs.msg import OccupancyGrid
+
+    from vasco_gpu.ros.grid import array_keeping_message
+
+    for cls in (OccupancyGrid, map_update_type()):
+        msg, data = array_keeping_message(cls), array("b", b"\x01\xff") * 8
+        msg.data = data
+        assert msg.data is data, cls
+        plain = cls(check_fields=False)
+        plain.data = data
+        assert plain.data is not data and plain.data == data  # what a plain message does: a copy
+
+    class Humble:
+        def __init__(self, **kwargs):
+            assert not kwargs, "Invalid arguments passed to constructor"
+
+    assert isinstance(array_keeping_message(Humble), Humble)

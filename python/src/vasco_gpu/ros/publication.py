@@ -15,7 +15,7 @@ from nav_msgs.msg import MapMetaData, OccupancyGrid
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from .canvas import Canvas, FullMap, fill_update
-from .grid import fill_grid
+from .grid import array_keeping_message, fill_grid
 from .tf_messages import map_update_type
 
 __all__ = ["MapPublication"]
@@ -42,8 +42,8 @@ class MapPublication:
         self.canvas = Canvas(fixed=fixed)
         self._published = -1  # the LiveMap version last published
         self.sent = False  # grid_msg published at least once: ~/dynamic_map serves it
-        self.grid_msg = OccupancyGrid()  # /map's message, filled again for each full map
-        self.update_msg = update_type()
+        self.grid_msg = array_keeping_message(OccupancyGrid)  # /map's, filled again for each full map
+        self.update_msg = array_keeping_message(update_type)
         self.counts = {"maps": 0, "updates": 0, "map_bytes": 0, "update_bytes": 0}
         self._finished = None  # the finish's buffer, written again for a map of its size
         self._subscribers = 0  # /map's, at the last publication
