@@ -10,6 +10,7 @@
 
 #include "carmen_compat/log_reader.h"
 #include "log_number.h"
+#include "log_short_decimal.h"
 
 namespace carmen {
 
@@ -86,23 +87,20 @@ class FieldParser {
     return true;
   }
 
-  // n numbers parsed as double and stored as float (the hot loop).
+  // n numbers parsed as double and stored as float (the hot loop): block by
+  // block while the line has 64 bytes and more left (log_short_decimal.h),
+  // and token by token where a block has no short decimal to convert first.
   bool floats(float *out, int n, const char *what) {
     const char *q = p_;
-    for (int i = 0; i < n; ++i) {
-      while (q < end_ && lex::is_sep(*q)) ++q;
-      double v;
-      const char *r = lex::fast_double(q, end_, v);
-      if (__builtin_expect(r == nullptr, 0)) {
-        p_ = q;
-        field_ += i;
-        if (!number(v, what, i)) return false;
-        q = p_;
-        field_ -= i + 1;
-      } else {
-        q = r;
+    int i = 0;
+    while (i < n) {
+      const int got = end_ - q >= lex::kBlock + 8 ? block_floats(q, out + i, n - i) : 0;
+      if (got > 0) {
+        i += got;
+        continue;
       }
-      out[i] = static_cast<float>(v);
+      if (!one_float(q, out[i], i, what)) return false;
+      ++i;
     }
     p_ = q;
     field_ += n;
@@ -144,6 +142,48 @@ class FieldParser {
   long long count_value_ = 0;
 
  private:
+  // Converts the short decimals among the tokens that end within the 64 bytes
+  // at q (q at a separator), in order and up to `want` of them, stopping
+  // before any other token. Moves q to the end of the last one converted;
+  // returns how many. q must have 72 bytes readable.
+  static int block_floats(const char *&q, float *out, int want) {
+    const lex::BlockMasks m = lex::block_masks(q);
+    const int clean = m.other ? __builtin_ctzll(m.other) : lex::kBlock;  // bytes before any other
+    uint64_t starts = ~m.sep & ~(~m.sep << 1);  // a token's first byte
+    uint64_t ends = m.sep & (~m.sep << 1);      // the separator after a token
+    int got = 0, last_end = 0;
+    while (got < want && ends != 0) {
+      const int s = __builtin_ctzll(starts), e = __builtin_ctzll(ends);
+      double v;
+      if (e > clean || !lex::block_decimal(q + s, e - s, m.dot >> s, v)) break;
+      out[got++] = static_cast<float>(v);
+      last_end = e;
+      starts &= starts - 1;
+      ends &= ends - 1;
+    }
+    q += last_end;
+    return got;
+  }
+
+  // The i-th of floats()'s numbers at q, by fast_double or else the whole
+  // token (which records a failure as field i).
+  bool one_float(const char *&q, float &out, int i, const char *what) {
+    while (q < end_ && lex::is_sep(*q)) ++q;
+    double v;
+    const char *r = lex::fast_double(q, end_, v);
+    if (__builtin_expect(r == nullptr, 0)) {
+      p_ = q;
+      field_ += i;
+      if (!number(v, what, i)) return false;
+      q = p_;
+      field_ -= i + 1;
+    } else {
+      q = r;
+    }
+    out = static_cast<float>(v);
+    return true;
+  }
+
   bool fail(Failure f, const char *w, int i, const char *b, const char *e) {
     failure = f;
     what = w;
