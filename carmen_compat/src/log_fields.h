@@ -94,7 +94,7 @@ class FieldParser {
     const char *q = p_;
     int i = 0;
     while (i < n) {
-      const int got = end_ - q >= lex::kBlock + 8 ? block_floats(q, out + i, n - i) : 0;
+      const int got = lex::kBlockParsing && end_ - q >= lex::kBlock + 8 ? block_floats(q, out + i, n - i) : 0;
       if (got > 0) {
         i += got;
         continue;

@@ -189,13 +189,13 @@ void init_mapper(Session *self, std::optional<vasco::MapperParams> params, const
 // the sessions before it. A refusal throws before anything is stored.
 vasco::Pose2 aligned_placement(vasco::Mapper &m, const vasco::ScanBatch &scans, const vasco::SessionInput &how,
                                vasco::AlignResult *found) {
+  const std::string call = how.hint ? "Mapper.insert(transform=(\"auto\", hint))" : "Mapper.insert(transform=\"auto\")";
   if (m.num_scans() == 0)
-    throw Error(ErrorCode::State,
-                "Mapper.insert(transform=\"auto\"): the session holds no scans to align to; the first scans set "
-                "the shared frame (insert them without a transform)");
+    throw Error(ErrorCode::State, call + ": the session holds no scans to align to; the first scans set the shared "
+                                         "frame (insert them without a transform)");
   *found = vasco::align_session_to(vasco::align_map_of(m.finish(), m.frame()), scans, m.params(), how.hint, 0);
   if (found->verdict != vasco::AlignVerdict::Aligned)
-    throw Error(ErrorCode::BadInput, "Mapper.insert(transform=\"auto\"): the scans are not aligned to the session's " +
+    throw Error(ErrorCode::BadInput, call + ": the scans are not aligned to the session's " +
                                          std::to_string(m.num_scans()) + " scans: " +
                                          vasco::align_candidates_text(*found) +
                                          "; give transform=(x, y, theta), or (\"auto\", (x, y, theta)) near it");

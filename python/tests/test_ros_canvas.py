@@ -261,3 +261,25 @@ def test_fill_update_fills_an_update_message():
     data = fill_update(msg, update, frame="map", stamp="t")
     assert (msg.header.frame_id, msg.header.stamp, msg.x, msg.y, msg.width, msg.height) == ("map", "t", 3, 4, 2, 1)
     assert msg.data is data and data.typecode == "b" and list(data) == [5, -1]
+
+
+def test_a_widened_crop_is_compared_whole_whatever_the_reach():
+    # CARMEN's crop can widen over blocks known before but never published (the frame grew
+    # inside the grid without a render; a border of 0): no scan since touched them, so the
+    # scans' reach does not hold them, and the update must carry them all the same.
+    rng = np.random.default_rng(5)
+    frame = NS(x0=0.0, y0=0.0, resolution=0.05, size_x=400, size_y=400)
+    canvas, sub = Canvas(fixed=True), Subscriber()
+    first = synthetic(frame, -100, -100, 60, 40, rng, ds=1)
+    publish_and_check(canvas, sub, first, frame)
+    (sx, sy, res, origin), data = first
+    cells = np.frombuffer(data, dtype=np.int8).reshape(sy, sx)
+    wider = np.concatenate([cells, rng.integers(0, 101, (sy, 1), dtype=np.int8)], axis=1)
+    second = ((sx + 1, sy, res, origin), wider.tobytes())
+    far = (origin[0] - 50.0, origin[1] - 50.0, origin[0] - 49.0, origin[1] - 49.0)  # nowhere near the new column
+    got = canvas.publish(second, frame, reach=far)
+    assert isinstance(got, MapUpdate)
+    sub.take(got)
+    np.testing.assert_array_equal(sub.cells, expected_canvas(sub.geometry, second))
+    # the same window again: only the reach is compared, and nothing changed there
+    assert canvas.publish(second, frame, reach=far) is None

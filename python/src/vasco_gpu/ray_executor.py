@@ -42,6 +42,11 @@ def actor_count(resources: Mapping[str, float], num_cpus: float = 1, num_gpus: f
     return max(1, math.floor(min(fits) + 1e-9))
 
 
+def _fail(failed: List[Tuple[cf.Future, BaseException]]) -> None:
+    for future, e in failed:
+        future.set_exception(e)
+
+
 class _Worker:
     """The actor's class: runs one task at a time in its own process."""
 
@@ -132,9 +137,10 @@ class RayExecutor(cf.Executor):
                 raise RuntimeError("RayExecutor: cannot submit after shutdown")
             future: cf.Future = cf.Future()
             self._queue.append((future, fn, args, kwargs))
-            self._start_queued()  # an idle actor takes it now, not at the dispatcher's next look
+            failed = self._start_queued()  # an idle actor takes it now, not at the dispatcher's next look
             self._lock.notify()
-            return future
+        _fail(failed)
+        return future
 
     def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
         with self._lock:
@@ -153,13 +159,16 @@ class RayExecutor(cf.Executor):
         try:
             while True:
                 with self._lock:
-                    self._start_queued()
-                    if self._closing and not self._queue and not self._running:
-                        return
+                    failed = self._start_queued()
+                    done = self._closing and not self._queue and not self._running
                     refs = list(self._running)
-                    if not refs:
+                    if not refs and not done and not failed:
                         self._lock.wait(1.0)  # submit and shutdown wake it
-                        continue
+                _fail(failed)
+                if done:
+                    return
+                if not refs:
+                    continue
                 ready, _ = self._ray.wait(refs, num_returns=1, timeout=_POLL_SECONDS, fetch_local=False)
                 for ref in ready:
                     self._settle(ref)
@@ -181,8 +190,11 @@ class RayExecutor(cf.Executor):
             if future.running() or future.set_running_or_notify_cancel():
                 future.set_exception(e)
 
-    def _start_queued(self) -> None:
-        # Called with the lock held.
+    def _start_queued(self) -> List[Tuple[cf.Future, BaseException]]:
+        """Hands queued calls to idle actors; called with the lock held. Returns the calls
+        that could not be handed over, for the caller to fail once it released the lock (a
+        future's done-callbacks run where its result is set, and may submit or shut down)."""
+        failed = []
         while self._queue and self._idle:
             future, fn, args, kwargs = self._queue.popleft()
             if not future.set_running_or_notify_cancel():
@@ -192,9 +204,10 @@ class RayExecutor(cf.Executor):
                 ref = actor.run.remote(fn, args, kwargs)
             except BaseException as e:  # e.g. an argument that cannot be pickled
                 self._idle.append(actor)
-                future.set_exception(e)
+                failed.append((future, e))
                 continue
             self._running[ref] = (future, actor)
+        return failed
 
     def _settle(self, ref) -> None:
         ray = self._ray
@@ -203,8 +216,10 @@ class RayExecutor(cf.Executor):
         try:
             result = ray.get(ref)
         except ray.exceptions.RayActorError as e:
-            self._replace(actor)
-            future.set_exception(e)
+            try:
+                self._replace(actor)
+            finally:  # the future is no longer in _running: it must be settled here, whatever happens
+                future.set_exception(e)
             return
         except ray.exceptions.RayTaskError as e:
             cause = e.cause if isinstance(e.cause, BaseException) else e

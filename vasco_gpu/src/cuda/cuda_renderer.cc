@@ -49,6 +49,10 @@ void CudaRenderer::reset_band(const GridGeometry &geo, const MapperParams &param
                                          std::to_string(band.width) + ") of a grid " + std::to_string(geo.size_x) +
                                          " cells wide (a bug)");
   select_device();
+  // The frame's window copy (a grown grid's finish, a whole read) is scratch
+  // of the frame's size: freed before a new grid is fitted into the device's
+  // memory, so that it never refuses a grid that fits without it.
+  window_.reset();
   GridGeometry grid = geo;
   grid.size_x = band.width;
   reserve_grid(grid);
@@ -124,9 +128,9 @@ finish::KnownBox CudaRenderer::finish_blocks(int downsample) {
 
 finish::KnownBox CudaRenderer::block_means(cuda::GridCells grid, int size_x, int size_y, int downsample) {
   const finish::Blocks blocks = finish::blocks_of(size_x, size_y, downsample);
+  blocks_ds_ = 0;  // until the caller says whose means they are (a failed growth empties blocks_)
   cuda_host::grow_to_checked(blocks_, std::max<size_t>(static_cast<size_t>(blocks.count()), 1),
                              "the finish's block means");
-  blocks_ds_ = 0;  // until the caller says whose means they are
   grow_to(known_, 1);
   grow_to(staging_known_, 1);
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
@@ -169,9 +173,11 @@ void CudaRenderer::download_occupancy(const finish::Blocks &blocks, const finish
 
 // The window's probabilities are the floats read() gives (launch_read_window:
 // the expressions finish uses), so the block means of the copy are the host
-// path's, bit for bit (MapperCuda tests of a grown grid).
-bool CudaRenderer::window_frame(const GridWindow &w, int downsample, int border, FinishedMap *frame,
-                                finish::Crop *crop) {
+// path's, bit for bit (MapperCuda tests of a grown grid). Throws
+// OutOfMemory, before anything but scratch changed, where the device cannot
+// hold the copy.
+FinishedMap CudaRenderer::window_frame(const GridWindow &w, double resolution, int downsample, int border,
+                                       finish::Crop *crop) {
   finish::check_arguments(downsample, border);
   require_grid("finish");
   if (w.x0 < 0 || w.y0 < 0 || w.width < 1 || w.height < 1 || w.width > grid_geo_.size_x - w.x0 ||
@@ -179,40 +185,55 @@ bool CudaRenderer::window_frame(const GridWindow &w, int downsample, int border,
     throw Error(ErrorCode::Internal, "a finish window outside the grid (a bug)");
   select_device();
   const size_t n = static_cast<size_t>(w.width) * static_cast<size_t>(w.height);
-  try {
-    cuda_host::grow_to_checked(window_, n, "the frame's window of the grid");
-  } catch (const Error &e) {
-    if (e.code() == ErrorCode::OutOfMemory) return false;
-    throw;
-  }
+  cuda_host::grow_to_checked(window_, n, "the frame's window of the grid");
   VG_CUDA_CHECK(cudaStreamSynchronize(stream_));
   cuda::launch_read_window(cells(), grid_geo_.size_y, w.x0, w.y0, w.width, w.height, window_.get(), stream_);
   cuda::GridCells copy;
   copy.probs = window_.get();
   const finish::KnownBox known = block_means(copy, w.width, w.height, downsample);
   *crop = finish::crop_of(known, finish::blocks_of(w.width, w.height, downsample), border);
-  *frame = finish::finished_frame(*crop, grid_geo_.resolution, downsample);
-  return true;
+  return finish::finished_frame(*crop, resolution, downsample);
+}
+
+// A device that cannot hold the window's copy or the finish's scratch (its
+// memory taken by the grid, or by another process): the host's way, as
+// before the device finished windows. The failed allocation's error is
+// cleared first, or the next launch check would report it.
+template <class DeviceWay, class HostWay>
+FinishedMap CudaRenderer::on_device_else(DeviceWay device_way, HostWay host_way) {
+  try {
+    return device_way();
+  } catch (const Error &e) {
+    if (e.code() != ErrorCode::OutOfMemory) throw;
+  }
+  (void)cudaGetLastError();
+  return host_way();
 }
 
 FinishedMap CudaRenderer::finish_window(const GridWindow &window, double resolution, int downsample, int border) {
-  FinishedMap m;
-  finish::Crop crop;
-  if (!window_frame(window, downsample, border, &m, &crop))
-    return Renderer::finish_window(window, resolution, downsample, border);
-  m.cells = download_crop(finish::blocks_of(window.width, window.height, downsample), crop);
-  return m;
+  return on_device_else(
+      [&] {
+        finish::Crop crop;
+        FinishedMap m = window_frame(window, resolution, downsample, border, &crop);
+        m.cells = download_crop(finish::blocks_of(window.width, window.height, downsample), crop);
+        return m;
+      },
+      [&] { return Renderer::finish_window(window, resolution, downsample, border); });
 }
 
+// out(n) is called once, after every allocation of the device's way: a
+// fallback never follows it.
 FinishedMap CudaRenderer::finish_occupancy_window(const GridWindow &window, double resolution, int downsample,
                                                   int border, const carmen::OccupancyValues &values,
                                                   const OccupancyOut &out) {
-  FinishedMap m;
-  finish::Crop crop;
-  if (!window_frame(window, downsample, border, &m, &crop))
-    return Renderer::finish_occupancy_window(window, resolution, downsample, border, values, out);
-  download_occupancy(finish::blocks_of(window.width, window.height, downsample), crop, values, out);
-  return m;
+  return on_device_else(
+      [&] {
+        finish::Crop crop;
+        FinishedMap m = window_frame(window, resolution, downsample, border, &crop);
+        download_occupancy(finish::blocks_of(window.width, window.height, downsample), crop, values, out);
+        return m;
+      },
+      [&] { return Renderer::finish_occupancy_window(window, resolution, downsample, border, values, out); });
 }
 
 std::vector<float> CudaRenderer::read(const GridWindow &w) {

@@ -142,9 +142,12 @@ class CudaRenderer : public Renderer {
   // The block means of `grid` (size_x x size_y cells) into blocks_, and the
   // known blocks' box.
   finish::KnownBox block_means(cuda::GridCells grid, int size_x, int size_y, int downsample);
-  // finish_frame of a window, copied into window_ first; false (nothing
-  // changed but scratch) where the device cannot hold the copy.
-  bool window_frame(const GridWindow &window, int downsample, int border, FinishedMap *frame, finish::Crop *crop);
+  // finish_frame of a window, copied into window_ first.
+  FinishedMap window_frame(const GridWindow &window, double resolution, int downsample, int border,
+                           finish::Crop *crop);
+  // device_way(), or host_way() where it ran out of device memory.
+  template <class DeviceWay, class HostWay>
+  FinishedMap on_device_else(DeviceWay device_way, HostWay host_way);
   // The crop of blocks_ (the block grid `blocks`): as floats, and as
   // OccupancyGrid data into out.
   std::vector<float> download_crop(const finish::Blocks &blocks, const finish::Crop &crop);

@@ -284,7 +284,8 @@ class Canvas:
 
     def _update(self, cells: np.ndarray, win: _Rect, reach: _Rect | None) -> MapUpdate | None:
         """The bounding box of the cells that differ from the canvas, written into it; only those
-        in `reach` (canvas cells) are compared where the window holds the last one."""
+        in `reach` (canvas cells) are compared where the window is the last one (a crop that
+        widens brings in cells known before but never published, which no scan since touched)."""
         old = self._window
         region = win if win.holds(old) else win.union(old)
         if region is win:
@@ -293,7 +294,7 @@ class Canvas:
             new = np.full((region.h, region.w), -1, dtype=np.int8)
             new[win.y - region.y:win.y - region.y + win.h, win.x - region.x:win.x - region.x + win.w] = cells
         self._window = win
-        if reach is not None and region is win:
+        if reach is not None and win == old:
             x, y = max(region.x, reach.x), max(region.y, reach.y)
             w, h = min(region.x + region.w, reach.x + reach.w) - x, min(region.y + region.h, reach.y + reach.h) - y
             if w <= 0 or h <= 0:

@@ -109,7 +109,8 @@ class LiveMap:
             self.mapper.insert(scans)
         except (RuntimeError, MemoryError) as e:
             raise LiveMapError(str(e)) from None
-        self._reached(poses if self.mapper.renders == renders else None)
+        finally:  # a refused insert that grew the grid rendered the stored scans again
+            self._reached(poses if self.mapper.renders == renders else None)
         self.stamps.extend(int(ns) for ns in stamps_ns)
         self.poses.frombytes(poses.tobytes())
         for m in mounts:
