@@ -25,6 +25,11 @@ LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability
 # What nav2's static layer subscribes map_updates with (rclcpp's default: reliable, volatile,
 # depth 10): an update is relative to the one before, so none may be dropped by the QoS; a
 # subscriber that joins late starts from the latched /map and the updates after it.
+# The finish's buffer is kept for the next publication up to this size: a small map made anew
+# page-faults each time it is published (often), while a kept one costs a byte a /map cell for
+# good beside the canvas (a large site of 2e8 cells: 200 MB); past it each publication's bytes
+# are used once and freed (glibc gives such a block back to the system at once).
+KEPT_FINISH_BYTES = 64 << 20
 UPDATES = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE,
                      history=HistoryPolicy.KEEP_LAST)
 
@@ -114,8 +119,9 @@ class MapPublication:
         if got is None:
             return {}
         if not isinstance(got[1], array):  # a new size: a buffer of it, written again next time
-            self._finished = array("b", got[1])
-            got = (got[0], self._finished)
+            self._finished = array("b", got[1]) if len(got[1]) <= KEPT_FINISH_BYTES else None
+            if self._finished is not None:
+                got = (got[0], self._finished)
         geometry = self.canvas.geometry
         if geometry is not None and geometry[2] != got[0][2]:
             self.canvas.reset()  # a new cell size: a canvas of the map's own size (its margin was in cells)
