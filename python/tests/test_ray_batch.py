@@ -65,12 +65,14 @@ def local_ray():
     """One Ray instance of two CPUs on this host for the module; none of its processes left after."""
     saved = os.environ.pop("RAY_ADDRESS", None)  # a new instance, never a cluster the caller has
     os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
+    # processes of earlier tests that outlive them (multiprocessing's resource tracker) are not Ray's
+    before = _descendants(os.getpid())
     ray.init(address="local", num_cpus=2, include_dashboard=False, _node_ip_address="127.0.0.1",
              log_to_driver=False)
     try:
         yield ray
     finally:
-        started = _descendants(os.getpid())
+        started = _descendants(os.getpid()) - before
         ray.shutdown()
         if saved is not None:
             os.environ["RAY_ADDRESS"] = saved
