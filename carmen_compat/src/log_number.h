@@ -19,6 +19,28 @@ constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+// A byte in each of the eight bytes of a word.
+constexpr uint64_t kOnes = 0x0101010101010101ull;
+
+// The digit at byte i of w, 8 bytes of a token loaded with p[i] in byte i.
+inline unsigned word_digit(uint64_t w, int i) { return static_cast<unsigned>(w >> (8 * i)) & 0x0Fu; }
+
+// The values of the three shapes most ranges take, their bytes loaded in w as
+// above: m / 10^f, one division of exact doubles, as fast_double and strtod
+// give it. two_decimals and the block parser (log_short_decimal.h) both use
+// them.
+inline double value_d_dd(uint64_t w) {
+  return static_cast<double>(word_digit(w, 0) * 100 + word_digit(w, 2) * 10 + word_digit(w, 3)) / kPow10[2];
+}
+inline double value_dd_dd(uint64_t w) {
+  return static_cast<double>(word_digit(w, 0) * 1000 + word_digit(w, 1) * 100 + word_digit(w, 3) * 10 +
+                             word_digit(w, 4)) /
+         kPow10[2];
+}
+inline double value_d_d(uint64_t w) {
+  return static_cast<double>(word_digit(w, 0) * 10 + word_digit(w, 2)) / kPow10[1];
+}
+
 // The shapes ranges are mostly written in (printf's "%.2f" below 100 m, or
 // "%g"): one or two digits, '.', two digits (or one), then a separator. They
 // are checked and converted from one 8-byte load: a branch on the shape
@@ -28,7 +50,6 @@ constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
 // fast_double's (m / 10^f).
 inline const char *two_decimals(const char *p, double &out) {
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-  constexpr uint64_t kOnes = 0x0101010101010101ull;
   uint64_t w;
   std::memcpy(&w, p, 8);  // p[i] in byte i
   // 0x80 in each byte that is an ASCII digit (on 7-bit values no carry
@@ -41,18 +62,16 @@ inline const char *two_decimals(const char *p, double &out) {
     return (digits & digit_bits) == digit_bits && ((w >> (8 * dot)) & 0xFF) == '.' &&
            is_sep(static_cast<char>(w >> (8 * end)));
   };
-  auto digit = [w](int i) { return static_cast<unsigned>(w >> (8 * i)) & 0x0Fu; };
   if (shape(0x80800080ull, 1, 4)) {  // d.dd
-    out = static_cast<double>(digit(0) * 100 + digit(2) * 10 + digit(3)) / kPow10[2];
+    out = value_d_dd(w);
     return p + 4;
   }
   if (shape(0x8080008080ull, 2, 5)) {  // dd.dd
-    out = static_cast<double>(digit(0) * 1000 + digit(1) * 100 + digit(3) * 10 + digit(4)) /
-          kPow10[2];
+    out = value_dd_dd(w);
     return p + 5;
   }
   if (shape(0x800080ull, 1, 3)) {  // d.d
-    out = static_cast<double>(digit(0) * 10 + digit(2)) / kPow10[1];
+    out = value_d_d(w);
     return p + 3;
   }
 #else

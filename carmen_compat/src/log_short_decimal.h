@@ -73,9 +73,6 @@ inline BlockMasks block_masks(const char *p) {
 
 namespace swar {
 
-constexpr uint64_t kOnes = 0x0101010101010101ull;
-constexpr uint64_t kHigh = kOnes * 0x80;
-
 // The low `bytes` bytes of a word set (bytes <= 7).
 inline uint64_t low_bytes(int bytes) { return (uint64_t(1) << (8 * bytes)) - 1; }
 
@@ -104,18 +101,17 @@ inline bool block_decimal(const char *p, int len, uint64_t dots, double &out) {
   dots &= (uint64_t(1) << len) - 1;
   uint64_t w;
   std::memcpy(&w, p, 8);  // p[i] in byte i
-  const auto digit = [w](int i) { return static_cast<unsigned>(w >> (8 * i)) & 0x0Fu; };
   // printf's "%.2f" and "%g" below 100 m: most ranges, a branch each.
   if (len == 4 && dots == 0x2) {  // d.dd
-    out = static_cast<double>(digit(0) * 100 + digit(2) * 10 + digit(3)) / kPow10[2];
+    out = value_d_dd(w);
     return true;
   }
   if (len == 3 && dots == 0x2) {  // d.d
-    out = static_cast<double>(digit(0) * 10 + digit(2)) / kPow10[1];
+    out = value_d_d(w);
     return true;
   }
   if (len == 5 && dots == 0x4) {  // dd.dd
-    out = static_cast<double>(digit(0) * 1000 + digit(1) * 100 + digit(3) * 10 + digit(4)) / kPow10[2];
+    out = value_dd_dd(w);
     return true;
   }
   const int has_dot = dots != 0;
