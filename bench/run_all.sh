@@ -13,13 +13,14 @@
 #                                          peers, MRPT's and OctoMap's grids beside ours (peer_bench, built by
 #                                          make bench-peers), only when named; large-site, a synthetic site of
 #                                          1e5 scans through log2map, a re-render and the node (PYTHON's
-#                                          vasco_gpu and rclpy), only when named)
+#                                          vasco_gpu and rclpy), only when named; ray, map_logs by executor,
+#                                          Ray's actors among them (PYTHON's vasco_gpu and ray), only when named)
 # COST_MODEL_OUT=FILE: batch_bench also writes auto's measured constants there
 # (vasco_gpu/src/backend_cost_model.txt is such a file); BATCH_ARGS: more of
 # batch_bench's options; BENCH_COMMIT: the commit to name where the tree is
 # a copy without its git history; PYTHON: the interpreter of the ros step (one with vasco_gpu,
 # rclpy and tf2_msgs), ROS_BENCH_ARGS: more of ros_node_bench.py's options; LIVEMAP_ARGS: live_map_steps.py's; PEER_ARGS: peer_bench's; ALIGN_ARGS: align_bench's;
-# LARGE_SITE_ARGS: large_site_bench.py's (default: the CPU backends' rows, cpu_float; a GPU host names
+# RAY_ARGS: ray_bench.py's; LARGE_SITE_ARGS: large_site_bench.py's (default: the CPU backends' rows, cpu_float; a GPU host names
 # --backends cuda_float cuda_exact --node-backend cuda_float).
 set -euo pipefail
 build=${1:?usage: bench/run_all.sh BUILD_DIR [STEP...]}
@@ -65,6 +66,7 @@ for step in $steps; do
                "${PYTHON:-python3}" bench/live_map_steps.py ${LIVEMAP_ARGS:-} ;;
     transport) run_as "python3 bench/ros_map_transport.py" "${PYTHON:-python3}" bench/ros_map_transport.py ;;
     peers) run "$build/bin/peer_bench" ${PEER_ARGS:-} ;;
+    ray) run_as "python3 bench/ray_bench.py ${RAY_ARGS:-}" "${PYTHON:-python3}" bench/ray_bench.py ${RAY_ARGS:-} ;;
     large-site) run_as "python3 bench/large_site_bench.py --bin $build/bin ${LARGE_SITE_ARGS:-}" \
                   "${PYTHON:-python3}" bench/large_site_bench.py --bin "$build/bin" ${LARGE_SITE_ARGS:-} ;;
     *) echo "bench/run_all.sh: unknown step '$step'" >&2; exit 2 ;;

@@ -6,6 +6,7 @@ dead actor, shutdown killing the actors)."""
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import operator
 import os
 import subprocess
@@ -60,15 +61,15 @@ def _state(pid):
     return text[text.rindex(")") + 2:].split()[0]
 
 
-@pytest.fixture(scope="module")
-def local_ray():
-    """One Ray instance of two CPUs on this host for the module; none of its processes left after."""
+@contextlib.contextmanager
+def ray_instance(**resources):
+    """A new local Ray instance of these resources for the block; none of its processes left after."""
     saved = os.environ.pop("RAY_ADDRESS", None)  # a new instance, never a cluster the caller has
     os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
     # processes of earlier tests that outlive them (multiprocessing's resource tracker) are not Ray's
     before = _descendants(os.getpid())
-    ray.init(address="local", num_cpus=2, include_dashboard=False, _node_ip_address="127.0.0.1",
-             log_to_driver=False)
+    ray.init(address="local", include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False,
+             **resources)
     try:
         yield ray
     finally:
@@ -77,6 +78,13 @@ def local_ray():
         if saved is not None:
             os.environ["RAY_ADDRESS"] = saved
     assert not _wait_gone(started), "Ray processes left after ray.shutdown()"
+
+
+@pytest.fixture(scope="module")
+def local_ray():
+    """One Ray instance of two CPUs on this host for the module."""
+    with ray_instance(num_cpus=2) as instance:
+        yield instance
 
 
 def _pids(workers):
@@ -158,6 +166,27 @@ def test_fail_fast(tmp_path, local_ray):
         assert not r.ok and "not mapped" in r.error, r.error
     assert (out / "garbage.map.gz").read_bytes() == b"an earlier map of garbage.log"
     assert not [n for n in os.listdir(out) if n.startswith(".")]
+
+
+def test_a_failed_constructor_leaves_no_actor(local_ray, monkeypatch):
+    """The third actor cannot be made: the constructor raises, and the two made before are
+    killed (their handles, still held here, answer no more)."""
+    made = []
+    real = RayExecutor._new_actor
+
+    def third_fails(self):
+        if len(made) == 2:
+            raise RuntimeError("no room for a third actor")
+        made.append(real(self))
+        return made[-1]
+
+    monkeypatch.setattr(RayExecutor, "_new_actor", third_fails)
+    with pytest.raises(RuntimeError, match="no room"):
+        RayExecutor(actors=3)
+    assert len(made) == 2
+    for actor in made:
+        with pytest.raises(ray.exceptions.RayActorError):
+            ray.get(actor.where.remote(), timeout=60)
 
 
 def test_lazy_import():

@@ -113,7 +113,13 @@ class RayExecutor(cf.Executor):
         self._queue: Deque[Tuple[cf.Future, Callable[..., Any], Tuple[Any, ...], Dict[str, Any]]] = \
             collections.deque()
         self._running: Dict[Any, Tuple[cf.Future, Any]] = {}  # ObjectRef -> (future, actor)
-        self._actors: List[Any] = [self._new_actor() for _ in range(int(actors))]
+        self._actors: List[Any] = []
+        try:
+            for _ in range(int(actors)):
+                self._actors.append(self._new_actor())
+        except BaseException:
+            self._kill_actors()  # those made before the failure: no actor outlives a failed constructor
+            raise
         self._idle: List[Any] = list(self._actors)
         self._closing = False
         self._dispatcher = threading.Thread(target=self._dispatch, name="RayExecutor", daemon=True)
