@@ -73,7 +73,8 @@ def main():
             rows += [("Ray, num_gpus=1/3", 3, lambda: RayExecutor(num_gpus=1 / 3)),
                      ("Ray, num_gpus=1", 1, lambda: RayExecutor(num_gpus=1))]
         else:
-            rows += [("Ray, num_cpus=1", 3, lambda: RayExecutor(actors=3))]
+            n = min(3, cores)  # an actor that does not fit would wait for ever: its log with it
+            rows += [("Ray, num_cpus=1", n, lambda: RayExecutor(actors=n))]
     with tempfile.TemporaryDirectory() as src:
         paths = []
         for i in range(args.copies):
