@@ -8,6 +8,7 @@ import math
 import re
 import subprocess
 import sys
+import tracemalloc
 from array import array
 from pathlib import Path
 
@@ -117,6 +118,30 @@ def test_new_parameters_map_every_stored_scan_again():
     assert live.finish().sha256() == fresh.finish().sha256()
     n = live.reset()
     assert n == 100 and len(live) == 0 and live.finish() is None
+
+
+def test_the_ranges_are_stored_once_in_the_mapper():
+    """A scan's ranges stay in the Mapper only (a large site's 10^5 scans: 144 MB, not twice):
+    the Python heap holds no copy of 4 MB of ranges added, and the copy set_params and a saved
+    session take comes back from the Mapper bit for bit."""
+    log = vg.load_log(CASES["intel.gfs__vasco_default_ds4"][0])
+    live = LiveMap(log.params, backend="cpu_double")
+    rng = np.random.default_rng(7)
+    # float64 given: add_many makes the float32 arrays (4 MB) while tracemalloc watches
+    ranges = [rng.uniform(0.1, 20, 1000) for _ in range(1000)]
+    want = np.concatenate(ranges).astype(np.float32)
+    tracemalloc.start()
+    try:
+        base = tracemalloc.get_traced_memory()[0]
+        live.add_many(np.arange(1000), np.zeros((1000, 3)), ranges, np.full(1000, -1.5), np.full(1000, 0.003),
+                      [None] * 1000)
+        held = tracemalloc.get_traced_memory()[0] - base
+    finally:
+        tracemalloc.stop()
+    assert held < 1_000_000, f"{held} bytes kept on the Python side for 4 MB of ranges"
+    assert live.stored_ranges().tobytes() == want.tobytes()
+    live.set_params(vg.Params(resolution=0.05))
+    assert live.stored_ranges().tobytes() == want.tobytes() and len(live) == 1000
 
 
 def test_grid_values_by_hand():

@@ -1,5 +1,5 @@
-"""LiveMap: the node's mapping session. Every scan it is given stays stored (in the Mapper, on
-the GPU for cuda, and its ranges here for a change of parameters); a Path of base poses moves
+"""LiveMap: the node's mapping session. Every scan it is given stays stored (its ranges in the
+Mapper only, also on the GPU for cuda; its stamp, pose and mount here); a Path of base poses moves
 every stored scan in its span and the whole grid is rendered again. No rclpy here: the node
 feeds it, and the tests drive it directly too.
 
@@ -73,7 +73,6 @@ class LiveMap:
         self.first_angle = array("d")
         self.angle_step = array("d")
         self.beam_counts = array("q")
-        self.ranges: list[np.ndarray] = []
         self.bytes = 0
         self._renders_settled = self.mapper.renders
         self.reach = EVERYWHERE
@@ -99,7 +98,7 @@ class LiveMap:
         more = sum(r.nbytes for r in ranges) + _SCAN_BYTES * len(ranges)
         if self.max_memory and self.bytes + more > self.max_memory:
             raise LiveMapError(f"max_memory {self.max_memory} bytes reached: {len(self)} scans stored "
-                               f"({self.bytes} bytes of ranges and poses here, the grid besides)")
+                               f"({self.bytes} bytes of ranges and poses, the grid besides)")
         poses = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
         counts = [len(r) for r in ranges]
         scans = _core.Scans(poses, ranges[0] if len(ranges) == 1 else np.concatenate(ranges), counts,
@@ -118,7 +117,6 @@ class LiveMap:
         self.first_angle.extend(float(a) for a in first_angles)
         self.angle_step.extend(float(a) for a in angle_steps)
         self.beam_counts.extend(counts)
-        self.ranges.extend(ranges)
         self.bytes += more
         self.version += 1
 
@@ -161,6 +159,10 @@ class LiveMap:
             if saved.params.to_dict() != old.to_dict():
                 self.set_params(old)
             raise
+
+    def stored_ranges(self) -> np.ndarray:
+        """Every stored scan's ranges, float32, scan after scan: a copy of the Mapper's."""
+        return self.mapper._stored_ranges()
 
     def _pose_array(self) -> np.ndarray:
         return np.frombuffer(self.poses, dtype=np.float64).reshape(-1, 3)
@@ -210,16 +212,18 @@ class LiveMap:
         refusal changes nothing)."""
         params.validate()
         old = self.mapper.params
+        # the ranges live in the Mapper only: copied out before start_over drops them (twice
+        # the ranges for the length of this call, once again after it)
+        scans = None if len(self) == 0 else _core.Scans(
+            self._pose_array(), self.stored_ranges(),
+            np.frombuffer(self.beam_counts, dtype=np.int64).astype(np.float64),
+            np.frombuffer(self.first_angle, dtype=np.float64), np.frombuffer(self.angle_step, dtype=np.float64))
         self.reach = EVERYWHERE
         self.mapper.start_over(params)
-        if len(self) == 0:
+        if scans is None:
             self.version += 1
             self._renders_settled = self.mapper.renders
             return
-        scans = _core.Scans(self._pose_array(), np.concatenate(self.ranges),
-                            np.frombuffer(self.beam_counts, dtype=np.int64).astype(np.float64),
-                            np.frombuffer(self.first_angle, dtype=np.float64),
-                            np.frombuffer(self.angle_step, dtype=np.float64))
         try:
             self.mapper.insert(scans)
         except (RuntimeError, MemoryError) as e:

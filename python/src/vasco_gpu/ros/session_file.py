@@ -137,7 +137,7 @@ class SavedSession:
                    first_angle=np.array(live.first_angle, dtype=np.float64),
                    angle_step=np.array(live.angle_step, dtype=np.float64),
                    beam_counts=np.array(live.beam_counts, dtype=np.int64),
-                   ranges=np.concatenate(live.ranges) if n else np.zeros(0, np.float32),
+                   ranges=live.stored_ranges(),
                    params=live.mapper.params,
                    options={**live.options, "max_memory": int(live.max_memory)})
 
