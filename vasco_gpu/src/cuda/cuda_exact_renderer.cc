@@ -239,12 +239,16 @@ void CudaExactRenderer::report_tile_lists(uint64_t pair_bound, size_t tiles) {
   VG_CUDA_CHECK(cudaMemcpy(begin.data(), tile_begin_.get(), tiles * 4, cudaMemcpyDeviceToHost));
   VG_CUDA_CHECK(cudaMemcpy(end.data(), tile_end_.get(), tiles * 4, cudaMemcpyDeviceToHost));
   uint64_t pairs = 0;
+  size_t empty = 0;
   std::vector<uint32_t> len(tiles);
-  for (size_t t = 0; t < tiles; ++t) pairs += len[t] = end[t] - begin[t];
+  for (size_t t = 0; t < tiles; ++t) {
+    pairs += len[t] = end[t] - begin[t];
+    empty += len[t] == 0;
+  }
   std::sort(len.begin(), len.end(), std::greater<uint32_t>());
-  std::fprintf(stderr, "  [cuda] beams %llu, pairs %llu (bound %llu), tiles %zu, longest lists %u %u %u %u\n",
+  std::fprintf(stderr, "  [cuda] beams %llu, pairs %llu (bound %llu), tiles %zu (%zu no beam crosses), longest lists %u %u %u %u\n",
                static_cast<unsigned long long>(beams_), static_cast<unsigned long long>(pairs),
-               static_cast<unsigned long long>(pair_bound), tiles, len.size() > 0 ? len[0] : 0,
+               static_cast<unsigned long long>(pair_bound), tiles, empty, len.size() > 0 ? len[0] : 0,
                len.size() > 1 ? len[1] : 0, len.size() > 2 ? len[2] : 0, len.size() > 3 ? len[3] : 0);
 }
 
