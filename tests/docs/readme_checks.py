@@ -383,8 +383,8 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             picked("bench/results/session-2026-12-06-h100.txt"),
         "text: ## build-bench/bin/session_bench": picked(BENCH_RUN),
         "text: ## python3 bench/batch_bench.py --bin build-bench/bin --copi": picked(BENCH_RUN),
-        "text: # vasco_gpu benchmarks: bench/run_all.sh build-gpu batch":
-            picked("bench/results/batch-2026-12-06c-h100.txt"),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build-ray-pip batch":
+            picked("bench/results/batch-2026-12-07-h100.txt"),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build peers": picked(PEERS_RUN),
         "text: re-render linear in cell updates (cpu_float): ns per update":
             picked("bench/results/large-site-2026-12-07b-2core.txt"),
@@ -413,6 +413,8 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             "python", fixture="logs", needs=["dask.distributed"],
             outputs=["maps/intel.gfs.map.gz", "maps/intel.gfs.png", "maps/fr101.carmen.map.gz",
                      "maps/fr101.carmen.png"]),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build-ray-pip ray":
+            picked("bench/results/ray-2026-12-07-h100.txt"),
         "python: ray.init()": Check(
             "python", fixture="logs", needs=["ray"],
             outputs=["maps/intel.gfs.map.gz", "maps/intel.gfs.png", "maps/fr101.carmen.map.gz",
