@@ -200,8 +200,8 @@ __global__ void pairs_kernel(KernelModel<double> m, const LineRec *lines, const 
 }
 
 // kNoTile into the slots past the real pairs, [offsets[n], capacity): only
-// the bound's slack (fr079: 1.06 million slots of 30.7 million), not the
-// whole capacity, which pairs_kernel writes anyway. Every slot when the real
+// the bound's slack (fr079: 1.06 million slots of 30.7 million), since
+// pairs_kernel writes every slot before offsets[n]. Every slot when the real
 // pairs passed the capacity: pairs_kernel then writes none, and the lists
 // come out empty.
 constexpr unsigned kPadBlocks = 256;
