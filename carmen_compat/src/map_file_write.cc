@@ -1,6 +1,5 @@
 // CARMEN map files: the encoders and the atomic writer (map_file.h).
 #include <unistd.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -8,6 +7,7 @@
 #include <cstring>
 #include <ctime>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -15,6 +15,7 @@
 #include "carmen_compat/error.h"
 #include "carmen_compat/file_names.h"
 #include "carmen_compat/map_file.h"
+#include "gzip_write.h"
 #include "map_file_bytes.h"
 
 namespace carmen {
@@ -190,65 +191,42 @@ struct PayloadEncoder {
   }
 };
 
-// Output to a temporary file, plain or gzip.
+// Output to a temporary file, plain or gzip (gzip_write.h).
 class Sink {
  public:
-  Sink(AtomicOutput &out, bool gzip) : final_(out.final_path()), gzip_(gzip) {
-    if (gzip_) {
-      const int fd = out.take_fd();
-      gz_ = gzdopen(fd, "wb");
-      if (gz_ == nullptr) {
-        ::close(fd);
-        throw FileError(final_, "cannot write " + out.temp_path() + ": " +
-                                    std::strerror(errno != 0 ? errno : ENOMEM));
-      }
+  Sink(AtomicOutput &out, bool gzip) : final_(out.final_path()) {
+    if (gzip) {
+      gz_ = std::make_unique<gzip::GzipWriter>(out.take_fd(), final_);
     } else {
       fp_ = out.take_stdio();
     }
   }
   ~Sink() {
-    if (gz_ != nullptr) gzclose(gz_);
     if (fp_ != nullptr) std::fclose(fp_);
   }
   Sink(const Sink &) = delete;
   Sink &operator=(const Sink &) = delete;
 
   void write(const std::string &bytes) {
-    size_t done = 0;
-    while (done < bytes.size()) {
-      const size_t k = std::min(bytes.size() - done, size_t{1} << 30);
-      if (gzip_) {
-        if (gzwrite(gz_, bytes.data() + done, static_cast<unsigned>(k)) != static_cast<int>(k)) {
-          int err = 0;
-          const char *msg = gzerror(gz_, &err);
-          throw FileError(final_, std::string("write failed: ") +
-                                      (err == Z_ERRNO ? std::strerror(errno) : (msg ? msg : "zlib error")));
-        }
-      } else if (std::fwrite(bytes.data() + done, 1, k, fp_) != k) {
-        throw FileError(final_, std::string("write failed: ") + std::strerror(errno));
-      }
-      done += k;
+    if (gz_) {
+      gz_->write(bytes.data(), bytes.size());
+    } else if (std::fwrite(bytes.data(), 1, bytes.size(), fp_) != bytes.size()) {
+      throw FileError(final_, std::string("write failed: ") + std::strerror(errno));
     }
   }
   void close() {
-    if (gzip_) {
-      const int rc = gzclose(gz_);
-      gz_ = nullptr;
-      if (rc != Z_OK) {
-        throw FileError(final_, std::string("write failed on close: ") +
-                                    (rc == Z_ERRNO ? std::strerror(errno) : "zlib error"));
-      }
-    } else {
-      const int rc = std::fclose(fp_);
-      fp_ = nullptr;
-      if (rc != 0) throw FileError(final_, std::string("write failed on close: ") + std::strerror(errno));
+    if (gz_) {
+      gz_->close();
+      return;
     }
+    const int rc = std::fclose(fp_);
+    fp_ = nullptr;
+    if (rc != 0) throw FileError(final_, std::string("write failed on close: ") + std::strerror(errno));
   }
 
  private:
   std::string final_;
-  bool gzip_;
-  gzFile gz_ = nullptr;
+  std::unique_ptr<gzip::GzipWriter> gz_;
   FILE *fp_ = nullptr;
 };
 

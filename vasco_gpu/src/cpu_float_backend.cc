@@ -40,6 +40,7 @@
 
 #include "beam_updates.h"
 #include "host_renderer.h"
+#include "huge_pages.h"
 #include "vasco_gpu/internal/beam_placement.h"
 #include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/internal/log_odds.h"
@@ -496,7 +497,7 @@ class CpuFloatRenderer : public HostGridRenderer {
       const std::vector<oracle::ScanStart> starts = place_scans(batch, geo, first, last);
       const EvidenceTable &ev = table_for(params);
       const Box box = reach_of(batch, starts, first, params, geo);
-      scratch_.assign(box.cells(), kUntouched);
+      assign_on_huge_pages(scratch_, box.cells(), kUntouched);
       // A chunk of scans at a time, in (scan, beam) order: the same sums as
       // placing every beam first, with the chunk's beams still in cache.
       for (size_t c = first; c < last; c += kScansPerChunk) {

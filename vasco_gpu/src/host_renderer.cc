@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "huge_pages.h"
 #include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
@@ -9,7 +10,7 @@ namespace vasco {
 void HostGridRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
   geo_ = geo;
   params_ = params;
-  cells_.assign(geo.num_cells(), -1.0f);  // keeps the allocation when the size does not grow
+  assign_on_huge_pages(cells_, geo.num_cells(), -1.0f);  // keeps the allocation when the size does not grow
 }
 
 void HostGridRenderer::apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) {
