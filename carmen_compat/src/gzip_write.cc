@@ -14,6 +14,7 @@
 #include <cstring>
 #include <new>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "carmen_compat/error.h"
@@ -110,9 +111,10 @@ std::unique_ptr<GzipWriter::Encoder> make_encoder(Codec codec) {
 
 }  // namespace
 
-GzipWriter::GzipWriter(int fd, std::string name, Codec codec)
-    : fd_(fd), name_(std::move(name)), out_(new unsigned char[kOut]) {
-  try {
+GzipWriter::GzipWriter(int fd, std::string name, Codec codec) : fd_(fd) {
+  try {  // the descriptor is the writer's from here: closed if it cannot be made
+    name_ = std::move(name);
+    out_.reset(new unsigned char[kOut]);
     enc_ = make_encoder(codec);
   } catch (...) {
     ::close(fd_);

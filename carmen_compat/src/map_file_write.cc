@@ -7,7 +7,7 @@
 #include <cstring>
 #include <ctime>
 #include <limits>
-#include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -196,7 +196,7 @@ class Sink {
  public:
   Sink(AtomicOutput &out, bool gzip) : final_(out.final_path()) {
     if (gzip) {
-      gz_ = std::make_unique<gzip::GzipWriter>(out.take_fd(), final_);
+      gz_.emplace(out.take_fd(), final_);  // in place: no allocation between taking the descriptor and owning it
     } else {
       fp_ = out.take_stdio();
     }
@@ -226,7 +226,7 @@ class Sink {
 
  private:
   std::string final_;
-  std::unique_ptr<gzip::GzipWriter> gz_;
+  std::optional<gzip::GzipWriter> gz_;
   FILE *fp_ = nullptr;
 };
 
