@@ -12,6 +12,7 @@ __all__ = ["main"]
 def main(argv=None) -> int:
     """Runs the node until SIGINT or SIGTERM; 0 on a clean exit, 2 for a bad parameter, 1 when
     ROS 2 is not there."""
+    import signal
     import sys
 
     if _asks_version(sys.argv if argv is None else argv):  # answered before rclpy (slow, maybe missing) loads
@@ -28,8 +29,16 @@ def main(argv=None) -> int:
 
     keep_message_buffers()  # before the large allocations start
     use_map_sized_shm()  # before rclpy loads Fast DDS
+    # SIGINT is held back while rclpy and the message packages load: one landing inside the
+    # import could end the process by the default action, exit -2 with nothing printed (Jazzy,
+    # a loaded machine: 4 starts of 72; strace shows Python resetting SIGINT to its default and
+    # killing itself before rclpy installed a handler). Held back, it is raised here after.
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
-        from .run import main as run
+        try:
+            from .run import main as run
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, before)
     except KeyboardInterrupt:  # SIGINT while rclpy loads: nothing started yet
         return 0
     except ImportError as e:  # rclpy or a message package
