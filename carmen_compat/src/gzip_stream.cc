@@ -24,10 +24,6 @@ namespace {
 
 constexpr std::size_t kScratch = std::size_t(256) << 10;  // a replay's bytes decoded again per step
 
-// Both libraries count bytes in 32 bits: a larger buffer is taken in parts.
-inline uint32_t clamp32(std::size_t n) {
-  return static_cast<uint32_t>(std::min<std::size_t>(n, UINT32_MAX));
-}
 
 class ZlibDecoder final : public MemberDecoder {
  public:

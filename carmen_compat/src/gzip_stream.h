@@ -26,6 +26,12 @@ namespace gzip {
 
 enum class Codec { ZLIB, ISAL };
 
+// Both libraries count bytes in 32 bits: a larger buffer is taken in parts,
+// this many bytes at a time (the decoders here, the writer in gzip_write.h).
+inline uint32_t clamp32(std::size_t n) {
+  return static_cast<uint32_t>(n < UINT32_MAX ? n : UINT32_MAX);
+}
+
 // ISAL when this build has ISA-L, else ZLIB. zlib is always built in, so
 // tests can hold the two to the same results.
 Codec default_codec();

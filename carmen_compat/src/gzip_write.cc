@@ -8,7 +8,6 @@
 #include <isa-l/igzip_lib.h>
 #endif
 
-#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -25,18 +24,32 @@ namespace gzip {
 namespace {
 
 constexpr std::size_t kOut = std::size_t(256) << 10;  // compressed bytes per write(2)
-constexpr std::size_t kIn = std::size_t(1) << 30;     // input bytes per step (both count in 32 bits)
 
 }  // namespace
 
-// One step: consume [in, in + in_len) (all of it, unless out fills), write
-// into out; `last`: the input ends here. Returns the output bytes made and
-// sets *done once the member's trailer is out.
+// One step: consumes what it can of [in, in + in_len) (all of it, unless out
+// fills; in and in_len advanced past it), writing into out; `last`: the input
+// ends there. Returns the output bytes made; *done once the member's trailer
+// is out. The codecs differ only in `run`.
 class GzipWriter::Encoder {
  public:
   virtual ~Encoder() = default;
-  virtual std::size_t step(const unsigned char *&in, std::size_t &in_len, unsigned char *out, std::size_t out_len,
-                           bool last, bool *done) = 0;
+  std::size_t step(const unsigned char *&in, std::size_t &in_len, unsigned char *out, std::size_t out_len,
+                   bool last, bool *done) {
+    const uint32_t take = clamp32(in_len);
+    uint32_t in_left = take, out_left = clamp32(out_len);
+    *done = run(in, in_left, out, out_left, last && take == in_len);
+    in += take - in_left;
+    in_len -= take - in_left;
+    return out_len - out_left;
+  }
+
+ private:
+  // The codec's deflate of in_left bytes at in into out_left bytes at out;
+  // both left as what remains after it. finish: no input follows. True once
+  // the trailer is out.
+  virtual bool run(const unsigned char *in, uint32_t &in_left, unsigned char *out, uint32_t &out_left,
+                   bool finish) = 0;
 };
 
 namespace {
@@ -49,22 +62,20 @@ class ZlibEncoder final : public GzipWriter::Encoder {
       throw std::bad_alloc();
   }
   ~ZlibEncoder() override { deflateEnd(&zs_); }
-  std::size_t step(const unsigned char *&in, std::size_t &in_len, unsigned char *out, std::size_t out_len,
-                   bool last, bool *done) override {
-    const uInt take = static_cast<uInt>(std::min(in_len, kIn));
-    zs_.next_in = const_cast<Bytef *>(in);
-    zs_.avail_in = take;
-    zs_.next_out = out;
-    zs_.avail_out = static_cast<uInt>(out_len);
-    const int ret = deflate(&zs_, last && take == in_len ? Z_FINISH : Z_NO_FLUSH);
-    if (ret == Z_STREAM_ERROR) throw std::logic_error("zlib's deflate refused its stream (a bug)");
-    in += take - zs_.avail_in;
-    in_len -= take - zs_.avail_in;
-    *done = ret == Z_STREAM_END;
-    return out_len - zs_.avail_out;
-  }
 
  private:
+  bool run(const unsigned char *in, uint32_t &in_left, unsigned char *out, uint32_t &out_left, bool finish) override {
+    zs_.next_in = const_cast<Bytef *>(in);
+    zs_.avail_in = in_left;
+    zs_.next_out = out;
+    zs_.avail_out = out_left;
+    const int ret = deflate(&zs_, finish ? Z_FINISH : Z_NO_FLUSH);
+    if (ret == Z_STREAM_ERROR) throw std::logic_error("zlib's deflate refused its stream (a bug)");
+    in_left = zs_.avail_in;
+    out_left = zs_.avail_out;
+    return ret == Z_STREAM_END;
+  }
+
   z_stream zs_{};
 };
 
@@ -78,24 +89,22 @@ class IsalEncoder final : public GzipWriter::Encoder {
     zs_.level_buf = level_buf_.data();
     zs_.level_buf_size = static_cast<uint32_t>(level_buf_.size());
   }
-  std::size_t step(const unsigned char *&in, std::size_t &in_len, unsigned char *out, std::size_t out_len,
-                   bool last, bool *done) override {
-    const uint32_t take = static_cast<uint32_t>(std::min(in_len, kIn));
+
+ private:
+  bool run(const unsigned char *in, uint32_t &in_left, unsigned char *out, uint32_t &out_left, bool finish) override {
     zs_.next_in = const_cast<uint8_t *>(in);
-    zs_.avail_in = take;
+    zs_.avail_in = in_left;
     zs_.next_out = out;
-    zs_.avail_out = static_cast<uint32_t>(out_len);
-    zs_.end_of_stream = last && take == in_len ? 1 : 0;
+    zs_.avail_out = out_left;
+    zs_.end_of_stream = finish ? 1 : 0;
     zs_.flush = NO_FLUSH;
     const int ret = isal_deflate(&zs_);
     if (ret != COMP_OK) throw std::logic_error("ISA-L's deflate refused its stream (a bug): " + std::to_string(ret));
-    in += take - zs_.avail_in;
-    in_len -= take - zs_.avail_in;
-    *done = zs_.internal_state.state == ZSTATE_END;
-    return out_len - zs_.avail_out;
+    in_left = zs_.avail_in;
+    out_left = zs_.avail_out;
+    return zs_.internal_state.state == ZSTATE_END;
   }
 
- private:
   std::vector<uint8_t> level_buf_;
   isal_zstream zs_{};
 };
