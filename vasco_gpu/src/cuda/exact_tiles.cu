@@ -364,7 +364,9 @@ constexpr int kLightWords = kTileThreads / 32, kHeavyWords = 8;
 // compiler chose 80 (12 blocks an SM; 93 with the bound written as 1).
 // session_bench on an H100, one run per bound (exact re-render, fr079 /
 // fr101 ms): 12 blocks 5.549 / 9.418, 14: 5.437 / 9.135, 16: 5.420 / 9.055
-// and 5.386 / 9.109 again, 18: 5.599 / 9.522, 20: 6.319 / 10.819.
+// and 5.386 / 9.109 again, 18: 5.599 / 9.522, 20: 6.319 / 10.819 (the heavy
+// blocks then at 110 registers). The heavy blocks' bound is 0, no minimum:
+// the one-argument form's code, 100 registers (1 written out gives 110).
 constexpr int kLightMinBlocks = 16;
 
 // Block b runs tile order[b] when it is a heavy one (b < *heavy_count, for the
@@ -377,7 +379,7 @@ constexpr int kLightMinBlocks = 16;
 // (a light block of a third the shared memory) made fr079's and fr101's
 // exact re-renders 0.08 and 0.09 ms slower on the H100 (session_bench).
 template <int kWords>
-__global__ void __launch_bounds__(32 * kWords, kWords == kHeavyWords ? 1 : kLightMinBlocks)
+__global__ void __launch_bounds__(32 * kWords, kWords == kHeavyWords ? 0 : kLightMinBlocks)
     tiles_kernel(KernelModel<double> m, const LineRec *lines, const uint32_t *sorted_beam, const uint32_t *order,
                  const uint32_t *tile_begin, const uint32_t *tile_end, const uint32_t *heavy_count,
                  const double2 *factors, const int *reach_global, float *grid, unsigned long long *updates) {
