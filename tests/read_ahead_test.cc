@@ -136,6 +136,50 @@ TEST(ReadAhead, ReadsUnderWayCountAtTheirEstimatesBeforeAnySizeIsKnown) {
   EXPECT_EQ(run.reserved_bytes(), 0u);
 }
 
+// fr079's case: logs estimated at 76 MB (8 bytes per byte of text) that
+// parse to 8 MB, 32 reads at once, 128 ahead, a 1 GiB budget. Counted at
+// their estimates, 14 reads run at first and fewer the further they run
+// ahead; once a read has ended, the budget counts the rest at the share of
+// its estimate it came to, and only the worst case (here 16 GiB) at the
+// estimate: all 32 run, until 128 are ahead.
+TEST(ReadAhead, ReadsUnderWayCountAtTheShareOfTheirEstimateAReadCameTo) {
+  const uint64_t mb = 1000 * 1000, budget = uint64_t{1} << 30;
+  const std::vector<uint64_t> estimates(200, 76 * mb);
+  cli::ReadAhead before(200, 32, 128, budget, estimates);
+  EXPECT_EQ(before.admit().size(), 14u);
+  before.read(0, 8 * mb);
+  EXPECT_EQ(before.admit().size(), 1u);  // 8 MB held: still 14 under way
+  for (size_t i = 1; i < 15; ++i) before.read(i, 8 * mb);
+  EXPECT_EQ(before.admit().size(), 12u);  // 15 held, 12 under way: 1 GiB at 76 MB each
+
+  cli::ReadAhead now(200, 32, 128, budget, estimates, 16 * budget);
+  EXPECT_EQ(now.admit().size(), 14u);  // nothing read yet: counted at the estimate
+  now.read(0, 8 * mb);
+  EXPECT_EQ(now.admit().size(), 19u);  // 32 under way, all now counted at 8 MB
+  EXPECT_EQ(now.expected_bytes(), 32 * 8 * mb);
+  EXPECT_EQ(now.reserved_bytes(), 32 * 76 * mb);
+  size_t admitted = 33;
+  for (size_t i = 1; i < admitted; ++i) {  // every read let through ends
+    now.read(i, 8 * mb);
+    admitted += now.admit().size();
+  }
+  EXPECT_EQ(admitted, 128u);  // `most` ahead, none taken
+  EXPECT_LE(now.held_bytes(), budget);
+}
+
+// Inputs that parse to far more of their estimate than the first did: the
+// budget may be passed by the reads under way, the worst case never.
+TEST(ReadAhead, TheWorstCaseHoldsWhateverTheInputsParseTo) {
+  const uint64_t mb = 1000 * 1000, budget = 200 * mb, worst = 1000 * mb;
+  std::vector<uint64_t> actual(40, 100 * mb);
+  actual[0] = 1 * mb;  // the first parses to a hundredth of its estimate, the rest to all of it
+  cli::ReadAhead ra(40, 16, 40, budget, std::vector<uint64_t>(40, 100 * mb), worst);
+  EXPECT_LE(peak_bytes(ra, actual), worst);
+  EXPECT_EQ(ra.held_bytes(), 0u);
+  EXPECT_EQ(ra.reserved_bytes(), 0u);
+  EXPECT_EQ(ra.expected_bytes(), 0u);
+}
+
 // The mean read so far counts where it is more than an input's estimate.
 TEST(ReadAhead, AReadUnderWayCountsAtTheMeanWhereThatIsMore) {
   cli::ReadAhead ra(10, 2, 10, 1000, std::vector<uint64_t>(10, 10));

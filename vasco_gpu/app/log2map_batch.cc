@@ -159,17 +159,28 @@ uint64_t usable_memory() {
   return bytes;
 }
 
+// The bytes parsed inputs read ahead may hold (those being mapped
+// included), the reads under way counted at what they are expected to hold:
+// 1 GiB (some 140 fr079-size logs), at most an eighth of the memory. What a
+// finished map holds until it is written is bounded apart (the write slots).
+uint64_t read_ahead_budget() { return std::min<uint64_t>(uint64_t{1} << 30, usable_memory() / 8); }
+
+// The same with the reads under way counted at the most they may hold (ten
+// times what a log parses to): an eighth of the memory, or
+// VASCO_BATCH_READ_WORST_MB MiB (batch_bench's A/B: 1024 counts them so
+// against the budget, as before, when the pool's reads were held to 14 at
+// once and fewer the further they ran ahead).
+uint64_t read_ahead_worst() {
+  const int mib = env_knob("VASCO_BATCH_READ_WORST_MB", 1, 1 << 24, 0);
+  return mib > 0 ? uint64_t(mib) << 20 : usable_memory() / 8;
+}
+
 // The environment's batch knobs, read (and checked) before any work.
 struct BatchKnobs {
   size_t ahead_per_thread = read_ahead_per_thread();
   int nice = pool_nice();
+  uint64_t read_worst = read_ahead_worst();
 };
-
-// The bytes parsed inputs read ahead may hold (those being mapped
-// included): 1 GiB (some 140 fr079-size logs), at most an eighth of the
-// memory. What a finished map holds until it is written is bounded apart
-// (the write slots).
-uint64_t read_ahead_budget() { return std::min<uint64_t>(uint64_t{1} << 30, usable_memory() / 8); }
 
 // The bytes a read input holds until it is mapped: its scans' arrays and
 // the per-scan records beside them (what grows with the log).
@@ -199,7 +210,7 @@ class BatchRun {
   BatchRun(const Options &opt, const ToolSpec &spec, BatchReport &report, int jobs, const BatchKnobs &knobs)
       : opt_(opt), spec_(spec), report_(report), writes_(2 * static_cast<size_t>(jobs)),
         ahead_(opt.inputs.size(), 2 * static_cast<size_t>(jobs), knobs.ahead_per_thread * static_cast<size_t>(jobs),
-               read_ahead_budget(), read_estimates(opt)),
+               read_ahead_budget(), read_estimates(opt), knobs.read_worst),
         read_(opt.inputs.size()), pool_(jobs, knobs.nice) {}
 
   ~BatchRun() { stop_reads(); }  // queued reads return at once; the pool drains

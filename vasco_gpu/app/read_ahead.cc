@@ -7,9 +7,11 @@
 
 namespace cli {
 
-ReadAhead::ReadAhead(size_t inputs, size_t in_flight, size_t most, uint64_t budget, std::vector<uint64_t> estimates)
+ReadAhead::ReadAhead(size_t inputs, size_t in_flight, size_t most, uint64_t budget, std::vector<uint64_t> estimates,
+                     uint64_t worst)
     : in_flight_max_(in_flight < 1 ? 1 : in_flight), most_(most < 1 ? 1 : most), budget_(budget),
-      estimates_(std::move(estimates)), bytes_(inputs, 0), reserved_for_(inputs, 0) {
+      worst_(worst > budget ? worst : budget), estimates_(std::move(estimates)), bytes_(inputs, 0),
+      reserved_for_(inputs, 0), expected_for_(inputs, 0) {
   estimates_.resize(inputs, 0);
 }
 
@@ -20,12 +22,31 @@ uint64_t ReadAhead::reservation(size_t i) const {
   return estimates_[i] > mean ? estimates_[i] : mean;
 }
 
+// What input i's read is expected to hold while it is under way: before
+// any read ended, the most it may; after, its estimate times the largest
+// share of their estimates the reads came to, or the mean read where that
+// is more (no estimate); never more than the most.
+uint64_t ReadAhead::expectation(size_t i) const {
+  const uint64_t most = reservation(i);
+  if (reads_ == 0) return most;
+  const uint64_t mean = read_bytes_ / reads_;
+  const double scaled = static_cast<double>(estimates_[i]) * share_;
+  const uint64_t expect = scaled >= static_cast<double>(most) ? most : static_cast<uint64_t>(scaled);
+  return expect > mean ? expect : mean;
+}
+
+// Whether `more` bytes fit beside `held` and `counted` within `limit`
+// (no overflow for huge estimates: a read of one may be under way, let
+// through as the next a mapper takes).
+static bool fits(uint64_t held, uint64_t counted, uint64_t more, uint64_t limit) {
+  return more <= limit && counted <= limit - more && held <= limit - more - counted;
+}
+
 bool ReadAhead::may_admit(size_t i) const {
   if (stopped_ || i >= bytes_.size()) return false;
   if (i <= taken_) return true;  // a mapper waits for it (or will next)
   if (in_flight_ >= in_flight_max_ || i - taken_ >= most_) return false;
-  const uint64_t more = reservation(i);
-  return more <= budget_ && held_ + reserved_ <= budget_ - more;  // no overflow for huge estimates
+  return fits(held_, expected_, expectation(i), budget_) && fits(held_, reserved_, reservation(i), worst_);
 }
 
 std::vector<size_t> ReadAhead::admit() {
@@ -33,6 +54,8 @@ std::vector<size_t> ReadAhead::admit() {
   while (may_admit(next_)) {
     reserved_for_[next_] = reservation(next_);
     reserved_ += reserved_for_[next_];
+    expected_for_[next_] = expectation(next_);
+    expected_ += expected_for_[next_];
     now.push_back(next_++);
     ++in_flight_;
   }
@@ -48,12 +71,32 @@ void ReadAhead::read(size_t i, uint64_t bytes) {
   if (in_flight_ > 0) --in_flight_;
   reserved_ -= reserved_for_[i];
   reserved_for_[i] = 0;
+  expected_ -= expected_for_[i];
+  expected_for_[i] = 0;
   bytes_[i] = bytes;
   held_ += bytes;
   if (bytes > 0) {
     read_bytes_ += bytes;
     ++reads_;
+    if (estimates_[i] > 0) {
+      const double share = static_cast<double>(bytes) / static_cast<double>(estimates_[i]);
+      if (share > share_ || reads_ == 1) {
+        share_ = share > share_ ? share : share_;
+        recount_expected();
+      }
+    }
   }
+}
+
+// The reads under way counted again at what they are now expected to hold
+// (what was let through before the first read ended counted at the most).
+void ReadAhead::recount_expected() {
+  expected_ = 0;
+  for (size_t k = 0; k < expected_for_.size(); ++k)
+    if (reserved_for_[k] > 0) {
+      expected_for_[k] = expectation(k);
+      expected_ += expected_for_[k];
+    }
 }
 
 void ReadAhead::released(size_t i) {
