@@ -1,5 +1,5 @@
 // log2map's batch knobs from the environment (VASCO_BATCH_READ_AHEAD,
-// VASCO_BATCH_POOL_NICE): a value that is not a whole number in the
+// VASCO_BATCH_POOL_NICE, VASCO_BATCH_READ_WORST_MB): a value that is not a whole number in the
 // knob's range is a usage error (exit 2) naming the variable, its value and
 // the range, before anything is written; unset or empty, the default.
 #include <gtest/gtest.h>
@@ -58,6 +58,24 @@ TEST(Log2MapBatchKnobs, APoolNiceThatIsNotAWholeNumberInRangeIsAUsageError) {
   const tooltest::ToolRun r = batch(out);
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_TRUE(contains(r.output, "VASCO_BATCH_POOL_NICE=nice: not a whole number from 0 to 19")) << r.output;
+}
+
+TEST(Log2MapBatchKnobs, AWorstCaseThatIsNotAWholeNumberOfMiBInRangeIsAUsageError) {
+  for (const char *bad : {"1G", "0", "16777217"}) {
+    TempDir out;
+    const EnvSet env("VASCO_BATCH_READ_WORST_MB", bad);
+    const tooltest::ToolRun r = batch(out);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
+    EXPECT_TRUE(contains(r.output, std::string("VASCO_BATCH_READ_WORST_MB=") + bad + ": not a whole number from 1 to "
+                                                                                     "16777216"))
+        << r.output;
+    EXPECT_TRUE(out.entries().empty()) << bad << ": " << out.entries().front() << " written";
+  }
+  TempDir out;
+  const EnvSet env("VASCO_BATCH_READ_WORST_MB", "1");  // below the budget: the budget (reads counted at worst, as before)
+  const tooltest::ToolRun r = batch(out);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(out.file("good.map.gz")));
 }
 
 TEST(Log2MapBatchKnobs, UnsetEmptyOrInRangeTheBatchRuns) {
