@@ -27,21 +27,28 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LOGS = os.path.join(ROOT, "logs")
 # Issue 59: a batch of 200 fr079 copies to .map.gz at its own choice, on one H100/H200 host.
 TARGET_LOGS_PER_S = 300
+# The floor experiment's row (--devices, read-ahead label) and the issue's rule: a missed target stands only where
+# a floor above it is measured and the batch's time is within 10 % of the floor's.
+FLOOR = ("", "read first")
+FLOOR_MARGIN = 1.10
 
 
 # The read-ahead settings a row may run with, by the label the tables print:
 # the default; 2 inputs ahead per pool thread (what a batch did before the
 # deeper read-ahead); the reads under way counted at their files' worst case
 # (8 bytes per byte of text) against the 1 GiB budget, as before they were
-# counted at the share of it a read came to.
-READ_AHEAD = {"": {}, "2": {"VASCO_BATCH_READ_AHEAD": "2"}, "worst 1G": {"VASCO_BATCH_READ_WORST_MB": "1024"}}
+# counted at the share of it a read came to; every input read before the first mapper starts (the
+# floor experiment: its run less that read is the start-up, the mappers and the last writes alone).
+READ_AHEAD = {"": {}, "2": {"VASCO_BATCH_READ_AHEAD": "2"}, "worst 1G": {"VASCO_BATCH_READ_WORST_MB": "1024"},
+              "read first": {"VASCO_BATCH_READ_FIRST": "1"}}
 
 
 def timed(cmd: list[str], read_ahead: str = "") -> tuple[float, subprocess.CompletedProcess]:
     """Wall-clock seconds of cmd; read_ahead: a READ_AHEAD label, the batch knobs it runs with
     ("": the defaults)."""
     env = dict(os.environ)
-    for knob in ("VASCO_BATCH_READ_AHEAD", "VASCO_BATCH_POOL_NICE", "VASCO_BATCH_READ_WORST_MB"):
+    for knob in ("VASCO_BATCH_READ_AHEAD", "VASCO_BATCH_POOL_NICE", "VASCO_BATCH_READ_WORST_MB",
+                 "VASCO_BATCH_READ_FIRST"):
         env.pop(knob, None)  # none exported leaks into a row
     env.update(READ_AHEAD[read_ahead])
     t = time.perf_counter()
@@ -259,13 +266,17 @@ def main() -> int:
             # interleaved, the pool at its default priority; the first row, one mapper reading 2
             # ahead, is what a batch did before the read-ahead and the mappers sharing a GPU. The
             # stage tables below are that first row and the batch's own choice, both ways.
+            # The floor experiment runs among them: the batch's own choice with every input read
+            # before its first mapper starts, timed less that read.
             configs = [(d, n) for d in device_sets(gpu_count()) for n in ("2", "")] + [("", "worst 1G"), ("", "")]
-            times = {c: [] for c in configs}
+            times = {c: [] for c in configs + [FLOOR]}
             for _ in range(a.repeat):
-                for d, n in configs:
-                    cmd = [log2map, "--backend", "cuda", "--quiet", "--out-dir", out, "--formats", a.formats]
-                    times[(d, n)].append(timed_ok(cmd + (["--devices", d] if d else []) + logs, n)[0])
+                for d, n in configs + [FLOOR]:
+                    cmd = [log2map, "--backend", "cuda", "--quiet", "--json", "--out-dir", out, "--formats", a.formats]
+                    s, p = timed_ok(cmd + (["--devices", d] if d else []) + logs, n)
+                    times[(d, n)].append(s - json.loads(p.stdout)["phases"].get("read_first", 0.0))
             scaling = [(d, n, len(logs) / min(times[(d, n)])) for d, n in configs]
+            floor_s = min(times[FLOOR])
             stage_lines += stages(log2map, "cuda", "0", logs, out, a.formats, "2")[0] + [""]
             stage_lines += stages(log2map, "cuda", "", logs, out, a.formats, "worst 1G")[0] + [""]
             lines, chosen_phases = stages(log2map, "cuda", "", logs, out, a.formats, "")
@@ -292,8 +303,18 @@ def main() -> int:
             print(f"{devices or '(its choice)':22} {ahead or 'default':>10} {rate:8.1f} {rate / scaling[0][2]:11.2f}x")
         chosen = scaling[-1][2]
         gpus = gpu_count()
+        floor = len(logs) / floor_s
+        print(f"floor: the batch's own choice with every input read before its first mapper starts, less that read "
+              f"(its start-up, mappers and last writes alone): {floor_s:.3f} s, {floor:.1f} logs/s; the batch's own "
+              f"choice took {len(logs) / chosen:.3f} s, {floor_s * chosen / len(logs):.0%} of the floor's rate")
+        verdict = "met" if chosen >= TARGET_LOGS_PER_S else "missed"
+        if chosen < TARGET_LOGS_PER_S:
+            within = len(logs) / chosen <= FLOOR_MARGIN * floor_s
+            verdict += (f"; the floor is {'below' if floor < TARGET_LOGS_PER_S else 'not below'} it and the batch "
+                        f"{'within' if within else 'not within'} {FLOOR_MARGIN - 1:.0%} of the floor's time: " +
+                        ("it stands missed" if floor < TARGET_LOGS_PER_S and within else "not excused"))
         print(f"target: >= {TARGET_LOGS_PER_S} logs/s of {os.path.basename(a.log)} to {a.formats} on one GPU, the "
-              f"batch's own choice: {chosen:.1f}, " + (("met" if chosen >= TARGET_LOGS_PER_S else "missed") if gpus == 1
+              f"batch's own choice: {chosen:.1f}, " + (verdict if gpus == 1
                                                        else f"not judged here ({gpus} GPUs: the target is one GPU's)"))
         if gpus == 1 and chosen < TARGET_LOGS_PER_S and chosen_phases.get("mapping", 0) > 0:
             ph = chosen_phases

@@ -108,7 +108,8 @@ void BatchReport::print_json(double total_s) const {
     }
     j << "}";
   }
-  j << "],\"pool_threads\":" << pool_threads_ << ",\"mappers\":" << mappers_ << ",\"phases\":{\"start\":" << start_s_
+  j << "],\"pool_threads\":" << pool_threads_ << ",\"mappers\":" << mappers_ << ",\"phases\":{\"read_first\":" << read_first_s_
+    << ",\"start\":" << start_s_
     << ",\"mapping\":" << mapping_s_ << ",\"drain\":" << drain_s_ << "}";
   j << ",\"done\":" << done << ",\"failed\":" << failures() << ",\"seconds\":" << total_s
     << ",\"inputs_per_s\":" << (total_s > 0 ? double(done) / total_s : 0.0) << "}\n";

@@ -39,10 +39,12 @@ class BatchReport {
     pool_threads_ = pool;
     mappers_ = mappers;
   }
-  // The run's phases, in seconds: until the first mapper had started (its
-  // backend; the pool reads meanwhile), until the last map was done, and
-  // until the last output was written. For --json.
-  void set_phases(double start_s, double mapping_s, double drain_s) {
+  // The run's phases, in seconds: every input's read, where they are read
+  // before the first mapper starts (VASCO_BATCH_READ_FIRST; else 0); until
+  // the first mapper had started (its backend; the pool reads meanwhile),
+  // until the last map was done, and until the last output was written. For --json.
+  void set_phases(double read_first_s, double start_s, double mapping_s, double drain_s) {
+    read_first_s_ = read_first_s;
     start_s_ = start_s;
     mapping_s_ = mapping_s;
     drain_s_ = drain_s;
@@ -70,7 +72,7 @@ class BatchReport {
   std::vector<BatchEntry> entries_;
   std::string backend_;
   int pool_threads_ = 0, mappers_ = 0;
-  double start_s_ = 0, mapping_s_ = 0, drain_s_ = 0;
+  double read_first_s_ = 0, start_s_ = 0, mapping_s_ = 0, drain_s_ = 0;
   mutable std::mutex mutex_;
   ProgressBar bar_;
   size_t finished_ = 0;

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <charconv>
 #include <cerrno>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
@@ -175,11 +176,17 @@ uint64_t read_ahead_worst() {
   return mib > 0 ? uint64_t(mib) << 20 : usable_memory() / 8;
 }
 
+// Whether every input is read before the first mapper starts, unbounded
+// by the read-ahead (VASCO_BATCH_READ_FIRST=1): batch_bench's floor
+// experiment, the mappers and their start-up with no read beside them.
+bool cli_read_first() { return env_knob("VASCO_BATCH_READ_FIRST", 0, 1, 0) == 1; }
+
 // The environment's batch knobs, read (and checked) before any work.
 struct BatchKnobs {
   size_t ahead_per_thread = read_ahead_per_thread();
   int nice = pool_nice();
   uint64_t read_worst = read_ahead_worst();
+  bool read_first = cli_read_first();
 };
 
 // The bytes a read input holds until it is mapped: its scans' arrays and
@@ -209,8 +216,10 @@ class BatchRun {
  public:
   BatchRun(const Options &opt, const ToolSpec &spec, BatchReport &report, int jobs, const BatchKnobs &knobs)
       : opt_(opt), spec_(spec), report_(report), writes_(2 * static_cast<size_t>(jobs)),
-        ahead_(opt.inputs.size(), 2 * static_cast<size_t>(jobs), knobs.ahead_per_thread * static_cast<size_t>(jobs),
-               read_ahead_budget(), read_estimates(opt), knobs.read_worst),
+        ahead_(opt.inputs.size(), 2 * static_cast<size_t>(jobs),
+               knobs.read_first ? opt.inputs.size() : knobs.ahead_per_thread * static_cast<size_t>(jobs),
+               knobs.read_first ? UINT64_MAX : read_ahead_budget(), read_estimates(opt),
+               knobs.read_first ? UINT64_MAX : knobs.read_worst),
         read_(opt.inputs.size()), pool_(jobs, knobs.nice) {}
 
   ~BatchRun() { stop_reads(); }  // queued reads return at once; the pool drains
@@ -218,6 +227,13 @@ class BatchRun {
   void start_reads() {
     std::lock_guard<std::mutex> lock(ahead_mutex_);
     submit_admitted();
+  }
+
+  // Until every input's read has ended (VASCO_BATCH_READ_FIRST: each let
+  // through, the read-ahead unbounded), or the batch stops.
+  void wait_all_read() {
+    std::unique_lock<std::mutex> lock(ahead_mutex_);
+    all_read_.wait(lock, [this] { return reads_ended_ == read_.size() || stop_; });
   }
 
   // Maps inputs until none is left, each on `mapper`; several callers (one
@@ -312,6 +328,7 @@ class BatchRun {
         std::lock_guard<std::mutex> lock(ahead_mutex_);
         ahead_.read(i, r ? bytes_held(r->input) : 0);
         submit_admitted();
+        if (++reads_ended_ == read_.size()) all_read_.notify_all();
       }
       if (error) return done->set_exception(error);
       done->set_value(std::move(r));
@@ -328,6 +345,7 @@ class BatchRun {
     stop_ = true;
     std::lock_guard<std::mutex> lock(ahead_mutex_);
     ahead_.stop();
+    all_read_.notify_all();
   }
 
   // waited_s: how long this mapper waited for the input's read.
@@ -378,9 +396,11 @@ class BatchRun {
   std::atomic<bool> shares_gpu_{false};
   std::mutex deferred_mutex_;
   std::vector<size_t> deferred_;  // out of memory beside another mapper: mapped again at the end
-  std::mutex ahead_mutex_;  // ahead_, next_, read_'s futures as they are made
+  std::mutex ahead_mutex_;  // ahead_, next_, reads_ended_, read_'s futures as they are made
+  std::condition_variable all_read_;
   cli::ReadAhead ahead_;
   size_t next_ = 0;
+  size_t reads_ended_ = 0;
   std::vector<std::future<std::unique_ptr<RunResult>>> read_;
   cli::TaskPool pool_;  // after what its tasks use (read_ included): joined first
 };
@@ -476,11 +496,13 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
   vasco::pipeline::check_outputs(inputs, files);
 
   BatchReport report(opt, std::move(entries));
-  double start_s = 0, mapped_s = 0;
+  double read_first_s = 0, start_s = 0, mapped_s = 0;
   {
     const int jobs = opt.jobs > 0 ? opt.jobs : all_cores();
     BatchRun run(opt, spec, report, jobs, knobs);
     run.start_reads();  // while the backend starts
+    const auto t_mappers = knobs.read_first ? (run.wait_all_read(), cli::Clock::now()) : t_start;
+    read_first_s = std::chrono::duration<double>(t_mappers - t_start).count();
     const std::vector<int> devices = batch_devices(opt);
     // One mapper for every input (per GPU): its backend (a GPU's context
     // and scratch) starts once. auto weighs a workload without end
@@ -489,7 +511,7 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     vasco::BackendOptions first = backend_options(opt);
     first.cuda_device = devices.front();
     vasco::Mapper mapper(vasco::MapperParams{}, opt.backend, first);
-    start_s = cli::seconds_since(t_start);
+    start_s = cli::seconds_since(t_mappers);
     report.set_backend(mapper.backend_name());
     const vasco::BackendInfo *chosen = vasco::find_backend(opt.backend);
     if (chosen != nullptr && chosen->chooses && !mapper.backend_traits().grid_on_device && !opt.quiet)
@@ -515,7 +537,7 @@ int run_batch(const Options &opt, const ToolSpec &spec) {
     run.report_not_run();
   }  // every write done
   const double total_s = cli::seconds_since(t_start);
-  report.set_phases(start_s, mapped_s - start_s, total_s - mapped_s);
+  report.set_phases(read_first_s, start_s, mapped_s - start_s - read_first_s, total_s - mapped_s);
   report.print_end(total_s);
   return report.failures() > 0 ? 1 : 0;
 }
