@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -76,6 +77,23 @@ TEST(Log2MapBatchKnobs, AWorstCaseThatIsNotAWholeNumberOfMiBInRangeIsAUsageError
   const tooltest::ToolRun r = batch(out);
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(std::filesystem::exists(out.file("good.map.gz")));
+}
+
+// VASCO_BATCH_READ_FIRST=1 (batch_bench's floor experiment): every input
+// read before the mapper starts, that read a phase of its own in --json.
+TEST(Log2MapBatchKnobs, ReadFirstReadsEveryInputBeforeTheMapperStarts) {
+  TempDir out;
+  const EnvSet env("VASCO_BATCH_READ_FIRST", "1");
+  const tooltest::ToolRun r =
+      tooltest::run_tool("log2map", {"-q", "--json", "--backend", "cpu_threads", "--out-dir", out.path(), kGood});
+  EXPECT_EQ(r.status, 0) << r.output;
+  const std::string key = "\"phases\":{\"read_first\":";
+  const size_t at = r.output.find(key);
+  ASSERT_NE(at, std::string::npos) << r.output;
+  EXPECT_GT(std::strtod(r.output.c_str() + at + key.size(), nullptr), 0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(out.file("good.map.gz")));
+  const EnvSet bad("VASCO_BATCH_READ_FIRST", "yes");
+  EXPECT_EQ(batch(out).status, 2);
 }
 
 TEST(Log2MapBatchKnobs, UnsetEmptyOrInRangeTheBatchRuns) {

@@ -148,12 +148,14 @@ TEST(Log2MapBatch, JsonReportsEveryInput) {
   EXPECT_TRUE(contains(r.output, ",\"mapper_wait\":")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"mappers\":1,")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"pool_threads\":")) << r.output;
-  // The phases: the start-up, then the mapping, which holds the one input's map, then the last writes.
+  // The phases: no read before the mappers (VASCO_BATCH_READ_FIRST unset), the start-up, then the
+  // mapping, which holds the one input's map, then the last writes.
   const auto number_after = [&](const std::string &key) {
     const size_t at = r.output.find(key);
     return at == std::string::npos ? -1.0 : std::strtod(r.output.c_str() + at + key.size(), nullptr);
   };
-  const double start = number_after("\"phases\":{\"start\":"), mapping = number_after(",\"mapping\":"),
+  EXPECT_EQ(number_after("\"phases\":{\"read_first\":"), 0) << r.output;
+  const double start = number_after(",\"start\":"), mapping = number_after(",\"mapping\":"),
                drain = number_after(",\"drain\":"), map = number_after(",\"map\":");
   EXPECT_GT(start, 0) << r.output;
   EXPECT_GT(map, 0) << r.output;
