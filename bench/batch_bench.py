@@ -8,6 +8,11 @@ faster of the two); last, the constants of auto's cost model
 
     python3 bench/batch_bench.py [--bin build/bin] [--copies 200] [--per-process 20]
 
+With a GPU, the cuda batch's rows (one to four mappers on a GPU, the read-ahead's settings, the
+batch's own choice) run interleaved beside a floor experiment: the batch's own choice with every
+input read before its first mapper starts, timed less that read (its start-up, mappers and last
+writes alone), printed beside issue 59's target of 300 logs/s.
+
 The batch is N copies (symbolic links under distinct names) of the bundled
 logs, fr079 first: --log picks another. Times are wall-clock seconds of the
 whole command, outputs (.map.gz) included; the best of --repeat runs.
