@@ -7,9 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <algorithm>
 #include <fstream>
-#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -73,22 +71,6 @@ TEST(HugePages, AGridOfMegabytesIsOnHugePagesWhereTheSystemGrantsThem) {
   // fragmented memory may give fewer than all, rarely none of 32 (defrag
   // "madvise" compacts for advised regions at fault time).
   EXPECT_GT(kb, 0) << "no huge page in the grid's mapping (THP " << mode << ")";
-}
-
-// What cpu_float keeps its sums in: grown without a value written, the
-// allocation kept while it is large enough, on huge pages at the first touch.
-TEST(HugePages, AGrownBufferKeepsItsAllocationWhileLargeEnoughAndIsOnHugePages) {
-  std::unique_ptr<float[]> p;
-  size_t capacity = 0;
-  float *first = vasco::grow_on_huge_pages(p, &capacity, size_t(16) << 20);  // 64 MiB
-  ASSERT_EQ(first, p.get());
-  EXPECT_EQ(capacity, size_t(16) << 20);
-  EXPECT_EQ(vasco::grow_on_huge_pages(p, &capacity, size_t(1) << 20), first);  // smaller: the same
-  EXPECT_EQ(capacity, size_t(16) << 20);
-  std::fill(first, first + capacity, 2.0f);
-  const std::string mode = thp_mode();
-  if (mode != "madvise" && mode != "always") GTEST_SKIP() << "transparent huge pages are '" << mode << "' here";
-  EXPECT_GT(huge_kb_at(first + capacity / 2), 0) << "no huge page in the buffer's mapping (THP " << mode << ")";
 }
 
 }  // namespace

@@ -41,7 +41,6 @@
 #include "beam_updates.h"
 #include "host_renderer.h"
 #include "huge_pages.h"
-#include "touched_blocks.h"
 #include "vasco_gpu/internal/beam_placement.h"
 #include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/internal/log_odds.h"
@@ -200,26 +199,17 @@ int64_t scan_reach(const ScanBatch &batch, const oracle::ScanStart &start, size_
 // before any beam is placed, so the sums are allocated once, over the cells a
 // log's scans reach (fr079 at vasco's defaults: a fifth of the start cells'
 // table-sized squares), and each scan's beams are added as they are placed.
-// `blocks` gets the box's blocks that some scan's reach square meets: the
-// only cells the sums need cleared and merged.
 Box reach_of(const ScanBatch &batch, const std::vector<oracle::ScanStart> &starts, size_t first,
-             const MapperParams &params, const GridGeometry &geo, TouchedBlocks *blocks) {
+             const MapperParams &params, const GridGeometry &geo) {
   const int64_t cut = std::max(params.table_size() - 1, 0);
   int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
-  std::vector<int64_t> reach(starts.size());
   for (size_t i = 0; i < starts.size(); ++i) {
     const oracle::ScanStart &s = starts[i];
-    const int64_t r = reach[i] = scan_reach(batch, s, first + i, params.wall_size, geo.resolution, cut);
+    const int64_t r = scan_reach(batch, s, first + i, params.wall_size, geo.resolution, cut);
     x0 = std::min<int64_t>(x0, s.x1 - r), x1 = std::max<int64_t>(x1, s.x1 + r);
     y0 = std::min<int64_t>(y0, s.y1 - r), y1 = std::max<int64_t>(y1, s.y1 + r);
   }
-  const Box box = clipped_box(x0, x1, y0, y1, geo);
-  blocks->reset(box);
-  for (size_t i = 0; i < starts.size(); ++i) {
-    const int64_t x = int64_t(starts[i].x1) - box.x_lo, y = int64_t(starts[i].y1) - box.y_lo;
-    blocks->mark(x - reach[i], x + reach[i], y - reach[i], y + reach[i]);
-  }
-  return box;
+  return clipped_box(x0, x1, y0, y1, geo);
 }
 
 // A closed-form walk (egrid::LineParams) in box-relative terms: the steps
@@ -506,10 +496,8 @@ class CpuFloatRenderer : public HostGridRenderer {
     if (first < last) {
       const std::vector<oracle::ScanStart> starts = place_scans(batch, geo, first, last);
       const EvidenceTable &ev = table_for(params);
-      const Box box = reach_of(batch, starts, first, params, geo, &blocks_);
-      Sum *acc = grow_on_huge_pages(scratch_, &scratch_cells_, box.cells());
-      const size_t h = static_cast<size_t>(box.height());
-      blocks_.for_each_run([&](int x, int y0, int y1) { std::fill(acc + x * h + y0, acc + x * h + y1, kUntouched); });
+      const Box box = reach_of(batch, starts, first, params, geo);
+      assign_on_huge_pages(scratch_, box.cells(), kUntouched);
       // A chunk of scans at a time, in (scan, beam) order: the same sums as
       // placing every beam first, with the chunk's beams still in cache.
       for (size_t c = first; c < last; c += kScansPerChunk) {
@@ -542,7 +530,7 @@ class CpuFloatRenderer : public HostGridRenderer {
   uint64_t add_beams(const std::vector<oracle::ScanStart> &starts, const PlacedBeam *beams, size_t n,
                      const EvidenceTable &ev, const GridGeometry &geo, const Box &box) {
     uint64_t updates = 0;
-    Sum *acc = scratch_.get();
+    Sum *acc = scratch_.data();
     for (size_t i = 0; i < n; ++i) {
       const PlacedBeam &b = beams[i];
       const oracle::ScanStart &s = starts[b.scan];
@@ -557,29 +545,24 @@ class CpuFloatRenderer : public HostGridRenderer {
   }
 
   // Each touched cell once: its log-odds (the prior's if unknown) plus the
-  // sum, back to a probability. Only the marked blocks hold sums: no scan
-  // reaches a cell outside them.
+  // sum, back to a probability.
   void merge(const EvidenceTable &ev, const Box &box, const GridGeometry &geo, float *cells) const {
     const double lp = ev.logit_prior();
-    blocks_.for_each_run([&](int x, int y0, int y1) {
-      const Sum *acc = scratch_.get() + static_cast<size_t>(x) * box.height();
+    for (int x = 0; x < box.width(); ++x) {
+      const Sum *acc = scratch_.data() + static_cast<size_t>(x) * box.height();
       float *col = cells + static_cast<size_t>(box.x_lo + x) * geo.size_y + box.y_lo;
-      for (int y = y0; y < y1; ++y) {
+      for (int y = 0; y < box.height(); ++y) {
         if (untouched(acc[y])) continue;
         const double before = col[y] == egrid::kUnknown ? lp : logit(col[y]);
         const double odds = std::exp(before + acc[y]);
         col[y] = static_cast<float>(1.0 - 1.0 / (1.0 + odds));
       }
-    });
+    }
   }
 
   std::unique_ptr<EvidenceTable> table_;
   TableCache table_key_;  // of table_
-  // The call's sums over its box, [x][y], written in the marked blocks
-  // alone; kept for its allocation.
-  std::unique_ptr<Sum[]> scratch_;
-  size_t scratch_cells_ = 0;
-  TouchedBlocks blocks_;  // the call's
+  std::vector<Sum> scratch_;  // the call's sums over its box, [x][y]; kept for its allocation
   ScanBeamPlacer placer_;
   std::vector<PlacedBeam> beams_;  // a chunk's, as placed
 };

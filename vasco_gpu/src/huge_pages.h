@@ -8,8 +8,6 @@
 #define VASCO_GPU_SRC_HUGE_PAGES_H
 
 #include <cstddef>
-#include <memory>
-#include <type_traits>
 #include <vector>
 
 namespace vasco {
@@ -30,22 +28,6 @@ void assign_on_huge_pages(std::vector<T> &v, size_t n, const T &value) {
     advise_huge_pages(v.data(), n * sizeof(T));
   }
   v.assign(n, value);
-}
-
-// A buffer of at least n elements left as they are (no value written: the
-// caller writes what it reads), a new allocation (when *capacity is less
-// than n) on huge pages, advised before anything touches it.
-template <class T>
-T *grow_on_huge_pages(std::unique_ptr<T[]> &p, size_t *capacity, size_t n) {
-  static_assert(std::is_trivially_default_constructible<T>::value, "new T[n] must leave the elements unwritten");
-  if (*capacity < n) {
-    p.reset();  // the old buffer freed first: never both at once
-    *capacity = 0;
-    p.reset(new T[n]);
-    *capacity = n;
-    advise_huge_pages(p.get(), n * sizeof(T));
-  }
-  return p.get();
 }
 
 }  // namespace vasco
