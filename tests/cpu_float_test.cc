@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -126,6 +128,61 @@ TEST(CpuFloat, AnglesThatOverflowUpdateTheCellsCpuDoubleUpdates) {
     EXPECT_EQ(got_stats.cell_updates, want_stats.cell_updates);
     EXPECT_GT(want_stats.cell_updates, 0u);
   }
+}
+
+// Two clusters of short scans at opposite corners of a grid made for a
+// drive between them: the sums' box spans both, most of it reached by
+// neither. One call gives, cell for cell, the bytes of each cluster's call
+// alone, also on a renderer whose last call summed over the whole box (no
+// sum of an earlier call is read again).
+TEST(CpuFloat, ClustersFarApartGiveTheBytesOfEachAlone) {
+  MapperParams params;
+  params.resolution = 0.05;
+  params.range_max = 20.0;
+  std::mt19937 rng(testing_support::test_seed());
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2), ang(-M_PI, M_PI);
+  std::uniform_real_distribution<float> r(0.3f, 1.5f);
+  const auto cluster = [&](double cx, double cy, ScanBatch *into, int stamp) {
+    for (int s = 0; s < 12; ++s) {
+      std::vector<float> ranges(91);
+      for (float &v : ranges) v = r(rng);
+      into->add_scan(cx + jitter(rng), cy + jitter(rng), ang(rng), -M_PI / 2, M_PI / 90, ranges.data(), 91, stamp + s);
+    }
+  };
+  // Every batch starts at one pose (the grid's cells are placed from the
+  // first scan's): b's with a scan there whose beams are all unused.
+  const std::vector<float> unused(91, std::nanf(""));
+  ScanBatch a, b, both, drive;
+  cluster(-12.0, -12.0, &a, 1);
+  b.add_scan(a.x[0], a.y[0], a.theta[0], -M_PI / 2, M_PI / 90, unused.data(), 91, 99);
+  cluster(12.0, 12.0, &b, 100);
+  both.append(a);
+  both.append(b);
+  const std::vector<float> far(181, 19.0f);
+  drive.add_scan(a.x[0], a.y[0], a.theta[0], -M_PI / 2, M_PI / 90, unused.data(), 91, 1);
+  for (int s = 0; s <= 24; ++s)
+    drive.add_scan(-12.0 + s, -12.0 + s, M_PI / 4, -M_PI / 2, M_PI / 180, far.data(), 181, s + 2);
+  const GridGeometry geo = size_grid(drive, params);
+  const std::unique_ptr<Renderer> reused = make_renderer("cpu_float");
+  MapStats wide_stats;
+  render_grid(*reused, drive, params, geo, &wide_stats);
+  ASSERT_GT(wide_stats.cell_updates, 1000000u) << "the drive must leave sums all over the box";
+  const std::vector<float> got = render_grid(*reused, both, params, geo);
+  const std::vector<float> only_a = render_grid(*make_renderer("cpu_float"), a, params, geo);
+  const std::vector<float> only_b = render_grid(*make_renderer("cpu_float"), b, params, geo);
+  const std::vector<float> oracle = render_grid(*make_renderer("cpu_double"), both, params, geo);
+  size_t known = 0, differ = 0;
+  for (size_t i = 0; i < got.size(); ++i) {
+    ASSERT_FALSE(only_a[i] != egrid::kUnknown && only_b[i] != egrid::kUnknown) << "the clusters must not meet";
+    const float want = only_a[i] != egrid::kUnknown ? only_a[i] : only_b[i];
+    known += want != egrid::kUnknown;
+    if (std::memcmp(&want, &got[i], sizeof(float)) != 0 && ++differ <= 5)
+      ADD_FAILURE() << "cell " << i << ": alone " << want << " (a " << only_a[i] << ", b " << only_b[i] << "), together " << got[i] << ", oracle " << oracle[i];
+    differ += (oracle[i] != egrid::kUnknown) != (got[i] != egrid::kUnknown);
+  }
+  EXPECT_EQ(differ, 0u);
+  EXPECT_GT(known, 1000u);
+  EXPECT_LT(known * 20, got.size()) << "the clusters must reach a small part of the box";
 }
 
 }  // namespace
