@@ -382,7 +382,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "text: # vasco_gpu benchmarks: bench/run_all.sh build session": picked("bench/results/session-2026-12-07b-h100.txt"),
         "text: ## python3 bench/batch_bench.py --bin build-bench/bin --copi": picked(BENCH_RUN),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build batch":
-            picked("bench/results/batch-2026-12-07b-h100.txt"),
+            picked("bench/results/batch-2026-12-07d-h100.txt"),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build peers": picked(PEERS_RUN),
         "text: re-render linear in cell updates (cpu_float): ns per update":
             picked("bench/results/large-site-2026-12-07d-2core.txt"),
