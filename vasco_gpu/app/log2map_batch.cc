@@ -166,8 +166,8 @@ uint64_t usable_memory() {
 // finished map holds until it is written is bounded apart (the write slots).
 uint64_t read_ahead_budget() { return std::min<uint64_t>(uint64_t{1} << 30, usable_memory() / 8); }
 
-// The same with the reads under way counted at the most they may hold (ten
-// times what a log parses to): an eighth of the memory, or
+// The same with the reads under way counted at the most they may hold
+// (several times what a log parses to): an eighth of the memory, or
 // VASCO_BATCH_READ_WORST_MB MiB (batch_bench's A/B: 1024 counts them so
 // against the budget, as before, when the pool's reads were held to 14 at
 // once and fewer the further they ran ahead).
