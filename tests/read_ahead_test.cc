@@ -180,6 +180,20 @@ TEST(ReadAhead, TheWorstCaseHoldsWhateverTheInputsParseTo) {
   EXPECT_EQ(ra.expected_bytes(), 0u);
 }
 
+// A read with no estimate (a pipe) says nothing of what a file's estimate
+// overstates: inputs with one stay counted at it until a read with one ends.
+TEST(ReadAhead, APipesReadLeavesTheEstimatesAsTheyAre) {
+  std::vector<uint64_t> estimates(10, 400);
+  estimates[0] = 0;  // input 0 is a pipe
+  cli::ReadAhead ra(10, 8, 10, 1000, estimates, 100000);
+  EXPECT_EQ(ra.admit(), (Inputs{0, 1, 2}));  // 0 + 400 + 400; a third 400 would pass 1000
+  ra.read(0, 10);
+  EXPECT_EQ(ra.admit(), Inputs{});  // still 800 expected of inputs 1 and 2, 400 more would pass
+  ra.read(1, 40);                   // a tenth of its estimate: the rest counted so
+  EXPECT_EQ(ra.expected_bytes(), 40u);
+  EXPECT_EQ(ra.admit(), (Inputs{3, 4, 5, 6, 7, 8, 9}));
+}
+
 // The mean read so far counts where it is more than an input's estimate.
 TEST(ReadAhead, AReadUnderWayCountsAtTheMeanWhereThatIsMore) {
   cli::ReadAhead ra(10, 2, 10, 1000, std::vector<uint64_t>(10, 10));

@@ -327,8 +327,8 @@ class BatchRun {
       {  // counted before a mapper can have it (and release it)
         std::lock_guard<std::mutex> lock(ahead_mutex_);
         ahead_.read(i, r ? bytes_held(r->input) : 0);
-        submit_admitted();
         if (++reads_ended_ == read_.size()) all_read_.notify_all();
+        submit_admitted();
       }
       if (error) return done->set_exception(error);
       done->set_value(std::move(r));

@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <utility>
 
@@ -23,12 +24,14 @@ uint64_t ReadAhead::reservation(size_t i) const {
 }
 
 // What input i's read is expected to hold while it is under way: before
-// any read ended, the most it may; after, its estimate times the largest
-// share of their estimates the reads came to, or the mean read where that
-// is more (no estimate); never more than the most.
+// any read ended (or, for an input with an estimate, before a read with one
+// ended: a pipe's says nothing of a file's share), the most it may; after,
+// its estimate times the largest share of their estimates the reads came
+// to, or the mean read where that is more (no estimate); never more than
+// the most.
 uint64_t ReadAhead::expectation(size_t i) const {
   const uint64_t most = reservation(i);
-  if (reads_ == 0) return most;
+  if (reads_ == 0 || (share_ == 0 && estimates_[i] > 0)) return most;
   const uint64_t mean = read_bytes_ / reads_;
   const double scaled = static_cast<double>(estimates_[i]) * share_;
   const uint64_t expect = scaled >= static_cast<double>(most) ? most : static_cast<uint64_t>(scaled);
@@ -56,6 +59,7 @@ std::vector<size_t> ReadAhead::admit() {
     reserved_ += reserved_for_[next_];
     expected_for_[next_] = expectation(next_);
     expected_ += expected_for_[next_];
+    under_way_.push_back(next_);
     now.push_back(next_++);
     ++in_flight_;
   }
@@ -73,6 +77,11 @@ void ReadAhead::read(size_t i, uint64_t bytes) {
   reserved_for_[i] = 0;
   expected_ -= expected_for_[i];
   expected_for_[i] = 0;
+  const auto at = std::find(under_way_.begin(), under_way_.end(), i);
+  if (at != under_way_.end()) {
+    *at = under_way_.back();
+    under_way_.pop_back();
+  }
   bytes_[i] = bytes;
   held_ += bytes;
   if (bytes > 0) {
@@ -80,8 +89,8 @@ void ReadAhead::read(size_t i, uint64_t bytes) {
     ++reads_;
     if (estimates_[i] > 0) {
       const double share = static_cast<double>(bytes) / static_cast<double>(estimates_[i]);
-      if (share > share_ || reads_ == 1) {
-        share_ = share > share_ ? share : share_;
+      if (share > share_) {
+        share_ = share;
         recount_expected();
       }
     }
@@ -92,11 +101,11 @@ void ReadAhead::read(size_t i, uint64_t bytes) {
 // (what was let through before the first read ended counted at the most).
 void ReadAhead::recount_expected() {
   expected_ = 0;
-  for (size_t k = 0; k < expected_for_.size(); ++k)
-    if (reserved_for_[k] > 0) {
-      expected_for_[k] = expectation(k);
-      expected_ += expected_for_[k];
-    }
+  for (size_t k : under_way_) {
+    const uint64_t e = expectation(k);  // the mean may have grown since k's reservation
+    expected_for_[k] = e < reserved_for_[k] ? e : reserved_for_[k];
+    expected_ += expected_for_[k];
+  }
 }
 
 void ReadAhead::released(size_t i) {

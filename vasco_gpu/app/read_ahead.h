@@ -73,6 +73,7 @@ class ReadAhead {
   std::vector<uint64_t> bytes_;      // per input: held until released
   std::vector<uint64_t> reserved_for_;  // per input: the most it may hold, while its read is under way
   std::vector<uint64_t> expected_for_;  // per input: what it is expected to hold, likewise
+  std::vector<size_t> under_way_;       // the inputs let through whose read has not ended
   size_t next_ = 0;                  // the next input to let through
   size_t taken_ = 0;                 // inputs taken by mappers
   size_t in_flight_ = 0;             // let through, read not yet ended
