@@ -48,7 +48,7 @@ static bool fits(uint64_t held, uint64_t counted, uint64_t more, uint64_t limit)
 bool ReadAhead::may_admit(size_t i) const {
   if (stopped_ || i >= bytes_.size()) return false;
   if (i <= taken_) return true;  // a mapper waits for it (or will next)
-  if (in_flight_ >= in_flight_max_ || i - taken_ >= most_) return false;
+  if (under_way_.size() >= in_flight_max_ || i - taken_ >= most_) return false;
   return fits(held_, expected_, expectation(i), budget_) && fits(held_, reserved_, reservation(i), worst_);
 }
 
@@ -61,7 +61,6 @@ std::vector<size_t> ReadAhead::admit() {
     expected_ += expected_for_[next_];
     under_way_.push_back(next_);
     now.push_back(next_++);
-    ++in_flight_;
   }
   return now;
 }
@@ -72,7 +71,6 @@ void ReadAhead::taken(size_t i) {
 
 void ReadAhead::read(size_t i, uint64_t bytes) {
   if (i >= bytes_.size()) return;
-  if (in_flight_ > 0) --in_flight_;
   reserved_ -= reserved_for_[i];
   reserved_for_[i] = 0;
   expected_ -= expected_for_[i];

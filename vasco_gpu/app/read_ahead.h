@@ -73,10 +73,9 @@ class ReadAhead {
   std::vector<uint64_t> bytes_;      // per input: held until released
   std::vector<uint64_t> reserved_for_;  // per input: the most it may hold, while its read is under way
   std::vector<uint64_t> expected_for_;  // per input: what it is expected to hold, likewise
-  std::vector<size_t> under_way_;       // the inputs let through whose read has not ended
+  std::vector<size_t> under_way_;       // let through, read not yet ended (how many: the reads at once)
   size_t next_ = 0;                  // the next input to let through
   size_t taken_ = 0;                 // inputs taken by mappers
-  size_t in_flight_ = 0;             // let through, read not yet ended
   uint64_t held_ = 0;                // bytes of inputs read and not released
   uint64_t reserved_ = 0;            // the reads under way's reservations
   uint64_t expected_ = 0;            // and their expectations
