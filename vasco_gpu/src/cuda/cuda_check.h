@@ -134,6 +134,14 @@ class PinnedBuffer {
 class Stream {
  public:
   Stream() { VG_CUDA_CHECK(cudaStreamCreateWithFlags(&s_, cudaStreamNonBlocking)); }
+  // A stream whose blocks the device schedules before those of streams of a
+  // lower priority, whenever both wait for room on a multiprocessor.
+  struct Highest {};
+  explicit Stream(Highest) {
+    int least = 0, greatest = 0;
+    VG_CUDA_CHECK(cudaDeviceGetStreamPriorityRange(&least, &greatest));
+    VG_CUDA_CHECK(cudaStreamCreateWithPriority(&s_, cudaStreamNonBlocking, greatest));
+  }
   ~Stream() {
     if (s_ != nullptr) cudaStreamDestroy(s_);
   }

@@ -185,7 +185,7 @@ void CudaExactRenderer::launch_tile_lists(const cuda::KernelModel<double> &m, ui
                      tile_bits, sort_tmp_.get(), sort_tmp_.size(), s);
   timer.mark("sort");
   cuda::launch_exact_tile_ranges(sorted_tile_.get(), pair_bound, tile_begin_.get(), tile_end_.get(), tiles, s);
-  cuda::exact_tile_order(tile_begin_.get(), tile_end_.get(), tiles, order_.get(), order_keys_.get(),
+  cuda::exact_tile_order(tile_begin_.get(), tile_end_.get(), tiles, nb, order_.get(), order_keys_.get(),
                          order_keys_out_.get(), order_ids_.get(), heavy_count_.get(), order_tmp_.get(),
                          order_tmp_.size(), s);
   timer.mark("tile order");
@@ -198,7 +198,8 @@ void CudaExactRenderer::launch_apply(uint64_t pair_bound, bool upload_beams, Map
   const size_t tiles = num_tiles();
   reserve_scratch(pair_bound, tiles);
   if (!side_stream_) {
-    side_stream_ = std::make_unique<cuda::Stream>();
+    const char *e = std::getenv("VASCO_EXP_SIDE_PRIORITY");  // EXPERIMENT
+    side_stream_ = (e && e[0] == '0') ? std::make_unique<cuda::Stream>() : std::make_unique<cuda::Stream>(cuda::Stream::Highest{});
     fork_ = std::make_unique<cuda::Event>();
     join_ = std::make_unique<cuda::Event>();
   }

@@ -44,8 +44,6 @@ void DevicePlacement::reserve_scratch(size_t num_beams, size_t num_scans) {
   const char *what = "exact mode (beam placement)";
   const size_t nb = std::max<size_t>(num_beams, 1);
   grow_to_checked(scans_dev_, std::max<size_t>(num_scans, 1), what);
-  grow_to_checked(angles_, nb, what);
-  grow_to_checked(scan_of_, nb, what);
   grow_to_checked(used_, nb + 1, what);
   grow_to_checked(slots_, nb + 1, what);
   grow_to_checked(scan_tmp_, std::max<size_t>(cuda::exact_scan_temp_bytes(num_beams), 1), what);
@@ -73,11 +71,10 @@ DevicePlacement::Placed DevicePlacement::place(const ScanBatch &scans, size_t fi
   VG_CUDA_CHECK(cudaMemsetAsync(counters_.get(), 0, 2 * sizeof(unsigned long long), stream));
   const float *ranges = ranges_.get() + scans.beam_offset[first];
   const cuda::PlacementModel m{geo.resolution, params.wall_size, params.table_size()};
-  cuda::launch_exact_angles(scans_dev_.get(), static_cast<int>(ns), angles_.get(), scan_of_.get(), stream);
   cuda::launch_exact_used(ranges, nb, used_.get(), stream);
   cuda::exact_scan(used_.get(), slots_.get(), nb, scan_tmp_.get(), scan_tmp_.size(), stream);
-  cuda::launch_exact_place(m, scans_dev_.get(), ranges, angles_.get(), scan_of_.get(), slots_.get(), nb, beams.get(),
-                           unsure_.get(), kUnsureCapacity, counters_.get(), stream);
+  cuda::launch_exact_place(m, scans_dev_.get(), static_cast<int>(ns), ranges, slots_.get(), beams.get(), unsure_.get(),
+                           kUnsureCapacity, counters_.get(), stream);
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_counters_.get(), counters_.get(), 2 * sizeof(unsigned long long),
                                 cudaMemcpyDeviceToHost, stream));
   VG_CUDA_CHECK(cudaMemcpyAsync(staging_used_.get(), slots_.get() + nb, sizeof(uint32_t), cudaMemcpyDeviceToHost,

@@ -52,8 +52,7 @@ class DevicePlacement {
   cuda::PinnedBuffer<cuda::UnsureBeam> staging_unsure_;
   cuda::PinnedBuffer<cuda::BeamFix> staging_fixes_;
   cuda::DeviceBuffer<cuda::ExactScan> scans_dev_;
-  cuda::DeviceBuffer<double> angles_;
-  cuda::DeviceBuffer<uint32_t> scan_of_, used_, slots_;
+  cuda::DeviceBuffer<uint32_t> used_, slots_;
   cuda::DeviceBuffer<unsigned char> scan_tmp_;
   cuda::DeviceBuffer<cuda::UnsureBeam> unsure_;
   cuda::DeviceBuffer<cuda::BeamFix> fixes_;

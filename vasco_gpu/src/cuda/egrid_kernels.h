@@ -89,7 +89,7 @@ void launch_exact_tables(const KernelModel<double> &m, double2 *factors, int *re
 // The beams' placement on the device (exact_placement.cu): what the host
 // does with the oracle's code (beam_placement.cc), from a record per scan
 // and the device's copy of the ranges. A scan's beam angles are the
-// oracle's repeated additions (oracle::SteppedAngles), a thread per scan. A
+// oracle's repeated additions (oracle::SteppedAngles), a warp per scan. A
 // beam's end cell is (int)(l + (range + wall) * cos(angle) / resolution) per
 // axis, computed with CUDA's cos and sin, which are within 2 ulp of the true
 // value as glibc's are within 1: where egrid::far_from_integers says the
@@ -118,21 +118,18 @@ struct PlacementModel {
   int table_size;
 };
 
-// Per scan: its beams' angles and scan indices (num_beams in all).
-void launch_exact_angles(const ExactScan *scans, int num_scans, double *angles, uint32_t *scan_of,
-                         cudaStream_t stream);
 // Per beam: 1 where it is used (egrid::is_beam_used), 0 else, and a 0 after
 // the last (num_beams + 1 entries, for exact_scan).
 void launch_exact_used(const float *ranges, size_t num_beams, uint32_t *used, cudaStream_t stream);
-// Per used beam i: its PlacedBeam at beams[slots[i]] (slots: exact_scan of
-// `used`). counters[0] += the beams' tile bounds (exact_tile_bound.h; the
+// Per used beam i of each scan (a warp per scan, its beams' angles summed
+// as the oracle sums them): its PlacedBeam at beams[slots[i]] (slots:
+// exact_scan of `used`). counters[0] += the beams' tile bounds (exact_tile_bound.h; the
 // box bound for an unsure beam), counters[1] += the unsure beams, the first
 // `unsure_capacity` of which are listed in `unsure` (their end cells left
 // for launch_exact_fix).
-void launch_exact_place(const PlacementModel &m, const ExactScan *scans, const float *ranges, const double *angles,
-                        const uint32_t *scan_of, const uint32_t *slots, size_t num_beams, PlacedBeam *beams,
-                        UnsureBeam *unsure, uint32_t unsure_capacity, unsigned long long *counters,
-                        cudaStream_t stream);
+void launch_exact_place(const PlacementModel &m, const ExactScan *scans, int num_scans, const float *ranges,
+                        const uint32_t *slots, PlacedBeam *beams, UnsureBeam *unsure, uint32_t unsure_capacity,
+                        unsigned long long *counters, cudaStream_t stream);
 // The host's end cells of the unsure beams.
 void launch_exact_fix(const BeamFix *fixes, size_t n, PlacedBeam *beams, cudaStream_t stream);
 
@@ -168,10 +165,12 @@ void launch_exact_tile_ranges(const uint32_t *sorted_tile, size_t num_pairs, uin
 // The order in which to run the tiles: longest list first (so that the
 // longest ones do not start last and make the tail), as tile ids in `order`,
 // and in *heavy_count how many of the first run as heavy tiles (a block of
-// their own; see launch_exact_tiles). Scratch: three arrays of num_tiles and
-// exact_order_temp_bytes(num_tiles) bytes.
+// their own; see launch_exact_tiles). A list holds a beam at most once (a
+// straight walk never re-enters a tile), so its length is at most num_beams,
+// and the sort looks at that many bits alone. Scratch: three arrays of
+// num_tiles and exact_order_temp_bytes(num_tiles) bytes.
 size_t exact_order_temp_bytes(size_t num_tiles);
-void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size_t num_tiles,
+void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size_t num_tiles, size_t num_beams,
                       uint32_t *order, uint32_t *scratch_keys, uint32_t *scratch_keys_out,
                       uint32_t *scratch_ids, uint32_t *heavy_count, void *temp, size_t temp_bytes,
                       cudaStream_t stream);

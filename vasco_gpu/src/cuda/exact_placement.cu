@@ -1,6 +1,6 @@
 // Exact mode's beam placement on the device (egrid_kernels.h says what and
-// why): the beam angles per scan, the used beams' slots, their end cells,
-// and the bound on their (tile, beam) pairs. Built with --fmad=false, as
+// why): the used beams' slots, then per scan its beams' angles, their end
+// cells, and the bound on their (tile, beam) pairs. Built with --fmad=false, as
 // the other exact_*.cu: the end cell's arithmetic is the oracle's expression,
 // each operation rounded on its own.
 
@@ -15,21 +15,6 @@
 namespace vasco {
 namespace cuda {
 namespace {
-
-// One thread per scan: the oracle's angles are a running sum (beam 0's, then
-// `step` added after every beam, skipped beams too), so each depends on the
-// last one's rounding and the scan's beams are summed in order.
-__global__ void angles_kernel(const ExactScan *scans, int num_scans, double *angles, uint32_t *scan_of) {
-  const int s = blockIdx.x * blockDim.x + threadIdx.x;
-  if (s >= num_scans) return;
-  const ExactScan sc = scans[s];
-  double angle = sc.angle0;
-  for (int b = 0; b < sc.beam_count; ++b) {
-    angles[sc.beam_begin + b] = angle;
-    scan_of[sc.beam_begin + b] = static_cast<uint32_t>(s);
-    angle += sc.step;
-  }
-}
 
 __global__ void used_kernel(const float *ranges, size_t n, uint32_t *used) {
   const size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
@@ -53,35 +38,56 @@ __device__ __forceinline__ bool sure_end_cell(const PlacementModel &m, const Exa
   return true;
 }
 
+// A warp per scan. The oracle's angles are a running sum (beam 0's, then
+// `step` added after every beam, skipped beams too), so each depends on the
+// last one's rounding: every lane runs the scan's whole sum, the same
+// additions in the same order, and keeps the angle of each 32nd beam, its
+// own. (A thread per scan writing every angle out for a second kernel took
+// 77 us of fr079's re-render on an H100, its stores 32 lines apart.)
 constexpr unsigned kPlaceThreads = 256;
+constexpr unsigned kScansPerBlock = kPlaceThreads / 32;
 
-__global__ void place_kernel(PlacementModel m, const ExactScan *scans, const float *ranges, const double *angles,
-                             const uint32_t *scan_of, const uint32_t *slots, size_t n, PlacedBeam *beams,
-                             UnsureBeam *unsure, uint32_t unsure_capacity, unsigned long long *counters) {
-  __shared__ unsigned long long block_bound;
-  if (threadIdx.x == 0) block_bound = 0;
-  __syncthreads();
-  const size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x;
+__device__ __forceinline__ unsigned long long warp_sum64(unsigned long long v) {
+  for (int offset = 16; offset > 0; offset >>= 1) v += __shfl_xor_sync(0xffffffffu, v, offset);
+  return v;
+}
+
+__global__ void place_kernel(PlacementModel m, const ExactScan *scans, int num_scans, const float *ranges,
+                             const uint32_t *slots, PlacedBeam *beams, UnsureBeam *unsure,
+                             uint32_t unsure_capacity, unsigned long long *counters) {
+  const int s = blockIdx.x * kScansPerBlock + threadIdx.x / 32;
+  const int lane = threadIdx.x & 31;
+  if (s >= num_scans) return;  // the whole warp
+  const ExactScan sc = scans[s];
   unsigned long long bound = 0;
-  if (i < n && egrid::is_beam_used(ranges[i])) {
-    const uint32_t s = scan_of[i], slot = slots[i];
-    const ExactScan sc = scans[s];
-    PlacedBeam b;
-    b.scan = s;
-    b.range = ranges[i];
-    if (sure_end_cell(m, sc, angles[i], b.range, &b.x2, &b.y2)) {
-      bound = beam_tile_bound(sc.x1, sc.y1, b.x2, b.y2, m.table_size);
-    } else {
-      b.x2 = b.y2 = 0;  // the host's fix follows
-      bound = max_beam_tile_bound(m.table_size);
-      const unsigned long long k = atomicAdd(&counters[1], 1ull);
-      if (k < unsure_capacity) unsure[k] = UnsureBeam{slot, s, angles[i], b.range};
+  double angle = sc.angle0;
+  for (int b0 = 0; b0 < sc.beam_count; b0 += 32) {
+    double mine = 0;
+#pragma unroll
+    for (int j = 0; j < 32; ++j) {
+      if (j == lane) mine = angle;
+      angle += sc.step;
     }
-    beams[slot] = b;
+    const int b = b0 + lane;
+    if (b >= sc.beam_count) continue;
+    const size_t i = static_cast<size_t>(sc.beam_begin) + b;
+    if (!egrid::is_beam_used(ranges[i])) continue;
+    const uint32_t slot = slots[i];
+    PlacedBeam pb;
+    pb.scan = static_cast<uint32_t>(s);
+    pb.range = ranges[i];
+    if (sure_end_cell(m, sc, mine, pb.range, &pb.x2, &pb.y2)) {
+      bound += beam_tile_bound(sc.x1, sc.y1, pb.x2, pb.y2, m.table_size);
+    } else {
+      pb.x2 = pb.y2 = 0;  // the host's fix follows
+      bound += max_beam_tile_bound(m.table_size);
+      const unsigned long long k = atomicAdd(&counters[1], 1ull);
+      if (k < unsure_capacity) unsure[k] = UnsureBeam{slot, static_cast<uint32_t>(s), mine, pb.range};
+    }
+    beams[slot] = pb;
   }
-  if (bound) atomicAdd(&block_bound, bound);
-  __syncthreads();
-  if (threadIdx.x == 0 && block_bound) atomicAdd(&counters[0], block_bound);
+  bound = warp_sum64(bound);
+  if (lane == 0 && bound) atomicAdd(&counters[0], bound);
 }
 
 __global__ void fix_kernel(const BeamFix *fixes, size_t n, PlacedBeam *beams) {
@@ -94,26 +100,17 @@ __global__ void fix_kernel(const BeamFix *fixes, size_t n, PlacedBeam *beams) {
 
 }  // namespace
 
-void launch_exact_angles(const ExactScan *scans, int num_scans, double *angles, uint32_t *scan_of,
-                         cudaStream_t stream) {
-  if (num_scans <= 0) return;
-  angles_kernel<<<blocks_for(static_cast<size_t>(num_scans), 64), 64, 0, stream>>>(scans, num_scans, angles,
-                                                                                  scan_of);
-  VG_CUDA_CHECK_LAUNCH();
-}
-
 void launch_exact_used(const float *ranges, size_t num_beams, uint32_t *used, cudaStream_t stream) {
   used_kernel<<<blocks_for(num_beams + 1, 256), 256, 0, stream>>>(ranges, num_beams, used);
   VG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_exact_place(const PlacementModel &m, const ExactScan *scans, const float *ranges, const double *angles,
-                        const uint32_t *scan_of, const uint32_t *slots, size_t num_beams, PlacedBeam *beams,
-                        UnsureBeam *unsure, uint32_t unsure_capacity, unsigned long long *counters,
-                        cudaStream_t stream) {
-  if (num_beams == 0) return;
-  place_kernel<<<blocks_for(num_beams, kPlaceThreads), kPlaceThreads, 0, stream>>>(
-      m, scans, ranges, angles, scan_of, slots, num_beams, beams, unsure, unsure_capacity, counters);
+void launch_exact_place(const PlacementModel &m, const ExactScan *scans, int num_scans, const float *ranges,
+                        const uint32_t *slots, PlacedBeam *beams, UnsureBeam *unsure, uint32_t unsure_capacity,
+                        unsigned long long *counters, cudaStream_t stream) {
+  if (num_scans <= 0) return;
+  place_kernel<<<blocks_for(static_cast<size_t>(num_scans), kScansPerBlock), kPlaceThreads, 0, stream>>>(
+      m, scans, num_scans, ranges, slots, beams, unsure, unsure_capacity, counters);
   VG_CUDA_CHECK_LAUNCH();
 }
 

@@ -4,6 +4,7 @@
 // order, the updates of the beams that cross their own cell.
 
 #include <cub/cub.cuh>
+#include <cstdlib>
 
 #include "cuda_check.h"
 #include "egrid_kernels.h"
@@ -403,11 +404,11 @@ __global__ void __launch_bounds__(32 * kWords, kWords == kHeavyWords ? 0 : kLigh
 
 // *count = the number of leading entries of `lengths` (sorted, longest first)
 // above kHeavyList, at most kHeavyBlocks.
-__global__ void heavy_count_kernel(const uint32_t *lengths, size_t n, uint32_t *count) {
-  size_t lo = 0, hi = n < kHeavyBlocks ? n : kHeavyBlocks;
+__global__ void heavy_count_kernel(const uint32_t *lengths, size_t n, uint32_t *count, uint32_t heavy_list, uint32_t heavy_blocks) {
+  size_t lo = 0, hi = n < heavy_blocks ? n : heavy_blocks;
   while (lo < hi) {
     const size_t mid = lo + (hi - lo) / 2;
-    if (lengths[mid] > kHeavyList) lo = mid + 1;
+    if (lengths[mid] > heavy_list) lo = mid + 1;
     else hi = mid;
   }
   *count = static_cast<uint32_t>(lo);
@@ -421,6 +422,12 @@ __global__ void tile_keys_kernel(const uint32_t *begin, const uint32_t *end, siz
   ids[t] = static_cast<uint32_t>(t);
 }
 
+// EXPERIMENT: runtime knobs for the heavy tiles' threshold and count.
+uint32_t env_u32(const char *name, uint32_t dflt) {
+  const char *e = std::getenv(name);
+  return e ? static_cast<uint32_t>(std::strtoul(e, nullptr, 10)) : dflt;
+}
+
 }  // namespace
 
 size_t exact_order_temp_bytes(size_t num_tiles) {
@@ -432,17 +439,20 @@ size_t exact_order_temp_bytes(size_t num_tiles) {
   return bytes;
 }
 
-void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size_t num_tiles,
+void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size_t num_tiles, size_t num_beams,
                       uint32_t *order, uint32_t *keys, uint32_t *keys_out, uint32_t *ids, uint32_t *heavy_count,
                       void *temp, size_t temp_bytes, cudaStream_t stream) {
   if (num_tiles == 0) return;
   tile_keys_kernel<<<blocks_for(num_tiles, 256), 256, 0, stream>>>(tile_begin, tile_end, num_tiles,
                                                                    keys, ids);
   VG_CUDA_CHECK_LAUNCH();
+  int length_bits = 1;
+  while (length_bits < 32 && (uint64_t(1) << length_bits) <= num_beams) ++length_bits;
   VG_CUDA_CHECK(cub::DeviceRadixSort::SortPairsDescending(temp, temp_bytes, keys, keys_out, ids, order,
-                                                          static_cast<int64_t>(num_tiles), 0, 32,
+                                                          static_cast<int64_t>(num_tiles), 0, length_bits,
                                                           stream));
-  heavy_count_kernel<<<1, 1, 0, stream>>>(keys_out, num_tiles, heavy_count);
+  heavy_count_kernel<<<1, 1, 0, stream>>>(keys_out, num_tiles, heavy_count, env_u32("VASCO_EXP_HEAVY_LIST", kHeavyList),
+                                          env_u32("VASCO_EXP_HEAVY_BLOCKS", kHeavyBlocks));
   VG_CUDA_CHECK_LAUNCH();
 }
 
@@ -458,7 +468,8 @@ void launch_exact_tiles(const KernelModel<double> &m, const LineRec *lines, cons
   // everything queued so far, joined before anything queued later.
   VG_CUDA_CHECK(cudaEventRecord(streams.fork, streams.main));
   VG_CUDA_CHECK(cudaStreamWaitEvent(streams.side, streams.fork, 0));
-  const unsigned heavy_blocks = static_cast<unsigned>(tiles < kHeavyBlocks ? tiles : kHeavyBlocks);
+  const size_t hb = env_u32("VASCO_EXP_HEAVY_BLOCKS", kHeavyBlocks);
+  const unsigned heavy_blocks = static_cast<unsigned>(tiles < hb ? tiles : hb);
   tiles_kernel<kHeavyWords><<<heavy_blocks, 32 * kHeavyWords, shared, streams.side>>>(
       m, lines, sorted_beam, order, tile_begin, tile_end, heavy_count, factors, reach, grid, updates);
   VG_CUDA_CHECK_LAUNCH();
