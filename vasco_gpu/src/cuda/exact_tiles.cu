@@ -470,11 +470,12 @@ void launch_exact_tiles(const KernelModel<double> &m, const LineRec *lines, cons
   VG_CUDA_CHECK(cudaStreamWaitEvent(streams.side, streams.fork, 0));
   const size_t hb = env_u32("VASCO_EXP_HEAVY_BLOCKS", kHeavyBlocks);
   const unsigned heavy_blocks = static_cast<unsigned>(tiles < hb ? tiles : hb);
-  tiles_kernel<kHeavyWords><<<heavy_blocks, 32 * kHeavyWords, shared, streams.side>>>(
+  const bool swap = env_u32("VASCO_EXP_SWAP", 0) != 0;  // EXPERIMENT
+  tiles_kernel<kHeavyWords><<<heavy_blocks, 32 * kHeavyWords, shared, swap ? streams.main : streams.side>>>(
       m, lines, sorted_beam, order, tile_begin, tile_end, heavy_count, factors, reach, grid, updates);
   VG_CUDA_CHECK_LAUNCH();
   // kMaxExactTiles keeps this below 2^31 blocks.
-  tiles_kernel<kLightWords><<<static_cast<unsigned>(tiles), 32 * kLightWords, shared, streams.main>>>(
+  tiles_kernel<kLightWords><<<static_cast<unsigned>(tiles), 32 * kLightWords, shared, swap ? streams.side : streams.main>>>(
       m, lines, sorted_beam, order, tile_begin, tile_end, heavy_count, factors, reach, grid, updates);
   VG_CUDA_CHECK_LAUNCH();
   VG_CUDA_CHECK(cudaEventRecord(streams.join, streams.side));
