@@ -198,8 +198,7 @@ void CudaExactRenderer::launch_apply(uint64_t pair_bound, bool upload_beams, Map
   const size_t tiles = num_tiles();
   reserve_scratch(pair_bound, tiles);
   if (!side_stream_) {
-    const char *e = std::getenv("VASCO_EXP_SIDE_PRIORITY");  // EXPERIMENT
-    side_stream_ = (e && e[0] == '0') ? std::make_unique<cuda::Stream>() : std::make_unique<cuda::Stream>(cuda::Stream::Highest{});
+    side_stream_ = std::make_unique<cuda::Stream>(cuda::Stream::Highest{});  // the heavy tiles' (exact_tiles.cu)
     fork_ = std::make_unique<cuda::Event>();
     join_ = std::make_unique<cuda::Event>();
   }

@@ -176,7 +176,8 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
                       cudaStream_t stream);
 
 // The streams of the tiles kernels: the light tiles run on `main`, the
-// heavy ones on `side` at the same time; `fork` and `join` (events) order
+// heavy ones on `side` (of the highest priority, so that its blocks start
+// first) at the same time; `fork` and `join` (events) order
 // `side` after what `main` queued before and `main`'s later work after it.
 struct TileStreams {
   cudaStream_t main, side;

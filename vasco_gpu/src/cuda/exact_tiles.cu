@@ -4,7 +4,6 @@
 // order, the updates of the beams that cross their own cell.
 
 #include <cub/cub.cuh>
-#include <cstdlib>
 
 #include "cuda_check.h"
 #include "egrid_kernels.h"
@@ -355,10 +354,18 @@ __device__ unsigned run_tile(const KernelModel<double> &m, uint32_t tile, int t,
 // same launch (four light tiles a block) 3.92; apart on a second stream,
 // above 4096 beams (at most 132) 3.89, above 2048 (at most 264) 3.81; with
 // at most 4096 heavy tiles in one launch the map phase went 5.84 -> 7.28 ms.
-// The light tiles' total work bounds it now.
+// The heavy blocks run on a stream of the highest priority (TileStreams):
+// without it the light launch took every multiprocessor first and the heavy
+// tiles ran after it, alone (ncu on an H100: light 2.33 ms, heavy 1.28, the
+// two together 3.62). session_bench on an H100 (two runs each, exact
+// re-render, fr079 / fr101 ms): no priority 5.149 5.211 / 8.935 8.834; the
+// heavy stream first, 264 heavy blocks 4.573 4.495 / 8.342 8.297; above
+// 4096 beams 4.562 4.589 / 8.266 8.325; at most 132 heavy blocks (one an
+// SM, the rest of its registers left to light tiles) 4.432 4.388 / 8.266
+// 8.116.
 constexpr uint32_t kHeavyList = 2048;
 // At most this many tiles run heavy: the longest lists, a block each.
-constexpr uint32_t kHeavyBlocks = 264;
+constexpr uint32_t kHeavyBlocks = 132;
 constexpr int kLightWords = kTileThreads / 32, kHeavyWords = 8;
 // The light blocks an SM must be able to hold at once (__launch_bounds__'s
 // second argument): 16 leaves 64 registers a thread (a few spilled) where the
@@ -404,11 +411,11 @@ __global__ void __launch_bounds__(32 * kWords, kWords == kHeavyWords ? 0 : kLigh
 
 // *count = the number of leading entries of `lengths` (sorted, longest first)
 // above kHeavyList, at most kHeavyBlocks.
-__global__ void heavy_count_kernel(const uint32_t *lengths, size_t n, uint32_t *count, uint32_t heavy_list, uint32_t heavy_blocks) {
-  size_t lo = 0, hi = n < heavy_blocks ? n : heavy_blocks;
+__global__ void heavy_count_kernel(const uint32_t *lengths, size_t n, uint32_t *count) {
+  size_t lo = 0, hi = n < kHeavyBlocks ? n : kHeavyBlocks;
   while (lo < hi) {
     const size_t mid = lo + (hi - lo) / 2;
-    if (lengths[mid] > heavy_list) lo = mid + 1;
+    if (lengths[mid] > kHeavyList) lo = mid + 1;
     else hi = mid;
   }
   *count = static_cast<uint32_t>(lo);
@@ -420,12 +427,6 @@ __global__ void tile_keys_kernel(const uint32_t *begin, const uint32_t *end, siz
   if (t >= n) return;
   keys[t] = end[t] - begin[t];
   ids[t] = static_cast<uint32_t>(t);
-}
-
-// EXPERIMENT: runtime knobs for the heavy tiles' threshold and count.
-uint32_t env_u32(const char *name, uint32_t dflt) {
-  const char *e = std::getenv(name);
-  return e ? static_cast<uint32_t>(std::strtoul(e, nullptr, 10)) : dflt;
 }
 
 }  // namespace
@@ -451,8 +452,7 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
   VG_CUDA_CHECK(cub::DeviceRadixSort::SortPairsDescending(temp, temp_bytes, keys, keys_out, ids, order,
                                                           static_cast<int64_t>(num_tiles), 0, length_bits,
                                                           stream));
-  heavy_count_kernel<<<1, 1, 0, stream>>>(keys_out, num_tiles, heavy_count, env_u32("VASCO_EXP_HEAVY_LIST", kHeavyList),
-                                          env_u32("VASCO_EXP_HEAVY_BLOCKS", kHeavyBlocks));
+  heavy_count_kernel<<<1, 1, 0, stream>>>(keys_out, num_tiles, heavy_count);
   VG_CUDA_CHECK_LAUNCH();
 }
 
@@ -468,14 +468,12 @@ void launch_exact_tiles(const KernelModel<double> &m, const LineRec *lines, cons
   // everything queued so far, joined before anything queued later.
   VG_CUDA_CHECK(cudaEventRecord(streams.fork, streams.main));
   VG_CUDA_CHECK(cudaStreamWaitEvent(streams.side, streams.fork, 0));
-  const size_t hb = env_u32("VASCO_EXP_HEAVY_BLOCKS", kHeavyBlocks);
-  const unsigned heavy_blocks = static_cast<unsigned>(tiles < hb ? tiles : hb);
-  const bool swap = env_u32("VASCO_EXP_SWAP", 0) != 0;  // EXPERIMENT
-  tiles_kernel<kHeavyWords><<<heavy_blocks, 32 * kHeavyWords, shared, swap ? streams.main : streams.side>>>(
+  const unsigned heavy_blocks = static_cast<unsigned>(tiles < kHeavyBlocks ? tiles : kHeavyBlocks);
+  tiles_kernel<kHeavyWords><<<heavy_blocks, 32 * kHeavyWords, shared, streams.side>>>(
       m, lines, sorted_beam, order, tile_begin, tile_end, heavy_count, factors, reach, grid, updates);
   VG_CUDA_CHECK_LAUNCH();
   // kMaxExactTiles keeps this below 2^31 blocks.
-  tiles_kernel<kLightWords><<<static_cast<unsigned>(tiles), 32 * kLightWords, shared, swap ? streams.side : streams.main>>>(
+  tiles_kernel<kLightWords><<<static_cast<unsigned>(tiles), 32 * kLightWords, shared, streams.main>>>(
       m, lines, sorted_beam, order, tile_begin, tile_end, heavy_count, factors, reach, grid, updates);
   VG_CUDA_CHECK_LAUNCH();
   VG_CUDA_CHECK(cudaEventRecord(streams.join, streams.side));
