@@ -379,7 +379,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "text: Targets (fr079, map phase):": quoted(MAPPING_RUN),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build-bench parse o": picked(BENCH_RUN),
         "text: ## build-bench/bin/parse_bench": quoted(BENCH_RUN),
-        "text: # vasco_gpu benchmarks: bench/run_all.sh build session": picked("bench/results/session-2026-12-07b-h100.txt"),
+        "text: # vasco_gpu benchmarks: bench/run_all.sh build session": picked("bench/results/session-2026-12-07c-h100.txt"),
         "text: ## python3 bench/batch_bench.py --bin build-bench/bin --copi": picked(BENCH_RUN),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build batch":
             picked("bench/results/batch-2026-12-07d-h100.txt"),
