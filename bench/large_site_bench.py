@@ -26,6 +26,10 @@ Steps per size:
                 of the updates): the line through the two renders splits the time into ns per
                 update (the slope) and a part that does not grow with the updates (the grid's
                 clear, cpu_float's sums over the area reached)
+  floor         update_floor_bench on the site's log: every used beam's cells walked in the log's
+                order, adding 1 a cell over the box they reach, nothing else: the linearity target's
+                floor experiment (how much the time per update grows with the site when nothing but
+                the updates' memory does)
   node          vasco_map_node (cpu_float here) with load_session:=FILE, max_memory:=0: its first
                 /map; then a Path of every pose (moved) -> the re-rendered /map; then --replay
                 scans as LaserScan + /tf at 40 Hz -> map_updates. Its resident memory (VmRSS,
@@ -41,7 +45,8 @@ Steps per size:
                 named by their size in bytes per grid or /map cell.
 
 Targets (issue 59): re-render time grows linearly with the cell updates: ns per update of the
-largest size within 10 % of the smallest's; the node holds at most 2 bytes per /map cell beyond the
+largest size within 10 % of the smallest's (beside it the floor's growth: above the target, the
+target stands missed where the render is within 10 % of the floor); the node holds at most 2 bytes per /map cell beyond the
 evidence grid (its resident memory after the Path's /map minus the grid's bytes; and the
 slope). Each printed met or missed.
 
@@ -192,6 +197,17 @@ def run_log2map(binary: Path, site: Path, backend: str, workdir: Path) -> dict:
     if proc.returncode != 0:
         return {"error": (err_text.strip().splitlines() or ["failed"])[-1]}
     return {"seconds": seconds, "peak": usage.ru_maxrss * 1024.0, "json": json.loads(out_text or "{}")}
+
+
+def run_floor(binary: Path, site: Path) -> dict:
+    """update_floor_bench on the site's log: the same beams' cells walked in the log's order, adding
+    1 a cell and nothing else (its JSON), or why not."""
+    if not binary.exists():
+        return {"error": f"{binary} not built (make benchmarks)"}
+    proc = subprocess.run([str(binary), str(site), "--runs", "3"], capture_output=True, text=True)
+    if proc.returncode != 0:
+        return {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
+    return json.loads(proc.stdout)
 
 
 def render_child(npz: str, backend: str, renders: int) -> dict:
@@ -484,6 +500,29 @@ def slope(rows: list):
     return (extra[1] - extra[0]) / d_map, (extra[1] - extra[0]) / d_grid
 
 
+def print_floor(rows: list, ratio: float) -> None:
+    """The linearity target's floor experiment: how much update_floor_bench's time per update grows
+    from the smallest site to the largest. A render updates the same cells in the same order and
+    does more per update, none of it growing with the site, so a growth of the floor above the target
+    is one no such render can go below; a floor that does not grow says the render's growth is its own."""
+    floors = [r.get("floor", {}) for r in (rows[0], rows[-1])]
+    if any("ns_per_update" not in f for f in floors):
+        why = next((f.get("error", "not run") for f in floors if "ns_per_update" not in f), "not run")
+        print(f"    floor: not measured ({why})")
+        return
+    f0, f1 = (f["ns_per_update"] for f in floors)
+    floor_ratio = f1 / f0
+    if floor_ratio > 1 + LINEAR_TOLERANCE:
+        within = ratio <= floor_ratio * (1 + LINEAR_TOLERANCE)
+        verdict = (f"above the target; the render within {LINEAR_TOLERANCE:.0%} of it: the target stands missed"
+                   if within else f"above the target, but the render is more than {LINEAR_TOLERANCE:.0%} above it")
+    else:
+        verdict = "within the target: a render's growth past it is its own (no floor excuses the miss)"
+    print(f"    floor (update_floor_bench: the same beams' cells walked in the log's order, adding 1 a cell, "
+          f"nothing else): ns per update {f0:.3f} and {f1:.3f} (updates {floors[0]['updates']:.3g} and "
+          f"{floors[1]['updates']:.3g}): ratio {floor_ratio:.3f}, {verdict}")
+
+
 def print_targets(rows: list, backends: list, node_backend: str | None) -> None:
     print("\nTargets")
     for b in backends:
@@ -501,6 +540,7 @@ def print_targets(rows: list, backends: list, node_backend: str | None) -> None:
               f"ratio {ratio:.3f} (linear: 1; target within {LINEAR_TOLERANCE:.0%}): {verdict}; the per-update slope "
               f"alone (the sparse render's line) {slopes[0] * 1e9:.3f} and {slopes[1] * 1e9:.3f} ns: ratio "
               f"{slopes[1] / slopes[0]:.3f}")
+        print_floor([r for r in rows if r["backend"] == b], ratio)
     if node_backend is None:
         return
     node_rows = [r for r in rows if r["backend"] == backends[0] and "mem_path" in r["node"]]
@@ -527,6 +567,10 @@ def bench_size(args, target: float, workdir: Path, modules) -> list:
                "render": run_renders(npz, b, args.renders), "node": {}}
         print(f"#   {b}: log2map and re-render done ({time.monotonic() - t0:.0f} s)", flush=True)
         rows.append(row)
+    floor = run_floor(args.bin / "update_floor_bench", site)
+    print(f"#   the updates' floor done ({time.monotonic() - t0:.0f} s)", flush=True)
+    for row in rows:
+        row["floor"] = floor
     if modules is not None:
         rows[0]["node"] = run_node(modules, site, saved, args.node_backend, args.replay)
         print(f"#   node ({args.node_backend}) done ({time.monotonic() - t0:.0f} s)", flush=True)
