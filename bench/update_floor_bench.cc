@@ -11,17 +11,15 @@
 // the cells in the log's order can go below.
 //
 //   update_floor_bench LOG [--runs N]   (prints one JSON object)
-#include <sys/mman.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <string>
 #include <vector>
 
+#include "huge_pages.h"  // vasco_gpu/src: the CPU backends' host buffers
 #include "vasco_gpu/internal/beam_placement.h"
 #include "vasco_gpu/internal/egrid_math.h"
 #include "vasco_gpu/pipeline/log_input.h"
@@ -51,27 +49,6 @@ Box reached_box(const vasco::PlacedBeams &placed, const vasco::GridGeometry &geo
   box.ny = std::max(0, std::min(y_hi, geo.size_y - 1) - box.y0 + 1);
   return box;
 }
-
-// Floats on 2 MiB-aligned memory with transparent huge pages asked for, as
-// the CPU backends' grids and sums are (vasco_gpu/src/huge_pages.h).
-struct HugeFloats {
-  float *p = nullptr;
-  size_t n = 0;
-  explicit HugeFloats(size_t count) : n(count) {
-    const size_t align = size_t(2) << 20, bytes = (std::max<size_t>(n, 1) * sizeof(float) + align - 1) / align * align;
-    p = static_cast<float *>(std::aligned_alloc(align, bytes));
-    if (p == nullptr) {
-      std::fprintf(stderr, "update_floor_bench: cannot allocate %zu bytes\n", bytes);
-      std::exit(1);
-    }
-#if defined(MADV_HUGEPAGE)
-    madvise(p, bytes, MADV_HUGEPAGE);
-#endif
-  }
-  ~HugeFloats() { std::free(p); }
-  HugeFloats(const HugeFloats &) = delete;
-  HugeFloats &operator=(const HugeFloats &) = delete;
-};
 
 // One beam's cells by pointer steps (as cpu_float walks a closed-form line):
 // the major axis moves the pointer by one stride a step, the minor axis by
@@ -142,17 +119,17 @@ int main(int argc, char **argv) {
   const vasco::LogInput in = vasco::load_log_input(lo);
   const vasco::PlacedBeams placed = vasco::place_beams(in.batch, in.geo, in.params, 0, 0, in.batch.num_scans());
   const Box box = reached_box(placed, in.geo);
-  HugeFloats sums(box.cells());
+  std::vector<float> sums;  // on huge pages, as the CPU backends' grids and sums
   std::vector<double> seconds;
   uint64_t updates = 0;
   for (int r = 0; r < runs; ++r) {
-    std::memset(sums.p, 0, box.cells() * sizeof(float));  // touched before the clock: no first-touch faults timed
+    vasco::assign_on_huge_pages(sums, box.cells(), 0.0f);  // touched before the clock: no first-touch faults timed
     const auto t0 = std::chrono::steady_clock::now();
-    updates = walk_all(placed, in.geo, box, in.params.table_size(), sums.p);
+    updates = walk_all(placed, in.geo, box, in.params.table_size(), sums.data());
     seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
   double check = 0;  // read the sums, so that the walk cannot be dropped
-  for (size_t i = 0; i < box.cells(); i += 4096) check += sums.p[i];
+  for (size_t i = 0; i < sums.size(); i += 4096) check += sums[i];
   std::sort(seconds.begin(), seconds.end());
   const double median = seconds[seconds.size() / 2];
   std::printf("{\"cells\": %llu, \"box_cells\": %llu, \"beams\": %llu, \"updates\": %llu, \"seconds\": %.6f, "

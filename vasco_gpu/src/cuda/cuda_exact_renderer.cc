@@ -178,8 +178,7 @@ void CudaExactRenderer::launch_tile_lists(const cuda::KernelModel<double> &m, ui
                            updates_.get() + 1, s);
   timer.mark("pairs");
   // kNoTile's low tile_bits bits must not name a tile: 2^tile_bits > tiles.
-  int tile_bits = 1;
-  while ((size_t(1) << tile_bits) <= tiles) ++tile_bits;
+  const int tile_bits = cuda::key_bits_above(tiles);
   if (pair_bound)
     cuda::exact_sort(pair_tile_.get(), sorted_tile_.get(), pair_beam_.get(), sorted_beam_.get(), pair_bound,
                      tile_bits, sort_tmp_.get(), sort_tmp_.size(), s);

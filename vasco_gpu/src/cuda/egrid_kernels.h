@@ -152,8 +152,17 @@ void launch_exact_pairs(const KernelModel<double> &m, const LineRec *lines, cons
                         size_t num_beams, size_t capacity, uint32_t *pair_tile, uint32_t *pair_beam,
                         unsigned long long *overflow, cudaStream_t stream);
 
+// The key bits a radix sort of keys up to n looks at: the fewest b (1 to 32)
+// with 2^b > n.
+inline int key_bits_above(uint64_t n) {
+  int b = 1;
+  while (b < 32 && (uint64_t(1) << b) <= n) ++b;
+  return b;
+}
+
 // Stable sort of the pairs by tile: each tile's beams stay in (scan, beam)
-// order. tile_bits must leave kNoTile's low bits above every real tile.
+// order. tile_bits must leave kNoTile's low bits above every real tile
+// (key_bits_above(num_tiles)).
 void exact_sort(const uint32_t *tile_in, uint32_t *tile_out, const uint32_t *beam_in,
                 uint32_t *beam_out, size_t num_pairs, int tile_bits, void *temp,
                 size_t temp_bytes, cudaStream_t stream);

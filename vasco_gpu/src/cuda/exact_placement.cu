@@ -10,6 +10,7 @@
 #include "egrid_kernels.h"
 #include "exact_tile_bound.h"
 #include "launch_shape.cuh"
+#include "warp_sum.cuh"
 #include "vasco_gpu/internal/egrid_math.h"
 
 namespace vasco {
@@ -47,11 +48,6 @@ __device__ __forceinline__ bool sure_end_cell(const PlacementModel &m, const Exa
 constexpr unsigned kPlaceThreads = 256;
 constexpr unsigned kScansPerBlock = kPlaceThreads / 32;
 
-__device__ __forceinline__ unsigned long long warp_sum64(unsigned long long v) {
-  for (int offset = 16; offset > 0; offset >>= 1) v += __shfl_xor_sync(0xffffffffu, v, offset);
-  return v;
-}
-
 __global__ void place_kernel(PlacementModel m, const ExactScan *scans, int num_scans, const float *ranges,
                              const uint32_t *slots, PlacedBeam *beams, UnsureBeam *unsure,
                              uint32_t unsure_capacity, unsigned long long *counters) {
@@ -86,7 +82,7 @@ __global__ void place_kernel(PlacementModel m, const ExactScan *scans, int num_s
     }
     beams[slot] = pb;
   }
-  bound = warp_sum64(bound);
+  bound = warp_sum(bound);
   if (lane == 0 && bound) atomicAdd(&counters[0], bound);
 }
 

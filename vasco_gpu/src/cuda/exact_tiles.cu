@@ -447,10 +447,8 @@ void exact_tile_order(const uint32_t *tile_begin, const uint32_t *tile_end, size
   tile_keys_kernel<<<blocks_for(num_tiles, 256), 256, 0, stream>>>(tile_begin, tile_end, num_tiles,
                                                                    keys, ids);
   VG_CUDA_CHECK_LAUNCH();
-  int length_bits = 1;
-  while (length_bits < 32 && (uint64_t(1) << length_bits) <= num_beams) ++length_bits;
   VG_CUDA_CHECK(cub::DeviceRadixSort::SortPairsDescending(temp, temp_bytes, keys, keys_out, ids, order,
-                                                          static_cast<int64_t>(num_tiles), 0, length_bits,
+                                                          static_cast<int64_t>(num_tiles), 0, key_bits_above(num_beams),
                                                           stream));
   heavy_count_kernel<<<1, 1, 0, stream>>>(keys_out, num_tiles, heavy_count);
   VG_CUDA_CHECK_LAUNCH();
