@@ -136,33 +136,13 @@ TEST(CpuFloat, AnglesThatOverflowUpdateTheCellsCpuDoubleUpdates) {
 // alone, also on a renderer whose last call summed over the whole box (no
 // sum of an earlier call is read again).
 TEST(CpuFloat, ClustersFarApartGiveTheBytesOfEachAlone) {
-  MapperParams params;
-  params.resolution = 0.05;
-  params.range_max = 20.0;
-  std::mt19937 rng(testing_support::test_seed());
-  std::uniform_real_distribution<double> jitter(-0.2, 0.2), ang(-M_PI, M_PI);
-  std::uniform_real_distribution<float> r(0.3f, 1.5f);
-  const auto cluster = [&](double cx, double cy, ScanBatch *into, int stamp) {
-    for (int s = 0; s < 12; ++s) {
-      std::vector<float> ranges(91);
-      for (float &v : ranges) v = r(rng);
-      into->add_scan(cx + jitter(rng), cy + jitter(rng), ang(rng), -M_PI / 2, M_PI / 90, ranges.data(), 91, stamp + s);
-    }
-  };
-  // Every batch starts at one pose (the grid's cells are placed from the
-  // first scan's): b's with a scan there whose beams are all unused.
-  const std::vector<float> unused(91, std::nanf(""));
-  ScanBatch a, b, both, drive;
-  cluster(-12.0, -12.0, &a, 1);
-  b.add_scan(a.x[0], a.y[0], a.theta[0], -M_PI / 2, M_PI / 90, unused.data(), 91, 99);
-  cluster(12.0, 12.0, &b, 100);
+  const testing_support::CornerClusters corners(testing_support::test_seed(), 12);
+  const ScanBatch &a = corners.a, &b = corners.b, &drive = corners.drive;
+  const MapperParams &params = corners.params;
+  const GridGeometry &geo = corners.geo;
+  ScanBatch both;
   both.append(a);
   both.append(b);
-  const std::vector<float> far(181, 19.0f);
-  drive.add_scan(a.x[0], a.y[0], a.theta[0], -M_PI / 2, M_PI / 90, unused.data(), 91, 1);
-  for (int s = 0; s <= 24; ++s)
-    drive.add_scan(-12.0 + s, -12.0 + s, M_PI / 4, -M_PI / 2, M_PI / 180, far.data(), 181, s + 2);
-  const GridGeometry geo = size_grid(drive, params);
   const std::unique_ptr<Renderer> reused = make_renderer("cpu_float");
   MapStats wide_stats;
   render_grid(*reused, drive, params, geo, &wide_stats);

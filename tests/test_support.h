@@ -39,6 +39,41 @@ inline LoadedLog load_log(const std::string &path, const MapperParams &params) {
   return l;
 }
 
+// Two clusters of short scans at opposite corners of a grid made for a
+// drive between them (params: 0.05 m, range_max 20). Every batch starts at
+// one pose (the grid's cells are placed from the first scan's): b's with a
+// scan there whose beams are all unused, as is the drive's first.
+struct CornerClusters {
+  ScanBatch a, b, drive;
+  MapperParams params;
+  GridGeometry geo;
+
+  CornerClusters(unsigned seed, int scans_per_cluster) {
+    params.resolution = 0.05;
+    params.range_max = 20.0;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> jitter(-0.2, 0.2), ang(-M_PI, M_PI);
+    std::uniform_real_distribution<float> r(0.3f, 1.5f);
+    const auto cluster = [&](double cx, double cy, ScanBatch *into, int stamp) {
+      for (int s = 0; s < scans_per_cluster; ++s) {
+        std::vector<float> ranges(91);
+        for (float &v : ranges) v = r(rng);
+        into->add_scan(cx + jitter(rng), cy + jitter(rng), ang(rng), -M_PI / 2, M_PI / 90, ranges.data(), 91,
+                       stamp + s);
+      }
+    };
+    const std::vector<float> unused(91, std::nanf(""));
+    cluster(-12.0, -12.0, &a, 1);
+    b.add_scan(a.x[0], a.y[0], a.theta[0], -M_PI / 2, M_PI / 90, unused.data(), 91, 99);
+    cluster(12.0, 12.0, &b, 100);
+    const std::vector<float> far(181, 19.0f);
+    drive.add_scan(a.x[0], a.y[0], a.theta[0], -M_PI / 2, M_PI / 90, unused.data(), 91, 1);
+    for (int s = 0; s <= 24; ++s)
+      drive.add_scan(-12.0 + s, -12.0 + s, M_PI / 4, -M_PI / 2, M_PI / 180, far.data(), 181, s + 2);
+    geo = size_grid(drive, params);
+  }
+};
+
 // Random scans with odd ranges: NaN, +-inf, negative, >= 50, 49.99.
 inline ScanBatch random_batch(std::mt19937 &rng, int num_scans, double spread) {
   std::uniform_real_distribution<double> pos(-spread, spread), ang(-M_PI, M_PI), rr(0, 12);

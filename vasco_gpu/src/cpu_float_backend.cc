@@ -17,8 +17,10 @@
 //    increments logit(p) - logit(prior), rounded to float, for a free and for
 //    an occupied cell.
 //  * The odds update multiplies odds, so a cell's updates add in log-odds.
-//    They are summed per call in a float scratch over the box the call's
-//    scans can reach, then each touched cell is converted once. Float, not
+//    They are summed per call in floats over the box the call's scans can
+//    reach, then each touched cell is converted once: in a scratch where the
+//    grid holds an earlier map, in the grid's own cells where it was just
+//    reset (a full render: no scratch, each cell written twice). Float, not
 //    double: half the bytes to touch for the first time in a fresh process
 //    (fr079: 12 MB, not 25) and to keep in cache (fr101 at vasco's defaults:
 //    26 MB, inside a 32 MB L3; double's 51 MB was not), which log2map's map
@@ -54,7 +56,7 @@ namespace {
 #error "cpu_float's never-updated mark is -0.0: it needs signed zeros (no -ffast-math)"
 #endif
 
-// The scratch's "never updated" mark: -0.0. Every increment is normalized
+// The sums' "never updated" mark: -0.0. Every increment is normalized
 // to never be -0.0 (x + 0.0f turns -0.0 into +0.0), and in round-to-nearest
 // a sum with a term other than -0.0 is never -0.0 (x + (-x) is +0.0), so a
 // touched cell can never hold it.
@@ -159,6 +161,17 @@ class EvidenceTable {
 // it only where the start box is large next to the beams (a few scans
 // inserted: clearing and merging the box would cost more than the pass).
 using beam_updates::Box;
+
+// Where a call's sums go: the cells of `box`, cell (x, y) at
+// base[(x - box.x_lo) * stride + (y - box.y_lo)]. The scratch (stride the
+// box's height) where the grid holds an earlier map, or the grid itself
+// (stride size_y) where it was just reset: its cells in the box start as
+// the "never updated" mark and are turned into probabilities in place.
+struct SumTarget {
+  Sum *base;
+  ptrdiff_t stride;
+  Box box;
+};
 
 Box clipped_box(int64_t x0, int64_t x1, int64_t y0, int64_t y1, const GridGeometry &geo) {
   Box b;
@@ -281,7 +294,8 @@ bool in_box(const Box &box, int64_t x, int64_t y) {  // one unsigned compare an 
 // table_size steps. A line whose two ends lie in the box lies in it (the box
 // is convex, and the walk's cells stay between the ends), which spares most
 // beams steps_in_box's divisions.
-WalkFrame frame_of(const egrid::LineParams &p, int x2, int y2, int table_size, const Box &box) {
+WalkFrame frame_of(const egrid::LineParams &p, int x2, int y2, int table_size, const SumTarget &to) {
+  const Box &box = to.box;
   WalkFrame f;
   const int64_t k_max = std::min(p.major_len, table_size - 1);
   if (in_box(box, p.x1, p.y1) && in_box(box, x2, y2)) {
@@ -294,7 +308,7 @@ WalkFrame frame_of(const egrid::LineParams &p, int x2, int y2, int table_size, c
   const uint64_t a = static_cast<uint64_t>(p.a), b = static_cast<uint64_t>(p.b);
   fixed_point_of(a, b, p.inc > 0, &f);
   const int minor_inc = p.flipped ? -p.inc : p.inc;
-  const ptrdiff_t h = box.height();  // the scratch is [x][y], as the grid
+  const ptrdiff_t h = to.stride;  // the sums are [x][y], as the grid
   f.major_step = p.steep ? p.inc : p.inc * h;
   f.minor_step = p.steep ? minor_inc * h : minor_inc;
   f.diagonal = f.major_step + f.minor_step;
@@ -420,9 +434,10 @@ void walk_runs(const WalkFrame &f, const RunEnds &e, const EvidenceTable &ev, Su
 // likewise up to n_stop. The runs' ends are three steps: k_sure (n reaches
 // n_sure), k_stop (n_stop) and k_free (d reaches the range, at most k_stop),
 // each found from an estimate unless the walk ends before it.
-uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &p, int x2, int y2, const Box &box,
-                              double range, Sum *acc) {
-  const WalkFrame f = frame_of(p, x2, y2, ev.size(), box);
+uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &p, int x2, int y2, double range,
+                              const SumTarget &to) {
+  Sum *acc = to.base;
+  const WalkFrame f = frame_of(p, x2, y2, ev.size(), to);
   const int64_t lo = f.k_first, hi = f.k_end;
   if (lo >= hi) return 0;
   // n at the last step is at most (hi - 1)^2 + b^2 (m <= b): when that is
@@ -459,7 +474,8 @@ uint64_t add_closed_form_beam(const EvidenceTable &ev, const egrid::LineParams &
 // table too large to build: the oracle's sequential walk, with its stop at a
 // cell past the table, and increments computed.
 uint64_t add_walked_beam(const EvidenceTable &ev, int x1, int y1, int x2, int y2, const GridGeometry &geo,
-                         const Box &box, int64_t n_free, Sum *acc) {
+                         int64_t n_free, const SumTarget &to) {
+  const Box &box = to.box;
   uint64_t updates = 0;
   const int t = ev.size();
   egrid::walk_beam_cells(x1, y1, x2, y2, t, geo.size_x, geo.size_y, [&](int cx, int cy, int i, int j) {
@@ -468,8 +484,7 @@ uint64_t add_walked_beam(const EvidenceTable &ev, int x1, int y1, int x2, int y2
     if (n >= ev.n_stop()) return false;
     // reach_of's box holds every cell a walk reaches; past it would be past the sums.
     if (cx < box.x_lo || cx >= box.x_hi || cy < box.y_lo || cy >= box.y_hi) return true;
-    acc[static_cast<size_t>(cx - box.x_lo) * box.height() + static_cast<size_t>(cy - box.y_lo)] +=
-        ev.increment(n, n < n_free);
+    to.base[static_cast<ptrdiff_t>(cx - box.x_lo) * to.stride + (cy - box.y_lo)] += ev.increment(n, n < n_free);
     ++updates;
     return true;
   });
@@ -486,8 +501,40 @@ class CpuFloatRenderer : public HostGridRenderer {
   // a full render: sizeof(Sum) a cell besides the grid, for the budget.
   CpuFloatRenderer() : HostGridRenderer("cpu_float", false, sizeof(Sum)) {}
 
+  // On a grid holding an earlier map: sums in the scratch over the box, then
+  // each touched cell's probability updated.
   void apply_to(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
                 const GridGeometry &geo, float *cells, MapStats *stats) override {
+    render(batch, first, last, params, geo, stats, [&](const Box &box) {
+      assign_on_huge_pages(scratch_, box.cells(), kUntouched);
+      return SumTarget{scratch_.data(), box.height(), box};
+    }, [&](const EvidenceTable &ev, const Box &box) { merge(ev, box, geo, cells); });
+  }
+
+  // On a grid just reset: the sums in the grid's own cells (no scratch), the
+  // box marked untouched and the rest of the stale cells unknown first, then
+  // the box turned into probabilities in place. Each cell of the box is
+  // written twice, the reset's write and the scratch's gone (a large site's
+  // re-render: the grid's reset was a tenth of it).
+  Box apply_to_reset(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
+                     const GridGeometry &geo, const Box &stale, float *cells, MapStats *stats) override {
+    Box reached;
+    render(batch, first, last, params, geo, stats, [&](const Box &box) {
+      fill_outside(cells, geo, stale, box);
+      fill_box(cells, geo, box, kUntouched);
+      reached = box;
+      return SumTarget{cells + egrid::cell_index(box.x_lo, box.y_lo, geo.size_y), geo.size_y, box};
+    }, [&](const EvidenceTable &ev, const Box &box) { convert_in_place(ev, box, geo, cells); });
+    if (reached.cells() == 0) fill_box(cells, geo, stale, -1.0f);  // no scans: nothing reached
+    return reached;
+  }
+
+ private:
+  // The scans' beams placed and their evidence summed into the target that
+  // `prepare(box)` returns for the box they reach, then `finish(ev, box)`.
+  template <class Prepare, class Finish>
+  void render(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params, const GridGeometry &geo,
+              MapStats *stats, Prepare &&prepare, Finish &&finish) {
     const auto t0 = std::chrono::steady_clock::now();
     MapStats st;
     last = std::min(last, batch.num_scans());
@@ -497,7 +544,7 @@ class CpuFloatRenderer : public HostGridRenderer {
       const std::vector<oracle::ScanStart> starts = place_scans(batch, geo, first, last);
       const EvidenceTable &ev = table_for(params);
       const Box box = reach_of(batch, starts, first, params, geo);
-      assign_on_huge_pages(scratch_, box.cells(), kUntouched);
+      const SumTarget to = prepare(box);
       // A chunk of scans at a time, in (scan, beam) order: the same sums as
       // placing every beam first, with the chunk's beams still in cache.
       for (size_t c = first; c < last; c += kScansPerChunk) {
@@ -512,15 +559,14 @@ class CpuFloatRenderer : public HostGridRenderer {
           n += used;
         }
         st.beams_used += n;
-        st.cell_updates += add_beams(starts, beams_.data(), n, ev, geo, box);
+        st.cell_updates += add_beams(starts, beams_.data(), n, ev, geo, to);
       }
-      merge(ev, box, geo, cells);
+      finish(ev, box);
     }
     st.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (stats != nullptr) *stats = st;
   }
 
- private:
   const EvidenceTable &table_for(const MapperParams &params) {
     table_key_.ensure(params, [&] { table_ = std::make_unique<EvidenceTable>(params); });
     return *table_;
@@ -528,20 +574,25 @@ class CpuFloatRenderer : public HostGridRenderer {
 
   // Placed beams, their scans' starts in `starts`.
   uint64_t add_beams(const std::vector<oracle::ScanStart> &starts, const PlacedBeam *beams, size_t n,
-                     const EvidenceTable &ev, const GridGeometry &geo, const Box &box) {
+                     const EvidenceTable &ev, const GridGeometry &geo, const SumTarget &to) {
     uint64_t updates = 0;
-    Sum *acc = scratch_.data();
     for (size_t i = 0; i < n; ++i) {
       const PlacedBeam &b = beams[i];
       const oracle::ScanStart &s = starts[b.scan];
       if (ev.tabulated() && egrid::is_closed_form_line(s.x1, s.y1, b.x2, b.y2)) {
-        updates += add_closed_form_beam(ev, egrid::line_params(s.x1, s.y1, b.x2, b.y2), b.x2, b.y2, box,
-                                        static_cast<double>(b.range), acc);
+        updates += add_closed_form_beam(ev, egrid::line_params(s.x1, s.y1, b.x2, b.y2), b.x2, b.y2,
+                                        static_cast<double>(b.range), to);
       } else {
-        updates += add_walked_beam(ev, s.x1, s.y1, b.x2, b.y2, geo, box, ev.n_free(static_cast<double>(b.range)), acc);
+        updates += add_walked_beam(ev, s.x1, s.y1, b.x2, b.y2, geo, ev.n_free(static_cast<double>(b.range)), to);
       }
     }
     return updates;
+  }
+
+  // A cell's probability from its log-odds before the call and its sum.
+  static float probability(double logit_before, Sum sum) {
+    const double odds = std::exp(logit_before + sum);
+    return static_cast<float>(1.0 - 1.0 / (1.0 + odds));
   }
 
   // Each touched cell once: its log-odds (the prior's if unknown) plus the
@@ -550,19 +601,39 @@ class CpuFloatRenderer : public HostGridRenderer {
     const double lp = ev.logit_prior();
     for (int x = 0; x < box.width(); ++x) {
       const Sum *acc = scratch_.data() + static_cast<size_t>(x) * box.height();
-      float *col = cells + static_cast<size_t>(box.x_lo + x) * geo.size_y + box.y_lo;
+      float *col = cells + egrid::cell_index(box.x_lo + x, box.y_lo, geo.size_y);
       for (int y = 0; y < box.height(); ++y) {
         if (untouched(acc[y])) continue;
-        const double before = col[y] == egrid::kUnknown ? lp : logit(col[y]);
-        const double odds = std::exp(before + acc[y]);
-        col[y] = static_cast<float>(1.0 - 1.0 / (1.0 + odds));
+        col[y] = probability(col[y] == egrid::kUnknown ? lp : logit(col[y]), acc[y]);
       }
+    }
+  }
+
+  // The box's sums, in the grid's cells, to probabilities from the prior;
+  // a cell never updated to unknown.
+  static void convert_in_place(const EvidenceTable &ev, const Box &box, const GridGeometry &geo, float *cells) {
+    const double lp = ev.logit_prior();
+    for (int x = box.x_lo; x < box.x_hi; ++x) {
+      float *col = cells + egrid::cell_index(x, box.y_lo, geo.size_y);
+      for (int y = 0; y < box.height(); ++y) col[y] = untouched(col[y]) ? egrid::kUnknown : probability(lp, col[y]);
+    }
+  }
+
+  // The cells of `stale` outside `box`, unknown.
+  static void fill_outside(float *cells, const GridGeometry &geo, const Box &stale, const Box &box) {
+    for (int x = stale.x_lo; x < stale.x_hi; ++x) {
+      float *col = cells + egrid::cell_index(x, 0, geo.size_y);
+      const bool crosses = x >= box.x_lo && x < box.x_hi;
+      const int below = crosses ? std::min(stale.y_hi, box.y_lo) : stale.y_hi;
+      if (below > stale.y_lo) std::fill(col + stale.y_lo, col + below, egrid::kUnknown);
+      const int above = crosses ? std::max(stale.y_lo, box.y_hi) : stale.y_hi;
+      if (crosses && stale.y_hi > above) std::fill(col + above, col + stale.y_hi, egrid::kUnknown);
     }
   }
 
   std::unique_ptr<EvidenceTable> table_;
   TableCache table_key_;  // of table_
-  std::vector<Sum> scratch_;  // the call's sums over its box, [x][y]; kept for its allocation
+  std::vector<Sum> scratch_;  // apply_to's sums over its box, [x][y]; kept for its allocation
   ScanBeamPlacer placer_;
   std::vector<PlacedBeam> beams_;  // a chunk's, as placed
 };

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "beam_updates.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/renderer.h"
 
@@ -36,13 +37,33 @@ class HostGridRenderer : public Renderer {
   virtual void apply_to(const ScanBatch &scans, size_t first, size_t last, const MapperParams &params,
                         const GridGeometry &geo, float *cells, MapStats *stats) = 0;
 
+  using Box = beam_updates::Box;
+  // The same on a grid just reset, which the backend writes itself: every
+  // cell of `cells` outside `stale` is unknown, those inside it hold an
+  // earlier render's values. It leaves the map of scans [first, last) in
+  // every cell and returns the box outside which its cells are unknown. A
+  // reset grid is filled once this way, not once by the reset and again by
+  // the render (a large site's re-render: DESIGN, the CPU backends). By
+  // default: the stale box filled with unknown, then apply_to.
+  virtual Box apply_to_reset(const ScanBatch &scans, size_t first, size_t last, const MapperParams &params,
+                             const GridGeometry &geo, const Box &stale, float *cells, MapStats *stats);
+
+  // Fills the cells of `box` in a grid of `geo` with `value`.
+  static void fill_box(float *cells, const GridGeometry &geo, const Box &box, float value);
+
  private:
+  // The reset that reset() left to the next apply (or read), and the box
+  // outside which the grid's cells are unknown already.
+  void complete_reset();
+
   std::string name_;
   bool exact_;
   const double scratch_bytes_per_cell_;
   GridGeometry geo_;
   MapperParams params_;
   std::vector<float> cells_;
+  bool reset_pending_ = false;
+  Box written_;
 };
 
 // The CPU backends, each in its own source file.
