@@ -26,7 +26,10 @@ struct Corners : testing_support::CornerClusters {
   explicit Corners(unsigned seed) : CornerClusters(seed, 8) {}
 
   std::vector<float> fresh(const std::string &backend, const ScanBatch &scans) const {
-    return render_grid(*make_renderer(backend), scans, params, geo);
+    return fresh(backend, scans, geo);
+  }
+  std::vector<float> fresh(const std::string &backend, const ScanBatch &scans, const GridGeometry &g) const {
+    return render_grid(*make_renderer(backend), scans, params, g);
   }
 };
 
@@ -77,6 +80,29 @@ TEST(HostGridRenderer, ARenderAfterAnIncrementalCallHoldsOnlyItsOwnCells) {
     render_grid(*reused, c.b, c.params, c.geo);
     EXPECT_EQ(where(split(*make_renderer(backend)), split(*reused)), "") << "the drive in two calls";
     EXPECT_EQ(where(c.fresh(backend, c.a), render_grid(*reused, c.a, c.params, c.geo)), "") << "then a corner";
+  }
+}
+
+// The grid's shape changes between renders (a Mapper's frame follows its
+// poses): smaller, then wider than tall, then the first again. The buffer is
+// kept at its largest, and cells one shape wrote lie elsewhere in the next.
+TEST(HostGridRenderer, GridsOfOtherShapesAfterAResetHoldOnlyTheirOwnCells) {
+  const Corners c(testing_support::test_seed() + 2);
+  GridGeometry small = c.geo, wide = c.geo;
+  small.size_x = c.geo.size_x * 2 / 3, small.size_y = c.geo.size_y * 3 / 5;
+  wide.size_x = c.geo.size_x + c.geo.size_x / 3, wide.size_y = c.geo.size_y / 2;
+  for (const char *backend : kHostBackends) {
+    SCOPED_TRACE(backend);
+    const std::unique_ptr<Renderer> reused = make_renderer(backend);
+    render_grid(*reused, c.drive, c.params, c.geo);
+    const std::vector<float> small_a = c.fresh(backend, c.a, small), wide_d = c.fresh(backend, c.drive, wide);
+    ASSERT_GT(known_cells(small_a), 1000u);
+    ASSERT_GT(known_cells(wide_d), 1000u);
+    EXPECT_EQ(where(small_a, render_grid(*reused, c.a, c.params, small)), "") << "smaller";
+    EXPECT_EQ(where(wide_d, render_grid(*reused, c.drive, c.params, wide)), "") << "wider";
+    EXPECT_EQ(where(c.fresh(backend, c.drive), render_grid(*reused, c.drive, c.params, c.geo)), "") << "the first";
+    EXPECT_EQ(where(small_a, render_grid(*reused, c.a, c.params, small)), "") << "smaller again";
+    EXPECT_EQ(where(c.fresh(backend, c.a), render_grid(*reused, c.a, c.params, c.geo)), "") << "the first again";
   }
 }
 

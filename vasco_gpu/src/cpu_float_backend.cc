@@ -512,20 +512,20 @@ class CpuFloatRenderer : public HostGridRenderer {
   }
 
   // On a grid just reset: the sums in the grid's own cells (no scratch), the
-  // box marked untouched and the rest of the stale cells unknown first, then
+  // box marked untouched and the stale cells outside it unknown first, then
   // the box turned into probabilities in place. Each cell of the box is
-  // written twice, the reset's write and the scratch's gone (a large site's
-  // re-render: the grid's reset was a tenth of it).
+  // written twice, where a reset, the scratch's fill, its read and the merge
+  // were four passes (a large site's re-render: docs/performance.md).
   Box apply_to_reset(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
-                     const GridGeometry &geo, const Box &stale, float *cells, MapStats *stats) override {
+                     const GridGeometry &geo, const CellRange &stale, float *cells, MapStats *stats) override {
     Box reached;
     render(batch, first, last, params, geo, stats, [&](const Box &box) {
-      fill_outside(cells, geo, stale, box);
+      clear_outside(cells, geo, stale, box);
       fill_box(cells, geo, box, kUntouched);
       reached = box;
       return SumTarget{cells + egrid::cell_index(box.x_lo, box.y_lo, geo.size_y), geo.size_y, box};
     }, [&](const EvidenceTable &ev, const Box &box) { convert_in_place(ev, box, geo, cells); });
-    if (reached.cells() == 0) fill_box(cells, geo, stale, -1.0f);  // no scans: nothing reached
+    if (reached.cells() == 0) clear_outside(cells, geo, stale, Box{});  // no scans: nothing reached
     return reached;
   }
 
@@ -616,18 +616,6 @@ class CpuFloatRenderer : public HostGridRenderer {
     for (int x = box.x_lo; x < box.x_hi; ++x) {
       float *col = cells + egrid::cell_index(x, box.y_lo, geo.size_y);
       for (int y = 0; y < box.height(); ++y) col[y] = untouched(col[y]) ? egrid::kUnknown : probability(lp, col[y]);
-    }
-  }
-
-  // The cells of `stale` outside `box`, unknown.
-  static void fill_outside(float *cells, const GridGeometry &geo, const Box &stale, const Box &box) {
-    for (int x = stale.x_lo; x < stale.x_hi; ++x) {
-      float *col = cells + egrid::cell_index(x, 0, geo.size_y);
-      const bool crosses = x >= box.x_lo && x < box.x_hi;
-      const int below = crosses ? std::min(stale.y_hi, box.y_lo) : stale.y_hi;
-      if (below > stale.y_lo) std::fill(col + stale.y_lo, col + below, egrid::kUnknown);
-      const int above = crosses ? std::max(stale.y_lo, box.y_hi) : stale.y_hi;
-      if (crosses && stale.y_hi > above) std::fill(col + above, col + stale.y_hi, egrid::kUnknown);
     }
   }
 

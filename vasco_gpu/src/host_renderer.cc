@@ -11,48 +11,70 @@ namespace {
 
 HostGridRenderer::Box whole_grid(const GridGeometry &geo) { return {0, geo.size_x, 0, geo.size_y}; }
 
+// The cells from a box's first to its last (x-major): a range holding it.
+HostGridRenderer::CellRange range_of(const GridGeometry &geo, const HostGridRenderer::Box &box) {
+  if (box.cells() == 0) return {};
+  return {static_cast<size_t>(egrid::cell_index(box.x_lo, box.y_lo, geo.size_y)),
+          static_cast<size_t>(egrid::cell_index(box.x_hi - 1, box.y_hi, geo.size_y))};
+}
+
+// The smallest range holding both.
+HostGridRenderer::CellRange hull(const HostGridRenderer::CellRange &a, const HostGridRenderer::CellRange &b) {
+  if (a.lo >= a.hi) return b;
+  if (b.lo >= b.hi) return a;
+  return {std::min(a.lo, b.lo), std::max(a.hi, b.hi)};
+}
+
+// The part of a range past the grid's n cells: the buffer's, not the grid's.
+HostGridRenderer::CellRange beyond(const HostGridRenderer::CellRange &r, size_t n) {
+  if (r.hi <= n) return {};
+  return {std::max(r.lo, n), r.hi};
+}
+
 }  // namespace
 
-// A grid of the same shape is reset lazily: the next apply from scan 0 writes
-// every cell anyway (apply_to_reset), and only the cells an earlier render
-// wrote need to become unknown.
+// The reset is left to the next apply from scan 0, which writes every cell
+// anyway (apply_to_reset): only the cells an earlier render may have written
+// need to become unknown, in whatever shape the grid had. A new buffer, when
+// the grid outgrows the old one, is unknown from the start.
 void HostGridRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
-  const bool same_shape = geo.size_x == geo_.size_x && geo.size_y == geo_.size_y && cells_.size() == geo.num_cells();
   geo_ = geo;
   params_ = params;
-  if (same_shape) {
-    reset_pending_ = true;
-    return;
+  if (cells_.size() < geo.num_cells()) {
+    assign_on_huge_pages(cells_, geo.num_cells(), -1.0f);
+    written_ = CellRange{};
   }
-  assign_on_huge_pages(cells_, geo.num_cells(), -1.0f);  // keeps the allocation when the size does not grow
-  reset_pending_ = false;
-  written_ = Box{};
+  reset_pending_ = true;
 }
 
 void HostGridRenderer::complete_reset() {
   if (!reset_pending_) return;
-  fill_box(cells_.data(), geo_, written_, -1.0f);
+  const size_t n = geo_.num_cells();
+  if (written_.lo < std::min(written_.hi, n))
+    std::fill(cells_.begin() + written_.lo, cells_.begin() + std::min(written_.hi, n), -1.0f);
+  written_ = beyond(written_, n);
   reset_pending_ = false;
-  written_ = Box{};
 }
 
 void HostGridRenderer::apply(const ScanBatch &scans, size_t first, size_t last, MapStats *stats) {
+  const size_t n = geo_.num_cells();
   if (reset_pending_ && first == 0) {
-    const Box stale = written_;
-    written_ = whole_grid(geo_);  // until it returns: a render that throws leaves every cell stale
-    written_ = apply_to_reset(scans, first, last, params_, geo_, stale, cells_.data(), stats);
+    const CellRange stale = written_;
+    written_ = {0, cells_.size()};  // until it returns: a render that throws leaves every cell stale
+    const Box box = apply_to_reset(scans, first, last, params_, geo_, stale, cells_.data(), stats);
+    written_ = hull(range_of(geo_, box), beyond(stale, n));  // the buffer past the grid is left as it was
     reset_pending_ = false;
     return;
   }
   complete_reset();
-  written_ = whole_grid(geo_);
+  written_ = hull(written_, CellRange{0, n});
   apply_to(scans, first, last, params_, geo_, cells_.data(), stats);
 }
 
 HostGridRenderer::Box HostGridRenderer::apply_to_reset(const ScanBatch &scans, size_t first, size_t last,
                                                        const MapperParams &params, const GridGeometry &geo,
-                                                       const Box &stale, float *cells, MapStats *stats) {
-  fill_box(cells, geo, stale, -1.0f);
+                                                       const CellRange &stale, float *cells, MapStats *stats) {
+  clear_outside(cells, geo, stale, Box{});
   apply_to(scans, first, last, params, geo, cells, stats);
   return whole_grid(geo);
 }
@@ -61,6 +83,25 @@ void HostGridRenderer::fill_box(float *cells, const GridGeometry &geo, const Box
   for (int x = box.x_lo; x < box.x_hi; ++x) {
     float *col = cells + egrid::cell_index(x, box.y_lo, geo.size_y);
     std::fill(col, col + box.height(), value);
+  }
+}
+
+// Column by column: a column's part of the range, less the box's rows.
+void HostGridRenderer::clear_outside(float *cells, const GridGeometry &geo, const CellRange &stale, const Box &box) {
+  const size_t n = geo.num_cells(), sy = static_cast<size_t>(geo.size_y);
+  const size_t lo = std::min(stale.lo, n), hi = std::min(stale.hi, n);
+  if (lo >= hi || sy == 0) return;
+  for (size_t x = lo / sy; x * sy < hi; ++x) {
+    const size_t y0 = std::max(lo, x * sy) - x * sy, y1 = std::min(hi, (x + 1) * sy) - x * sy;
+    float *col = cells + x * sy;
+    const bool crosses = box.cells() > 0 && x >= static_cast<size_t>(box.x_lo) && x < static_cast<size_t>(box.x_hi);
+    if (!crosses) {
+      std::fill(col + y0, col + y1, -1.0f);
+      continue;
+    }
+    const size_t b0 = static_cast<size_t>(box.y_lo), b1 = static_cast<size_t>(box.y_hi);
+    if (y0 < std::min(y1, b0)) std::fill(col + y0, col + std::min(y1, b0), -1.0f);
+    if (std::max(y0, b1) < y1) std::fill(col + std::max(y0, b1), col + y1, -1.0f);
   }
 }
 

@@ -38,22 +38,28 @@ class HostGridRenderer : public Renderer {
                         const GridGeometry &geo, float *cells, MapStats *stats) = 0;
 
   using Box = beam_updates::Box;
-  // The same on a grid just reset, which the backend writes itself: every
-  // cell of `cells` outside `stale` is unknown, those inside it hold an
-  // earlier render's values. It leaves the map of scans [first, last) in
-  // every cell and returns the box outside which its cells are unknown. A
-  // reset grid is filled once this way, not once by the reset and again by
-  // the render (a large site's re-render: DESIGN, the CPU backends). By
-  // default: the stale box filled with unknown, then apply_to.
+  // Cells [lo, hi) of the buffer (x-major): every cell outside is unknown.
+  struct CellRange {
+    size_t lo = 0, hi = 0;
+  };
+  // The same on a grid just reset, which the backend writes itself: the
+  // cells in `stale` may hold an earlier render's values (in an earlier
+  // shape of the grid), every other cell is unknown. It leaves the map of
+  // scans [first, last) in every cell of the grid and returns the box
+  // outside which its cells are unknown. A reset grid is filled once this
+  // way, not once by the reset and again by the render (a large site's
+  // re-render: docs/performance.md). By default: the stale cells made
+  // unknown, then apply_to.
   virtual Box apply_to_reset(const ScanBatch &scans, size_t first, size_t last, const MapperParams &params,
-                             const GridGeometry &geo, const Box &stale, float *cells, MapStats *stats);
+                             const GridGeometry &geo, const CellRange &stale, float *cells, MapStats *stats);
 
-  // Fills the cells of `box` in a grid of `geo` with `value`.
+  // The cells of `box` in a grid of `geo` set to `value`.
   static void fill_box(float *cells, const GridGeometry &geo, const Box &box, float value);
+  // The cells of `stale` outside `box` (in a grid of `geo`) made unknown.
+  static void clear_outside(float *cells, const GridGeometry &geo, const CellRange &stale, const Box &box);
 
  private:
-  // The reset that reset() left to the next apply (or read), and the box
-  // outside which the grid's cells are unknown already.
+  // The reset that reset() left to the next apply (or read).
   void complete_reset();
 
   std::string name_;
@@ -61,9 +67,9 @@ class HostGridRenderer : public Renderer {
   const double scratch_bytes_per_cell_;
   GridGeometry geo_;
   MapperParams params_;
-  std::vector<float> cells_;
+  std::vector<float> cells_;  // the grid: its first geo_.num_cells(); kept at its largest size
   bool reset_pending_ = false;
-  Box written_;
+  CellRange written_;  // the cells an apply may have written since the buffer was all unknown
 };
 
 // The CPU backends, each in its own source file.
