@@ -84,8 +84,9 @@ TEST(HostGridRenderer, ARenderAfterAnIncrementalCallHoldsOnlyItsOwnCells) {
 }
 
 // The grid's shape changes between renders (a Mapper's frame follows its
-// poses): smaller, then wider than tall, then the first again. The buffer is
-// kept at its largest, and cells one shape wrote lie elsewhere in the next.
+// poses): smaller, then wider than tall, then the first again, taller (into
+// the buffer's room) and twice as wide (past it). The buffer is kept at its
+// largest, and cells one shape wrote lie elsewhere in the next.
 TEST(HostGridRenderer, GridsOfOtherShapesAfterAResetHoldOnlyTheirOwnCells) {
   const Corners c(testing_support::test_seed() + 2);
   GridGeometry small = c.geo, wide = c.geo;
@@ -103,6 +104,11 @@ TEST(HostGridRenderer, GridsOfOtherShapesAfterAResetHoldOnlyTheirOwnCells) {
     EXPECT_EQ(where(c.fresh(backend, c.drive), render_grid(*reused, c.drive, c.params, c.geo)), "") << "the first";
     EXPECT_EQ(where(small_a, render_grid(*reused, c.a, c.params, small)), "") << "smaller again";
     EXPECT_EQ(where(c.fresh(backend, c.a), render_grid(*reused, c.a, c.params, c.geo)), "") << "the first again";
+    GridGeometry taller = c.geo, larger = c.geo;  // into the buffer's room, then past it
+    taller.size_y += c.geo.size_y / 16;
+    larger.size_x *= 2;
+    EXPECT_EQ(where(c.fresh(backend, c.drive, taller), render_grid(*reused, c.drive, c.params, taller)), "") << "taller";
+    EXPECT_EQ(where(c.fresh(backend, c.a, larger), render_grid(*reused, c.a, c.params, larger)), "") << "larger";
   }
 }
 

@@ -56,6 +56,13 @@ TEST(HugePages, AssignGivesTheCellsAndKeepsTheAllocationWhileTheSizeDoesNotGrow)
   vasco::assign_on_huge_pages(v, n * 2, 2.0f);  // larger: a new one, every cell given
   ASSERT_EQ(v.size(), n * 2);
   for (size_t i = 0; i < v.size(); i += 4099) ASSERT_EQ(v[i], 2.0f) << i;
+  std::vector<float> roomy;
+  vasco::assign_on_huge_pages(roomy, n, -1.0f, n + n / 8);
+  EXPECT_GE(roomy.capacity(), n + n / 8);
+  const float *at = roomy.data();
+  vasco::assign_on_huge_pages(roomy, n + n / 8, 3.0f);  // grown into its room: the same allocation
+  EXPECT_EQ(roomy.data(), at);
+  for (size_t i = 0; i < roomy.size(); i += 4099) ASSERT_EQ(roomy[i], 3.0f) << i;
   std::vector<float> small;
   vasco::assign_on_huge_pages(small, 10, 1.0f);  // under the advice's size: plain assign
   EXPECT_EQ(small, std::vector<float>(10, 1.0f));

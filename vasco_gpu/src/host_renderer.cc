@@ -35,13 +35,20 @@ HostGridRenderer::CellRange beyond(const HostGridRenderer::CellRange &r, size_t 
 
 // The reset is left to the next apply from scan 0, which writes every cell
 // anyway (apply_to_reset): only the cells an earlier render may have written
-// need to become unknown, in whatever shape the grid had. A new buffer, when
-// the grid outgrows the old one, is unknown from the start.
+// need to become unknown, in whatever shape the grid had. A grid that
+// outgrows the buffer grows it, the new cells unknown: in place where the
+// allocation has room, else in a new allocation, unknown from the start,
+// with an eighth more room (re-renders after loop closures move the frame a
+// little at a time; a new allocation of a large site's grid, faulted in
+// again, cost more than the render's passes over it).
 void HostGridRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
   geo_ = geo;
   params_ = params;
-  if (cells_.size() < geo.num_cells()) {
-    assign_on_huge_pages(cells_, geo.num_cells(), -1.0f);
+  const size_t n = geo.num_cells();
+  if (cells_.size() < n && cells_.capacity() >= n) {
+    cells_.resize(n, -1.0f);
+  } else if (cells_.size() < n) {
+    assign_on_huge_pages(cells_, n, -1.0f, n + n / 8);
     written_ = CellRange{};
   }
   reset_pending_ = true;

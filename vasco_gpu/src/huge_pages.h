@@ -7,6 +7,7 @@
 #ifndef VASCO_GPU_SRC_HUGE_PAGES_H
 #define VASCO_GPU_SRC_HUGE_PAGES_H
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -19,13 +20,17 @@ void advise_huge_pages(void *p, size_t bytes);
 
 // v.assign(n, value), a new allocation (when the old one is too small) on
 // huge pages: advised before assign touches it. Keeps the allocation when the
-// size does not grow, as assign does.
+// size does not grow, as assign does. A new allocation reserves `capacity`
+// elements where that is more than n: address space, not memory (a page
+// is resident from its first touch), for a buffer that grows a little at a
+// time (a grid whose frame follows its poses) to grow into without moving.
 template <class T>
-void assign_on_huge_pages(std::vector<T> &v, size_t n, const T &value) {
+void assign_on_huge_pages(std::vector<T> &v, size_t n, const T &value, size_t capacity = 0) {
   if (v.capacity() < n) {
     std::vector<T>().swap(v);  // the old cells freed first: never both at once
-    v.reserve(n);
-    advise_huge_pages(v.data(), n * sizeof(T));
+    capacity = std::max(n, capacity);
+    v.reserve(capacity);
+    advise_huge_pages(v.data(), capacity * sizeof(T));
   }
   v.assign(n, value);
 }
