@@ -15,28 +15,31 @@ written once per size as a session file (vasco_gpu/ros/session_file.py: a CARMEN
 log2map maps as it is and the node's load_session restores), resolution 0.05 m, downsample 1
 (the map's cell is the grid's), vasco's other defaults; laser mount (0, 0, 0), stamps 25 ms apart.
 
-Steps per size:
-  log2map       log2map --backend B --max-memory 0 FILE OUT.pgm: its wall time and peak resident
-                memory (the child's ru_maxrss, os.wait4); the map phase from its --json
-  re-render     a Mapper session (another process) inserts every scan, then renders every scan at
-                moved poses --renders times (the trajectory turned about its first pose by a few
-                mrad, as a loop closure moves it): median seconds, Mapper.last_stats()'s
-                cell_updates, ns per cell update, the session's resident bytes and the process's
-                peak; and every 100th scan rendered in the same frame (the same area, a hundredth
-                of the updates): the line through the two renders splits the time into ns per
-                update (the slope) and a part that does not grow with the updates (the grid's
-                clear, cpu_float's sums over the area reached)
-  floor         update_floor_bench on the site's log: every used beam's cells walked in the log's
-                order, adding 1 a cell over the box they reach, nothing else: the linearity target's
-                floor experiment (how much the time per update grows with the site when nothing but
-                the updates' memory does)
+Steps (every size's site is made first; the sizes are timed in turn where a ratio between them
+is the target, so that a drift of a shared machine's speed falls on every size alike):
+  log2map       per size: log2map --backend B --max-memory 0 FILE OUT.pgm: its wall time and peak
+                resident memory (the child's ru_maxrss, os.wait4); the map phase from its --json
+  re-render     one process (another than this) with a Mapper session per size, each inserting
+                every scan and rendering once (the session's resident bytes), then --renders rounds
+                of every session rendering every scan at moved poses, the sizes in turn (the
+                trajectory turned about its first pose by a few mrad, as a loop closure moves it):
+                median seconds, Mapper.last_stats()'s cell_updates, ns per cell update; and every
+                100th scan rendered in the same frame (the same area, a hundredth of the updates):
+                the line through the two renders splits the time into ns per update (the slope)
+                and a part that does not grow with the updates (the grid's passes over the area
+                reached); the process's peak
+  floor         update_floor_bench on the sites' logs, in turn: every used beam's cells walked in
+                the log's order, adding 1 a cell over the box they reach, nothing else: the
+                linearity target's floor experiment (how much the time per update grows with the
+                site when nothing but the updates' memory does)
   node          vasco_map_node (cpu_float here) with load_session:=FILE, max_memory:=0: its first
                 /map; then a Path of every pose (moved) -> the re-rendered /map; then --replay
                 scans as LaserScan + /tf at 40 Hz -> map_updates. Its resident memory (VmRSS,
                 VmHWM, /proc) minus the evidence grid's bytes, per /map cell and per grid cell:
                 the grid's bytes measured (the re-render's session: grid, renderer scratch,
                 stored scans, resident), and as the renderer's host bytes a cell (4 grid floats,
-                + 4 for cpu_float's float sums over the cells reached, host_renderer.h: a bound); the slope of the resident memory between the two
+                + 4 for cpu_float's float sums over the cells reached, host_renderer.h: a bound,
+                which its incremental inserts use); the slope of the resident memory between the two
                 sizes per cell (the same scans: what grows with the cells only); the bytes of each
                 /map and map_updates message's data; publish -> a subscriber's callback (the
                 message's source timestamp, which Fast DDS takes as the publisher writes it, ->
@@ -199,43 +202,61 @@ def run_log2map(binary: Path, site: Path, backend: str, workdir: Path) -> dict:
     return {"seconds": seconds, "peak": usage.ru_maxrss * 1024.0, "json": json.loads(out_text or "{}")}
 
 
-def run_floor(binary: Path, site: Path) -> dict:
-    """update_floor_bench on the site's log: the same beams' cells walked in the log's order, adding
-    1 a cell and nothing else (its JSON), or why not."""
+def run_floor(binary: Path, sites: list) -> list:
+    """update_floor_bench on the sites' logs, walked in turn run after run: the same beams' cells
+    walked in the log's order, adding 1 a cell and nothing else (its JSON a site), or why not."""
     if not binary.exists():
-        return {"error": f"{binary} not built (make benchmarks)"}
-    proc = subprocess.run([str(binary), str(site), "--runs", "3"], capture_output=True, text=True)
+        return [{"error": f"{binary} not built (make benchmarks)"}] * len(sites)
+    proc = subprocess.run([str(binary), *map(str, sites), "--runs", "3"], capture_output=True, text=True)
     if proc.returncode != 0:
-        return {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
-    return json.loads(proc.stdout)
+        return [{"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}] * len(sites)
+    return [json.loads(line) for line in proc.stdout.strip().splitlines()]
 
 
-def render_child(npz: str, backend: str, renders: int) -> dict:
-    """In its own process (--render-child): insert every scan, then `renders` renders at moved
-    poses; the session's resident bytes (VmRSS after, less before it was made: the grid, the
-    renderer's scratch, the stored scans); then every SPARSE-th scan rendered in the same frame
-    (the same area reached, a hundredth of the updates), which splits a render's time into a part
-    per cell update and a part that does not grow with them."""
+def render_child(npzs: list, backend: str, renders: int) -> dict:
+    """In its own process (--render-child): a Mapper session per site, each inserting every scan
+    and rendering once (its resident bytes: VmRSS then, less before it was made: the grid, the
+    renderer's scratch, the stored scans); then `renders` rounds, each re-rendering every site's
+    session once at moved poses (the trajectory turned about its first pose by a few mrad, as a
+    loop closure moves it), the sites in turn, so that a drift of the machine's speed over the run
+    falls on every size alike; then the same with every SPARSE-th scan in each session's frame (the
+    same area reached, a hundredth of the updates), which splits a render's time into a part per
+    cell update and a part that does not grow with them."""
     import vasco_gpu as vg
 
-    data = np.load(npz)
-    poses, ranges = data["poses"], data["ranges"]
     name, mode = MAPPER_BACKEND.get(backend, (backend, None))
-    before = proc_bytes("self", "VmRSS")
-    m = vg.Mapper(site_params(), backend=name, cuda_mode=mode, max_memory_bytes=0, expected_renders=renders + 1)
-    t0 = time.perf_counter()
-    m.insert(scans_of(poses, ranges))
-    insert_s, times = time.perf_counter() - t0, timed_renders(m, poses, renders)
-    stats, frame, session_rss = m.last_stats, m.frame, proc_bytes("self", "VmRSS") - before
-    del m
-    sparse = vg.Mapper(site_params(), backend=name, cuda_mode=mode, max_memory_bytes=0, frame=frame,
-                       frame_centre=(frame.x0, frame.y0))
-    sparse.insert(scans_of(poses[::SPARSE], ranges[::SPARSE]))
-    sparse_times = timed_renders(sparse, poses[::SPARSE], renders)
-    return {"insert_s": insert_s, "render_s": times, "updates": stats["cell_updates"], "map_s": stats["map_s"],
-            "cells": frame.size_x * frame.size_y, "grid": [frame.size_x, frame.size_y], "session_rss": session_rss,
-            "sparse_s": float(np.median(sparse_times)), "sparse_updates": sparse.last_stats["cell_updates"],
-            "peak": proc_bytes("self", "VmHWM")}
+    sites = []
+    for npz in npzs:
+        data = np.load(npz)
+        poses, ranges = data["poses"], data["ranges"]
+        before = proc_bytes("self", "VmRSS")
+        m = vg.Mapper(site_params(), backend=name, cuda_mode=mode, max_memory_bytes=0, expected_renders=renders + 1)
+        t0 = time.perf_counter()
+        m.insert(scans_of(poses, ranges))
+        insert_s = time.perf_counter() - t0
+        m.render(moved(poses, renders))  # untimed: every buffer a render uses resident before the bytes are read
+        frame = m.frame
+        sites.append({"mapper": m, "poses": poses, "ranges": ranges, "out": {
+            "insert_s": insert_s, "render_s": [], "cells": frame.size_x * frame.size_y,
+            "grid": [frame.size_x, frame.size_y], "session_rss": proc_bytes("self", "VmRSS") - before}})
+    for k in range(renders):
+        for site in sites:
+            site["out"]["render_s"].append(timed_render(site["mapper"], moved(site["poses"], k)))
+            stats = site["mapper"].last_stats
+            site["out"].update(updates=stats["cell_updates"], map_s=stats["map_s"])
+    for site in sites:  # the full sessions freed before the sparse ones are made
+        frame = site.pop("mapper").frame
+        site["sparse"] = vg.Mapper(site_params(), backend=name, cuda_mode=mode, max_memory_bytes=0, frame=frame,
+                                   frame_centre=(frame.x0, frame.y0))
+        site["sparse"].insert(scans_of(site["poses"][::SPARSE], site["ranges"][::SPARSE]))
+        site["out"]["sparse_s"] = []
+    for k in range(renders):
+        for site in sites:
+            site["out"]["sparse_s"].append(timed_render(site["sparse"], moved(site["poses"][::SPARSE], k)))
+    for site in sites:
+        site["out"]["sparse_updates"] = site["sparse"].last_stats["cell_updates"]
+        site["out"]["sparse_s"] = float(np.median(site["out"]["sparse_s"]))
+    return {"sites": [site["out"] for site in sites], "peak": proc_bytes("self", "VmHWM")}
 
 
 def scans_of(poses: np.ndarray, ranges: np.ndarray):
@@ -244,13 +265,10 @@ def scans_of(poses: np.ndarray, ranges: np.ndarray):
     return vg.Scans(poses, ranges.ravel(), np.full(len(poses), BEAMS), -math.pi / 2, math.pi / (BEAMS - 1))
 
 
-def timed_renders(mapper, poses: np.ndarray, renders: int) -> list:
-    times = []
-    for k in range(renders):
-        t0 = time.perf_counter()
-        mapper.render(moved(poses, k))
-        times.append(time.perf_counter() - t0)
-    return times
+def timed_render(mapper, poses: np.ndarray) -> float:
+    t0 = time.perf_counter()
+    mapper.render(poses)
+    return time.perf_counter() - t0
 
 
 def per_update(m: dict) -> tuple[float, float]:
@@ -261,8 +279,9 @@ def per_update(m: dict) -> tuple[float, float]:
     return slope, full - slope * m["updates"]
 
 
-def run_renders(npz: Path, backend: str, renders: int) -> dict:
-    args = [sys.executable, __file__, "--render-child", str(npz), backend, str(renders)]
+def run_renders(npzs: list, backend: str, renders: int) -> dict:
+    """render_child's figures: {"sites": one dict a site, "peak": the process's VmHWM}, or an error."""
+    args = [sys.executable, __file__, "--render-child", backend, str(renders), *map(str, npzs)]
     done = subprocess.run(args, capture_output=True, text=True)
     if done.returncode != 0:
         return {"error": (done.stderr.strip().splitlines() or ["failed"])[-1]}
@@ -422,10 +441,11 @@ def mb(b: float) -> str:
 def print_tools(rows: list) -> None:
     print("\nlog2map and the re-render (a Mapper session): seconds; ns per cell update of the median render; the")
     print("line through it and the sparse render (every 100th scan, same frame): ns/upd slope, and the seconds that")
-    print("do not grow with the updates (rest s); session: the Mapper's resident bytes; peak: the process's")
+    print("do not grow with the updates (rest s); session: the Mapper's resident bytes. The sizes' sessions")
+    print("re-render in one process, in turn (the render columns are of one time); log2map's peak is its own")
     head = (f"{'cells':>8} {'backend':<11} {'grid':>13} {'log2map s':>9} {'map s':>6} {'peak':>9} {'insert s':>8} "
             f"{'render s':>8} {'updates':>14} {'ns/upd':>7} {'sparse s':>8} {'ns/upd slope':>12} {'rest s':>6} "
-            f"{'session':>9} {'peak':>9}")
+            f"{'session':>9}")
     print(head + "\n" + "-" * len(head))
     for r in rows:
         l, m = r["log2map"], r["render"]
@@ -436,7 +456,10 @@ def print_tools(rows: list) -> None:
         print(f"{r['target']:>8.0e} {r['backend']:<11} {m['grid'][0]:>6}x{m['grid'][1]:<6} {l['seconds']:>9.2f} "
               f"{l['json']['seconds']['map']:>6.2f} {mb(l['peak']):>9} {m['insert_s']:>8.2f} {med:>8.2f} "
               f"{m['updates']:>14,} {med / m['updates'] * 1e9:>7.3f} {m['sparse_s']:>8.3f} {slope * 1e9:>12.3f} "
-              f"{rest:>6.2f} {mb(m['session_rss']):>9} {mb(m['peak']):>9}")
+              f"{rest:>6.2f} {mb(m['session_rss']):>9}")
+    peaks = {r["backend"]: r["render_peak"] for r in rows if r.get("render_peak") is not None}
+    for backend, peak in peaks.items():
+        print(f"#   the re-render process's peak ({backend}, every size's session in it): {mb(peak)}")
 
 
 def beyond_grid(mem: dict, row: dict, key: str = "VmRSS") -> float:
@@ -516,6 +539,8 @@ def print_floor(rows: list, ratio: float) -> None:
         within = ratio <= floor_ratio * (1 + LINEAR_TOLERANCE)
         verdict = (f"above the target; the render within {LINEAR_TOLERANCE:.0%} of it: the target stands missed"
                    if within else f"above the target, but the render is more than {LINEAR_TOLERANCE:.0%} above it")
+    elif ratio <= 1 + LINEAR_TOLERANCE:
+        verdict = "within the target, as the render is"
     else:
         verdict = "within the target: a render's growth past it is its own (no floor excuses the miss)"
     print(f"    floor (update_floor_bench: the same beams' cells walked in the log's order, adding 1 a cell, "
@@ -556,32 +581,45 @@ def print_targets(rows: list, backends: list, node_backend: str | None) -> None:
               f"cancel): {s[0]:.2f} bytes per /map cell, {s[1]:.2f} per grid cell: {verdict}")
 
 
-def bench_size(args, target: float, workdir: Path, modules) -> list:
+def bench_sites(args, workdir: Path, modules) -> list:
+    """Every size's site made, then log2map on each; the re-renders and the floor of every size in
+    one process each (the sizes in turn); the node on each; one row a (size, backend)."""
     t0 = time.monotonic()
-    site, npz, saved, side = write_site(workdir, target, args.scans)
-    print(f"# {target:.0e} cells: a {side:.1f} m site, {args.scans} scans, session file "
-          f"{site.stat().st_size / 1e6:.0f} MB, made in {time.monotonic() - t0:.1f} s", flush=True)
-    rows = []
+    sites = []
+    for target in args.cells:
+        site, npz, saved, side = write_site(workdir, target, args.scans)
+        print(f"# {target:.0e} cells: a {side:.1f} m site, {args.scans} scans, session file "
+              f"{site.stat().st_size / 1e6:.0f} MB, made in {time.monotonic() - t0:.1f} s", flush=True)
+        sites.append((target, site, npz, saved))
+    rows = {}
+    for target, site, _, _ in sites:
+        for b in args.backends:
+            rows[target, b] = {"target": target, "backend": b, "node": {},
+                               "log2map": run_log2map(args.bin / "log2map", site, b, workdir)}
+        print(f"#   {target:.0e}: log2map done ({time.monotonic() - t0:.0f} s)", flush=True)
     for b in args.backends:
-        row = {"target": target, "backend": b, "log2map": run_log2map(args.bin / "log2map", site, b, workdir),
-               "render": run_renders(npz, b, args.renders), "node": {}}
-        print(f"#   {b}: log2map and re-render done ({time.monotonic() - t0:.0f} s)", flush=True)
-        rows.append(row)
-    floor = run_floor(args.bin / "update_floor_bench", site)
-    print(f"#   the updates' floor done ({time.monotonic() - t0:.0f} s)", flush=True)
-    for row in rows:
-        row["floor"] = floor
-    if modules is not None:
-        rows[0]["node"] = run_node(modules, site, saved, args.node_backend, args.replay)
-        print(f"#   node ({args.node_backend}) done ({time.monotonic() - t0:.0f} s)", flush=True)
-    site.unlink()
-    npz.unlink()
-    return rows
+        renders = run_renders([npz for _, _, npz, _ in sites], b, args.renders)
+        for i, (target, _, _, _) in enumerate(sites):
+            rows[target, b]["render"] = renders["sites"][i] if "sites" in renders else renders
+            rows[target, b]["render_peak"] = renders.get("peak")
+        print(f"#   {b}: the re-renders, the sizes in turn, done ({time.monotonic() - t0:.0f} s)", flush=True)
+    floors = run_floor(args.bin / "update_floor_bench", [site for _, site, _, _ in sites])
+    print(f"#   the updates' floor, the sizes in turn, done ({time.monotonic() - t0:.0f} s)", flush=True)
+    for (target, _, _, _), floor in zip(sites, floors):
+        for b in args.backends:
+            rows[target, b]["floor"] = floor
+    for target, site, npz, saved in sites:
+        if modules is not None:
+            rows[target, args.backends[0]]["node"] = run_node(modules, site, saved, args.node_backend, args.replay)
+            print(f"#   {target:.0e}: node ({args.node_backend}) done ({time.monotonic() - t0:.0f} s)", flush=True)
+        site.unlink()
+        npz.unlink()
+    return [rows[target, b] for target in args.cells for b in args.backends]
 
 
 def main() -> int:
-    if len(sys.argv) == 5 and sys.argv[1] == "--render-child":
-        print(json.dumps(render_child(sys.argv[2], sys.argv[3], int(sys.argv[4]))))
+    if len(sys.argv) >= 5 and sys.argv[1] == "--render-child":
+        print(json.dumps(render_child(sys.argv[4:], sys.argv[2], int(sys.argv[3]))))
         return 0
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bin", type=Path, default=ROOT / "build" / "bin", help="where log2map is")
@@ -605,8 +643,7 @@ def main() -> int:
     rows = []
     try:
         with tempfile.TemporaryDirectory(dir=args.workdir) as tmp:
-            for target in args.cells:
-                rows += bench_size(args, target, Path(tmp), modules)
+            rows = bench_sites(args, Path(tmp), modules)
     finally:
         if modules:
             modules[1].try_shutdown()

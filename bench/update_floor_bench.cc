@@ -10,12 +10,14 @@
 // updates come while it is still in cache) is what no render that updates
 // the cells in the log's order can go below.
 //
-//   update_floor_bench LOG [--runs N]   (prints one JSON object)
+//   update_floor_bench LOG... [--runs N]   (one JSON object a log; several logs are
+//   walked in turn, run after run, so that the ratio between them is of one time)
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -96,46 +98,70 @@ uint64_t walk_all(const vasco::PlacedBeams &placed, const vasco::GridGeometry &g
   return updates;
 }
 
+// A log's beams, placed, and the box they reach; its sums and timed walks.
+struct Site {
+  std::string log;
+  vasco::LogInput in;
+  vasco::PlacedBeams placed;
+  Box box;
+  std::vector<float> sums;  // on huge pages, as the CPU backends' grids and sums
+  std::vector<double> seconds;
+  uint64_t updates = 0;
+};
+
+double walk_once(Site &site) {
+  vasco::assign_on_huge_pages(site.sums, site.box.cells(), 0.0f);  // touched before the clock: no first-touch faults timed
+  const auto t0 = std::chrono::steady_clock::now();
+  site.updates = walk_all(site.placed, site.in.geo, site.box, site.in.params.table_size(), site.sums.data());
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void print_site(const Site &site) {
+  double check = 0;  // read the sums, so that the walk cannot be dropped
+  for (size_t i = 0; i < site.sums.size(); i += 4096) check += site.sums[i];
+  std::vector<double> seconds = site.seconds;
+  std::sort(seconds.begin(), seconds.end());
+  const double median = seconds[seconds.size() / 2];
+  std::printf("{\"log\": \"%s\", \"cells\": %llu, \"box_cells\": %llu, \"beams\": %llu, \"updates\": %llu, "
+              "\"seconds\": %.6f, \"ns_per_update\": %.4f, \"check\": %.1f}\n",
+              site.log.c_str(), static_cast<unsigned long long>(site.in.geo.num_cells()),
+              static_cast<unsigned long long>(site.box.cells()),
+              static_cast<unsigned long long>(site.placed.beams.size()), static_cast<unsigned long long>(site.updates),
+              median, site.updates ? median / static_cast<double>(site.updates) * 1e9 : 0.0, check);
+}
+
 }  // namespace
 
 int main(int argc, char **argv) {
-  std::string log;
+  std::vector<std::string> logs;
   int runs = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--runs" && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else if (log.empty() && a[0] != '-') log = a;
-    else {
-      std::fprintf(stderr, "usage: update_floor_bench LOG [--runs N]\n");
-      return 2;
-    }
+    else if (a[0] != '-') logs.push_back(a);
+    else logs.clear(), i = argc;
   }
-  if (log.empty()) {
-    std::fprintf(stderr, "usage: update_floor_bench LOG [--runs N]\n");
+  if (logs.empty()) {
+    std::fprintf(stderr, "usage: update_floor_bench LOG... [--runs N]\n");
     return 2;
   }
-  vasco::LogInputOptions lo;
-  lo.log = log;
-  const vasco::LogInput in = vasco::load_log_input(lo);
-  const vasco::PlacedBeams placed = vasco::place_beams(in.batch, in.geo, in.params, 0, 0, in.batch.num_scans());
-  const Box box = reached_box(placed, in.geo);
-  std::vector<float> sums;  // on huge pages, as the CPU backends' grids and sums
-  std::vector<double> seconds;
-  uint64_t updates = 0;
-  for (int r = 0; r < runs; ++r) {
-    vasco::assign_on_huge_pages(sums, box.cells(), 0.0f);  // touched before the clock: no first-touch faults timed
-    const auto t0 = std::chrono::steady_clock::now();
-    updates = walk_all(placed, in.geo, box, in.params.table_size(), sums.data());
-    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  std::vector<Site> sites(logs.size());
+  for (size_t i = 0; i < logs.size(); ++i) {
+    vasco::LogInputOptions lo;
+    lo.log = sites[i].log = logs[i];
+    try {
+      sites[i].in = vasco::load_log_input(lo);
+    } catch (const std::exception &e) {
+      std::fprintf(stderr, "update_floor_bench: %s\n", e.what());  // it names the log
+      return 1;
+    }
+    sites[i].placed = vasco::place_beams(sites[i].in.batch, sites[i].in.geo, sites[i].in.params, 0, 0,
+                                         sites[i].in.batch.num_scans());
+    sites[i].box = reached_box(sites[i].placed, sites[i].in.geo);
   }
-  double check = 0;  // read the sums, so that the walk cannot be dropped
-  for (size_t i = 0; i < sums.size(); i += 4096) check += sums[i];
-  std::sort(seconds.begin(), seconds.end());
-  const double median = seconds[seconds.size() / 2];
-  std::printf("{\"cells\": %llu, \"box_cells\": %llu, \"beams\": %llu, \"updates\": %llu, \"seconds\": %.6f, "
-              "\"ns_per_update\": %.4f, \"check\": %.1f}\n",
-              static_cast<unsigned long long>(in.geo.num_cells()), static_cast<unsigned long long>(box.cells()),
-              static_cast<unsigned long long>(placed.beams.size()), static_cast<unsigned long long>(updates), median,
-              updates ? median / static_cast<double>(updates) * 1e9 : 0.0, check);
+  // The logs in turn, run after run: a drift of the machine's speed falls on each alike.
+  for (int r = 0; r < runs; ++r)
+    for (Site &site : sites) site.seconds.push_back(walk_once(site));
+  for (const Site &site : sites) print_site(site);
   return 0;
 }
