@@ -380,12 +380,13 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "text: # vasco_gpu benchmarks: bench/run_all.sh build-bench parse o": picked(BENCH_RUN),
         "text: ## build-bench/bin/parse_bench": quoted(BENCH_RUN),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build session": picked("bench/results/session-2026-12-07c-h100.txt"),
+        "text: # commit: 7ae01d1": picked("bench/results/session-2026-12-07d-h100.txt"),
         "text: ## python3 bench/batch_bench.py --bin build-bench/bin --copi": picked(BENCH_RUN),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build batch":
             picked("bench/results/batch-2026-12-07d-h100.txt"),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build peers": picked(PEERS_RUN),
         "text: re-render linear in cell updates (cpu_float): ns per update":
-            picked("bench/results/large-site-2026-12-07f-2core.txt"),
+            picked("bench/results/large-site-2026-12-07g-2core.txt"),
         "text: Where a user sees it: log2map --json --backend cpu_float, se": quoted(PEERS_RUN),
     },
     "bench/results/HISTORY.md": {
