@@ -387,6 +387,8 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "text: # vasco_gpu benchmarks: bench/run_all.sh build peers": picked(PEERS_RUN),
         "text: re-render linear in cell updates (cpu_float): ns per update":
             picked("bench/results/large-site-2026-12-07g-2core.txt"),
+        "text: re-render linear in cell updates (cuda_exact): ns per update":
+            picked("bench/results/large-site-2026-12-07h-h100.txt"),
         "text: Where a user sees it: log2map --json --backend cpu_float, se": quoted(PEERS_RUN),
     },
     "bench/results/HISTORY.md": {
