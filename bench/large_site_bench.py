@@ -215,10 +215,11 @@ def run_floor(binary: Path, sites: list) -> list:
 
 def render_child(npzs: list, backend: str, renders: int) -> dict:
     """In its own process (--render-child): a Mapper session per site, each inserting every scan
-    and rendering once (its resident bytes: VmRSS then, less before it was made: the grid, the
-    renderer's scratch, the stored scans); then `renders` rounds, each re-rendering every site's
-    session once at moved poses (the trajectory turned about its first pose by a few mrad, as a
-    loop closure moves it), the sites in turn, so that a drift of the machine's speed over the run
+    and rendering once at moved poses (its resident bytes: VmRSS then, less before it was made:
+    the grid, the renderer's scratch, the stored scans); then `renders` rounds, each re-rendering
+    every site's session once at poses moved further (the trajectory turned about its first pose
+    by a few mrad more each round, as a loop closure moves it: the frame grows by a few cells a
+    render), the sites in turn, so that a drift of the machine's speed over the run
     falls on every size alike; then the same with every SPARSE-th scan in each session's frame (the
     same area reached, a hundredth of the updates), which splits a render's time into a part per
     cell update and a part that does not grow with them."""
@@ -234,23 +235,27 @@ def render_child(npzs: list, backend: str, renders: int) -> dict:
         t0 = time.perf_counter()
         m.insert(scans_of(poses, ranges))
         insert_s = time.perf_counter() - t0
-        m.render(moved(poses, renders))  # untimed: every buffer a render uses resident before the bytes are read
+        m.render(moved(poses, 0))  # untimed: every buffer a render uses resident before the bytes are read
         frame = m.frame
         sites.append({"mapper": m, "poses": poses, "ranges": ranges, "out": {
             "insert_s": insert_s, "render_s": [], "cells": frame.size_x * frame.size_y,
             "grid": [frame.size_x, frame.size_y], "session_rss": proc_bytes("self", "VmRSS") - before}})
-    for k in range(renders):
+    del m  # the sessions are the sites' alone
+    # Each round turns the trajectory further (2 mrad for the untimed render, then 4, 6, ...), as
+    # a loop closure moves it: the frame grows by a few cells a render, as it does in use.
+    for k in range(1, renders + 1):
         for site in sites:
             site["out"]["render_s"].append(timed_render(site["mapper"], moved(site["poses"], k)))
             stats = site["mapper"].last_stats
             site["out"].update(updates=stats["cell_updates"], map_s=stats["map_s"])
-    for site in sites:  # the full sessions freed before the sparse ones are made
-        frame = site.pop("mapper").frame
+    frames = [site.pop("mapper").frame for site in sites]  # the full sessions freed before the sparse ones
+    for site, frame in zip(sites, frames):
         site["sparse"] = vg.Mapper(site_params(), backend=name, cuda_mode=mode, max_memory_bytes=0, frame=frame,
                                    frame_centre=(frame.x0, frame.y0))
         site["sparse"].insert(scans_of(site["poses"][::SPARSE], site["ranges"][::SPARSE]))
+        site["sparse"].render(moved(site["poses"][::SPARSE], 0))  # untimed, as the full sessions' first
         site["out"]["sparse_s"] = []
-    for k in range(renders):
+    for k in range(1, renders + 1):
         for site in sites:
             site["out"]["sparse_s"].append(timed_render(site["sparse"], moved(site["poses"][::SPARSE], k)))
     for site in sites:

@@ -134,7 +134,7 @@ TEST(CpuFloat, AnglesThatOverflowUpdateTheCellsCpuDoubleUpdates) {
 // drive between them: the sums' box spans both, most of it reached by
 // neither. One call gives, cell for cell, the bytes of each cluster's call
 // alone, also on a renderer whose last call summed over the whole box (no
-// sum of an earlier call is read again).
+// value of an earlier call is read again).
 TEST(CpuFloat, ClustersFarApartGiveTheBytesOfEachAlone) {
   const testing_support::CornerClusters corners(testing_support::test_seed(), 12);
   const ScanBatch &a = corners.a, &b = corners.b, &drive = corners.drive;
@@ -163,6 +163,26 @@ TEST(CpuFloat, ClustersFarApartGiveTheBytesOfEachAlone) {
   EXPECT_EQ(differ, 0u);
   EXPECT_GT(known, 1000u);
   EXPECT_LT(known * 20, got.size()) << "the clusters must reach a small part of the box";
+}
+
+// A full render sums in the grid's own cells (apply_to_reset); a call on a
+// grid already written sums in a scratch and merges (apply_to). On a grid
+// of unknown cells the two give the same bytes: an empty call first
+// completes the reset, so the whole log goes the scratch's way.
+TEST(CpuFloat, TheScratchAndTheGridsOwnCellsGiveTheSameBytes) {
+  const testing_support::CornerClusters corners(testing_support::test_seed(), 12);
+  for (const ScanBatch *scans : {&corners.drive, &corners.a}) {
+    const std::vector<float> in_grid = render_grid(*make_renderer("cpu_float"), *scans, corners.params, corners.geo);
+    const std::unique_ptr<Renderer> r = make_renderer("cpu_float");
+    r->reset(corners.geo, corners.params);
+    r->apply(*scans, 0, 0, nullptr);
+    MapStats stats;
+    r->apply(*scans, 0, scans->num_scans(), &stats);
+    const std::vector<float> scratch = r->read(GridWindow{0, 0, corners.geo.size_x, corners.geo.size_y});
+    ASSERT_GT(stats.cell_updates, 1000u);
+    const size_t i = testing_support::first_difference(in_grid, scratch);
+    EXPECT_EQ(i, in_grid.size()) << "cell " << i << ": in the grid " << in_grid[i] << ", by the scratch " << scratch[i];
+  }
 }
 
 }  // namespace

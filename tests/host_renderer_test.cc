@@ -59,6 +59,10 @@ TEST(HostGridRenderer, ARenderElsewhereAfterAResetHoldsOnlyItsOwnCells) {
     EXPECT_EQ(known_cells(reused->read(GridWindow{0, 0, c.geo.size_x, c.geo.size_y})), 0u) << "read after a reset";
     EXPECT_EQ(known_cells(reused->finish(1, 0).cells), 0u) << "finish after a reset";
     EXPECT_EQ(where(want_a, render_grid(*reused, c.a, c.params, c.geo)), "") << "after a reset read back";
+    EXPECT_EQ(known_cells(render_grid(*reused, ScanBatch(), c.params, c.geo)), 0u) << "no scans after a render";
+    reused->reset(c.geo, c.params);
+    reused->reset(c.geo, c.params);
+    EXPECT_EQ(where(want_b, render_grid(*reused, c.b, c.params, c.geo)), "") << "after two resets";
   }
 }
 

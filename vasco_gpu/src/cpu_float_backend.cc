@@ -519,13 +519,14 @@ class CpuFloatRenderer : public HostGridRenderer {
   Box apply_to_reset(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
                      const GridGeometry &geo, const CellRange &stale, float *cells, MapStats *stats) override {
     Box reached;
+    bool prepared = false;
     render(batch, first, last, params, geo, stats, [&](const Box &box) {
       clear_outside(cells, geo, stale, box);
       fill_box(cells, geo, box, kUntouched);
-      reached = box;
+      reached = box, prepared = true;
       return SumTarget{cells + egrid::cell_index(box.x_lo, box.y_lo, geo.size_y), geo.size_y, box};
     }, [&](const EvidenceTable &ev, const Box &box) { convert_in_place(ev, box, geo, cells); });
-    if (reached.cells() == 0) clear_outside(cells, geo, stale, Box{});  // no scans: nothing reached
+    if (!prepared) clear_outside(cells, geo, stale, Box{});  // no scans
     return reached;
   }
 

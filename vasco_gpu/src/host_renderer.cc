@@ -42,15 +42,19 @@ HostGridRenderer::CellRange beyond(const HostGridRenderer::CellRange &r, size_t 
 // little at a time; a new allocation of a large site's grid, faulted in
 // again, cost more than the render's passes over it).
 void HostGridRenderer::reset(const GridGeometry &geo, const MapperParams &params) {
-  geo_ = geo;
-  params_ = params;
   const size_t n = geo.num_cells();
   if (cells_.size() < n && cells_.capacity() >= n) {
     cells_.resize(n, -1.0f);
   } else if (cells_.size() < n) {
-    assign_on_huge_pages(cells_, n, -1.0f, n + n / 8);
+    // The old buffer is freed first: if the new one cannot be had, the
+    // renderer is left with no grid (0 x 0), never a geometry past its buffer.
     written_ = CellRange{};
+    reset_pending_ = false;
+    geo_ = GridGeometry();  // 0 x 0
+    assign_on_huge_pages(cells_, n, -1.0f, n + n / 8);
   }
+  geo_ = geo;
+  params_ = params;
   reset_pending_ = true;
 }
 
