@@ -133,18 +133,19 @@ void print_site(const Site &site) {
 }  // namespace
 
 int main(int argc, char **argv) {
+  const auto usage = [] {
+    std::fprintf(stderr, "usage: update_floor_bench LOG... [--runs N]\n");
+    return 2;
+  };
   std::vector<std::string> logs;
   int runs = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--runs" && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
     else if (a[0] != '-') logs.push_back(a);
-    else logs.clear(), i = argc;
+    else return usage();
   }
-  if (logs.empty()) {
-    std::fprintf(stderr, "usage: update_floor_bench LOG... [--runs N]\n");
-    return 2;
-  }
+  if (logs.empty()) return usage();
   std::vector<Site> sites(logs.size());
   for (size_t i = 0; i < logs.size(); ++i) {
     vasco::LogInputOptions lo;

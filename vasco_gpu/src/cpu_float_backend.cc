@@ -512,21 +512,19 @@ class CpuFloatRenderer : public HostGridRenderer {
   }
 
   // On a grid just reset: the sums in the grid's own cells (no scratch), the
-  // box marked untouched and the stale cells outside it unknown first, then
-  // the box turned into probabilities in place. Each cell of the box is
+  // box marked untouched first, then turned into probabilities in place, and
+  // the stale cells outside it made unknown. Each cell of the box is
   // written twice, where a reset, the scratch's fill, its read and the merge
   // were four passes (a large site's re-render: docs/performance.md).
   Box apply_to_reset(const ScanBatch &batch, size_t first, size_t last, const MapperParams &params,
                      const GridGeometry &geo, const CellRange &stale, float *cells, MapStats *stats) override {
-    Box reached;
-    bool prepared = false;
+    Box reached;  // empty where there are no scans
     render(batch, first, last, params, geo, stats, [&](const Box &box) {
-      clear_outside(cells, geo, stale, box);
       fill_box(cells, geo, box, kUntouched);
-      reached = box, prepared = true;
+      reached = box;
       return SumTarget{cells + egrid::cell_index(box.x_lo, box.y_lo, geo.size_y), geo.size_y, box};
     }, [&](const EvidenceTable &ev, const Box &box) { convert_in_place(ev, box, geo, cells); });
-    if (!prepared) clear_outside(cells, geo, stale, Box{});  // no scans
+    clear_outside(cells, geo, stale, reached);  // the walks write inside the box only
     return reached;
   }
 

@@ -60,10 +60,8 @@ void HostGridRenderer::reset(const GridGeometry &geo, const MapperParams &params
 
 void HostGridRenderer::complete_reset() {
   if (!reset_pending_) return;
-  const size_t n = geo_.num_cells();
-  if (written_.lo < std::min(written_.hi, n))
-    std::fill(cells_.begin() + written_.lo, cells_.begin() + std::min(written_.hi, n), -1.0f);
-  written_ = beyond(written_, n);
+  clear_outside(cells_.data(), geo_, written_, Box{});
+  written_ = beyond(written_, geo_.num_cells());
   reset_pending_ = false;
 }
 
