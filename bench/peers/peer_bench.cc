@@ -7,7 +7,9 @@
 // a warm-up, then N timed runs of the insertion alone, and the row is their median. The peers do not
 // implement CARMEN's sensor model (mrpt_grid and octomap_build say what differs), so a ratio compares the
 // cost of building a comparable map, not the same map; a sanity line per peer counts the cells its map
-// holds as occupied and as free beside cpu_double's, to show the maps cover the same ground.
+// holds as occupied and as free beside cpu_double's, to show the maps cover the same ground. The target
+// (cpu_float against MRPT) is judged on rounds of its own after the table: cpu_float's render, MRPT's
+// insertion and log2map's map phase in turn, each round's ratio from the same minute (head_to_head).
 //
 //   peer_bench [--runs N] [--dataset fr079|fr101|all]
 #include <malloc.h>
@@ -290,26 +292,29 @@ CellCounts count_mrpt(const COccupancyGridMap2D &m) {
   return c;
 }
 
-// Every scan inserted into a grid allocated beforehand (the allocation is not timed).
+// Every scan inserted into a grid allocated beforehand (the allocation is not timed): the seconds. The
+// grid is left in *last; *refused counts the scans MRPT refused.
+double mrpt_insert_once(const Job &job, const MrptScans &scans, std::unique_ptr<COccupancyGridMap2D> *last,
+                        size_t *refused) {
+  last->reset();
+  auto m = mrpt_grid(job);
+  const unsigned size_x = m->getSizeX(), size_y = m->getSizeY();
+  const double t0 = now_s();
+  for (size_t s = 0; s < scans.obs.size(); ++s) *refused += !m->insertObservation(scans.obs[s], scans.poses[s]);
+  const double t = now_s() - t0;
+  if (m->getSizeX() != size_x || m->getSizeY() != size_y)
+    std::fprintf(stderr, "peer_bench: MRPT grew its grid during the run (timed)\n");
+  *last = std::move(m);
+  return t;
+}
+
 Row run_mrpt(const Job &job, CellCounts *counts) {
   const MrptScans scans = mrpt_scans(job.batch);
   Row row = make_row(job, kMrptLabel);
   row.beams = scans.beams;
   std::unique_ptr<COccupancyGridMap2D> last;
   size_t refused = 0;
-  row.map_s = timed_median(job.runs, [&] {
-    last.reset();
-    auto m = mrpt_grid(job);
-    const unsigned size_x = m->getSizeX(), size_y = m->getSizeY();
-    const double t0 = now_s();
-    for (size_t s = 0; s < scans.obs.size(); ++s)
-      refused += !m->insertObservation(scans.obs[s], scans.poses[s]);
-    const double t = now_s() - t0;
-    if (m->getSizeX() != size_x || m->getSizeY() != size_y)
-      std::fprintf(stderr, "peer_bench: MRPT grew its grid during the run (timed)\n");
-    last = std::move(m);
-    return t;
-  });
+  row.map_s = timed_median(job.runs, [&] { return mrpt_insert_once(job, scans, &last, &refused); });
   if (refused > 0) std::fprintf(stderr, "peer_bench: MRPT refused %zu scans\n", refused);
   *counts = count_mrpt(*last);
   return row;
@@ -530,9 +535,12 @@ void print_table(const std::vector<Row> &rows) {
               "octree, one z layer used), one end voxel, clamped log-odds.\n");
 }
 
-// The target (issue: "beat MRPT on one core"): cpu_float (one core) builds its map at least 1.25x as fast
-// as MRPT (one core) on every log and parameter set measured; a miss says by how much.
-constexpr double kTargetOverMrpt = 1.25;
+// The target (issue 59: "keep cpu_float at least as fast as MRPT's COccupancyGridMap2D on one core in
+// log2map's map phase"): log2map's map phase at least 1.0x MRPT's speed on every log and parameter set
+// measured. The round before asked 1.25x ("beat MRPT on one core"), met on an AMD EPYC host
+// (docs/performance.md, "Peers"); it is printed beside, not judged.
+constexpr double kTargetOverMrpt = 1.0;
+constexpr double kEarlierGoal = 1.25;
 
 // Why a miss, as measured (docs/performance.md, "Peers"): on fr079 / paper on the development machine cpu_float's render
 // took ~182 ms, of it ~117 in the walk loops (0.72 ns an update: 6 to 8 instructions and the loops' exits), ~39
@@ -543,26 +551,6 @@ constexpr const char *kWhyMissed =
     "  why: cpu_float makes ~8% more updates than MRPT (CARMEN's 0.2 m wall behind every hit) at ~0.7 ns an "
     "update (6 to 8 instructions), plus ~23 ns a beam of set-up (the walk's frame, two 64-bit divisions, and the "
     "searches for where its free, range_sure and stop runs end); docs/performance.md \"History\" lists what was tried\n";
-
-void print_target(const std::vector<Row> &rows) {
-  bool header = false, missed = false;
-  for (const Row &r : rows) {
-    if (r.mapper != "cpu_float" || r.map_s <= 0) continue;
-    const double mrpt = time_of(rows, r, kMrptLabel);
-    if (mrpt <= 0) continue;
-    if (!header) std::printf("\nTarget: cpu_float at least %.2fx MRPT's speed, one core each:\n", kTargetOverMrpt);
-    header = true;
-    const double x = mrpt / r.map_s;
-    std::printf("  %s / %s: cpu_float %s ms, MRPT %s ms: %.2fx: %s", r.data.c_str(), r.params.c_str(),
-                ms(r.map_s).c_str(), ms(mrpt).c_str(), x, x >= kTargetOverMrpt ? "met\n" : "missed");
-    if (x < kTargetOverMrpt) {
-      missed = true;
-      std::printf(" (needs %s ms, %.0f%% less)\n", ms(mrpt / kTargetOverMrpt).c_str(),
-                  100.0 * (1.0 - mrpt / kTargetOverMrpt / r.map_s));
-    }
-  }
-  if (missed) std::printf("%s", kWhyMissed);
-}
 
 // Where a user sees it: log2map's seconds.map (--json) for cpu_float, a
 // fresh process per run (its memory touched for the first time, caches
@@ -590,58 +578,75 @@ double log2map_map_seconds(const std::string &log2map, const Dataset &ds, const 
   return median(t);
 }
 
-std::string pct(double share) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%+.0f%%", 100.0 * share);
-  return buf;
+// cpu_float beside MRPT for the target, round by round: a round times cpu_float's render (a warm
+// renderer, as its table row), MRPT's insertion (a grid allocated beforehand) and log2map's map phase (a
+// process of its own) one after the other, so that a drift of this shared machine's speed falls on the
+// three alike, and a round's ratio is MRPT's time over ours in that round. The table's rows, each mapper's
+// runs in a block, minutes apart, moved MRPT's ratio by a third between two runs of the bench.
+struct HeadToHead {
+  std::string data, params;
+  std::vector<double> render, mrpt, cli;  // seconds, a round each; cli empty without log2map
+  double first = -1;                      // a fresh renderer's first render (first_render_seconds)
+};
+
+#if defined(VASCO_HAVE_MRPT)
+HeadToHead head_to_head(const Job &job, const Dataset &ds, const ParamSet &ps, const std::string &log2map,
+                        int rounds) {
+  HeadToHead h;
+  h.data = job.data;
+  h.params = job.params;
+  const MrptScans scans = mrpt_scans(job.batch);
+  std::unique_ptr<COccupancyGridMap2D> last;
+  size_t refused = 0;
+  auto renderer = vasco::make_renderer("cpu_float", vasco::BackendOptions{});
+  const auto render = [&] {
+    const double t0 = now_s();
+    renderer->reset(job.geo, job.p);
+    renderer->apply(job.batch, 0, job.batch.num_scans(), nullptr);
+    return now_s() - t0;
+  };
+  render();  // the warm-up round: the renderer's table and grid, MRPT's code and pages
+  mrpt_insert_once(job, scans, &last, &refused);
+  for (int r = 0; r < rounds; ++r) {
+    h.render.push_back(render());
+    h.mrpt.push_back(mrpt_insert_once(job, scans, &last, &refused));
+    const double cli = log2map_map_seconds(log2map, ds, ps, 1);
+    if (cli > 0) h.cli.push_back(cli);
+  }
+  if (h.cli.size() != h.render.size()) h.cli.clear();  // log2map absent or failing: no column
+  return h;
+}
+#endif
+
+// The median over the rounds of MRPT's time over ours.
+double median_ratio(const std::vector<double> &mrpt, const std::vector<double> &ours) {
+  std::vector<double> x;
+  for (size_t i = 0; i < mrpt.size() && i < ours.size(); ++i) x.push_back(mrpt[i] / ours[i]);
+  return x.empty() ? -1 : median(x);
 }
 
-// Why a case missed where a user sees it: its render row already misses
-// (the render's own, the target above), or log2map's gap over the render row
-// against a fresh renderer's first render here: covered when the first render
-// is at least half the gap above the warm one.
-std::string cli_miss_reason(double mrpt, double render, double cli, double first) {
-  const double gap = cli / render - 1.0;
-  if (mrpt / render < kTargetOverMrpt)
-    return "the render itself misses (the target above); log2map " + pct(gap) + " over it";
-  if (first <= 0) return "log2map " + pct(gap) + " over the render row; no first render measured";
-  const double first_gap = first / render - 1.0;
-  return "log2map " + pct(gap) + " over the render row, a first render here " + pct(first_gap) +
-         (first_gap >= 0.5 * gap ? ": a fresh renderer's table and first touch of its sums"
-                                 : ": not a first render's cost (the process's own)");
-}
-
-// The target where a user sees it: log2map's map phase against MRPT's
-// insertion measured above (the same minutes), beside a fresh renderer's
-// first render in this process, which measures why it is above the render row.
-void print_cli_target(const Bench &b, const char *argv0) {
-  const std::string log2map = self_dir(argv0) + "/log2map";
-  bool header = false;
-  std::vector<std::string> why;
-  for (const Dataset &ds : bench_datasets())
-    for (const ParamSet &ps : bench_param_sets()) {
-      Row key;
-      key.data = ds.name;
-      key.params = ps.name;
-      const double mrpt = time_of(b.rows, key, kMrptLabel), render = time_of(b.rows, key, "cpu_float");
-      if (mrpt <= 0 || render <= 0) continue;
-      const double cli = log2map_map_seconds(log2map, ds, ps, b.opt.runs);
-      if (cli <= 0) continue;
-      if (!header)
-        std::printf("\nWhere a user sees it: log2map --json --backend cpu_float, seconds.map (median of %d, a "
-                    "process each), against MRPT's insertion above:\n", b.opt.runs);
-      header = true;
-      const double x = mrpt / cli, first = row_of(b.rows, key, "cpu_float")->first_s;
-      const std::string first_text = first > 0 ? ms(first) + " ms, " + pct(first / render - 1.0) : "not measured";
-      std::printf("  %s / %s: log2map %s ms (render above %s ms, %s; a first render here %s), MRPT %s ms: %.2fx: %s\n",
-                  ds.name.c_str(), ps.name.c_str(), ms(cli).c_str(), ms(render).c_str(), pct(cli / render - 1.0).c_str(),
-                  first_text.c_str(), ms(mrpt).c_str(), x, x >= kTargetOverMrpt ? "met" : "missed");
-      if (x < kTargetOverMrpt) why.push_back(ds.name + " / " + ps.name + ": " + cli_miss_reason(mrpt, render, cli, first));
+void print_target(const std::vector<HeadToHead> &cases, int rounds) {
+  if (cases.empty()) return;
+  std::printf("\nTarget (issue 59): cpu_float at least %.2fx MRPT's speed in log2map's map phase, one core each.\n"
+              "%d rounds, each timing cpu_float's render (warm), MRPT's insertion and log2map --json --backend "
+              "cpu_float's seconds.map (a process) in turn; x = MRPT's time / ours in the same round, the median "
+              "over the rounds (times: medians):\n", kTargetOverMrpt, rounds);
+  bool missed = false;
+  for (const HeadToHead &h : cases) {
+    const double render_x = median_ratio(h.mrpt, h.render), cli_x = median_ratio(h.mrpt, h.cli);
+    const std::string first = h.first > 0 ? ms(h.first) + " ms" : "not measured";
+    std::printf("  %s / %s: MRPT %s ms; render %s ms: %.2fx (a first render %s)", h.data.c_str(), h.params.c_str(),
+                ms(median(h.mrpt)).c_str(), ms(median(h.render)).c_str(), render_x, first.c_str());
+    if (h.cli.empty()) {
+      std::printf("; log2map: not run (not beside this program, or it failed): missed\n");
+      missed = true;
+      continue;
     }
-  if (!why.empty())
-    std::printf("  why (\"a first render\": a new renderer each run in this process, its table built and its memory "
-                "new):\n");
-  for (const std::string &w : why) std::printf("    %s\n", w.c_str());
+    std::printf("; log2map %s ms: %.2fx: %s (%.2fx, the round before's goal: %s)\n", ms(median(h.cli)).c_str(), cli_x,
+                cli_x >= kTargetOverMrpt ? "met" : "missed", kEarlierGoal, cli_x >= kEarlierGoal ? "met" : "missed");
+    missed = missed || cli_x < kTargetOverMrpt;
+  }
+  if (missed) std::printf("%s", kWhyMissed);
 }
 
 void print_sanity(const std::vector<Sanity> &sanity) {
@@ -666,6 +671,22 @@ void print_sanity(const std::vector<Sanity> &sanity) {
 #endif
 }
 
+#if defined(VASCO_HAVE_MRPT)
+// The head-to-head rounds of one job (its log and parameter set found by name for log2map's options).
+HeadToHead head_to_head_of(const Bench &b, const Job &job, const std::string &log2map) {
+  std::fprintf(stderr, "%s / %s: cpu_float, MRPT and log2map in turn ...\n", job.data.c_str(), job.params.c_str());
+  for (const Dataset &ds : bench_datasets())
+    for (const ParamSet &ps : bench_param_sets()) {
+      if (ds.name != job.data || ps.name != job.params) continue;
+      HeadToHead h = head_to_head(job, ds, ps, log2map, b.opt.runs);
+      const Row *r = row_of(b.rows, make_row(job, ""), "cpu_float");
+      if (r != nullptr) h.first = r->first_s;
+      return h;
+    }
+  return HeadToHead{job.data, job.params, {}, {}, {}, -1};
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -683,9 +704,12 @@ int main(int argc, char **argv) {
     for (const ParamSet &ps : bench_param_sets()) jobs.push_back(bench_param_set(&b, ds, ps));
   }
   first_renders(&b, jobs);
+  std::vector<HeadToHead> cases;
+#if defined(VASCO_HAVE_MRPT)
+  for (const Job &job : jobs) cases.push_back(head_to_head_of(b, job, self_dir(argv[0]) + "/log2map"));
+#endif
   print_table(b.rows);
-  print_target(b.rows);
-  print_cli_target(b, argv[0]);
+  print_target(cases, b.opt.runs);
   print_sanity(b.sanity);
   return 0;
 }
