@@ -382,6 +382,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
         "text: # vasco_gpu benchmarks: bench/run_all.sh build session": picked("bench/results/session-2026-12-07c-h100.txt"),
         "text: # commit: 7ae01d1": picked("bench/results/session-2026-12-07d-h100.txt"),
         "text: # commit: dc4ddaf": picked("bench/results/peers-2026-12-07-2core.txt"),
+        "text: # commit: 260ad79": picked("bench/results/peers-2026-12-07b-2core.txt"),
         "text: ## python3 bench/batch_bench.py --bin build-bench/bin --copi": picked(BENCH_RUN),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build batch":
             picked("bench/results/batch-2026-12-07d-h100.txt"),
