@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_support.h"  // vasco_gpu/app: json_string
 #include "huge_pages.h"  // vasco_gpu/src: the CPU backends' host buffers
 #include "vasco_gpu/internal/beam_placement.h"
 #include "vasco_gpu/internal/egrid_math.h"
@@ -122,9 +123,9 @@ void print_site(const Site &site) {
   std::vector<double> seconds = site.seconds;
   std::sort(seconds.begin(), seconds.end());
   const double median = seconds[seconds.size() / 2];
-  std::printf("{\"log\": \"%s\", \"cells\": %llu, \"box_cells\": %llu, \"beams\": %llu, \"updates\": %llu, "
+  std::printf("{\"log\": %s, \"cells\": %llu, \"box_cells\": %llu, \"beams\": %llu, \"updates\": %llu, "
               "\"seconds\": %.6f, \"ns_per_update\": %.4f, \"check\": %.1f}\n",
-              site.log.c_str(), static_cast<unsigned long long>(site.in.geo.num_cells()),
+              cli::json_string(site.log).c_str(), static_cast<unsigned long long>(site.in.geo.num_cells()),
               static_cast<unsigned long long>(site.box.cells()),
               static_cast<unsigned long long>(site.placed.beams.size()), static_cast<unsigned long long>(site.updates),
               median, site.updates ? median / static_cast<double>(site.updates) * 1e9 : 0.0, check);
