@@ -41,7 +41,8 @@ is the target, so that a drift of a shared machine's speed falls on every size a
                 + 4 for cpu_float's float sums over the cells reached, host_renderer.h: a bound,
                 which its incremental inserts use); the slope of the resident memory between the two
                 sizes per cell (the same scans: what grows with the cells only); the bytes of each
-                /map and map_updates message's data; publish -> a subscriber's callback (the
+                /map and map_updates message's data; a bare node's (no session, once ready): the
+                fixed part, printed beside each size's figure as its floor; publish -> a subscriber's callback (the
                 message's source timestamp, which Fast DDS takes as the publisher writes it, ->
                 this process's callback entry, one system clock); the node's largest mappings
                 (/proc/PID/smaps: each buffer above glibc's mmap threshold is a mapping of its own),
@@ -438,6 +439,27 @@ def run_node(modules, site: Path, saved, backend: str, replay: int) -> dict:
         listener.close()
 
 
+def run_bare_node(modules, backend: str) -> dict:
+    """The node with no session (the same backend, no map yet): its resident memory once ready, the
+    fixed part every size's node holds before its first cell (interpreter, rclpy, Fast DDS, the
+    library): the node target's floor for a size's own figure."""
+    ros_support = modules[0]
+    name, mode = MAPPER_BACKEND.get(backend, (backend, "float"))
+    proc = ros_support.NodeProcess({"backend": name, "cuda_mode": mode, "max_memory": 0})
+    try:
+        proc.wait_for("ready", timeout=120)
+        time.sleep(1.0)
+        return node_memory(proc.proc.pid)
+    except AssertionError as e:
+        return {"error": str(e).splitlines()[0]}
+    finally:
+        try:
+            proc.interrupt(timeout=30)
+        except subprocess.TimeoutExpired:
+            pass  # killed below
+        proc.kill()
+
+
 # -- the printout ------------------------------------------------------------------------------
 def mb(b: float) -> str:
     return "-" if b is None or b < 0 else f"{b / 1e6:,.0f} MB"
@@ -574,11 +596,17 @@ def print_targets(rows: list, backends: list, node_backend: str | None) -> None:
     if node_backend is None:
         return
     node_rows = [r for r in rows if r["backend"] == backends[0] and "mem_path" in r["node"]]
+    bare_node = node_rows[0]["node"].get("bare", {}) if node_rows else {}
+    bare = bare_node.get("VmRSS", -1)
+    if "error" in bare_node:
+        print(f"  a bare node (no session): error: {bare_node['error']}")
     for r in node_rows:
-        extra = beyond_grid(r["node"]["mem_path"], r) / r["node"]["path"]["bytes"]
-        verdict = "met" if extra <= NODE_TARGET_BYTES else "MISSED"
-        print(f"  node beyond the evidence grid ({node_backend}, {r['target']:.0e} cells): {extra:.2f} bytes per /map "
-              f"cell (target <= {NODE_TARGET_BYTES:g}): {verdict}")
+        extra, cells, grid = beyond_grid(r["node"]["mem_path"], r), r["node"]["path"]["bytes"], r["render"]["cells"]
+        verdict = "met" if extra / cells <= NODE_TARGET_BYTES else "MISSED"
+        less = (f"; less a bare node's own ({mb(bare)}, no session: the floor of the fixed part) "
+                f"{(extra - bare) / cells:.2f} per /map cell, {(extra - bare) / grid:.2f} per grid cell" if bare > 0 else "")
+        print(f"  node beyond the evidence grid ({node_backend}, {r['target']:.0e} cells): {extra / cells:.2f} bytes per /map "
+              f"cell, {extra / grid:.2f} per grid cell (target <= {NODE_TARGET_BYTES:g} per /map cell): {verdict}{less}")
     s = slope(node_rows)
     if s is not None:
         verdict = "met" if s[0] <= NODE_TARGET_BYTES else "MISSED"
@@ -613,9 +641,11 @@ def bench_sites(args, workdir: Path, modules) -> list:
     for (target, _, _, _), floor in zip(sites, floors):
         for b in args.backends:
             rows[target, b]["floor"] = floor
+    bare = run_bare_node(modules, args.node_backend) if modules is not None else {}
     for target, site, npz, saved in sites:
         if modules is not None:
             rows[target, args.backends[0]]["node"] = run_node(modules, site, saved, args.node_backend, args.replay)
+            rows[target, args.backends[0]]["node"]["bare"] = bare
             print(f"#   {target:.0e}: node ({args.node_backend}) done ({time.monotonic() - t0:.0f} s)", flush=True)
         site.unlink()
         npz.unlink()

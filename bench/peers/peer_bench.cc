@@ -27,6 +27,8 @@
 #include <vector>
 
 #include "../bench_support.h"
+#include "mrpt_peer.h"
+#include "peer_support.h"
 #include "vasco_gpu/backend.h"
 #include "vasco_gpu/internal/cpu_threads_backend.h"
 #include "vasco_gpu/internal/egrid_math.h"
@@ -36,17 +38,39 @@
 #include "vasco_gpu/renderer.h"
 #include "vasco_gpu/pipeline/log_scans.h"
 
-#if defined(VASCO_HAVE_MRPT)
-#include <mrpt/maps/COccupancyGridMap2D.h>
-#include <mrpt/obs/CObservation2DRangeScan.h>
-#include <mrpt/poses/CPose3D.h>
-#endif
 #if defined(VASCO_HAVE_OCTOMAP)
 #include <octomap/OcTree.h>
 #endif
 
+namespace peers {
+
+double log2map_map_seconds(const std::string &log2map, const bench::Dataset &ds, const bench::ParamSet &ps, int runs) {
+  if (access(log2map.c_str(), X_OK) != 0) return -1;
+  const std::string out = bench::temp_map_path();
+  const std::string cmd = bench::shell_quoted(log2map) + " --quiet --json --backend cpu_float " + ps.log2map_args + " " +
+                          bench::shell_quoted(ds.path) + " " + bench::shell_quoted(out) + " 2>/dev/null";
+  std::vector<double> t;
+  for (int i = 0; i < runs; ++i) {
+    FILE *p = popen(cmd.c_str(), "r");
+    if (p == nullptr) return -1;
+    std::string json;
+    char buf[4096];
+    for (size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) json.append(buf, n);
+    const int rc = pclose(p);
+    std::remove(out.c_str());
+    const size_t sec = json.find("\"seconds\":{");
+    const size_t map = sec == std::string::npos ? sec : json.find("\"map\":", sec);
+    if (rc != 0 || map == std::string::npos) return -1;
+    t.push_back(std::strtod(json.c_str() + map + 6, nullptr));
+  }
+  return bench::median(t);
+}
+
+}  // namespace peers
+
 namespace {
 
+using namespace peers;  // NOLINT(google-build-using-namespace): the shared job, row and labels
 using bench::bench_datasets;
 using bench::bench_param_sets;
 using bench::Dataset;
@@ -58,26 +82,10 @@ using bench::self_dir;
 using bench::shell_quoted;
 using bench::temp_map_path;
 
-const char *const kMrptLabel = "MRPT COccupancyGridMap2D";
-const char *const kOctomapLabel = "OctoMap OcTree";
-
 struct Options {
   int runs = 3;
   std::string dataset = "all";
   bool octomap = true;  // --no-octomap: leave out its rows (minutes per log on one core)
-};
-
-// Cells of a map on either side of even odds; unknown cells (and any exactly at 0.5) are in neither.
-struct CellCounts {
-  uint64_t occupied = 0, free = 0;
-};
-
-// One table row; map_s < 0 when the mapper was not built (`missing` says what to install).
-struct Row {
-  std::string data, params, mapper, missing;
-  uint64_t scans = 0, beams = 0;
-  double map_s = -1;
-  double first_s = -1;  // cpu_float: a fresh renderer's first apply (first_render_seconds)
 };
 
 // A peer's map beside cpu_double's, for the sanity lines.
@@ -86,43 +94,12 @@ struct Sanity {
   CellCounts peer, ours;
 };
 
-// What every mapper of one log and parameter set shares: the scans, parameters and our grid.
-struct Job {
-  std::string data, params;
-  vasco::MapperParams p;
-  vasco::ScanBatch batch;
-  vasco::GridGeometry geo;
-  int runs = 3;
-};
-
 struct Bench {
   Options opt;
   int threads = 1;
   std::vector<Row> rows;
   std::vector<Sanity> sanity;
 };
-
-// A beam the peers insert: one with a return. CARMEN skips ranges >= 50 m, NaN and +inf (egrid_math.h);
-// -inf, which CARMEN walks as a degenerate beam, has no sensible end point for a peer.
-[[maybe_unused]] bool has_return(float r) { return std::isfinite(r) && vasco::egrid::is_beam_used(r); }
-
-// A warm-up call of `run` (which times its own insertion and returns the seconds), then `runs` timed
-// calls: their median.
-double timed_median(int runs, const std::function<double()> &run) {
-  run();
-  std::vector<double> t;
-  for (int r = 0; r < runs; ++r) t.push_back(run());
-  return median(t);
-}
-
-Row make_row(const Job &job, const std::string &mapper) {
-  Row row;
-  row.data = job.data;
-  row.params = job.params;
-  row.mapper = mapper;
-  row.scans = job.batch.num_scans();
-  return row;
-}
 
 // The row of `mapper` (a label's prefix) for r's log and parameter set (rows const or not); null when
 // there is none.
@@ -193,133 +170,6 @@ double first_render_seconds(const Job &job, const std::string &backend) {
   }
   return median(t);
 }
-
-// ---------------------------------------------------------------------------------------------------------
-// MRPT
-// ---------------------------------------------------------------------------------------------------------
-#if defined(VASCO_HAVE_MRPT)
-using mrpt::maps::COccupancyGridMap2D;
-
-// MRPT's per-beam updates as probabilities: its int8 log-odds step is 1/16 (CLogOddsGridMapLUT), a free
-// update adds max(1, p2l(freeness certainty)) steps and an occupied one subtracts 3 * max(1, p2l(occupancy
-// certainty)) (COccupancyGridMap2D_insert.cpp, MRPT 2.5).
-void mrpt_update_probs(const COccupancyGridMap2D::TInsertionOptions &io, double *p_occ, double *p_emp) {
-  const int occ = 3 * std::max(1, int(COccupancyGridMap2D::p2l(io.maxOccupancyUpdateCertainty)));
-  const int emp = std::max(1, int(COccupancyGridMap2D::p2l(io.maxFreenessUpdateCertainty)));
-  *p_occ = 1 / (1 + std::exp(-occ / 16.0));
-  *p_emp = 1 / (1 + std::exp(emp / 16.0));
-}
-
-// MRPT's insertion options as near ours as its model allows. What differs from CARMEN's model
-// (COccupancyGridMap2D_insert.cpp, "simple rays", MRPT 2.5):
-//  - a beam frees the cells from the laser to its end cell and marks that one cell occupied; CARMEN
-//    marks every cell from the hit to wall_size (0.2 m: 8 cells) behind it occupied;
-//  - the evidence is the same at every distance; CARMEN's fades to the prior from range_sure to range_max;
-//  - cells hold int8 log-odds in steps of 1/16 (Debian builds MRPT with 8-bit cells), saturating at
-//    +-127 steps, so the update is the nearest step to ours (mrpt_update_probs) and not exact; CARMEN
-//    keeps float probabilities updated in double odds;
-//  - MRPT multiplies the occupied update by 3: the occupancy certainty below is chosen so that 3 times
-//    its log-odds is log-odds(p_occ); the free update is log-odds(p_emp) through the freeness certainty;
-//  - like CARMEN, a beam longer than range_max frees the cells up to range_max and marks none (CARMEN's
-//    evidence there has faded to the prior), and a cell crossed by several beams of a scan is updated once
-//    per beam; there is no range_sure.
-void set_mrpt_options(const vasco::MapperParams &p, COccupancyGridMap2D::TInsertionOptions *io) {
-  const double logit_occ = std::log(p.p_occ / (1 - p.p_occ));
-  io->maxDistanceInsertion = float(p.range_max);
-  io->maxOccupancyUpdateCertainty = float(1 / (1 + std::exp(-logit_occ / 3)));
-  io->maxFreenessUpdateCertainty = float(1 - p.p_emp);
-  io->considerInvalidRangesAsFreeSpace = false;  // CARMEN skips beams without a return
-  io->wideningBeamsWithDistance = false;         // CARMEN traces one line per beam
-  io->decimation = 1;
-  io->useMapAltitude = false;
-}
-
-// A grid over our grid's world extent (allocated and cleared here, not in the timed loop).
-std::unique_ptr<COccupancyGridMap2D> mrpt_grid(const Job &job) {
-  const vasco::GridGeometry &g = job.geo;
-  // MRPT grows its grid (a copy of it, inside the timed loop) when an end point comes within 15 cells of
-  // an edge; 16 cells more on every side keep it at this size.
-  const double margin = 16 * g.resolution;
-  auto m = std::make_unique<COccupancyGridMap2D>(
-      float(g.world_x(0) - margin), float(g.world_x(g.size_x) + margin), float(g.world_y(0) - margin),
-      float(g.world_y(g.size_y) + margin), float(g.resolution));
-  set_mrpt_options(job.p, &m->insertionOptions);
-  return m;
-}
-
-// The scans as MRPT observations and robot poses, built once and not timed (our backends too get
-// the parsed batch).
-struct MrptScans {
-  std::vector<mrpt::obs::CObservation2DRangeScan> obs;
-  std::vector<mrpt::poses::CPose3D> poses;
-  uint64_t beams = 0;
-};
-
-MrptScans mrpt_scans(const vasco::ScanBatch &b) {
-  MrptScans m;
-  m.obs.resize(b.num_scans());
-  for (size_t s = 0; s < b.num_scans(); ++s) {
-    const int n = b.beams_in(s);
-    const float *r = b.ranges_of(s);
-    mrpt::obs::CObservation2DRangeScan &o = m.obs[s];
-    o.resizeScan(n);
-    // MRPT's insertion spaces n beams aperture / n apart from heading - aperture / 2 (rightToLeft; the
-    // mirror image otherwise): aperture = n |step| keeps our spacing, and the heading below puts its beam
-    // b on ours (it is our laser heading when the scan is symmetric about it, as MRPT assumes).
-    o.aperture = float(n * std::fabs(b.angle_step[s]));
-    o.rightToLeft = b.angle_step[s] >= 0;
-    o.maxRange = float(vasco::egrid::kLaserRangeLimit);
-    o.sensorPose = mrpt::poses::CPose3D();
-    for (int i = 0; i < n; ++i) {
-      const bool used = has_return(r[i]);
-      o.setScanRange(i, used ? r[i] : 0.0f);
-      o.setScanRangeValidity(i, used);
-      m.beams += used;
-    }
-    const double heading = b.theta[s] + b.first_angle[s] + 0.5 * n * b.angle_step[s];
-    m.poses.emplace_back(b.x[s], b.y[s], 0.0, heading, 0.0, 0.0);
-  }
-  return m;
-}
-
-// The grid stores the probability of being free (raw log-odds > 0: free; getCell gives 1 for free).
-CellCounts count_mrpt(const COccupancyGridMap2D &m) {
-  CellCounts c;
-  for (const auto v : m.getRawMap()) {
-    if (v < 0) ++c.occupied;
-    else if (v > 0) ++c.free;
-  }
-  return c;
-}
-
-// Every scan inserted into a grid allocated beforehand (the allocation is not timed): the seconds. The
-// grid is left in *last; *refused counts the scans MRPT refused.
-double mrpt_insert_once(const Job &job, const MrptScans &scans, std::unique_ptr<COccupancyGridMap2D> *last,
-                        size_t *refused) {
-  last->reset();
-  auto m = mrpt_grid(job);
-  const unsigned size_x = m->getSizeX(), size_y = m->getSizeY();
-  const double t0 = now_s();
-  for (size_t s = 0; s < scans.obs.size(); ++s) *refused += !m->insertObservation(scans.obs[s], scans.poses[s]);
-  const double t = now_s() - t0;
-  if (m->getSizeX() != size_x || m->getSizeY() != size_y)
-    std::fprintf(stderr, "peer_bench: MRPT grew its grid during the run (timed)\n");
-  *last = std::move(m);
-  return t;
-}
-
-Row run_mrpt(const Job &job, CellCounts *counts) {
-  const MrptScans scans = mrpt_scans(job.batch);
-  Row row = make_row(job, kMrptLabel);
-  row.beams = scans.beams;
-  std::unique_ptr<COccupancyGridMap2D> last;
-  size_t refused = 0;
-  row.map_s = timed_median(job.runs, [&] { return mrpt_insert_once(job, scans, &last, &refused); });
-  if (refused > 0) std::fprintf(stderr, "peer_bench: MRPT refused %zu scans\n", refused);
-  *counts = count_mrpt(*last);
-  return row;
-}
-#endif  // VASCO_HAVE_MRPT
 
 // ---------------------------------------------------------------------------------------------------------
 // OctoMap
@@ -552,72 +402,6 @@ constexpr const char *kWhyMissed =
     "update (6 to 8 instructions), plus ~23 ns a beam of set-up (the walk's frame, two 64-bit divisions, and the "
     "searches for where its free, range_sure and stop runs end); docs/performance.md \"History\" lists what was tried\n";
 
-// Where a user sees it: log2map's seconds.map (--json) for cpu_float, a
-// fresh process per run (its memory touched for the first time, caches
-// cold), the median of `runs`; < 0 when log2map is not beside this program
-// or fails.
-double log2map_map_seconds(const std::string &log2map, const Dataset &ds, const ParamSet &ps, int runs) {
-  if (access(log2map.c_str(), X_OK) != 0) return -1;
-  const std::string out = temp_map_path();
-  const std::string cmd = shell_quoted(log2map) + " --quiet --json --backend cpu_float " + ps.log2map_args + " " +
-                          shell_quoted(ds.path) + " " + shell_quoted(out) + " 2>/dev/null";
-  std::vector<double> t;
-  for (int i = 0; i < runs; ++i) {
-    FILE *p = popen(cmd.c_str(), "r");
-    if (p == nullptr) return -1;
-    std::string json;
-    char buf[4096];
-    for (size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) json.append(buf, n);
-    const int rc = pclose(p);
-    std::remove(out.c_str());
-    const size_t sec = json.find("\"seconds\":{");
-    const size_t map = sec == std::string::npos ? sec : json.find("\"map\":", sec);
-    if (rc != 0 || map == std::string::npos) return -1;
-    t.push_back(std::strtod(json.c_str() + map + 6, nullptr));
-  }
-  return median(t);
-}
-
-// cpu_float beside MRPT for the target, round by round: a round times cpu_float's render (a warm
-// renderer, as its table row), MRPT's insertion (a grid allocated beforehand) and log2map's map phase (a
-// process of its own) one after the other, so that a drift of this shared machine's speed falls on the
-// three alike, and a round's ratio is MRPT's time over ours in that round. The table's rows, each mapper's
-// runs in a block, minutes apart, moved MRPT's ratio by a third between two runs of the bench.
-struct HeadToHead {
-  std::string data, params;
-  std::vector<double> render, mrpt, cli;  // seconds, a round each; cli empty without log2map
-  double first = -1;                      // a fresh renderer's first render (first_render_seconds)
-};
-
-#if defined(VASCO_HAVE_MRPT)
-HeadToHead head_to_head(const Job &job, const Dataset &ds, const ParamSet &ps, const std::string &log2map,
-                        int rounds) {
-  HeadToHead h;
-  h.data = job.data;
-  h.params = job.params;
-  const MrptScans scans = mrpt_scans(job.batch);
-  std::unique_ptr<COccupancyGridMap2D> last;
-  size_t refused = 0;
-  auto renderer = vasco::make_renderer("cpu_float", vasco::BackendOptions{});
-  const auto render = [&] {
-    const double t0 = now_s();
-    renderer->reset(job.geo, job.p);
-    renderer->apply(job.batch, 0, job.batch.num_scans(), nullptr);
-    return now_s() - t0;
-  };
-  render();  // the warm-up round: the renderer's table and grid, MRPT's code and pages
-  mrpt_insert_once(job, scans, &last, &refused);
-  for (int r = 0; r < rounds; ++r) {
-    h.render.push_back(render());
-    h.mrpt.push_back(mrpt_insert_once(job, scans, &last, &refused));
-    const double cli = log2map_map_seconds(log2map, ds, ps, 1);
-    if (cli > 0) h.cli.push_back(cli);
-  }
-  if (h.cli.size() != h.render.size()) h.cli.clear();  // log2map absent or failing: no column
-  return h;
-}
-#endif
-
 // The median over the rounds of MRPT's time over ours.
 double median_ratio(const std::vector<double> &mrpt, const std::vector<double> &ours) {
   std::vector<double> x;
@@ -662,10 +446,8 @@ void print_sanity(const std::vector<Sanity> &sanity) {
               "one cell per hit)\n");
 #if defined(VASCO_HAVE_MRPT)
   const vasco::MapperParams p;
-  COccupancyGridMap2D::TInsertionOptions io;
-  set_mrpt_options(p, &io);
   double p_occ = 0, p_emp = 0;
-  mrpt_update_probs(io, &p_occ, &p_emp);
+  mrpt_update_probs(p, &p_occ, &p_emp);
   std::printf("  MRPT's per-beam update, the nearest its int8 log-odds allow: occupied p = %.3f, "
               "free p = %.3f (ours: p_occ %.2f, p_emp %.2f)\n", p_occ, p_emp, p.p_occ, p.p_emp);
 #endif
