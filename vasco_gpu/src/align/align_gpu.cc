@@ -1,6 +1,6 @@
 // The host side of the GPU global search (align_gpu.h): the rotations' cos
 // and sin as the CPU search computes them, the device's local maxima, and
-// the best distinct leaves among them.
+// best_distinct (align_search.h) among them.
 #include "align_gpu.h"
 
 #include <algorithm>
@@ -15,32 +15,6 @@ namespace align_detail {
 
 #if defined(VASCO_HAVE_CUDA)
 namespace {
-
-// branch_and_bound's order: the larger sum first, ties by the smallest
-// (rotation, tx, ty).
-bool precedes(const Leaf &a, const Leaf &b) {
-  return std::make_tuple(-a.sum, a.rotation, a.tx, a.ty) < std::make_tuple(-b.sum, b.rotation, b.tx, b.ty);
-}
-
-// branch_and_bound's "same candidate" (align_search.h's Distinctness).
-bool same_candidate(const SearchSpace &s, const Distinctness &d, const Leaf &a, const Leaf &b) {
-  const double turn = std::abs(angle_difference(s.theta(a.rotation), s.theta(b.rotation)));
-  return std::hypot(a.tx - b.tx, a.ty - b.ty) + turn * d.radius_cells <= d.cells;
-}
-
-// The best leaves, each kept unless it is the same candidate as a better
-// one kept: what branch_and_bound keeps, each the best of those near it.
-std::vector<Leaf> best_distinct(std::vector<Leaf> maxima, const SearchSpace &s, int keep, const Distinctness &d) {
-  std::sort(maxima.begin(), maxima.end(), precedes);
-  std::vector<Leaf> kept;
-  for (const Leaf &leaf : maxima) {
-    if (static_cast<int>(kept.size()) >= keep) break;
-    const bool near_kept =
-        std::any_of(kept.begin(), kept.end(), [&](const Leaf &k) { return same_candidate(s, d, k, leaf); });
-    if (!near_kept) kept.push_back(leaf);
-  }
-  return kept;
-}
 
 // After the list overflows at the floor: floors at these fractions of the
 // best sum. The candidates that matter score near the best.

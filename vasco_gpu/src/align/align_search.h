@@ -52,9 +52,25 @@ struct Distinctness {
   double cells = 0;
 };
 
-// The `keep` best distinct leaves (each the best of those near it) whose
-// sums beat `floor_sum`, best first (ties: the smallest (rotation, tx, ty));
-// none if no leaf beats it. On `threads` threads over rotations.
+// The order of leaves: the larger sum first, ties by the smallest
+// (rotation, tx, ty).
+bool precedes(const Leaf &a, const Leaf &b);
+// Whether two leaves are at most `cells` apart (Distinctness's distance: a
+// metric, the translations' Euclidean one plus the rotations' angle times
+// the radius).
+bool within(const SearchSpace &space, const Distinctness &d, const Leaf &a, const Leaf &b, double cells);
+
+// The candidates both searches return, so that the GPU's and the CPU's are
+// the same whatever the order their leaves come in: the peaks (leaves that
+// no neighbour at their rotation beats: translations one cell away in the
+// rotation's box) whose sums beat the floor, taken best first (`precedes`),
+// each unless it is the same candidate as one taken, `keep` at most. This
+// selects from `peaks` (every peak above the floor, or every one above a
+// sum that the keep-th taken beats: the same selection).
+std::vector<Leaf> best_distinct(std::vector<Leaf> peaks, const SearchSpace &space, int keep, const Distinctness &d);
+
+// best_distinct over every peak whose sum beats `floor_sum`; none if no leaf
+// beats it. On `threads` threads over rotations, the same result for any.
 std::vector<Leaf> branch_and_bound(const SearchSpace &space, float floor_sum, int keep, const Distinctness &distinct,
                                    int threads);
 
