@@ -331,7 +331,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
                       "test -f a.yaml && test -f d/intel.map.gz && test -f d/intel.png"]),
         "sh: log2map monday.log.gz --add tuesday.log.gz@12.5,-3.0,1.5708": Check(
             "run", fixture="sessions", outputs=["both.map.gz"]),
-        "text: # date: 2026-12-06 22:21 UTC": picked("bench/results/align-2026-12-06-2core.txt"),
+        "text: # date: 2026-12-07 22:55 UTC": picked("bench/results/align-2026-12-07-2core.txt"),
         "text: # date: 2026-12-06 22:46 UTC": picked("bench/results/align-2026-12-06-h100.txt"),
         "sh: log2map -q --json first.log --add second.log@auto both.map": Check(
             "covered-by", files=[("tests/log2map_auto_test.cc", [
@@ -388,7 +388,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             picked("bench/results/batch-2026-12-07d-h100.txt"),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build peers": picked(PEERS_RUN),
         "text: re-render linear in cell updates (cpu_float): ns per update":
-            picked("bench/results/large-site-2026-12-07i-2core.txt"),
+            picked("bench/results/large-site-2026-12-07j-2core.txt"),
         "text: re-render linear in cell updates (cuda_exact): ns per update":
             picked("bench/results/large-site-2026-12-07h-h100.txt"),
         "text: Where a user sees it: log2map --json --backend cpu_float, se": quoted(PEERS_RUN),
