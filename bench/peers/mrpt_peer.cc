@@ -18,9 +18,7 @@
 
 namespace peers {
 
-using bench::Dataset;
 using bench::now_s;
-using bench::ParamSet;
 
 #if defined(VASCO_HAVE_MRPT)
 using mrpt::maps::COccupancyGridMap2D;
@@ -151,8 +149,7 @@ Row run_mrpt(const Job &job, CellCounts *counts) {
   return row;
 }
 
-HeadToHead head_to_head(const Job &job, const Dataset &ds, const ParamSet &ps, const std::string &log2map,
-                        int rounds) {
+HeadToHead head_to_head(const Job &job, const std::string &log2map, int rounds) {
   HeadToHead h;
   h.data = job.data;
   h.params = job.params;
@@ -171,7 +168,7 @@ HeadToHead head_to_head(const Job &job, const Dataset &ds, const ParamSet &ps, c
   for (int r = 0; r < rounds; ++r) {
     h.render.push_back(render());
     h.mrpt.push_back(mrpt_insert_once(job, scans, &last, &refused));
-    const double cli = log2map_map_seconds(log2map, ds, ps, 1);
+    const double cli = log2map_map_seconds(log2map, job, 1);
     if (cli > 0) h.cli.push_back(cli);
   }
   if (h.cli.size() != h.render.size()) h.cli.clear();  // log2map absent or failing: no column
@@ -184,14 +181,6 @@ void mrpt_update_probs(const vasco::MapperParams &p, double *p_occ, double *p_em
   update_probs(io, p_occ, p_emp);
 }
 
-bool mrpt_built() { return true; }
-#else
-bool mrpt_built() { return false; }
-Row run_mrpt(const Job &job, CellCounts *) { return make_row(job, kMrptLabel); }
-HeadToHead head_to_head(const Job &job, const bench::Dataset &, const bench::ParamSet &, const std::string &, int) {
-  return HeadToHead{job.data, job.params, {}, {}, {}, -1};
-}
-void mrpt_update_probs(const vasco::MapperParams &, double *p_occ, double *p_emp) { *p_occ = *p_emp = 0; }
 #endif  // VASCO_HAVE_MRPT
 
 }  // namespace peers

@@ -44,11 +44,11 @@
 
 namespace peers {
 
-double log2map_map_seconds(const std::string &log2map, const bench::Dataset &ds, const bench::ParamSet &ps, int runs) {
+double log2map_map_seconds(const std::string &log2map, const Job &job, int runs) {
   if (access(log2map.c_str(), X_OK) != 0) return -1;
   const std::string out = bench::temp_map_path();
-  const std::string cmd = bench::shell_quoted(log2map) + " --quiet --json --backend cpu_float " + ps.log2map_args + " " +
-                          bench::shell_quoted(ds.path) + " " + bench::shell_quoted(out) + " 2>/dev/null";
+  const std::string cmd = bench::shell_quoted(log2map) +  " --quiet --json --backend cpu_float " + job.log2map_args + " " +
+                          bench::shell_quoted(job.log_path) + " " + bench::shell_quoted(out) + " 2>/dev/null";
   std::vector<double> t;
   for (int i = 0; i < runs; ++i) {
     FILE *p = popen(cmd.c_str(), "r");
@@ -285,6 +285,8 @@ Job bench_param_set(Bench *b, const Dataset &ds, const ParamSet &ps) {
   Job job;
   job.data = ds.name;
   job.params = ps.name;
+  job.log_path = ds.path;
+  job.log2map_args = ps.log2map_args;
   job.p = ps.params;
   job.runs = b->opt.runs;
   vasco::LogLoadStats stats;
@@ -454,18 +456,13 @@ void print_sanity(const std::vector<Sanity> &sanity) {
 }
 
 #if defined(VASCO_HAVE_MRPT)
-// The head-to-head rounds of one job (its log and parameter set found by name for log2map's options).
+// The head-to-head rounds of one job, beside its fresh renderer's first render.
 HeadToHead head_to_head_of(const Bench &b, const Job &job, const std::string &log2map) {
   std::fprintf(stderr, "%s / %s: cpu_float, MRPT and log2map in turn ...\n", job.data.c_str(), job.params.c_str());
-  for (const Dataset &ds : bench_datasets())
-    for (const ParamSet &ps : bench_param_sets()) {
-      if (ds.name != job.data || ps.name != job.params) continue;
-      HeadToHead h = head_to_head(job, ds, ps, log2map, b.opt.runs);
-      const Row *r = row_of(b.rows, make_row(job, ""), "cpu_float");
-      if (r != nullptr) h.first = r->first_s;
-      return h;
-    }
-  return HeadToHead{job.data, job.params, {}, {}, {}, -1};
+  HeadToHead h = head_to_head(job, log2map, b.opt.runs);
+  const Row *r = row_of(b.rows, make_row(job, ""), "cpu_float");
+  if (r != nullptr) h.first = r->first_s;
+  return h;
 }
 #endif
 

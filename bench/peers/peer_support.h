@@ -36,6 +36,7 @@ struct Row {
 // What every mapper of one log and parameter set shares: the scans, parameters and our grid.
 struct Job {
   std::string data, params;
+  std::string log_path, log2map_args;  // the log and the parameters as log2map takes them (its map phase)
   vasco::MapperParams p;
   vasco::ScanBatch batch;
   vasco::GridGeometry geo;
@@ -79,7 +80,7 @@ inline Row make_row(const Job &job, const std::string &mapper) {
 // fresh process per run (its memory touched for the first time, caches
 // cold), the median of `runs`; < 0 when log2map is not beside this program
 // or fails.
-double log2map_map_seconds(const std::string &log2map, const bench::Dataset &ds, const bench::ParamSet &ps, int runs);
+double log2map_map_seconds(const std::string &log2map, const Job &job, int runs);
 
 }  // namespace peers
 
