@@ -1,7 +1,9 @@
 """The published map's canvas and its updates (vasco_gpu.ros.canvas), without ROS: updates
 applied to a full map give the next full map, a growing canvas at least doubles its area with
 the finished map located exactly in it, a canvas the size of the map is today's /map bit for
-bit, a fixed frame gives only updates, reset starts again."""
+bit, a fixed frame gives only updates, reset starts again. Every test runs on both stores of
+the canvas's cells (canvas_cells.py): plain, and packed in tiles of 7 cells (odd, so the maps'
+edges cut tiles), and the packed store is checked against a NumPy array."""
 
 from __future__ import annotations
 
@@ -13,11 +15,21 @@ import numpy as np
 import pytest
 
 from vasco_gpu import _core
+from vasco_gpu.ros import canvas_cells
 from vasco_gpu.ros.canvas import Canvas, FullMap, MapUpdate, fill_update
 from vasco_gpu.ros.grid import finished_grid
 from vasco_gpu.ros.live_map import LiveMap
 
 MODE = ("trinary", 0.25, 0.65)
+
+
+@pytest.fixture(params=["plain", "packed"], autouse=True)
+def store(request, monkeypatch):
+    """The canvas's cells plain (the default for a map of these sizes) or packed, small tiles."""
+    if request.param == "packed":
+        monkeypatch.setattr(canvas_cells, "PACKED_CANVAS_BYTES", -1)
+        monkeypatch.setattr(canvas_cells, "TILE", 7)
+    return request.param
 
 
 class Subscriber:
@@ -283,3 +295,35 @@ def test_a_widened_crop_is_compared_whole_whatever_the_reach():
     np.testing.assert_array_equal(sub.cells, expected_canvas(sub.geometry, second))
     # the same window again: only the reach is compared, and nothing changed there
     assert canvas.publish(second, frame, reach=far) is None
+
+
+def test_packed_cells_are_the_cells_written(store):
+    # boxes written and read at random against a NumPy array; tiles of one value and deflated
+    # ones both (a box of one value written over a whole tile, random values elsewhere)
+    rng = np.random.default_rng(9)
+    h, w = 40, 53
+    cells, want = canvas_cells.cells_for(h, w), np.full((h, w), -1, dtype=np.int8)
+    assert cells.packed == (store == "packed")
+    for _ in range(200):
+        y, x = int(rng.integers(0, h)), int(rng.integers(0, w))
+        bh, bw = int(rng.integers(0, h - y + 1)), int(rng.integers(0, w - x + 1))
+        values = rng.choice(np.array([-1, 0, 100], dtype=np.int8), (bh, bw)) if rng.random() < 0.5 else \
+            np.full((bh, bw), rng.choice([-1, 0, 100]), dtype=np.int8)
+        cells.write(y, x, values)
+        want[y:y + bh, x:x + bw] = values
+        y, x = int(rng.integers(0, h)), int(rng.integers(0, w))
+        bh, bw = int(rng.integers(0, h - y + 1)), int(rng.integers(0, w - x + 1))
+        np.testing.assert_array_equal(cells.cells_of(y, x, bh, bw), want[y:y + bh, x:x + bw])
+    np.testing.assert_array_equal(np.frombuffer(cells.whole(), dtype=np.int8).reshape(h, w), want)
+    # full maps: the last window back to -1 (outside it every cell is -1 already), the new written
+    every, old, win = NS(x=0, y=0, w=w, h=h), NS(x=3, y=4, w=20, h=10), NS(x=30, y=1, w=20, h=30)
+    new = rng.integers(-1, 101, (win.h, win.w), dtype=np.int8)
+    cells.replace(None, every, want)
+    cells.replace(every, old, want[old.y:old.y + old.h, old.x:old.x + old.w])
+    data = cells.replace(old, win, new)
+    want[:] = -1
+    want[win.y:win.y + win.h, win.x:win.x + win.w] = new
+    for got in (data, cells.whole()):
+        np.testing.assert_array_equal(np.frombuffer(got, dtype=np.int8).reshape(h, w), want)
+    if store == "packed":
+        assert 0 < cells.packed_bytes() < h * w

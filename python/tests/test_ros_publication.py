@@ -1,6 +1,7 @@
 """MapPublication without a ROS graph (its publishers stand-ins): what it keeps between
 publications. A finish's buffer past KEPT_FINISH_BYTES is used once and dropped (a large site's
-map would otherwise be held twice, the canvas and the buffer); either way the map it keeps for
+map would otherwise be held twice, the canvas and the buffer), and a packed canvas's /map message
+lets its array go once published (the DDS writer holds the map); either way the map it keeps for
 ~/dynamic_map is the finished map placed in the canvas, computed here independently."""
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ ros_support.import_or_skip("rclpy")
 from builtin_interfaces.msg import Time  # noqa: E402
 
 from test_ros_canvas import MODE, add_scans, expected_canvas  # noqa: E402
-from vasco_gpu.ros import publication  # noqa: E402
+from vasco_gpu.ros import canvas_cells, publication  # noqa: E402
 from vasco_gpu.ros.live_map import LiveMap  # noqa: E402
 
 
@@ -41,9 +42,12 @@ SETTINGS = NS(map_mode=MODE[0], free_thresh=MODE[1], occupied_thresh=MODE[2], ma
               map_frame="map")
 
 
-@pytest.mark.parametrize("kept", [publication.KEPT_FINISH_BYTES, 0])
-def test_the_kept_map_is_the_finished_map_whether_the_buffer_is_kept_or_not(intel, monkeypatch, kept):
+@pytest.mark.parametrize("kept, packed", [(publication.KEPT_FINISH_BYTES, False), (0, False), (0, True)])
+def test_the_kept_map_is_the_finished_map_whether_the_buffer_is_kept_or_not(intel, monkeypatch, kept, packed):
     monkeypatch.setattr(publication, "KEPT_FINISH_BYTES", kept)
+    if packed:  # a packed canvas: the message drops its map once published
+        monkeypatch.setattr(canvas_cells, "PACKED_CANVAS_BYTES", -1)
+        monkeypatch.setattr(canvas_cells, "TILE", 7)
     pub = publication.MapPublication(Node(), fixed=False)
     live = LiveMap(intel.params, backend="cpu_float")
     scans = intel.scans.select(0, 120)
@@ -58,4 +62,5 @@ def test_the_kept_map_is_the_finished_map_whether_the_buffer_is_kept_or_not(inte
         got = np.frombuffer(kept_map.data, dtype=np.int8).reshape(info.height, info.width)
         np.testing.assert_array_equal(got, expected_canvas(geometry, live.finish_grid(*MODE)))
         assert (pub._finished is None) == (kept == 0)
+        assert (len(pub.grid_msg.data) == 0) == packed and len(kept_map.data) == info.width * info.height
     assert pub.map_pub.sent + pub.update_pub.sent == 8 and pub.update_pub.sent > 0

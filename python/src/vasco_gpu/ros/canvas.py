@@ -23,8 +23,8 @@ did not overflow keeps its place, so the margin lies where the map grew, and the
 holds the old one. A new lattice makes a new canvas centred on the window, as large as the old
 one where the window fits (the canvas never shrinks, except on reset), by the growth rule where
 it does not. A side chosen anew differs from the window's side by an even number of cells.
-Cost: one byte per canvas cell for the canvas kept here, one more per copy of it the node's
-message holds; after a growth a side is at most twice the map's (plus a cell), so a canvas holds
+Cost: one byte per canvas cell for the canvas kept here (a large canvas is packed, far less:
+canvas_cells.py), one more per copy of it the node's message holds; after a growth a side is at most twice the map's (plus a cell), so a canvas holds
 up to 4 x the map's cells, about 2 x on average (intel at 0.025 m, batches of 10 scans: a
 2327 x 2636 canvas, 6.1 MB, for the final 1297 x 1326 map). A map that grows to n times its
 first area grows its canvas O(log n) times (intel: 4 growths, 5 full maps, 86 updates in 91
@@ -56,6 +56,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .canvas_cells import cells_for
+
 __all__ = ["Canvas", "FullMap", "MapUpdate", "fill_update"]
 
 # A side that must grow: the factor on the old side when one side grows, and when both do
@@ -67,9 +69,10 @@ _GROW_BOTH = 1.5
 @dataclass(frozen=True)
 class FullMap:
     """A whole /map: geometry (size_x, size_y, resolution, (x, y, theta)) as grid.fill_grid
-    takes it, and data, the canvas row-major from the lower-left cell (int8, -1 unknown). data is
-    the canvas's own array: later publications write into it (in place while the size is the
-    same), so it always holds the last /map with its updates applied."""
+    takes it, and data, the canvas row-major from the lower-left cell (int8, -1 unknown). A plain
+    canvas's data is its own array: later publications write into it (in place while the size is
+    the same), so it always holds the last /map with its updates applied; a packed one's is made
+    for this map alone (Canvas.packed)."""
 
     geometry: tuple
     data: array
@@ -151,10 +154,14 @@ class Canvas:
         self._lattice: _Lattice | None = None
         self._rect: _Rect | None = None     # the canvas, in blocks from the lattice's centre
         self._window: _Rect | None = None   # the last finished map, in canvas cells
-        self._data = array("b")
-        self._cells = np.frombuffer(self._data, dtype=np.int8).reshape(0, 0)
+        self._cells = cells_for(0, 0)
         self.growths = 0    # canvases made for a window that left its canvas on the same lattice
         self.lattices = 0   # canvases made for a new lattice (the first one included)
+
+    @property
+    def packed(self) -> bool:
+        """The canvas is packed (canvas_cells.py): a FullMap's data is not kept here."""
+        return self._cells.packed
 
     @property
     def geometry(self) -> tuple | None:
@@ -170,7 +177,7 @@ class Canvas:
     def current(self) -> FullMap | None:
         """The canvas as last published with its updates (what a GetMap answers); None before
         a map."""
-        return None if self._rect is None else FullMap(self.geometry, self._data)
+        return None if self._rect is None else FullMap(self.geometry, self._cells.whole())
 
     def publish(self, finished, frame, *, full: bool = False, reach=None) -> FullMap | MapUpdate | None:
         """What to publish for `finished` (LiveMap.finish_grid's ((size_x, size_y, resolution,
@@ -253,16 +260,12 @@ class Canvas:
 
     # -- what is sent ----------------------------------------------------------------------
     def _full(self, cells: np.ndarray, win: _Rect, size_changed: bool) -> FullMap:
-        r = self._rect
+        r, old = self._rect, self._window  # outside the last window every cell is -1 already
         if size_changed:
-            self._data = array("b", b"\xff") * (r.w * r.h)  # every cell -1
-            self._cells = np.frombuffer(self._data, dtype=np.int8).reshape(r.h, r.w)
-        elif self._window is not None:
-            old = self._window  # outside it every cell is -1 already
-            self._cells[old.y:old.y + old.h, old.x:old.x + old.w] = -1
-        self._cells[win.y:win.y + win.h, win.x:win.x + win.w] = cells
+            self._cells, old = cells_for(r.h, r.w), None  # every cell -1
+        data = self._cells.replace(old, win, cells)
         self._window = win
-        return FullMap(self.geometry, self._data)
+        return FullMap(self.geometry, data)
 
     def _cells_of(self, reach) -> _Rect:
         """A world box's canvas cells, one of margin a side, clipped to the canvas (empty for
@@ -301,7 +304,7 @@ class Canvas:
                 return None
             new = new[y - region.y:y - region.y + h, x - region.x:x - region.x + w]
             region = _Rect(x, y, w, h)
-        now = self._cells[region.y:region.y + region.h, region.x:region.x + region.w]
+        now = self._cells.cells_of(region.y, region.x, region.h, region.w)
         # the whole window compared: 0.7 ms for a 2000 x 2000 canvas with nothing changed on
         # the 2-core machine, a box of the whole canvas costs its copy besides (2 to 6 ms); a
         # batch's reach is a few hundred cells a side
@@ -312,7 +315,7 @@ class Canvas:
         cols = np.flatnonzero(changed.any(axis=0))
         r0, r1, c0, c1 = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
         patch = new[r0:r1, c0:c1]
-        now[r0:r1, c0:c1] = patch
+        self._cells.write(region.y + r0, region.x + c0, patch)
         data = array("b")
         data.frombytes(patch.tobytes())
         return MapUpdate(region.x + c0, region.y + r0, c1 - c0, r1 - r0, data)

@@ -15,6 +15,7 @@ from nav_msgs.msg import MapMetaData, OccupancyGrid
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from .canvas import Canvas, FullMap, fill_update
+from .canvas_cells import PACKED_CANVAS_BYTES
 from .grid import array_keeping_message, fill_grid
 from .tf_messages import map_update_type
 
@@ -25,11 +26,12 @@ LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability
 # What nav2's static layer subscribes map_updates with (rclcpp's default: reliable, volatile,
 # depth 10): an update is relative to the one before, so none may be dropped by the QoS; a
 # subscriber that joins late starts from the latched /map and the updates after it.
-# The finish's buffer is kept for the next publication up to this size: a small map made anew
-# page-faults each time it is published (often), while a kept one costs a byte a /map cell for
-# good beside the canvas (a large site of 2e8 cells: 200 MB); past it each publication's bytes
-# are used once and freed (glibc gives such a block back to the system at once).
-KEPT_FINISH_BYTES = 64 << 20
+# The finish's buffer is kept for the next publication up to this size, the size past which the
+# canvas is packed: a small map made anew page-faults each time it is published (often), while a
+# kept one costs a byte a /map cell for good beside the latched sample (a large site of 2e8
+# cells: 200 MB); past it each publication's bytes are used once and freed (glibc gives such a
+# block back to the system at once).
+KEPT_FINISH_BYTES = PACKED_CANVAS_BYTES
 UPDATES = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE,
                      history=HistoryPolicy.KEEP_LAST)
 
@@ -71,26 +73,33 @@ class MapPublication:
         frame (the node active), the map sent so far is replaced at once by one of its geometry
         with every cell unknown: /map is latched, and a subscriber joining later (map_server,
         nav2, RViz) must not get the map of the scans just dropped."""
-        sent = self.canvas.current() if frame is not None and self.sent else None
+        geometry = self.canvas.geometry if frame is not None and self.sent else None
         self.canvas.reset()
         self._published = -1
-        self.sent = sent is not None  # inactive: ~/dynamic_map has no map until the next one
-        if sent is not None:
-            fill_grid(self.grid_msg, sent.geometry, array("b", b"\xff") * len(sent.data), frame=frame, stamp=stamp)
+        self.sent = geometry is not None  # inactive: ~/dynamic_map has no map until the next one
+        if geometry is not None:
+            cells = geometry[0] * geometry[1]
+            fill_grid(self.grid_msg, geometry, array("b", b"\xff") * cells, frame=frame, stamp=stamp)
             self.map_pub.publish(self.grid_msg)
             self.meta_pub.publish(self.grid_msg.info)
             self._updated, self._full_at = False, time.monotonic()
-            self._count("map", len(sent.data))
+            self._count("map", cells)
 
     def current(self) -> OccupancyGrid:
         """The last /map message with every update since applied (~/dynamic_map's answer), its
         stamp the last publication's. Its data is the canvas's: rclpy messages copy an array
-        unless they check their fields, so it is given again here. After a reset, until the
-        next map: the empty map the reset published (its data in the message itself)."""
+        unless they check their fields, so it is given again here. A packed canvas's is unpacked
+        into a message of its own, dropped with the answer. After a reset, until the next map:
+        the empty map the reset published (its data in the message itself)."""
         canvas = self.canvas.current()
-        if canvas is not None:
+        if canvas is None:
+            return self.grid_msg
+        if not self.canvas.packed:
             self.grid_msg.data = canvas.data
-        return self.grid_msg
+            return self.grid_msg
+        msg = array_keeping_message(OccupancyGrid)
+        msg.header, msg.info, msg.data = self.grid_msg.header, self.grid_msg.info, canvas.data
+        return msg
 
     def publish(self, live, settings, stamp: Time, *, now: bool = False) -> dict:
         """Publishes what changed in live's grid since the last publication: a full /map (and
@@ -135,6 +144,8 @@ class MapPublication:
             t2 = time.perf_counter()
             self.map_pub.publish(self.grid_msg)
             self.meta_pub.publish(self.grid_msg.info)
+            if self.canvas.packed:  # the message's array was made for it: the writer holds the map now
+                self.grid_msg.data = array("b")
             self.sent, self._updated, self._full_at = True, False, time.monotonic()
             self._count("map", len(out.data))
         else:
