@@ -16,20 +16,40 @@ from __future__ import annotations
 import ctypes
 import platform
 
-__all__ = ["KEPT_FREE_BYTES", "MESSAGE_BUFFER_BYTES", "keep_message_buffers"]
+__all__ = ["KEPT_FREE_BYTES", "MESSAGE_BUFFER_BYTES", "give_back_free_memory", "keep_message_buffers"]
 
 MESSAGE_BUFFER_BYTES = 8 << 20  # a 2000 x 2000 map (4 MB) and its copies
 KEPT_FREE_BYTES = 32 << 20  # what the heap may hold freed: at most this much more than the node uses
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3  # <malloc.h>
 
 
+def _libc_function(name: str):
+    if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc":
+        return None
+    try:
+        return getattr(ctypes.CDLL(None), name)
+    except (OSError, AttributeError):
+        return None
+
+
+def give_back_free_memory() -> bool:
+    """glibc's malloc_trim(0): the free pages of every arena go back to the system, also those
+    below the trim threshold and between chunks in use. After a large site's full /map (a
+    packed canvas): making and packing it frees tens of MB in pieces under the mmap threshold,
+    which the heap would otherwise hold for good (bench/large_site_bench.py). A few ms; not done
+    for small maps, whose buffers the thresholds keep on purpose. True where it ran."""
+    trim = _libc_function("malloc_trim")
+    if trim is None:
+        return False
+    trim.argtypes, trim.restype = [ctypes.c_size_t], ctypes.c_int
+    trim(0)
+    return True
+
+
 def keep_message_buffers() -> bool:
     """Raises glibc's mmap and trim thresholds in this process (as above); True where it did."""
-    if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc":
-        return False
-    try:
-        mallopt = ctypes.CDLL(None).mallopt
-    except (OSError, AttributeError):
+    mallopt = _libc_function("mallopt")
+    if mallopt is None:
         return False
     mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
     return mallopt(_M_MMAP_THRESHOLD, MESSAGE_BUFFER_BYTES) == 1 and mallopt(_M_TRIM_THRESHOLD, KEPT_FREE_BYTES) == 1

@@ -17,6 +17,7 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from .canvas import Canvas, FullMap, fill_update
 from .canvas_cells import PACKED_CANVAS_BYTES
 from .grid import array_keeping_message, fill_grid
+from .message_buffers import give_back_free_memory
 from .tf_messages import map_update_type
 
 __all__ = ["MapPublication"]
@@ -146,6 +147,7 @@ class MapPublication:
             self.meta_pub.publish(self.grid_msg.info)
             if self.canvas.packed:  # the message's array was made for it: the writer holds the map now
                 self.grid_msg.data = array("b")
+                give_back_free_memory()
             self.sent, self._updated, self._full_at = True, False, time.monotonic()
             self._count("map", len(out.data))
         else:
