@@ -42,7 +42,9 @@ is the target, so that a drift of a shared machine's speed falls on every size a
                 which its incremental inserts use); the slope of the resident memory between the two
                 sizes per cell (the same scans: what grows with the cells only); the bytes of each
                 /map and map_updates message's data; a bare node's (no session, once ready): the
-                fixed part, printed beside each size's figure as its floor; publish -> a subscriber's callback (the
+                fixed part; and one latched OccupancyGrid of each size's /map cells published by
+                a process that does nothing else (large_site_node.latched_floor): with the bare
+                node's, the floor printed beside each size's figure; publish -> a subscriber's callback (the
                 message's source timestamp, which Fast DDS takes as the publisher writes it, ->
                 this process's callback entry, one system clock); the node's largest mappings
                 (/proc/PID/smaps: each buffer above glibc's mmap threshold is a mapping of its own),
@@ -52,7 +54,8 @@ Targets (issue 59): re-render time grows linearly with the cell updates: ns per 
 largest size within 10 % of the smallest's (beside it the floor's growth: above the target, the
 target stands missed where the render is within 10 % of the floor); the node holds at most 2 bytes per /map cell beyond the
 evidence grid (its resident memory after the Path's /map minus the grid's bytes; and the
-slope). Each printed met or missed.
+slope; where a size's floor is above the target, a figure within 10 % of it stands missed).
+Each printed met or missed.
 
 Default for this 2-core CPU machine: --scans 100000 --cells 1e8 4e8 --backends cpu_float (about
 7 minutes). GPU rows: --backends cuda_float cuda_exact (log2map and the re-render; the node runs

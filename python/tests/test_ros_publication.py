@@ -45,9 +45,11 @@ SETTINGS = NS(map_mode=MODE[0], free_thresh=MODE[1], occupied_thresh=MODE[2], ma
 @pytest.mark.parametrize("kept, packed", [(publication.KEPT_FINISH_BYTES, False), (0, False), (0, True)])
 def test_the_kept_map_is_the_finished_map_whether_the_buffer_is_kept_or_not(intel, monkeypatch, kept, packed):
     monkeypatch.setattr(publication, "KEPT_FINISH_BYTES", kept)
-    if packed:  # a packed canvas: the message drops its map once published
+    trims = []
+    if packed:  # a packed canvas: the message drops its map once published, and the heap is trimmed
         monkeypatch.setattr(canvas_cells, "PACKED_CANVAS_BYTES", -1)
         monkeypatch.setattr(canvas_cells, "TILE", 7)
+        monkeypatch.setattr(publication, "give_back_free_memory", lambda: trims.append(pub.map_pub.sent) or True)
     pub = publication.MapPublication(Node(), fixed=False)
     live = LiveMap(intel.params, backend="cpu_float")
     scans = intel.scans.select(0, 120)
@@ -64,3 +66,7 @@ def test_the_kept_map_is_the_finished_map_whether_the_buffer_is_kept_or_not(inte
         assert (pub._finished is None) == (kept == 0)
         assert (len(pub.grid_msg.data) == 0) == packed and len(kept_map.data) == info.width * info.height
     assert pub.map_pub.sent + pub.update_pub.sent == 8 and pub.update_pub.sent > 0
+    # a packed canvas: trimmed after each full map, and again at the next publication (what its
+    # caller freed since); a plain one never
+    fulls = pub.map_pub.sent
+    assert (len(trims) in (2 * fulls - 1, 2 * fulls)) if packed else trims == [], (trims, fulls)

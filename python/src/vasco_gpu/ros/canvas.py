@@ -24,13 +24,14 @@ holds the old one. A new lattice makes a new canvas centred on the window, as la
 one where the window fits (the canvas never shrinks, except on reset), by the growth rule where
 it does not. A side chosen anew differs from the window's side by an even number of cells.
 Cost: one byte per canvas cell for the canvas kept here (a large canvas is packed, far less:
-canvas_cells.py), one more per copy of it the node's message holds; after a growth a side is at most twice the map's (plus a cell), so a canvas holds
-up to 4 x the map's cells, about 2 x on average (intel at 0.025 m, batches of 10 scans: a
-2327 x 2636 canvas, 6.1 MB, for the final 1297 x 1326 map). A map that grows to n times its
-first area grows its canvas O(log n) times (intel: 4 growths, 5 full maps, 86 updates in 91
-publications). A new lattice is a geometry change too: a full /map, which nav2's static layer
-takes as a resize. With ds > 1 a growing frame moves its blocks often (intel at 0.05 m, ds 2:
-9 new lattices in the same 91 publications); a fixed frame never does.
+canvas_cells.py), one more per copy of it the node's message holds; after a growth a side is
+at most twice the map's (plus a cell), so a canvas holds up to 4 x the map's cells, about 2 x
+on average (intel at 0.025 m, batches of 10 scans: a 2327 x 2636 canvas, 6.1 MB, for the final
+1297 x 1326 map). A map that grows to n times its first area grows its canvas O(log n) times
+(intel: 4 growths, 5 full maps, 86 updates in 91 publications). A new lattice is a geometry
+change too: a full /map, which nav2's static layer takes as a resize. With ds > 1 a growing
+frame moves its blocks often (intel at 0.05 m, ds 2: 9 new lattices in the same 91
+publications); a fixed frame never does.
 
 Fixed mode (a frame that never moves): the canvas is the frame's whole block extent, blocks
 [0, n - 1) of n = size // ds (CARMEN's crop never reaches block n - 1): every finished map

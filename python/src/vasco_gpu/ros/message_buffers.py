@@ -35,9 +35,11 @@ def _libc_function(name: str):
 def give_back_free_memory() -> bool:
     """glibc's malloc_trim(0): the free pages of every arena go back to the system, also those
     below the trim threshold and between chunks in use. After a large site's full /map (a
-    packed canvas): making and packing it frees tens of MB in pieces under the mmap threshold,
-    which the heap would otherwise hold for good (bench/large_site_bench.py). A few ms; not done
-    for small maps, whose buffers the thresholds keep on purpose. True where it ran."""
+    packed canvas), and again at the publication after it: making and packing the map, and the
+    callback that asked for it (a Path's bytes, 8 MB for 10^5 poses), free tens of MB in pieces
+    under the mmap threshold, which the heap would otherwise hold for good
+    (bench/large_site_bench.py). A few ms; not done for small maps, whose buffers the
+    thresholds keep on purpose. True where it ran."""
     trim = _libc_function("malloc_trim")
     if trim is None:
         return False

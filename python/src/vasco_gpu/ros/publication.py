@@ -57,6 +57,7 @@ class MapPublication:
         self._subscribers = 0  # /map's, at the last publication
         self._updated = False  # updates sent since the last full map
         self._full_at = -1e9  # time.monotonic() of the last full map
+        self._trim_due = False  # a large map was published: the heap's free pages go back at the next call
 
     def destroy(self) -> None:
         for pub in (self.map_pub, self.meta_pub, self.update_pub):
@@ -113,6 +114,9 @@ class MapPublication:
         reach a subscriber first, which applies it to the map before and then loses it under
         the new one. The changes wait for the next publication, which carries them all (the
         update is the difference from the last canvas sent)."""
+        if self._trim_due:  # what the callback that published it freed since (a Path's bytes) goes back too
+            self._trim_due = False
+            give_back_free_memory()
         # A subscriber that joined since got the latched /map, without the updates sent after it:
         # it gets the map as it is now, in one piece (nav2's static layer joining late).
         subscribers = self.map_pub.get_subscription_count()
@@ -147,7 +151,7 @@ class MapPublication:
             self.meta_pub.publish(self.grid_msg.info)
             if self.canvas.packed:  # the message's array was made for it: the writer holds the map now
                 self.grid_msg.data = array("b")
-                give_back_free_memory()
+                self._trim_due = give_back_free_memory()
             self.sent, self._updated, self._full_at = True, False, time.monotonic()
             self._count("map", len(out.data))
         else:
