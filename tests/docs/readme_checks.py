@@ -388,7 +388,7 @@ CHECKS: Dict[str, Dict[str, Check]] = {
             picked("bench/results/batch-2026-12-07d-h100.txt"),
         "text: # vasco_gpu benchmarks: bench/run_all.sh build peers": picked(PEERS_RUN),
         "text: re-render linear in cell updates (cpu_float): ns per update":
-            picked("bench/results/large-site-2026-12-08b-2core.txt"),
+            picked("bench/results/large-site-2026-12-08d-2core.txt"),
         "text: re-render linear in cell updates (cuda_exact): ns per update":
             picked("bench/results/large-site-2026-12-07h-h100.txt"),
         "text: Where a user sees it: log2map --json --backend cpu_float, se": quoted(PEERS_RUN),
