@@ -418,8 +418,8 @@ def round_ratios(a: dict, z: dict) -> list:
     """Each round's ns per update at the largest size over the smallest's: a round renders the sizes
     one after the other, so a drift of the machine's speed between rounds cancels in its ratio
     (it would not in a ratio of the sizes' medians, each of other rounds)."""
-    ua, uz = a.get("updates_each", [a["updates"]] * len(a["render_s"])), z.get("updates_each", [z["updates"]] * len(z["render_s"]))
-    return [(tz / nz) / (ta / na) for ta, na, tz, nz in zip(a["render_s"], ua, z["render_s"], uz)]
+    return [(tz / nz) / (ta / na)
+            for ta, na, tz, nz in zip(a["render_s"], a["updates_each"], z["render_s"], z["updates_each"])]
 
 
 def print_targets(rows: list, backends: list, node_backend: str | None) -> None:

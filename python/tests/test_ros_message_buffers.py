@@ -10,6 +10,9 @@ import sys
 
 import pytest
 
+GLIBC_ONLY = pytest.mark.skipif(platform.system() != "Linux" or platform.libc_ver()[0] != "glibc",
+                                reason="glibc's malloc only")
+
 # Two buffers of 1.5 MB (a map's serialised copies) made and freed 50 times, after a warm-up;
 # prints the minor page faults of the 50 rounds.
 CHURN = """
@@ -38,7 +41,7 @@ def faults(mode: str) -> int:
     return int(out.stdout)
 
 
-@pytest.mark.skipif(platform.system() != "Linux" or platform.libc_ver()[0] != "glibc", reason="glibc's malloc only")
+@GLIBC_ONLY
 def test_kept_buffers_fault_in_no_fresh_pages_per_message():
     default, kept = faults("default"), faults("kept")
     # 50 rounds of 2 x 367 pages of 4 KiB when every buffer is fresh: glibc's defaults trim the
@@ -64,7 +67,7 @@ print(before, rss_kb())
 """
 
 
-@pytest.mark.skipif(platform.system() != "Linux" or platform.libc_ver()[0] != "glibc", reason="glibc's malloc only")
+@GLIBC_ONLY
 def test_free_memory_between_buffers_goes_back_to_the_system():
     out = subprocess.run([sys.executable, "-c", HOLES], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr

@@ -103,6 +103,13 @@ class PackedCells:
                 yield ty, tx, (slice(r0 - ty * t, r1 - ty * t), slice(c0 - tx * t, c1 - tx * t)), \
                     (slice(r0 - y, r1 - y), slice(c0 - x, c1 - x))
 
+    def _every_tile(self):
+        """(ty, tx, the tile's cells in the canvas as a pair of slices) for every tile."""
+        t = self._tile
+        for ty, row in enumerate(self._tiles):
+            for tx in range(len(row)):
+                yield ty, tx, (slice(ty * t, (ty + 1) * t), slice(tx * t, (tx + 1) * t))
+
     def cells_of(self, y: int, x: int, h: int, w: int) -> np.ndarray:
         """The box's cells: a copy."""
         out = np.empty((h, w), dtype=np.int8)
@@ -130,20 +137,16 @@ class PackedCells:
         data = array("b", b"\xff") * (self.h * self.w)
         whole = np.frombuffer(data, dtype=np.int8).reshape(self.h, self.w)
         whole[win.y:win.y + win.h, win.x:win.x + win.w] = cells
-        t = self._tile
-        for ty, row in enumerate(self._tiles):
-            for tx in range(len(row)):
-                row[tx] = self._pack(whole[ty * t:(ty + 1) * t, tx * t:(tx + 1) * t])
+        for ty, tx, in_canvas in self._every_tile():
+            self._tiles[ty][tx] = self._pack(whole[in_canvas])
         return data
 
     def whole(self) -> array:
         """The canvas unpacked, a new array('b')."""
         data = array("b", bytes(self.h * self.w))
         whole = np.frombuffer(data, dtype=np.int8).reshape(self.h, self.w)
-        t = self._tile
-        for ty, row in enumerate(self._tiles):
-            for tx in range(len(row)):
-                whole[ty * t:(ty + 1) * t, tx * t:(tx + 1) * t] = self._unpack(ty, tx)
+        for ty, tx, in_canvas in self._every_tile():
+            whole[in_canvas] = self._unpack(ty, tx)
         return data
 
     def packed_bytes(self) -> int:
